@@ -1,0 +1,5 @@
+import sys
+
+from camtube.cli import main
+
+sys.exit(main())

@@ -1,0 +1,82 @@
+"""CLI of the design stage: ``camtube design`` and ``camtube dxf``."""
+from __future__ import annotations
+
+import argparse
+import math
+
+from camtube.cliutil import add_pattern_argument, load_from_args
+
+
+def register(sub) -> None:
+    p = sub.add_parser("design", help="print the derived geometry of a pattern",
+                       description="Print phi, ybar, moment arm, closure angle, tube length, backbone "
+                                   "area and second moment of area (mm, rad and deg).")
+    add_pattern_argument(p)
+    p.set_defaults(func=cmd_design)
+
+    p = sub.add_parser("dxf", help="write the unrolled design DXF",
+                       description="Write the unrolled drawing: x along the tube from the tip, y arc length "
+                                   "on the outer surface (mm, R2013, $INSUNITS=4).")
+    add_pattern_argument(p)
+    p.add_argument("-o", "--output", required=True, metavar="OUT.dxf", help="output DXF file")
+    p.set_defaults(func=cmd_dxf)
+
+
+def design_report(pattern) -> str:
+    """Text table of a pattern's derived geometry."""
+    from camtube.design.geometry import beam_depth_mm, pattern_geometry
+
+    geo = pattern_geometry(pattern)
+    g = geo.first
+    t = pattern.tube
+    rows = [
+        ("pattern", pattern.name, ""),
+        ("notches / holes", f"{len(pattern.notches)} / {len(pattern.holes)}", ""),
+        ("tube r_o / r_i / wall", f"{t.outer_radius_mm:.3f} / {t.inner_radius_mm:.3f} / {t.wall_mm:.3f}", "mm"),
+        ("tube length", f"{t.length_mm:.3f}", "mm"),
+        ("notched length (sum of h)", f"{geo.notched_length_mm:.3f}", "mm"),
+        ("backbone angle phi", f"{g.phi_rad:.3f}", f"rad ({math.degrees(g.phi_rad):.1f} deg)"),
+        ("centroid ybar", f"{g.ybar_mm:.3f}", "mm"),
+        ("moment arm ybar + r_i - r_t", f"{g.moment_arm_mm:.3f}", "mm"),
+        ("backbone area", f"{g.area_mm2:.4f}", "mm^2"),
+        ("backbone second moment", f"{g.second_moment_mm4:.5f}", "mm^4"),
+        ("closure angle per notch", f"{math.degrees(g.closure_angle_rad):.2f}", "deg"),
+        ("closure angle, all notches", f"{math.degrees(geo.total_closure_angle_rad):.1f}", "deg"),
+        ("backbone strain at closure", f"{g.closure_strain:.3f}", ""),
+        ("beam depth r_o (1 - cos(s / 2 r_o))", f"{beam_depth_mm(t.outer_radius_mm, g.arc_mm):.3f}", "mm"),
+    ]
+    if not geo.uniform:
+        rows.append(("note", "notches differ: values are for the first notch", ""))
+    w = max(len(r[0]) for r in rows)
+    return "\n".join(f"{a:<{w}}  {b} {c}".rstrip() for a, b, c in rows)
+
+
+def cmd_design(args: argparse.Namespace) -> int:
+    loaded = load_from_args(args)
+    print(design_report(loaded.pattern))
+    extra = _design_extras(loaded.pattern)
+    if extra:
+        print(extra)
+    return 0
+
+
+def _design_extras(pattern) -> str:
+    """Sections other stages add to ``camtube design`` (the predicted stroke-angle curve)."""
+    try:
+        from camtube.model.predict import design_summary
+    except ModuleNotFoundError:
+        return ""
+    return design_summary(pattern)
+
+
+def cmd_dxf(args: argparse.Namespace) -> int:
+    from camtube.export.dxf import design_dxf
+    from camtube.io import write_atomic
+
+    loaded = load_from_args(args)
+    text = design_dxf(loaded.pattern)
+    path = write_atomic(args.output, text)
+    p = loaded.pattern
+    print(f"wrote {path}: {len(p.notches)} notches, {len(p.holes)} holes, "
+          f"sheet {p.tube.length_mm:g} x {p.tube.circumference_mm:.4f} mm")
+    return 0

@@ -1,0 +1,155 @@
+"""The one neutral path type: closed contours in the unrolled frame.
+
+A :class:`Contour` is a closed polygon in (x, y) mm on the unrolled outer
+surface (see :mod:`camtube.design.pattern` for the frame). Every output of
+camtube (design DXF, toolpaths, G-code, job file, previews) is written from
+contours. The wrap to a rotary axis happens only in the post-processor.
+
+Two forms of the same cut exist:
+
+- *unwrapped*: one contour per cut, ``y`` may leave ``[0, 2 pi r_o)`` when
+  the cut straddles the seam ``y = 0``. This is what a rotary stage cuts (A is
+  continuous) and what the planner uses.
+- *seam-split*: the pieces of the cut inside ``0 <= y <= 2 pi r_o`` (the seam
+  line ``y = 2 pi r_o`` is the same line as ``y = 0``). This is the drawing a
+  CAD user would make on a flat sheet, and what the design DXF holds.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from camtube.design.pattern import Cut, Pattern
+from camtube.tol import TOL
+
+
+@dataclass(frozen=True)
+class Contour:
+    """A closed polygon (last point joins the first; not repeated).
+
+    Attributes
+    ----------
+    points : tuple[tuple[float, float], ...]
+        Vertices (x_mm, y_mm), counter-clockwise.
+    kind : str
+        ``notch``, ``hole`` or ``cut`` (from a foreign DXF).
+    cut_index : int
+        Index of the cut in ``Pattern.cuts`` it comes from (-1 if unknown).
+    """
+
+    points: tuple[tuple[float, float], ...]
+    kind: str = "cut"
+    cut_index: int = -1
+
+    @property
+    def xy(self) -> np.ndarray:
+        """(n, 2) float array of the vertices."""
+        return np.asarray(self.points, dtype=float)
+
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        """(xmin, ymin, xmax, ymax) in mm."""
+        a = self.xy
+        return float(a[:, 0].min()), float(a[:, 1].min()), float(a[:, 0].max()), float(a[:, 1].max())
+
+    @property
+    def area_mm2(self) -> float:
+        """Signed area (positive for counter-clockwise)."""
+        a = self.xy
+        x, y = a[:, 0], a[:, 1]
+        return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+    @property
+    def length_mm(self) -> float:
+        """Perimeter of the closed polygon."""
+        a = self.xy
+        return float(np.linalg.norm(np.roll(a, -1, axis=0) - a, axis=1).sum())
+
+
+def rectangle(x0: float, y0: float, x1: float, y1: float, kind: str = "cut", cut_index: int = -1) -> Contour:
+    """Axis-aligned rectangle, counter-clockwise from (x0, y0)."""
+    return Contour(((x0, y0), (x1, y0), (x1, y1), (x0, y1)), kind, cut_index)
+
+
+def cut_contour(cut: Cut, outer_radius_mm: float, cut_index: int = -1) -> Contour:
+    """Unwrapped contour of one cut (``y`` may leave ``[0, 2 pi r_o)``)."""
+    y0, y1 = cut.y_range_mm(outer_radius_mm)
+    return rectangle(cut.x_start_mm, y0, cut.x_end_mm, y1, cut.kind, cut_index)
+
+
+def cut_contours(pattern: Pattern) -> tuple[Contour, ...]:
+    """Unwrapped contours of every cut of ``pattern``, in ``pattern.cuts`` order."""
+    ro = pattern.tube.outer_radius_mm
+    return tuple(cut_contour(c, ro, i) for i, c in enumerate(pattern.cuts))
+
+
+def split_at_seam(contour: Contour, circumference_mm: float) -> tuple[Contour, ...]:
+    """Pieces of an axis-aligned rectangular contour inside ``0 <= y <= C``.
+
+    A rectangle that crosses ``y = 0`` (or ``y = C``) becomes two closed
+    rectangles, one ending on ``y = C`` and one starting on ``y = 0``. A
+    rectangle inside the sheet is returned unchanged (shifted by a multiple of
+    C if needed).
+    """
+    x0, y0, x1, y1 = contour.bounds
+    if len(contour.points) != 4:
+        raise ValueError("split_at_seam handles rectangles only")
+    c = circumference_mm
+    shift = math.floor(y0 / c) * c
+    y0, y1 = y0 - shift, y1 - shift
+    if abs(y0 - c) <= TOL.merge:  # starts on the seam: same as starting at 0
+        y0, y1 = 0.0, y1 - c
+    if y1 <= c + TOL.merge:
+        return (rectangle(x0, y0, x1, min(y1, c), contour.kind, contour.cut_index),)
+    return (
+        rectangle(x0, y0, x1, c, contour.kind, contour.cut_index),
+        rectangle(x0, 0.0, x1, y1 - c, contour.kind, contour.cut_index),
+    )
+
+
+def sheet_contours(pattern: Pattern) -> tuple[Contour, ...]:
+    """Seam-split contours of every cut (what the design DXF draws)."""
+    c = pattern.tube.circumference_mm
+    out: list[Contour] = []
+    for con in cut_contours(pattern):
+        out.extend(split_at_seam(con, c))
+    return tuple(out)
+
+
+def outline(pattern: Pattern) -> Contour:
+    """The unrolled tube surface [0, L] x [0, 2 pi r_o] (construction, never cut)."""
+    return rectangle(0.0, 0.0, pattern.tube.length_mm, pattern.tube.circumference_mm, "outline")
+
+
+def merge_seam_pieces(contours, circumference_mm: float) -> list[Contour]:
+    """Join seam-split rectangles back into unwrapped ones.
+
+    A piece ending on ``y = C`` and a piece starting on ``y = 0`` with the same
+    x-range (within :data:`camtube.tol.TOL.merge`) and kind are one cut; the
+    joined rectangle spans ``[y0 - C, y1']`` is returned as ``[y0, C + y1']``.
+    Non-rectangles and unmatched pieces pass through unchanged.
+    """
+    c = circumference_mm
+    tol = 1e-6
+    items = list(contours)
+    used = [False] * len(items)
+    out: list[Contour] = []
+    for i, a in enumerate(items):
+        if used[i]:
+            continue
+        ax0, ay0, ax1, ay1 = a.bounds
+        if len(a.points) == 4 and abs(ay1 - c) <= tol and ay0 > tol:
+            for j, b in enumerate(items):
+                if used[j] or j == i or len(b.points) != 4 or b.kind != a.kind:
+                    continue
+                bx0, by0, bx1, by1 = b.bounds
+                if abs(by0) <= tol and abs(bx0 - ax0) <= tol and abs(bx1 - ax1) <= tol and by1 < c - tol:
+                    used[i] = used[j] = True
+                    out.append(rectangle(ax0, ay0, ax1, c + by1, a.kind, a.cut_index))
+                    break
+        if not used[i]:
+            used[i] = True
+            out.append(a)
+    return out

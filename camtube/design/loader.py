@@ -1,0 +1,351 @@
+"""Load a pattern YAML into a validated :class:`~camtube.design.pattern.Pattern`.
+
+The YAML is parsed once, checked against :data:`camtube.design.schema.SCHEMA`
+(unknown keys rejected with a "did you mean"), overridden by ``--set`` pairs,
+built into plain values, and run through the design rules. Every error names
+the file, the line, the key, the value, the allowed range and the fix; all
+errors are reported together.
+"""
+from __future__ import annotations
+
+import difflib
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterable
+
+import yaml
+
+from camtube.design import rules as design_rules
+from camtube.design.generate import notch_row
+from camtube.design.pattern import Pattern, Process, RepeatRule, Rules, Tendon, Tube, hole, notch, sort_cuts
+from camtube.design.schema import SCHEMA, Field
+from camtube.errors import Issue, PatternError
+
+
+@dataclass(frozen=True)
+class Loaded:
+    """A loaded pattern with what the loader learnt about it.
+
+    Attributes
+    ----------
+    pattern : Pattern
+    warnings : list[Issue]
+        Design warnings (closure angle, strain).
+    origins : tuple[str, ...]
+        YAML key each cut came from, parallel to ``pattern.cuts``.
+    """
+
+    pattern: Pattern
+    warnings: tuple[Issue, ...]
+    origins: tuple[str, ...]
+
+
+def _line_map(text: str) -> dict[str, int]:
+    """Dotted key -> 1-based line of its value, from the YAML node tree."""
+    out: dict[str, int] = {}
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError:
+        return out
+
+    def walk(node, prefix):
+        if isinstance(node, yaml.MappingNode):
+            for k, v in node.value:
+                key = f"{prefix}.{k.value}" if prefix else str(k.value)
+                out[key] = k.start_mark.line + 1
+                walk(v, key)
+        elif isinstance(node, yaml.SequenceNode):
+            for i, v in enumerate(node.value):
+                key = f"{prefix}[{i}]"
+                out[key] = v.start_mark.line + 1
+                walk(v, key)
+
+    if root is not None:
+        walk(root, "")
+    return out
+
+
+def _did_you_mean(word: str, options: Iterable[str]) -> str:
+    m = difflib.get_close_matches(word, list(options), n=1, cutoff=0.5)
+    return f"did you mean '{m[0]}'?" if m else "remove it"
+
+
+def parse_override(item: str) -> tuple[str, Any]:
+    """``'notch.count=20'`` -> ``('notch.count', 20)`` (value parsed as YAML)."""
+    if "=" not in item:
+        raise PatternError([Issue("--set", "expected KEY=VALUE", item, "e.g. notch.count=20",
+                                  "write the key, an equals sign and the value")])
+    key, _, value = item.partition("=")
+    try:
+        parsed = yaml.safe_load(value)
+    except yaml.YAMLError:
+        parsed = value
+    return key.strip(), parsed
+
+
+def _schema_node(parts: list[str]):
+    node: Any = SCHEMA
+    for p in parts:
+        if isinstance(node, Field) and node.kind == "rows":
+            if p.isdigit():
+                node = dict(node.row)
+                continue
+            return None
+        if not isinstance(node, dict) or p not in node:
+            return None
+        node = node[p]
+    return node
+
+
+def apply_overrides(raw: dict, overrides: Iterable[str], file: str | None = None) -> dict:
+    """Return a copy of ``raw`` with ``key=value`` overrides applied.
+
+    Keys are dotted paths (``notch.count``, ``process.repeats``,
+    ``holes.0.x``); an unknown key is an error with a "did you mean".
+    """
+    import copy
+
+    raw = copy.deepcopy(raw) if raw else {}
+    issues = []
+    for item in overrides:
+        key, value = parse_override(item)
+        parts = key.split(".")
+        if _schema_node(parts) is None:
+            from camtube.design.schema import iter_fields
+
+            known = [k for k, _ in iter_fields() if "[]" not in k]
+            issues.append(Issue(key, "unknown key in --set", None, "a key of the pattern schema",
+                                _did_you_mean(key, known), file))
+            continue
+        node = raw
+        for depth, p in enumerate(parts[:-1]):
+            nxt = parts[depth + 1]
+            if p.isdigit() and isinstance(node, list):
+                idx = int(p)
+                if idx >= len(node):
+                    issues.append(Issue(key, f"index {idx} is past the end of the list", None,
+                                        f"0..{len(node) - 1}", "add the entry in the YAML first"))
+                    node = None
+                    break
+                node = node[idx]
+                continue
+            if not isinstance(node.get(p), (dict, list)):
+                node[p] = [] if nxt.isdigit() else {}
+            node = node[p]
+        if node is None:
+            continue
+        last = parts[-1]
+        if last.isdigit() and isinstance(node, list):
+            node[int(last)] = value
+        else:
+            node[last] = value
+    if issues:
+        raise PatternError(issues)
+    return raw
+
+
+class _Reader:
+    """Collects issues while converting raw YAML values to typed values."""
+
+    def __init__(self, file: str | None, lines: dict[str, int]):
+        self.file, self.lines, self.issues = file, lines, []
+
+    def issue(self, key, message, value=None, allowed="", fix=""):
+        self.issues.append(Issue(key, message, value, allowed, fix, self.file, self.lines.get(key)))
+
+    def check_keys(self, mapping: dict, allowed: dict, prefix: str) -> None:
+        for k in mapping:
+            if k not in allowed:
+                key = f"{prefix}.{k}" if prefix else str(k)
+                self.issue(key, "unknown key", None, "one of " + ", ".join(allowed), _did_you_mean(str(k), allowed))
+
+    def value(self, mapping: dict, name: str, f: Field, key: str):
+        if name not in mapping or mapping[name] is None:
+            if f.default is ...:
+                self.issue(key, "required key is missing", None, f.allowed(), f"add '{name}: <value>'")
+                return None
+            return f.default
+        v = mapping[name]
+        return self.convert(v, f, key)
+
+    def convert(self, v, f: Field, key: str):
+        if f.kind == "str":
+            return str(v)
+        if f.kind == "choice":
+            if v not in f.choices:
+                self.issue(key, "not an allowed choice", v, f.allowed(), _did_you_mean(str(v), f.choices))
+                return None
+            return v
+        if f.kind == "int_or_auto":
+            if v == "auto":
+                return None
+            return self.number(v, f, key, integer=True)
+        if f.kind == "floats":
+            if not isinstance(v, (list, tuple)):
+                self.issue(key, "expected a list", v, f.allowed(), "write e.g. [0, 90, 180, 270]")
+                return ()
+            return tuple(self.number(x, f, f"{key}[{i}]") for i, x in enumerate(v))
+        if f.kind == "rows":
+            if not isinstance(v, list):
+                self.issue(key, "expected a list of mappings", v, f.allowed(), "write one '- key: value' entry per item")
+                return ()
+            rows = []
+            spec = dict(f.row)
+            for i, item in enumerate(v):
+                rk = f"{key}[{i}]"
+                if not isinstance(item, dict):
+                    self.issue(rk, "expected a mapping", item, f.allowed(), "write 'key: value' pairs")
+                    continue
+                self.check_keys(item, spec, rk)
+                rows.append({n: self.value(item, n, rf, f"{rk}.{n}") for n, rf in f.row})
+            return tuple(rows)
+        return self.number(v, f, key, integer=(f.kind == "int"))
+
+    def number(self, v, f: Field, key: str, integer: bool = False):
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            self.issue(key, "expected a number", v, f.allowed(), "write a plain number (no units)")
+            return None
+        if integer and (isinstance(v, float) and not float(v).is_integer()):
+            self.issue(key, "expected a whole number", v, f.allowed(), f"use {round(v)}")
+            return None
+        x = float(v)
+        if not math.isfinite(x):
+            self.issue(key, "must be finite", v, f.allowed(), "write a finite number")
+            return None
+        lo_bad = x <= f.lo if f.lo_open else x < f.lo
+        hi_bad = x >= f.hi if f.hi_open else x > f.hi
+        if lo_bad or hi_bad:
+            fix = "use a positive value" if f.lo == 0 and f.lo_open else "bring it inside the allowed range"
+            self.issue(key, "out of range", v, f.allowed(), fix)
+            return None
+        return int(x) if integer else x
+
+
+def _section(reader: _Reader, raw: dict, name: str) -> dict:
+    body = raw.get(name)
+    if body is None:
+        body = {}
+    if not isinstance(body, dict):
+        reader.issue(name, "expected a mapping", body, "key: value pairs", f"indent the keys under '{name}:'")
+        body = {}
+    spec = SCHEMA[name]
+    reader.check_keys(body, spec, name)
+    return {k: reader.value(body, k, f, f"{name}.{k}") for k, f in spec.items()}
+
+
+def read_yaml(path: str | os.PathLike) -> tuple[dict, dict[str, int], str]:
+    """Read a YAML mapping; returns ``(raw, line_map, file)``; syntax errors name the line."""
+    file = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise PatternError([Issue("file", f"cannot read pattern: {exc.strerror}", file, "a readable YAML file",
+                                  "check the path")]) from None
+    try:
+        raw = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        raise PatternError([Issue("yaml", f"not valid YAML: {getattr(exc, 'problem', exc)}", None,
+                                  "YAML mapping", "fix the syntax at the line shown", file,
+                                  mark.line + 1 if mark else None)]) from None
+    if raw is None:
+        raw = {}
+    if not isinstance(raw, dict):
+        raise PatternError([Issue("<top>", "a pattern file must be a mapping of sections", None,
+                                  "sections " + ", ".join(SCHEMA), "start the file with 'tube:'", file, 1)])
+    return raw, _line_map(text), file
+
+
+def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = None, name: str | None = None) -> Loaded:
+    """Validate raw YAML data and build a checked :class:`Pattern`.
+
+    Raises :class:`~camtube.errors.PatternError` listing every problem.
+    """
+    lines = lines or {}
+    r = _Reader(file, lines)
+    r.check_keys(raw, SCHEMA, "")
+    tube = _section(r, raw, "tube")
+    tendon = _section(r, raw, "tendon")
+    proc = _section(r, raw, "process")
+    rl = _section(r, raw, "rules")
+    has_notch = raw.get("notch") is not None
+    gen = _section(r, raw, "notch") if has_notch else None
+    holes = r.convert(raw.get("holes") or [], SCHEMA["holes"], "holes")
+    extra = r.convert(raw.get("cuts") or [], SCHEMA["cuts"], "cuts")
+    if gen and gen.get("layout") == "directions" and not gen.get("directions_deg"):
+        r.issue("notch.directions_deg", "layout 'directions' needs a list of angles", None,
+                "a non-empty list of angles in deg", "add e.g. directions_deg: [0, 90, 180, 270]")
+    if not has_notch and not extra:
+        r.issue("notch", "the pattern has no notches", None, "a 'notch:' generator or a 'cuts:' list",
+                "add a 'notch:' section")
+    if r.issues:
+        raise PatternError(r.issues)
+
+    cuts, origins = [], []
+    if gen:
+        row = notch_row(gen["count"], gen["width"], gen["spacing"], gen["arc"], gen["first_offset"],
+                        gen["angle_deg"], gen["layout"], gen["directions_deg"])
+        cuts += row
+        origins += ["notch"] * len(row)
+    for i, c in enumerate(extra):
+        cuts.append(notch(c["x"], c["width"], c["arc"], c["angle_deg"]))
+        origins.append(f"cuts[{i}]")
+    for i, h in enumerate(holes):
+        cuts.append(hole(h["x"], h["size"], h["angle_deg"]))
+        origins.append(f"holes[{i}]")
+    order = sorted(range(len(cuts)), key=lambda k: (cuts[k].x_mm, cuts[k].angle_deg, cuts[k].kind))
+    cuts = sort_cuts(cuts)
+    origins = [origins[k] for k in order]
+
+    process = Process(
+        power_w=proc["power_w"], frequency_khz=proc["frequency_khz"], scan_speed_mm_s=proc["scan_speed_mm_s"],
+        wavelength_nm=proc["wavelength_nm"], drill_offset_mm=proc["drill_offset"],
+        drill_passes=proc["drill_passes"], defocus_mm=proc["defocus"], repeats=proc["repeats"],
+        repeat_rule=tuple(sorted((RepeatRule(x["max_depth"], x["repeats"]) for x in proc["repeat_rule"]),
+                                 key=lambda q: q.max_depth_mm)),
+        kerf_mm=proc["kerf"], rapid_speed_mm_s=proc["rapid_speed_mm_s"], focus_speed_mm_s=proc["focus_speed_mm_s"],
+    )
+    pattern = Pattern(
+        name=raw.get("name") or name or "pattern",
+        tube=Tube(tube["outer_radius"], tube["inner_radius"], tube["length"], tube["material"]),
+        cuts=cuts,
+        process=process,
+        tendon=Tendon(tendon["radius"], tendon["length"], tendon["modulus_gpa"], tendon["material"]),
+        rules=Rules(rl["min_backbone_arc"], rl["min_web"], rl["max_strain"], rl["max_stroke"]),
+        source=file,
+    )
+    errors, warnings = design_rules.check(pattern, origins, file, lines)
+    if process.kerf_mm and process.kerf_mm >= min(c.width_mm for c in cuts) / 2:
+        errors.append(Issue("process.kerf", "kerf is as wide as half the narrowest cut", process.kerf_mm,
+                            f"< {min(c.width_mm for c in cuts) / 2:g} mm", "check the kerf width", file,
+                            lines.get("process.kerf")))
+    if errors:
+        raise PatternError(errors)
+    return Loaded(pattern, tuple(warnings), tuple(origins))
+
+
+def load(path: str | os.PathLike, overrides: Iterable[str] = ()) -> Loaded:
+    """Load, override, validate and build a pattern file.
+
+    ``process:`` may be a mapping or the name of a process YAML file next to
+    the pattern (its keys are the ``process`` keys); the pattern's own
+    ``process_overrides``-style changes go through ``--set process.KEY=...``.
+    """
+    raw, lines, file = read_yaml(path)
+    proc = raw.get("process")
+    if isinstance(proc, str):
+        ppath = Path(path).parent / proc
+        praw, _, pfile = read_yaml(ppath)
+        raw = dict(raw)
+        raw["process"] = praw.get("process", praw)
+    raw = apply_overrides(raw, overrides, file)
+    set_keys = {parse_override(o)[0] for o in overrides}
+    lines = {k: v for k, v in lines.items() if k not in set_keys}  # a --set value has no line
+    return build(raw, file, lines, name=Path(path).stem)
+
+
+def load_pattern(path: str | os.PathLike, overrides: Iterable[str] = ()) -> Pattern:
+    """Shortcut: the validated :class:`Pattern` of a YAML file."""
+    return load(path, overrides).pattern

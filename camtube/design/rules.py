@@ -1,0 +1,154 @@
+"""Design-rule checks on a built :class:`~camtube.design.pattern.Pattern`.
+
+Errors make a pattern unusable (nothing is written); warnings are what a
+designer needs to know (notch closure, backbone strain at closure).
+"""
+from __future__ import annotations
+
+import math
+from typing import Sequence
+
+from camtube.design.geometry import joint_geometry
+from camtube.design.pattern import Cut, Pattern
+from camtube.errors import Issue
+
+
+def _circular_gap(a0: float, a1: float, b0: float, b1: float, c: float) -> float:
+    """Gap between arcs [a0, a1] and [b0, b1] on a circle of length c (0 if they overlap)."""
+    best = math.inf
+    for k in (-1.0, 0.0, 1.0):
+        lo, hi = b0 + k * c, b1 + k * c
+        best = min(best, max(0.0, lo - a1, a0 - hi))
+    return best
+
+
+def cut_distance_mm(a: Cut, b: Cut, outer_radius_mm: float) -> float:
+    """Shortest distance between two cuts on the unrolled surface (0 if they touch or overlap).
+
+    Negative-overlap is not measured: overlapping cuts report 0 and
+    :func:`cuts_overlap` tells them apart from touching ones.
+    """
+    c = 2.0 * math.pi * outer_radius_mm
+    dx = max(0.0, b.x_start_mm - a.x_end_mm, a.x_start_mm - b.x_end_mm)
+    ay, by = a.y_range_mm(outer_radius_mm), b.y_range_mm(outer_radius_mm)
+    dy = _circular_gap(ay[0], ay[1], by[0], by[1], c)
+    return math.hypot(dx, dy)
+
+
+def cuts_overlap(a: Cut, b: Cut, outer_radius_mm: float, tol: float = 1e-9) -> bool:
+    """True if the two cut regions share area (not only an edge)."""
+    c = 2.0 * math.pi * outer_radius_mm
+    ox = min(a.x_end_mm, b.x_end_mm) - max(a.x_start_mm, b.x_start_mm)
+    if ox <= tol:
+        return False
+    ay, by = a.y_range_mm(outer_radius_mm), b.y_range_mm(outer_radius_mm)
+    for k in (-1.0, 0.0, 1.0):
+        oy = min(ay[1], by[1] + k * c) - max(ay[0], by[0] + k * c)
+        if oy > tol:
+            return True
+    return False
+
+
+def _describe(cut: Cut) -> str:
+    return f"{cut.kind} at x={cut.x_mm:.4g} mm, angle {cut.angle_deg:.4g} deg"
+
+
+def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | None = None,
+          lines: dict[str, int] | None = None) -> tuple[list[Issue], list[Issue]]:
+    """Run every design rule. Returns ``(errors, warnings)``.
+
+    Parameters
+    ----------
+    origins : sequence of str, optional
+        For each cut of ``pattern.cuts``, the YAML key it came from
+        (``notch``, ``cuts[2]``, ``holes[0]``), so messages name the key.
+    lines : dict, optional
+        Dotted key -> line number in ``file``.
+    """
+    t = pattern.tube
+    ro, ri = t.outer_radius_mm, t.inner_radius_mm
+    circ = t.circumference_mm
+    rules = pattern.rules
+    origins = list(origins) if origins is not None else [c.kind for c in pattern.cuts]
+    lines = lines or {}
+    errors: list[Issue] = []
+    warnings: list[Issue] = []
+
+    def err(key, msg, value=None, allowed="", fix=""):
+        errors.append(Issue(key, msg, value, allowed, fix, file, lines.get(key)))
+
+    def warn(key, msg, value=None, allowed="", fix=""):
+        warnings.append(Issue(key, msg, value, allowed, fix, file, lines.get(key)))
+
+    if not ri < ro:
+        err("tube.inner_radius", "inner radius must be smaller than the outer radius",
+            ri, f"< tube.outer_radius = {ro:g} mm", "check r_i and r_o (radii, not diameters)")
+        return errors, warnings  # everything below depends on a valid section
+
+    seen_keys: set[str] = set()
+    for cut, origin in zip(pattern.cuts, origins):
+        key_arc = "notch.arc" if origin == "notch" else (f"{origin}.arc" if cut.kind == "notch" else f"{origin}.size")
+        key_x = "notch.first_offset" if origin == "notch" else f"{origin}.x"
+        if cut.kind == "notch" and (origin != "notch" or "arc" not in seen_keys):
+            if cut.arc_mm >= circ:
+                err(key_arc, "notch arc must be shorter than the outer circumference",
+                    cut.arc_mm, f"< 2 pi r_o = {circ:.4f} mm", "reduce the arc s")
+            elif circ - cut.arc_mm < rules.min_backbone_arc_mm:
+                err(key_arc, f"backbone arc 2 pi r_o - s = {circ - cut.arc_mm:.4f} mm is thinner than "
+                    f"rules.min_backbone_arc", cut.arc_mm,
+                    f"<= {circ - rules.min_backbone_arc_mm:.4f} mm", "reduce the arc s or lower rules.min_backbone_arc")
+            if origin == "notch":
+                seen_keys.add("arc")
+        if cut.kind == "hole" and cut.arc_mm >= circ / 2.0:
+            err(key_arc, "hole is wider than half the circumference", cut.arc_mm, f"< {circ / 2:.4f} mm",
+                "use a smaller hole")
+        if cut.x_start_mm < -1e-12 or cut.x_end_mm > t.length_mm + 1e-12:
+            err(key_x, f"{_describe(cut)} spans x = [{cut.x_start_mm:.4g}, {cut.x_end_mm:.4g}] mm, outside the tube",
+                round(cut.x_mm, 9), f"the cut inside 0 <= x <= tube.length = {t.length_mm:g} mm",
+                "move the cut or lengthen tube.length")
+
+    # pairwise overlap / web: sweep in x so long patterns stay near-linear
+    order = sorted(range(len(pattern.cuts)), key=lambda i: pattern.cuts[i].x_start_mm)
+    cuts = pattern.cuts
+    reported = 0
+    for a_pos, i in enumerate(order):
+        a = cuts[i]
+        for j in order[a_pos + 1:]:
+            b = cuts[j]
+            if b.x_start_mm > a.x_end_mm + rules.min_web_mm:
+                break
+            hole_pair = "hole" in (a.kind, b.kind)
+            if cuts_overlap(a, b, ro):
+                what = "collides with" if hole_pair else "overlaps"
+                err(origins[j] if origins[j] != "notch" else "notch.spacing",
+                    f"{_describe(b)} {what} {_describe(a)}", None, "cuts must not overlap",
+                    "move the hole along x or around the tube" if hole_pair else "increase notch.spacing or move the cut")
+            else:
+                d = cut_distance_mm(a, b, ro)
+                if d < rules.min_web_mm - 1e-12:
+                    what = "is too close to" if not hole_pair else "collides with (web too thin)"
+                    key = origins[j] if origins[j] != "notch" else "notch.spacing"
+                    err(key, f"{_describe(b)} {what} {_describe(a)}: web {d:.4g} mm", round(d, 9),
+                        f">= rules.min_web = {rules.min_web_mm:g} mm",
+                        "move the hole away from the notches" if hole_pair else "increase notch.spacing")
+            reported += 1
+        if len(errors) > 50:
+            break
+
+    notches = pattern.notches
+    if notches and not errors:
+        geoms = [joint_geometry(ro, ri, n.arc_mm, n.width_mm, pattern.tendon.radius_mm) for n in notches]
+        g = geoms[0]
+        total = sum(x.closure_angle_rad for x in geoms)
+        warn("notch.width", f"notch closure angle h/(r_o+ybar) = {math.degrees(g.closure_angle_rad):.2f} deg "
+             f"per notch, {math.degrees(total):.1f} deg for all {len(notches)} notches "
+             "(the joint cannot bend further: notches close)", None)
+        worst = max(geoms, key=lambda x: x.closure_strain)
+        if worst.closure_strain > rules.max_strain:
+            safe_deg = math.degrees(rules.max_strain * worst.notch_width_mm / worst.extreme_fibre_mm)
+            warn("rules.max_strain", f"backbone strain at notch closure is {worst.closure_strain:.3f}, above the "
+                 f"{t.material} limit {rules.max_strain:g}: the backbone yields before the notch closes",
+                 round(worst.closure_strain, 6), f"<= {rules.max_strain:g}",
+                 f"keep the bend below {safe_deg:.2f} deg per notch "
+                 f"({safe_deg * len(notches):.1f} deg in total), or narrow the notch width h")
+    return errors, warnings

@@ -1,0 +1,156 @@
+"""The pattern YAML schema: every key, its type, unit, range, default and meaning.
+
+This table is the single source of truth for the loader (validation, "did you
+mean" hints, ``--set`` overrides) and for the schema section of the README
+(``python -m camtube.design.schema`` prints it as Markdown).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+INF = math.inf
+
+
+@dataclass(frozen=True)
+class Field:
+    """One YAML key.
+
+    ``kind``: ``float``, ``int``, ``str``, ``choice``, ``floats`` (list of
+    float), ``int_or_auto``, ``rows`` (list of mappings, see ``row``).
+    ``lo``/``hi`` bound numbers; ``lo_open``/``hi_open`` make a bound strict.
+    ``default`` of ``...`` means required.
+    """
+
+    kind: str
+    unit: str = ""
+    doc: str = ""
+    default: object = ...
+    lo: float = -INF
+    hi: float = INF
+    lo_open: bool = False
+    hi_open: bool = False
+    choices: tuple[str, ...] = ()
+    row: tuple[tuple[str, "Field"], ...] = ()
+
+    def allowed(self) -> str:
+        if self.kind == "choice":
+            return "one of " + ", ".join(self.choices)
+        if self.kind == "str":
+            return "text"
+        if self.kind in ("rows",):
+            return "a list of mappings with keys " + ", ".join(k for k, _ in self.row)
+        lo = "" if self.lo == -INF else f"{'>' if self.lo_open else '>='} {self.lo:g}"
+        hi = "" if self.hi == INF else f"{'<' if self.hi_open else '<='} {self.hi:g}"
+        rng = " and ".join(p for p in (lo, hi) if p)
+        what = {
+            "float": "a finite number",
+            "int": "a whole number",
+            "floats": "a list of finite numbers",
+            "int_or_auto": "'auto' or a whole number",
+        }[self.kind]
+        unit = f" {self.unit}" if self.unit else ""
+        return f"{what}{(' ' + rng) if rng else ''}{unit}"
+
+
+POS = dict(lo=0.0, lo_open=True)
+
+_HOLE_ROW = (
+    ("x", Field("float", "mm", "axial centre of the hole from the tip", ..., 0.0, INF, True)),
+    ("size", Field("float", "mm", "side of the square hole", 0.3, **POS)),
+    ("angle_deg", Field("float", "deg", "rotary angle of the hole centre", 180.0, -360.0, 720.0)),
+)
+_CUT_ROW = (
+    ("x", Field("float", "mm", "axial centre of the notch from the tip", ..., 0.0, INF, True)),
+    ("width", Field("float", "mm", "axial width h", ..., **POS)),
+    ("arc", Field("float", "mm", "arc s on the outer surface", ..., **POS)),
+    ("angle_deg", Field("float", "deg", "rotary angle of the notch centre", 180.0, -360.0, 720.0)),
+)
+_RULE_ROW = (
+    ("max_depth", Field("float", "mm", "largest beam depth this row covers", ..., **POS)),
+    ("repeats", Field("int", "", "repeats of the focus+defocus group", ..., 1, 1000)),
+)
+
+SCHEMA: dict[str, dict[str, Field]] | dict = {
+    "name": Field("str", "", "pattern name (defaults to the file name)", None),
+    "tube": {
+        "outer_radius": Field("float", "mm", "outer radius r_o", ..., **POS),
+        "inner_radius": Field("float", "mm", "inner radius r_i (< r_o)", ..., **POS),
+        "length": Field("float", "mm", "length of the modelled segment from the tip", ..., **POS),
+        "material": Field("choice", "", "tube material (sets the strain limit's meaning)", "polyimide",
+                          choices=("polyimide", "pebax", "nitinol", "other")),
+    },
+    "notch": {
+        "layout": Field("choice", "", "uan: all notches at angle_deg; bidirectional: alternate "
+                        "angle_deg and angle_deg+180; directions: cycle through directions_deg",
+                        "uan", choices=("uan", "bidirectional", "directions")),
+        "count": Field("int", "", "number of notches n", ..., 0, 100000),
+        "width": Field("float", "mm", "axial notch width h", ..., **POS),
+        "spacing": Field("float", "mm", "web c between adjacent notches (edge to edge)", ..., **POS),
+        "arc": Field("float", "mm", "notch arc s on the outer surface", ..., **POS),
+        "first_offset": Field("float", "mm", "tip to the tip-side edge of the first notch", ..., 0.0),
+        "angle_deg": Field("float", "deg", "rotary angle of the (first) notch centre", 180.0, -360.0, 720.0),
+        "directions_deg": Field("floats", "deg", "with layout: directions, the centre angle of "
+                                "successive notches, repeated", ()),
+    },
+    "holes": Field("rows", "", "square tendon holes", (), row=_HOLE_ROW),
+    "cuts": Field("rows", "", "extra notches placed by hand", (), row=_CUT_ROW),
+    "tendon": {
+        "radius": Field("float", "mm", "tendon radius r_t", 0.04, **POS),
+        "length": Field("float", "mm", "unloaded tendon length L0", 70.0, **POS),
+        "modulus_gpa": Field("float", "GPa", "tendon Young's modulus E_t (initial value for fits)", 28.0, **POS),
+        "material": Field("str", "", "tendon material", "UHMWPE"),
+    },
+    "process": {
+        "power_w": Field("float", "W", "average laser power", 2.0, **POS),
+        "frequency_khz": Field("float", "kHz", "pulse repetition frequency", 60.0, **POS),
+        "scan_speed_mm_s": Field("float", "mm/s", "cutting speed on the outer surface", 25.0, **POS),
+        "wavelength_nm": Field("float", "nm", "laser wavelength", 1030.0, **POS),
+        "drill_offset": Field("float", "mm", "step between the cuts of a drill group", 0.005, 0.0),
+        "drill_passes": Field("int", "", "cuts per drill group", 4, 1, 100),
+        "defocus": Field("float", "mm", "second focus level, into the material", 0.1, 0.0),
+        "repeats": Field("int_or_auto", "", "repeats of the focus+defocus group; auto uses repeat_rule",
+                         "auto", 1, 1000),
+        "repeat_rule": Field("rows", "", "beam depth -> repeats; first row with depth <= max_depth wins",
+                             ({"max_depth": 1.0, "repeats": 4}, {"max_depth": 1.3, "repeats": 6},
+                              {"max_depth": 2.0, "repeats": 8}), row=_RULE_ROW),
+        "kerf": Field("float", "mm", "kerf width for compensation (0 = off)", 0.0, 0.0),
+        "rapid_speed_mm_s": Field("float", "mm/s", "laser-off traverse speed (time estimate)", 50.0, **POS),
+        "focus_speed_mm_s": Field("float", "mm/s", "Z focus move speed (time estimate)", 5.0, **POS),
+    },
+    "rules": {
+        "min_backbone_arc": Field("float", "mm", "smallest backbone arc 2 pi r_o - s allowed", 0.3, 0.0),
+        "min_web": Field("float", "mm", "smallest material bridge between two cuts", 0.1, 0.0),
+        "max_strain": Field("float", "", "backbone strain limit of the tube material (warning)", 0.03, **POS),
+        "max_stroke": Field("float", "mm", "largest tendon stroke the joint is driven to", 2.0, **POS),
+    },
+}
+
+
+def iter_fields():
+    """Yield ``(dotted_key, Field)`` for every key of the schema (rows expanded as key[].sub)."""
+    for sec, body in SCHEMA.items():
+        if isinstance(body, Field):
+            yield sec, body
+            for k, f in body.row:
+                yield f"{sec}[].{k}", f
+        else:
+            for k, f in body.items():
+                yield f"{sec}.{k}", f
+                for rk, rf in f.row:
+                    yield f"{sec}.{k}[].{rk}", rf
+
+
+def markdown() -> str:
+    """The schema as a Markdown table (for the README)."""
+    lines = ["| key | type / allowed | default | meaning |", "|---|---|---|---|"]
+    for key, f in iter_fields():
+        d = "required" if f.default is ... else ("" if f.default in (None, ()) else f"`{f.default}`")
+        if f.kind == "rows" and f.default not in ((), ...):
+            d = "see below"
+        lines.append(f"| `{key}` | {f.allowed()} | {d} | {f.doc} |")
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    print(markdown())

@@ -1,0 +1,72 @@
+"""Errors and warnings that name the file, key, value, allowed range and fix."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+class CamtubeError(Exception):
+    """Base of every error camtube raises on purpose (bad input, unsafe job)."""
+
+
+@dataclass
+class Issue:
+    """One problem found in an input.
+
+    Attributes
+    ----------
+    key : str
+        Dotted key of the offending value (``notch.arc``) or a description of
+        the location (``cut[3]``).
+    message : str
+        What is wrong.
+    value : object
+        The offending value (``None`` if not a single value).
+    allowed : str
+        The allowed range or set, in words, with units.
+    fix : str
+        What the user can do.
+    file : str | None
+        Source file, if known.
+    line : int | None
+        1-based line in the source file, if known.
+    """
+
+    key: str
+    message: str
+    value: object = None
+    allowed: str = ""
+    fix: str = ""
+    file: str | None = None
+    line: int | None = None
+
+    def __str__(self) -> str:
+        where = self.file or "<pattern>"
+        if self.line is not None:
+            where += f":{self.line}"
+        parts = [f"{where}: {self.key}: {self.message}"]
+        if self.value is not None:
+            parts.append(f"got {self.value!r}")
+        if self.allowed:
+            parts.append(f"allowed: {self.allowed}")
+        if self.fix:
+            parts.append(f"fix: {self.fix}")
+        return "; ".join(parts)
+
+
+class PatternError(CamtubeError):
+    """A pattern (or process) failed to load or violates a design rule.
+
+    Holds every :class:`Issue` found, not only the first.
+    """
+
+    def __init__(self, issues: list[Issue]):
+        self.issues = list(issues)
+        super().__init__("\n".join(str(i) for i in self.issues))
+
+
+class DataError(CamtubeError):
+    """A measurement file is malformed (the message names the line)."""
+
+
+class SafetyError(CamtubeError):
+    """A job failed the laser safety check; nothing was written."""

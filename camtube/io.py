@@ -1,0 +1,61 @@
+"""File handling: the only place that writes files, always atomically.
+
+Writers elsewhere return ``str``/``bytes``; this layer puts them on disk via a
+temporary file in the same directory and :func:`os.replace`, so a crash or a
+rejected input never leaves a half-written output behind.
+"""
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+
+def write_atomic(path: str | os.PathLike, data: str | bytes) -> Path:
+    """Write ``data`` to ``path`` atomically and return the path.
+
+    ``str`` is encoded as UTF-8 with ``\\n`` line endings, unchanged.
+    Parent directories are created.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    payload = data.encode("utf-8") if isinstance(data, str) else bytes(data)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(payload)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+    return path
+
+
+def write_atomic_with(path: str | os.PathLike, writer) -> Path:
+    """Atomically create ``path`` with a library that insists on writing a file.
+
+    ``writer(tmp_path: str)`` writes the complete file at ``tmp_path`` (same
+    directory, same suffix); on success it is renamed onto ``path``.
+    Used for STEP/STL exporters that take a filename.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    try:
+        writer(tmp)
+        if not os.path.exists(tmp) or os.path.getsize(tmp) == 0:
+            raise OSError(f"writer produced no output for {path}")
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+    return path
