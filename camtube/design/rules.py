@@ -49,6 +49,17 @@ def cuts_overlap(a: Cut, b: Cut, outer_radius_mm: float, tol: float = 1e-9) -> b
     return False
 
 
+def _pair_key(origin_a: str, origin_b: str, a: Cut, b: Cut) -> str:
+    """The YAML key to blame for a clash: the hole, else a hand-placed cut, else the notch spacing."""
+    for o, c in ((origin_b, b), (origin_a, a)):
+        if c.kind == "hole":
+            return o
+    for o in (origin_b, origin_a):
+        if o != "notch":
+            return o
+    return "notch.spacing"
+
+
 def _describe(cut: Cut) -> str:
     return f"{cut.kind} at x={cut.x_mm:.4g} mm, angle {cut.angle_deg:.4g} deg"
 
@@ -118,16 +129,15 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
             if b.x_start_mm > a.x_end_mm + rules.min_web_mm:
                 break
             hole_pair = "hole" in (a.kind, b.kind)
+            key = _pair_key(origins[i], origins[j], a, b)
             if cuts_overlap(a, b, ro):
                 what = "collides with" if hole_pair else "overlaps"
-                err(origins[j] if origins[j] != "notch" else "notch.spacing",
-                    f"{_describe(b)} {what} {_describe(a)}", None, "cuts must not overlap",
+                err(key, f"{_describe(b)} {what} {_describe(a)}", None, "cuts must not overlap",
                     "move the hole along x or around the tube" if hole_pair else "increase notch.spacing or move the cut")
             else:
                 d = cut_distance_mm(a, b, ro)
                 if d < rules.min_web_mm - 1e-12:
                     what = "is too close to" if not hole_pair else "collides with (web too thin)"
-                    key = origins[j] if origins[j] != "notch" else "notch.spacing"
                     err(key, f"{_describe(b)} {what} {_describe(a)}: web {d:.4g} mm", round(d, 9),
                         f">= rules.min_web = {rules.min_web_mm:g} mm",
                         "move the hole away from the notches" if hole_pair else "increase notch.spacing")

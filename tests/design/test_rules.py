@@ -1,0 +1,172 @@
+"""Every design rule: feed the bad value, check the message names key, value, range and fix.
+
+Also: when a pattern is rejected, no output file is left behind.
+"""
+from __future__ import annotations
+
+import math
+
+import pytest
+import yaml
+
+from camtube.cli import main
+from camtube.design import load
+from camtube.errors import PatternError
+from tests.conftest import PATTERNS
+
+TUBE1 = PATTERNS / "tube1.yaml"
+
+
+def reject(overrides, path=TUBE1) -> str:
+    with pytest.raises(PatternError) as exc:
+        load(path, overrides)
+    return str(exc.value)
+
+
+def write_pattern(tmp_path, data, name="p.yaml"):
+    p = tmp_path / name
+    p.write_text(yaml.safe_dump(data, sort_keys=False))
+    return p
+
+
+def base_raw():
+    raw = yaml.safe_load(TUBE1.read_text())
+    raw["process"] = {}
+    return raw
+
+
+CASES = [
+    # (overrides, key named, words in the message)
+    (["tube.inner_radius=0.8"], "tube.inner_radius", ["smaller than the outer radius", "0.8", "< tube.outer_radius = 0.75"]),
+    (["tube.length=-3"], "tube.length", ["out of range", "-3", "> 0 mm", "positive"]),
+    (["notch.width=0"], "notch.width", ["out of range", "> 0 mm"]),
+    ([".nan"], None, None),  # placeholder replaced below
+    (["notch.arc=.inf"], "notch.arc", ["must be finite"]),
+    (["tendon.radius=-0.04"], "tendon.radius", ["out of range"]),
+    (["notch.arc=4.8"], "notch.arc", ["shorter than the outer circumference", "4.8", "< 2 pi r_o = 4.7124"]),
+    (["notch.arc=4.6"], "notch.arc", ["backbone arc", "min_backbone_arc", "reduce the arc"]),
+    (["notch.first_offset=9"], "notch.first_offset", ["outside the tube", "tube.length = 14"]),
+    (["tube.length=5"], "notch.first_offset", ["outside the tube", "lengthen tube.length"]),
+    (["notch.spacing=0.05"], "notch.spacing", ["too close", "web 0.05", ">= rules.min_web = 0.1", "increase notch.spacing"]),
+    (["holes.0.x=1.5"], "holes[0]", ["collides with", "notch at x=1.75", "move the hole"]),
+    (["holes.0.x=1.3"], "holes[0]", ["collides with (web too thin)", "web 0.05"]),
+    (["notch.count=2.5"], "notch.count", ["whole number", "use 2"]),
+    (["notch.count=ten"], "notch.count", ["expected a number", "plain number"]),
+    (["notch.layout=uni"], "notch.layout", ["not an allowed choice", "uan, bidirectional, directions"]),
+    (["notch.layout=directions"], "notch.directions_deg", ["needs a list of angles"]),
+    (["process.repeats=0"], "process.repeats", ["out of range"]),
+    (["process.kerf=0.3"], "process.kerf", ["half the narrowest cut"]),
+]
+CASES[3] = (["notch.spacing=.nan"], "notch.spacing", ["must be finite"])
+
+
+@pytest.mark.parametrize("overrides,key,words", CASES, ids=[c[0][0] for c in CASES])
+def test_rule_message(overrides, key, words):
+    msg = reject(overrides)
+    assert "tube1.yaml" in msg
+    assert f"{key}:" in msg
+    for w in words:
+        assert w in msg, f"{w!r} not in {msg!r}"
+
+
+def test_message_gives_line_number_of_yaml_key(tmp_path):
+    raw = base_raw()
+    raw["notch"]["arc"] = 9.0
+    p = write_pattern(tmp_path, raw)
+    msg = reject([], p)
+    line = next(i for i, t in enumerate(p.read_text().splitlines(), 1) if t.strip().startswith("arc:"))
+    assert f"p.yaml:{line}: notch.arc" in msg
+
+
+@pytest.mark.parametrize("section,bad,hint", [
+    (None, "tubes", "did you mean 'tube'?"),
+    ("tube", "outer_radus", "did you mean 'outer_radius'?"),
+    ("notch", "widht", "did you mean 'width'?"),
+    ("process", "scan_speed", "did you mean 'scan_speed_mm_s'?"),
+])
+def test_unknown_keys_rejected_with_hint(tmp_path, section, bad, hint):
+    raw = base_raw()
+    if section is None:
+        raw[bad] = {}
+    else:
+        raw[section][bad] = 1.0
+    msg = reject([], write_pattern(tmp_path, raw))
+    assert "unknown key" in msg and hint in msg
+
+
+def test_unknown_key_in_hole_row_and_set(tmp_path):
+    raw = base_raw()
+    raw["holes"][0]["sise"] = 0.3
+    msg = reject([], write_pattern(tmp_path, raw))
+    assert "holes[0].sise: unknown key" in msg and "did you mean 'size'?" in msg
+    assert "did you mean 'notch.count'?" in reject(["notch.cont=3"])
+
+
+def test_overlapping_cuts(tmp_path):
+    raw = base_raw()
+    raw["cuts"] = [{"x": 2.0, "width": 0.5, "arc": 1.0, "angle_deg": 180}]
+    msg = reject([], write_pattern(tmp_path, raw))
+    assert "overlaps" in msg and "cuts must not overlap" in msg
+
+
+def test_overlap_across_the_seam(tmp_path):
+    raw = base_raw()
+    raw["notch"]["angle_deg"] = 0  # notches straddle y = 0
+    raw["holes"] = []
+    raw["cuts"] = [{"x": 1.75, "width": 0.3, "arc": 0.4, "angle_deg": 350}]
+    msg = reject([], write_pattern(tmp_path, raw))
+    assert "overlaps" in msg
+
+
+def test_all_errors_reported_together():
+    msg = reject(["notch.width=-1", "tendon.length=0", "process.power_w=-2"])
+    assert "notch.width" in msg and "tendon.length" in msg and "process.power_w" in msg
+
+
+def test_yaml_syntax_error_names_line(tmp_path):
+    p = tmp_path / "bad.yaml"
+    p.write_text("tube:\n  outer_radius: 0.75\n  inner_radius: [0.45\nnotch: {}\n")
+    msg = reject([], p)
+    assert "bad.yaml:" in msg and "not valid YAML" in msg
+
+
+def test_missing_required_key(tmp_path):
+    raw = base_raw()
+    del raw["notch"]["arc"]
+    msg = reject([], write_pattern(tmp_path, raw))
+    assert "notch.arc: required key is missing" in msg
+
+
+def test_warnings_closure_and_strain():
+    w = [str(x) for x in load(TUBE1).warnings]
+    assert any("closure angle" in x and "23.60 deg per notch" in x and "236.0 deg" in x for x in w)
+    assert any("strain at notch closure is 0.267" in x and "limit 0.03" in x for x in w)
+    # a generous material limit silences the strain warning but keeps the closure note
+    w2 = [str(x) for x in load(TUBE1, ["rules.max_strain=0.5"]).warnings]
+    assert not any("strain" in x for x in w2) and any("closure" in x for x in w2)
+
+
+@pytest.mark.parametrize("cmd", ["dxf"])
+def test_rejected_pattern_writes_nothing(tmp_path, capsys, cmd):
+    out = tmp_path / "out.dxf"
+    rc = main([cmd, str(TUBE1), "--set", "notch.arc=4.8", "-o", str(out)])
+    assert rc == 2
+    assert not out.exists()
+    assert list(tmp_path.iterdir()) == []
+    assert "notch.arc" in capsys.readouterr().err
+
+
+def test_override_types_and_list_index():
+    p = load(TUBE1, ["notch.count=12", "holes.0.angle_deg=170", "process.repeats=5"]).pattern
+    assert len(p.notches) == 12 and p.holes[0].angle_deg == 170 and p.process.repeats == 5
+    assert "past the end" in reject(["holes.3.x=1"])
+
+
+def test_bidirectional_and_directions_layouts():
+    p = load(PATTERNS / "tube1-bidirectional.yaml").pattern
+    angles = [n.angle_deg for n in p.notches]
+    assert angles[:4] == [180.0, 0.0, 180.0, 0.0]
+    q = load(TUBE1, ["notch.layout=directions", "notch.directions_deg=[0, 90, 180, 270]",
+                     "notch.arc=1.0", "holes.0.angle_deg=45"]).pattern
+    assert [n.angle_deg for n in q.notches][:5] == [0.0, 90.0, 180.0, 270.0, 0.0]
+    assert math.isclose(q.notches[1].x_mm - q.notches[0].x_mm, 1.0)
