@@ -54,3 +54,16 @@ def test_light_commands_do_not_import_heavy_libraries(tmp_path, argv):
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60).stdout
     assert "HEAVY []" in out, out
+
+
+def test_preview_svg_draws_every_sheet_piece(tmp_path):
+    import xml.etree.ElementTree as ET
+
+    from camtube.design import load_pattern, sheet_contours
+
+    out = tmp_path / "p.svg"
+    assert main(["preview", str(PATTERNS / "tube1-bidirectional.yaml"), "-o", str(out), "-q"]) == 0
+    root = ET.parse(out).getroot()
+    polys = root.findall("{http://www.w3.org/2000/svg}polygon")
+    pieces = sheet_contours(load_pattern(PATTERNS / "tube1-bidirectional.yaml"))
+    assert len(polys) == len(pieces) + 1  # + the outline

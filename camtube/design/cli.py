@@ -21,6 +21,13 @@ def register(sub) -> None:
     p.add_argument("-o", "--output", required=True, metavar="OUT.dxf", help="output DXF file")
     p.set_defaults(func=cmd_dxf)
 
+    p = sub.add_parser("preview", help="write an SVG picture of the unrolled pattern",
+                       description="Write an SVG of the unrolled sheet (x from the tip, y arc length, mm) "
+                                   "with notches in red and holes in blue.")
+    add_pattern_argument(p)
+    p.add_argument("-o", "--output", required=True, metavar="OUT.svg", help="output SVG file")
+    p.set_defaults(func=cmd_preview)
+
 
 def design_report(pattern) -> str:
     """Text table of a pattern's derived geometry."""
@@ -79,4 +86,14 @@ def cmd_dxf(args: argparse.Namespace) -> int:
     p = loaded.pattern
     print(f"wrote {path}: {len(p.notches)} notches, {len(p.holes)} holes, "
           f"sheet {p.tube.length_mm:g} x {p.tube.circumference_mm:.4f} mm")
+    return 0
+
+
+def cmd_preview(args: argparse.Namespace) -> int:
+    from camtube.export.svg import unrolled_svg
+    from camtube.io import write_atomic
+
+    loaded = load_from_args(args)
+    path = write_atomic(args.output, unrolled_svg(loaded.pattern))
+    print(f"wrote {path}")
     return 0
