@@ -67,3 +67,12 @@ def test_preview_svg_draws_every_sheet_piece(tmp_path):
     polys = root.findall("{http://www.w3.org/2000/svg}polygon")
     pieces = sheet_contours(load_pattern(PATTERNS / "tube1-bidirectional.yaml"))
     assert len(polys) == len(pieces) + 1  # + the outline
+
+
+def test_readme_schema_table_is_current():
+    from camtube.design.schema import markdown
+    from tests.conftest import ROOT
+
+    text = (ROOT / "README.md").read_text()
+    block = text.split("<!-- schema:start -->")[1].split("<!-- schema:end -->")[0].strip()
+    assert block == markdown().strip(), "README schema is stale: paste the output of `camtube schema`"

@@ -21,6 +21,9 @@ def register(sub) -> None:
     p.add_argument("-o", "--output", required=True, metavar="OUT.dxf", help="output DXF file")
     p.set_defaults(func=cmd_dxf)
 
+    p = sub.add_parser("schema", help="print every pattern YAML key with units, range and default (Markdown)")
+    p.set_defaults(func=cmd_schema)
+
     p = sub.add_parser("preview", help="write an SVG picture of the unrolled pattern",
                        description="Write an SVG of the unrolled sheet (x from the tip, y arc length, mm) "
                                    "with notches in red and holes in blue.")
@@ -96,4 +99,11 @@ def cmd_preview(args: argparse.Namespace) -> int:
     loaded = load_from_args(args)
     path = write_atomic(args.output, unrolled_svg(loaded.pattern))
     print(f"wrote {path}")
+    return 0
+
+
+def cmd_schema(args: argparse.Namespace) -> int:
+    from camtube.design.schema import markdown
+
+    print(markdown())
     return 0

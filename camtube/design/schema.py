@@ -2,7 +2,7 @@
 
 This table is the single source of truth for the loader (validation, "did you
 mean" hints, ``--set`` overrides) and for the schema section of the README
-(``python -m camtube.design.schema`` prints it as Markdown).
+(``camtube schema`` prints it as Markdown).
 """
 from __future__ import annotations
 
@@ -150,7 +150,3 @@ def markdown() -> str:
             d = "see below"
         lines.append(f"| `{key}` | {f.allowed()} | {d} | {f.doc} |")
     return "\n".join(lines)
-
-
-if __name__ == "__main__":  # pragma: no cover
-    print(markdown())
