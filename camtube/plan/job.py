@@ -9,6 +9,7 @@ is continuous). The path starts and ends at ``contour.points[0]``.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 from camtube.design.contour import Contour
 from camtube.design.pattern import Process
@@ -93,3 +94,10 @@ class Job:
     @property
     def cut_length_mm(self) -> float:
         return sum(p.length_mm for p in self.passes)
+
+    @cached_property
+    def packed(self):
+        """:class:`camtube.plan.packed.Packed` arrays of the passes (computed once, cached)."""
+        from camtube.plan.packed import pack
+
+        return pack(self)
