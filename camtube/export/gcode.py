@@ -1,0 +1,173 @@
+"""G-code post-processor: one emitter for every :class:`~camtube.export.dialects.Dialect`.
+
+The wrap to the rotary axis happens here and only here: ``A = degrees(y / r_o)``
+with the same x, A = 0 at y = 0. Passes are cut at the angles of their
+unwrapped contour, whose centre lies in [0, 360) deg, so A stays within
+(-180, 540) deg however long the job: A never winds up, and a rotary stage
+with cables or a limited range never needs an unwind (a rapid between cuts may
+turn the long way round, at most one turn; the time estimate includes it).
+
+:func:`gcode` builds the machine moves (coordinates rounded exactly as they are
+printed), converts them back to the unrolled frame, runs the safety check on
+them, and only then formats the text. Same job and dialect: byte-identical text.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from camtube import __version__
+from camtube.export.dialects import LINUXCNC, Dialect
+from camtube.plan.moves import CUT, FOCUS, Moves, estimate, job_moves
+from camtube.plan.safety import check_moves
+
+
+@dataclass(frozen=True, eq=False)
+class MachineMoves:
+    """The moves of a job in one dialect's machine axes, rounded as printed.
+
+    Attributes
+    ----------
+    neutral : Moves
+        The unrolled move list they come from.
+    ax, ay, az : (m,) float
+        Axis values (mm, or deg for a rotary second axis), rounded to ``dialect.decimals``.
+    feed : (m,) float
+        F of every cutting move (1/min in G93, else mm/min or deg/min), rounded; 0 elsewhere.
+    """
+
+    neutral: Moves
+    ax: np.ndarray
+    ay: np.ndarray
+    az: np.ndarray
+    feed: np.ndarray
+    dialect: Dialect
+    outer_radius_mm: float
+
+    def unrolled(self) -> Moves:
+        """The emitted moves back in the unrolled frame (what the safety check sees)."""
+        y = np.radians(self.ay) * self.outer_radius_mm if self.dialect.rotary else self.ay
+        n = self.neutral
+        return Moves(self.ax, y, -self.az, n.kind, n.laser, n.pass_index, n.vertex, n.speed)
+
+
+def machine_moves(job, dialect: Dialect = LINUXCNC, moves: Moves | None = None) -> MachineMoves:
+    """Map the job's moves to ``dialect``'s axes and feeds (vectorised)."""
+    mv = job_moves(job) if moves is None else moves
+    ro = job.outer_radius_mm
+    dec = dialect.decimals
+    ax = np.round(mv.x, dec)
+    ay = np.round(np.degrees(mv.y / ro) if dialect.rotary else mv.y, dec)
+    az = np.round(-mv.z, dec) + 0.0  # + 0.0: no "-0.000000"
+    # surface length of each move from the printed coordinates
+    ys = np.radians(ay) * ro if dialect.rotary else ay
+    dx = np.diff(np.concatenate(([0.0], ax)))
+    dy = np.diff(np.concatenate(([0.0], ys)))
+    dz = np.diff(np.concatenate(([0.0], az)))
+    surf = np.hypot(dx, dy)
+    cut = mv.kind == CUT
+    feed = np.zeros(len(mv))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        minutes = surf / (mv.speed * 60.0)
+        if dialect.feed_mode == "inverse_time":
+            feed[cut] = 1.0 / minutes[cut]
+        else:
+            # G94: F applies to the XYZ distance if the move has any, else to the rotary angle
+            lin = np.hypot(dx, dz) if dialect.rotary else np.sqrt(dx * dx + dy * dy + dz * dz)
+            rot = np.abs(np.diff(np.concatenate(([0.0], ay)))) if dialect.rotary else np.zeros(len(mv))
+            per = np.where(lin > 0, lin, rot)
+            feed[cut] = per[cut] / minutes[cut]
+    feed = np.round(feed, dialect.feed_decimals)
+    return MachineMoves(mv, ax, ay, az, feed, dialect, ro)
+
+
+def _header(job, dialect: Dialect, mm: MachineMoves) -> list[str]:
+    est = estimate(job, mm.neutral)
+    pr = job.process
+    c = dialect.comment_line
+    ax, ay, az = dialect.axes
+    wrap = (f"{ay} = degrees(y / r_o) deg, r_o = {job.outer_radius_mm:g} mm" if dialect.rotary
+            else f"{ay} = y mm (unrolled sheet)")
+    return [
+        c(f"camtube {__version__} job {job.name}, dialect {dialect.name}: {dialect.description}"),
+        c(f"frame: {ax} = x mm from the tip, {wrap}, {az} = -focus offset into the material mm"),
+        c(f"process: {pr.power_w:g} W, {pr.frequency_khz:g} kHz, {pr.scan_speed_mm_s:g} mm/s on the outer surface, "
+          f"{pr.drill_passes} drill cuts {pr.drill_offset_mm:g} mm apart, defocus {pr.defocus_mm:g} mm, "
+          f"{job.repeats} repeats, ordering {job.ordering}"),
+        c(f"{est.cuts} cuts, {est.passes} passes, cut length {est.cut_length_mm:.3f} mm, estimated "
+          f"{est.total_s:.1f} s, lower bound {est.lower_bound_s:.1f} s, ratio {est.ratio:.4f}"),
+    ]
+
+
+def emit(job, mm: MachineMoves, memo: bool = True, progress: Callable[[int, int], None] | None = None) -> str:
+    """Format checked machine moves as G-code text (no safety check: use :func:`gcode`).
+
+    ``memo`` reuses the text of a path's cutting moves for later passes over
+    the same path at the same speed (their rows are identical by
+    construction); ``memo=False`` formats every row (tests compare both).
+    """
+    d = dialect = mm.dialect
+    n = mm.neutral
+    ax, ay, az = d.axes
+    f = f"{{:.{d.decimals}f}}"
+    ff = f"{{:.{d.feed_decimals}f}}"
+    rapid = f"G0 {ax}{f} {ay}{f}".format
+    focus = f"G0 {az}{f}".format
+    cut = f"G1 {ax}{f} {ay}{f} F{ff}".format
+    X, Y, Z, F = mm.ax.tolist(), mm.ay.tolist(), mm.az.tolist(), mm.feed.tolist()
+    kind = n.kind
+    rows = n.pass_rows().tolist()
+    pk = job.packed
+    geom, speed = pk.pass_geom.tolist(), pk.pass_speed.tolist()
+    out = _header(job, dialect, mm)
+    out.extend(d.preamble)
+    blocks: dict[tuple[int, float], str] = {}
+    settings = None
+    c = d.comment_line
+    off = d.laser_off
+    passes = job.passes
+    total = len(passes)
+    for p in range(total):
+        ps = passes[p]
+        r0, r1 = rows[p], rows[p + 1]
+        out.append(c(f"pass {p}: cut {ps.cut_index} {ps.kind}, repeat {ps.repeat}, focus {ps.focus_level} "
+                     f"({ps.focus_offset_mm:g} mm), drill {ps.drill_index} (offset {ps.offset_mm:.4f} mm)"))
+        out.append(rapid(X[r0], Y[r0]))
+        k = r0 + 1
+        if kind[k] == FOCUS:
+            out.append(focus(Z[k]))
+            k += 1
+        fields = d.fields(ps.power_w, ps.frequency_khz)
+        key = (ps.power_w, ps.frequency_khz)
+        if d.settings and key != settings:
+            out.extend(s.format(**fields) for s in d.settings)
+        settings = key
+        out.append(d.laser_on.format(**fields))
+        bkey = (geom[p], speed[p])
+        blk = blocks.get(bkey) if memo else None
+        if blk is None:
+            blk = "\n".join([cut(X[i], Y[i], F[i]) for i in range(k, r1)])
+            blocks[bkey] = blk
+        out.append(blk)
+        out.append(off)
+        if progress is not None and (p % 4096 == 4095 or p == total - 1):
+            progress(p + 1, total)
+    out.extend(d.postamble)
+    out.append("")
+    return "\n".join(out)
+
+
+def gcode(job, dialect: Dialect = LINUXCNC, progress: Callable[[int, int], None] | None = None) -> str:
+    """Safety-checked G-code of ``job`` in ``dialect``.
+
+    Raises
+    ------
+    SafetyError
+        The emitted moves fail :func:`camtube.plan.safety.check_moves`; no text is returned.
+    """
+    mm = machine_moves(job, dialect)
+    check_moves(job, mm.unrolled())
+    return emit(job, mm, progress=progress)
