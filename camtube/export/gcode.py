@@ -22,6 +22,7 @@ import numpy as np
 from camtube import __version__
 from camtube.export.dialects import LINUXCNC, Dialect
 from camtube.plan.moves import CUT, FOCUS, Moves, estimate, job_moves
+from camtube.plan.packed import no_gc
 from camtube.plan.safety import check_moves
 
 
@@ -170,4 +171,5 @@ def gcode(job, dialect: Dialect = LINUXCNC, progress: Callable[[int, int], None]
     """
     mm = machine_moves(job, dialect)
     check_moves(job, mm.unrolled())
-    return emit(job, mm, progress=progress)
+    with no_gc():
+        return emit(job, mm, progress=progress)

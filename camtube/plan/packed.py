@@ -8,12 +8,38 @@ index of its path and its settings. ``Job.packed`` computes it from the passes
 """
 from __future__ import annotations
 
+import gc
+from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Iterator, Sequence
 
 import numpy as np
 
 from camtube.design.contour import Contour
+
+
+@contextmanager
+def no_gc() -> Iterator[None]:
+    """Pause the cyclic garbage collector while building 10^5-10^6 small objects.
+
+    The objects made (passes, tuples, strings) hold no reference cycles; without
+    this, each generational collection re-walks every object made so far and
+    planning 10,000 notches takes twice as long.
+    """
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()
+
+
+def points_bounds(points) -> tuple[float, float, float, float]:
+    """(xmin, ymin, xmax, ymax) of a point tuple, without NumPy (fast for a few points)."""
+    xs = [p[0] for p in points]
+    ys = [p[1] for p in points]
+    return min(xs), min(ys), max(xs), max(ys)
 
 
 def is_axis_rectangle(contour: Contour) -> bool:
