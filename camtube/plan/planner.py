@@ -271,8 +271,9 @@ def _plan(source, process, ordering, outer_radius_mm, length_mm, name) -> Job:
     fwd = tour(design)
     starts = [_chain_starts(design, fwd, (0.0, 0.0))]
     if ordering == "interleaved":
-        last = design[fwd[-1]].points[starts[0][fwd[-1]]]
-        starts.append(_chain_starts(design, fwd[::-1], last))
+        # backward rounds start where forward rounds end and vice versa
+        starts.append(_chain_starts(design, fwd[::-1], design[fwd[-1]].points[starts[0][fwd[-1]]]))
+        starts[0] = _chain_starts(design, fwd, design[fwd[0]].points[starts[1][fwd[0]]])
 
     geom_list: list[Contour] = []  # index (direction * n_cut + cut) * n_drill + drill
     shifted = [[offset_contour(c, o, i) for o in offsets] for i, c in enumerate(design)]
