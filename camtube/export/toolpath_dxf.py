@@ -10,6 +10,8 @@ regions and the tube surface are on construction layers (not plotted).
 """
 from __future__ import annotations
 
+import math
+
 from camtube.design.contour import rectangle
 from camtube.export.dxf import add_contour, new_document, to_string
 from camtube.plan.safety import check_job
@@ -38,10 +40,10 @@ def toolpath_document(job):
         layer.description = desc
         layer.dxf.plot = 0
     msp = doc.modelspace()
-    circ = 2.0 * 3.141592653589793 * job.outer_radius_mm
-    add_contour(msp, rectangle(0.0, 0.0, job.length_mm, circ), "CONSTRUCTION-OUTLINE")
+    circ = 2.0 * math.pi * job.outer_radius_mm
     for c in job.design:
         add_contour(msp, c, "CONSTRUCTION-DESIGN")
+    add_contour(msp, rectangle(0.0, 0.0, job.length_mm, circ), "CONSTRUCTION-OUTLINE")  # last: read_contours' size
     for p in job.passes:
         add_contour(msp, p.contour, layer_name(p.focus_level, p.drill_index))
     return doc
