@@ -1,0 +1,129 @@
+"""Fast triangle meshes of the cut tube (manifold3d booleans, returned as trimesh).
+
+The tube is a polygonal annulus (``segments`` sides on the inner and outer
+circle) along X, minus one *cutter* per removed region of the unrolled sheet.
+A cutter is built flat -- the region (any polygon with holes, in unwrapped
+``(x, y)`` mm) extruded over a radial interval a little wider than the wall --
+refined so that no edge spans more than a small angle, and then *warped*
+onto the cylinder with ``(x, y, r) -> (x, r cos(y/r_o), r sin(y/r_o))``
+(see :mod:`camtube.cad.frame`). Every vertical edge of the flat prism becomes
+a radial line, so cut walls are radial and lie exactly at the cut's angles;
+the warped caps lie outside the wall (chord sag below half the margin), so
+they never touch material. One boolean subtracts all cutters at once.
+
+The same function meshes the design (regions = the design rectangles) and the
+as-cut result of a kerf simulation (regions = kerf union + freed slugs).
+"""
+from __future__ import annotations
+
+import math
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from camtube.design.contour import Contour, cut_contours
+from camtube.design.pattern import Pattern
+
+#: Sides of the polygonal inner and outer circles of the tube mesh.
+DEFAULT_SEGMENTS = 256
+
+
+def _rings(region) -> list[np.ndarray]:
+    """Closed rings (n, 2) of a Contour or a shapely (Multi)Polygon, holes included."""
+    if isinstance(region, Contour):
+        return [region.xy]
+    from shapely.geometry.polygon import orient
+
+    polys = getattr(region, "geoms", [region])
+    rings: list[np.ndarray] = []
+    for p in polys:
+        if p.is_empty:
+            continue
+        p = orient(p, 1.0)
+        rings.append(np.asarray(p.exterior.coords, dtype=float)[:-1, :2])
+        rings.extend(np.asarray(r.coords, dtype=float)[:-1, :2] for r in p.interiors)
+    return rings
+
+
+def tube_manifold(outer_radius_mm: float, inner_radius_mm: float, length_mm: float,
+                  regions: Iterable, segments: int = DEFAULT_SEGMENTS):
+    """The tube minus radial-walled cuts, as a ``manifold3d.Manifold``.
+
+    Parameters
+    ----------
+    outer_radius_mm, inner_radius_mm, length_mm : float
+        r_o > r_i > 0 and L; the tube spans ``0 <= x <= L`` along X.
+    regions : iterable of Contour or shapely Polygon/MultiPolygon
+        Removed regions of the unrolled sheet (unwrapped ``y`` allowed: the
+        wrap is periodic). A region must span less than ``2 pi r_o`` in ``y``.
+    segments : int
+        Sides of the polygonal circles (volume error ~ (2 pi / segments)^2 / 6).
+    """
+    import manifold3d as m3
+
+    ro, ri, L = float(outer_radius_mm), float(inner_radius_mm), float(length_mm)
+    margin = 0.25 * (ro - ri)
+    r_out, r_in = ro + margin, max(ri - margin, 0.5 * ri)
+    # largest angle step whose chord at r_out stays outside r_o + margin / 2
+    dth = 2.0 * math.acos((ro + 0.5 * margin) / r_out)
+    step = max(min(dth * ro, ro - ri), 1e-3)
+    circ = 2.0 * math.pi * ro
+
+    tube = m3.Manifold.cylinder(L, ro, ro, segments) - m3.Manifold.cylinder(L + 2.0, ri, ri, segments).translate(
+        (0.0, 0.0, -1.0))
+    tube = tube.rotate((0.0, 90.0, 0.0))  # axis Z -> X, 0 <= x <= L
+
+    def warp(v):
+        v = np.asarray(v, dtype=float)
+        th = v[:, 1] / ro
+        r = -v[:, 2]  # prism built at z = -r keeps the warp orientation-preserving
+        return np.column_stack([v[:, 0], r * np.cos(th), r * np.sin(th)])
+
+    cutters = []
+    for reg in regions:
+        rings = _rings(reg)
+        if not rings:
+            continue
+        ys = np.concatenate([r[:, 1] for r in rings])
+        if ys.max() - ys.min() >= circ:
+            raise ValueError(f"a removed region spans {ys.max() - ys.min():.4f} mm >= the circumference {circ:.4f} mm")
+        cs = m3.CrossSection([np.ascontiguousarray(r) for r in rings], m3.FillRule.EvenOdd)
+        prism = m3.Manifold.extrude(cs, r_out - r_in).translate((0.0, 0.0, -r_out)).refine_to_length(step)
+        cutters.append(prism.warp_batch(warp))
+    if not cutters:
+        return tube
+    return tube - m3.Manifold.batch_boolean(cutters, m3.OpType.Add)
+
+
+def to_trimesh(manifold):
+    """``manifold3d.Manifold`` -> ``trimesh.Trimesh`` (vertices mm, no re-processing)."""
+    import trimesh
+
+    m = manifold.to_mesh()
+    verts = np.asarray(m.vert_properties, dtype=float)[:, :3]
+    faces = np.asarray(m.tri_verts, dtype=np.int64)
+    return trimesh.Trimesh(verts, faces, process=False)
+
+
+def tube_mesh(outer_radius_mm: float, inner_radius_mm: float, length_mm: float,
+              regions: Iterable, segments: int = DEFAULT_SEGMENTS):
+    """:func:`tube_manifold` as a ``trimesh.Trimesh``."""
+    return to_trimesh(tube_manifold(outer_radius_mm, inner_radius_mm, length_mm, regions, segments))
+
+
+def design_regions(pattern: Pattern) -> Sequence[Contour]:
+    """The removed regions of the design: one unwrapped rectangle per cut."""
+    return cut_contours(pattern)
+
+
+def design_mesh(pattern: Pattern, segments: int = DEFAULT_SEGMENTS):
+    """Mesh of the tube as designed: notches and holes as radial-walled annular sectors."""
+    t = pattern.tube
+    return tube_mesh(t.outer_radius_mm, t.inner_radius_mm, t.length_mm, design_regions(pattern), segments)
+
+
+def stl_bytes(mesh) -> bytes:
+    """Binary STL of a trimesh (mm), deterministic."""
+    from trimesh.exchange.stl import export_stl
+
+    return export_stl(mesh)
