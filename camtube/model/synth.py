@@ -1,0 +1,145 @@
+"""Synthetic measurements from the base model, so a new user can try the fit loop at once.
+
+What the generator does (per sample, all lengths mm, forces N, angles deg):
+
+* stroke: ``n_cycles`` triangles 0 -> ``max_stroke`` -> 0 at a constant
+  lead-screw speed, sampled at ``rate_hz`` (an EM tracker's rate);
+* tendon slack: the first ``slack_mm`` of stroke moves nothing (deadband);
+* angle and force from the closed base model with a joint bending stiffness
+  (:func:`camtube.model.predict.stroke_only_angle_rad`):
+  ``theta = s / (arm + K C / arm)``, ``F = K theta / arm``,
+  ``s = max(stroke - slack, 0)``; each sample's stiffness is the
+  pattern's ``K`` times a factor drawn from ``1 +- stiffness_spread``;
+* noise: Gaussian, ``noise_angle_deg`` on the angle (EM tracker, ~0.25 deg)
+  and ``noise_force_N`` on the force (small load cell, ~5 mN).
+
+No hysteresis, creep or first-cycle effect: this is the paper's model plus
+sensor noise, so fitting it returns the generating ``E_t`` and an RMSE at the
+noise floor ``sqrt(sigma_angle^2 + (deg(C / arm) sigma_F)^2)``
+(:func:`noise_floor_deg`). Deterministic for a given ``seed``.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from camtube.design.geometry import pattern_geometry
+from camtube.design.pattern import Pattern
+from camtube.model.dataset import Dataset
+from camtube.model.predict import POLYIMIDE_MODULUS_GPA, joint_stiffness_nmm_per_rad, stroke_only_angle_rad
+
+
+def triangle_stroke(max_stroke_mm: float, speed_mm_s: float, rate_hz: float,
+                    n_cycles: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Time (s), stroke (mm) and cycle (1-based) of ``n_cycles`` triangles 0 -> max -> 0.
+
+    Returns arrays of shape ``(n_cycles * m,)``, ``m = round(2 max / speed * rate)``
+    samples per cycle; each cycle starts at stroke 0.
+    """
+    period = 2.0 * max_stroke_mm / speed_mm_s
+    m = max(int(round(period * rate_hz)), 4)
+    t1 = np.arange(m) / m * period
+    s1 = max_stroke_mm - np.abs(max_stroke_mm - speed_mm_s * t1)
+    time = (np.arange(n_cycles)[:, None] * period + t1[None, :]).ravel()
+    stroke = np.tile(s1, n_cycles)
+    cycle = np.repeat(np.arange(1, n_cycles + 1), m)
+    return time, stroke, cycle
+
+
+def noise_floor_deg(pattern: Pattern, noise_angle_deg: float = 0.25, noise_force_N: float = 0.005,
+                    modulus_gpa: float | None = None) -> float:
+    """RMSE (deg) a perfect base model leaves on noisy data: ``sqrt(sa^2 + (deg(C/arm) sF)^2)``."""
+    g = pattern_geometry(pattern).first
+    e_t = pattern.tendon.modulus_gpa if modulus_gpa is None else modulus_gpa
+    c = pattern.tendon.length_mm / (e_t * 1e3 * pattern.tendon.area_mm2)
+    return math.hypot(noise_angle_deg, math.degrees(c / g.moment_arm_mm) * noise_force_N)
+
+
+def synthesize(
+    pattern: Pattern,
+    n_samples: int = 2,
+    n_cycles: int = 50,
+    noise_angle_deg: float = 0.25,
+    noise_force_N: float = 0.005,
+    seed: int = 0,
+    *,
+    modulus_gpa: float | None = None,
+    max_stroke_mm: float | None = None,
+    speed_mm_s: float = 0.5,
+    rate_hz: float = 40.0,
+    slack_mm: float = 0.05,
+    stiffness_nmm_per_rad: float | None = None,
+    stiffness_spread: float = 0.1,
+) -> Dataset:
+    """A synthetic measurement :class:`Dataset` of ``pattern`` from the base model.
+
+    Parameters
+    ----------
+    pattern : Pattern
+        Geometry, tendon (E_t, L0, r_t) and ``rules.max_stroke``.
+    n_samples, n_cycles : int
+        Samples ``"1"``, ``"2"``, ... each with cycles 1..n_cycles.
+    noise_angle_deg, noise_force_N : float
+        Standard deviations of the Gaussian sensor noise.
+    seed : int
+        Seed of :func:`numpy.random.default_rng`.
+    modulus_gpa : float, optional
+        Tendon E_t used to generate (default: the pattern's).
+    max_stroke_mm : float, optional
+        Peak stroke (default: ``pattern.rules.max_stroke``).
+    speed_mm_s, rate_hz : float
+        Lead-screw speed and sampling rate.
+    slack_mm : float
+        Tendon slack at the start of every cycle.
+    stiffness_nmm_per_rad : float, optional
+        Joint stiffness K (default: E_pi I / (n h) with E_pi = 2.5 GPa).
+    stiffness_spread : float
+        Relative spread of K between samples (uniform in +- spread).
+
+    Returns
+    -------
+    Dataset
+        ``n_samples * n_cycles * m`` rows; ``extra`` is empty.
+    """
+    if n_samples < 1 or n_cycles < 1:
+        raise ValueError("n_samples and n_cycles must be >= 1")
+    rng = np.random.default_rng(seed)
+    g = pattern_geometry(pattern).first
+    e_t = pattern.tendon.modulus_gpa if modulus_gpa is None else modulus_gpa
+    c = pattern.tendon.length_mm / (e_t * 1e3 * pattern.tendon.area_mm2)
+    k0 = (joint_stiffness_nmm_per_rad(pattern, POLYIMIDE_MODULUS_GPA)
+          if stiffness_nmm_per_rad is None else stiffness_nmm_per_rad)
+    smax = pattern.rules.max_stroke_mm if max_stroke_mm is None else max_stroke_mm
+    time, stroke, cycle = triangle_stroke(smax, speed_mm_s, rate_hz, n_cycles)
+    arm = g.moment_arm_mm
+    cols: dict[str, list[np.ndarray]] = {k: [] for k in ("sample", "cycle", "time", "stroke", "force", "angle")}
+    for i in range(n_samples):
+        k = k0 * (1.0 + stiffness_spread * rng.uniform(-1.0, 1.0))
+        theta = stroke_only_angle_rad(stroke - slack_mm, arm, k, c)
+        force = k * theta / arm
+        m = stroke.shape[0]
+        cols["sample"].append(np.full(m, str(i + 1), dtype=object))
+        cols["cycle"].append(cycle)
+        cols["time"].append(time)
+        cols["stroke"].append(stroke)
+        cols["force"].append(force + rng.normal(0.0, noise_force_N, m))
+        cols["angle"].append(np.degrees(theta) + rng.normal(0.0, noise_angle_deg, m))
+    cat = {k: np.concatenate(v) for k, v in cols.items()}
+    return Dataset(cat["sample"], cat["cycle"].astype(int), cat["time"], cat["stroke"],
+                   cat["force"], cat["angle"])
+
+
+def to_csv(dataset: Dataset) -> str:
+    """The CSV text of ``dataset`` (see :func:`camtube.model.data.format_csv`)."""
+    from camtube.model.data import format_csv
+
+    return format_csv(dataset)
+
+
+def write(dataset: Dataset, path: str | Path) -> Path:
+    """Write ``dataset`` as CSV to ``path`` atomically; returns the path."""
+    from camtube.io import write_atomic
+
+    return write_atomic(path, to_csv(dataset))
