@@ -188,6 +188,7 @@ def design_summary(pattern: Pattern, steps: int = 5,
     ]
     for s, a, f in zip(strokes, ang, force):
         strain = g.strain_at(math.radians(a) / len(geo.notches))
-        flag = "  notches closed" if a > closure_deg else ""
+        flag = ("  notches closed" if a > closure_deg
+                else f"  strain > {pattern.rules.max_strain:g}" if strain > pattern.rules.max_strain else "")
         lines.append(f"  {s:10.3f}  {a:9.2f}  {f:8.3f}  {strain:7.4f}{flag}")
     return "\n".join(lines)

@@ -1,0 +1,178 @@
+"""CLI of the model stage: ``camtube model fit`` and ``camtube model synth``.
+
+``register(sub)`` adds the ``model`` command and its own sub-commands; other
+modules add theirs to the same group: if :mod:`camtube.model.diagnose_cli`
+exists, its ``register(model_sub)`` is called with the ``model`` sub-parsers.
+Handlers import numpy/scipy/matplotlib lazily.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+
+def register(sub) -> None:
+    p = sub.add_parser("model", help="fit the joint model to measurements, make synthetic data",
+                       description="Joint mechanics: tendon stroke (mm) and force (N) -> joint angle (deg).")
+    p.set_defaults(func=lambda args: (p.print_help(), 1)[1])
+    model_sub = p.add_subparsers(dest="model_command", metavar="SUBCOMMAND")
+
+    f = model_sub.add_parser(
+        "fit", help="fit the model to a measurement CSV and print the RMSE per sample",
+        description="Compare the paper's model L_t = (ybar + r_i - r_t) theta + F L0 / (E_t pi r_t^2) with "
+                    "measured stroke, force and angle. By default, like the paper: each sample's last "
+                    "loading cycle, slack deadband removed, E_t fitted, L0 and E_t start from the pattern.")
+    f.add_argument("data", metavar="DATA.csv",
+                   help="columns sample, cycle, time_s, stroke_mm, force_N, angle_deg (extra columns kept)")
+    _add_pattern_option(f)
+    f.add_argument("--cycles", default="last", metavar="SPEC",
+                   help="cycles to fit: last (default), last20, all, 5, 31-50, 2-, or a comma list")
+    f.add_argument("--branch", default="loading", choices=("loading", "unloading", "both"),
+                   help="stroke direction to fit (default: loading, as in the paper)")
+    f.add_argument("--no-deadband", dest="deadband", action="store_false",
+                   help="keep the slack deadband (default: remove it per cycle, as in the paper)")
+    f.add_argument("--deadband-threshold", type=float, default=None, metavar="DEG",
+                   help="smallest angle rise (deg) that counts as motion (default max(0.5, 4 x noise))")
+    f.add_argument("--fit", dest="fit_params", default="E_t", metavar="P1,P2",
+                   help="parameters to fit, full names (default E_t; e.g. E_t,arm_scale; 'none')")
+    f.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
+                   help="hold a parameter at a value (units as listed: E_t GPa, L0 mm); repeatable")
+    f.add_argument("--effects", default="", metavar="A,B", help="effects to add to the base model, by name")
+    f.add_argument("--effect-file", action="append", default=[], metavar="F.py",
+                   help="a .py file defining or registering Effect objects (loaded before --effects)")
+    f.add_argument("--json", metavar="OUT.json", help="write the summary as JSON")
+    f.add_argument("--plot", metavar="OUT.png", help="write angle and residual vs stroke (PNG)")
+    f.set_defaults(func=cmd_fit)
+
+    s = model_sub.add_parser(
+        "synth", help="write a synthetic measurement CSV from the base model",
+        description="Triangular stroke 0 -> rules.max_stroke -> 0 at a lead-screw speed, force from the "
+                    "joint bending stiffness (E_pi 2.5 GPa), Gaussian EM-tracker and load-cell noise.")
+    _add_pattern_option(s)
+    s.add_argument("-o", "--output", required=True, metavar="DATA.csv", help="output CSV file")
+    s.add_argument("--samples", type=int, default=2, help="number of samples (default 2)")
+    s.add_argument("--cycles", type=int, default=50, help="cycles per sample (default 50)")
+    s.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    s.add_argument("--noise-angle", type=float, default=0.25, metavar="DEG",
+                   help="angle noise standard deviation, deg (default 0.25)")
+    s.add_argument("--noise-force", type=float, default=0.005, metavar="N",
+                   help="force noise standard deviation, N (default 0.005)")
+    s.add_argument("--slack", type=float, default=0.05, metavar="MM", help="tendon slack, mm (default 0.05)")
+    s.add_argument("--speed", type=float, default=0.5, metavar="MM_S", help="stroke speed, mm/s (default 0.5)")
+    s.add_argument("--rate", type=float, default=40.0, metavar="HZ", help="sampling rate, Hz (default 40)")
+    s.add_argument("--modulus", type=float, default=None, metavar="GPA",
+                   help="tendon E_t used to generate, GPa (default: the pattern's)")
+    s.set_defaults(func=cmd_synth)
+
+    try:
+        diag = importlib.import_module("camtube.model.diagnose_cli")
+    except ModuleNotFoundError as exc:
+        if exc.name != "camtube.model.diagnose_cli":
+            raise
+    else:
+        diag.register(model_sub)
+
+
+def _add_pattern_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--pattern", required=True, metavar="PATTERN", help="pattern YAML of the joint (see patterns/)")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a pattern scalar, e.g. --set tendon.length=80")
+    p.add_argument("-q", "--quiet", action="store_true", help="do not print design warnings")
+
+
+def _names(text: str) -> list[str]:
+    return [t.strip() for t in text.split(",") if t.strip() and t.strip().lower() != "none"]
+
+
+def build_model(pattern, effects: str = "", effect_files=()):
+    """JointModel of ``pattern`` with effect files loaded and ``effects`` (comma list) added."""
+    from camtube.model.api import get_effect, load_effect_file
+    from camtube.model.fit import FitError
+    from camtube.model.predict import model_for_pattern
+
+    for path in effect_files:
+        try:
+            load_effect_file(path)
+        except (OSError, ImportError, SyntaxError, ValueError) as exc:
+            raise FitError(f"{path}: cannot load the effect file: {exc}") from None
+    try:
+        effs = [get_effect(n) for n in _names(effects)]
+    except KeyError as exc:
+        raise FitError(exc.args[0]) from None
+    return model_for_pattern(pattern, effs)
+
+
+def _parse_fix(items: list[str]) -> dict[str, float]:
+    from camtube.model.fit import FitError
+
+    out = {}
+    for it in items:
+        name, sep, val = it.partition("=")
+        try:
+            out[name.strip()] = float(val)
+        except ValueError:
+            sep = ""
+        if not sep:
+            raise FitError(f"--fix {it!r}: use NAME=VALUE with a number, e.g. --fix L0=70")
+    return out
+
+
+def cmd_fit(args: argparse.Namespace) -> int:
+    from camtube.cliutil import load_from_args
+    from camtube.io import write_atomic
+    from camtube.model.data import find_slack, load_csv, prepare, remove_deadband, select_cycles
+    from camtube.model.fit import fit
+    from camtube.model.predict import pattern_values
+    from camtube.model.report_fit import fit_json, fit_text
+
+    pattern = load_from_args(args).pattern
+    model = build_model(pattern, args.effects, args.effect_file)
+    raw = load_csv(args.data)
+    rows = prepare(raw, args.cycles, args.branch, args.deadband, args.deadband_threshold)
+    fixed = pattern_values(pattern)
+    fixed.update(_parse_fix(args.fix))
+    result = fit(model, rows, _names(args.fit_params), fixed)
+
+    sel = (f"cycles {args.cycles}, {args.branch} branch, "
+           + ("slack deadband removed" if args.deadband else "deadband kept"))
+    title = (f"{pattern.name}: {args.data} ({len(raw)} rows; fitted {result.n_points}: {sel})"
+             + (f"; effects: {', '.join(e.name for e in model.effects)}" if model.effects else ""))
+    print(fit_text(result, title))
+    if args.deadband:
+        slack = find_slack(select_cycles(raw, args.cycles), args.deadband_threshold)
+        for smp in rows.samples:
+            vals = [v.stroke_mm for (s, _), v in slack.items() if s == smp]
+            if vals:
+                print(f"slack of sample {smp}: {min(vals):.3f}-{max(vals):.3f} mm over {len(vals)} cycle(s)")
+    meta = {"pattern": pattern.name, "data": str(args.data),
+            "selection": {"cycles": args.cycles, "branch": args.branch, "deadband": bool(args.deadband)}}
+    if args.json:
+        print(f"wrote {write_atomic(args.json, fit_json(result, meta))}")
+    if args.plot:
+        from camtube.model.plot import fit_png
+
+        full = raw
+        if args.deadband:
+            full = remove_deadband(raw, args.deadband_threshold)
+        png = fit_png(result, full, title=f"{pattern.name}: model vs measurement ({sel})")
+        print(f"wrote {write_atomic(args.plot, png)}")
+    return 0
+
+
+def cmd_synth(args: argparse.Namespace) -> int:
+    from camtube.cliutil import load_from_args
+    from camtube.model.synth import noise_floor_deg, synthesize, write
+
+    pattern = load_from_args(args).pattern
+    if args.samples < 1 or args.cycles < 1:
+        print("camtube model synth: --samples and --cycles must be >= 1", file=sys.stderr)
+        return 2
+    data = synthesize(pattern, args.samples, args.cycles, args.noise_angle, args.noise_force, args.seed,
+                      modulus_gpa=args.modulus, speed_mm_s=args.speed, rate_hz=args.rate,
+                      slack_mm=args.slack)
+    path = write(data, args.output)
+    floor = noise_floor_deg(pattern, args.noise_angle, args.noise_force, args.modulus)
+    print(f"wrote {path}: {len(data)} rows, {args.samples} sample(s) x {args.cycles} cycles, "
+          f"stroke 0-{pattern.rules.max_stroke_mm:g} mm; a perfect fit leaves RMSE ~{floor:.3f} deg")
+    return 0
