@@ -1,0 +1,171 @@
+"""Measurement CSV: round trip, validation errors with line numbers, selection, deadband removal."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from camtube.design.loader import load_pattern
+from camtube.errors import DataError
+from camtube.model.data import (
+    find_slack, format_csv, load_csv, parse_csv, parse_cycles, prepare, remove_deadband,
+    select_branch, select_cycles,
+)
+from camtube.model.synth import synthesize
+from tests.conftest import PATTERNS
+
+HEADER = "sample,cycle,time_s,stroke_mm,force_N,angle_deg"
+GOOD = [HEADER, "A,1,0.0,0.0,0.0,0.0", "A,1,0.1,0.1,0.2,1.0", "A,2,0.2,0.2,0.4,2.0"]
+
+
+@pytest.fixture(scope="module")
+def tube2():
+    return load_pattern(PATTERNS / "tube2.yaml")
+
+
+def _csv(lines):
+    return "\n".join(lines) + "\n"
+
+
+def test_round_trip_keeps_values_and_extra_columns(tube2):
+    d = synthesize(tube2, n_samples=2, n_cycles=3, seed=3)
+    d = type(d)(d.sample, d.cycle, d.time_s, d.stroke_mm, d.force_N, d.angle_deg,
+                {"temp_C": np.full(len(d), 21.5), "note": np.array(["x"] * len(d), dtype=object)})
+    text = format_csv(d)
+    back = parse_csv(text)
+    assert back.samples == ["1", "2"] and len(back) == len(d)
+    np.testing.assert_array_equal(back.cycle, d.cycle)
+    np.testing.assert_allclose(back.stroke_mm, d.stroke_mm, atol=1e-6)
+    np.testing.assert_allclose(back.angle_deg, d.angle_deg, atol=1e-5)
+    np.testing.assert_allclose(back.force_N, d.force_N, atol=1e-6)
+    assert back.extra["temp_C"].dtype == float and back.extra["note"][0] == "x"
+    assert format_csv(back) == text  # deterministic, stable
+
+
+def test_comments_blank_lines_column_order_and_interleaved_samples():
+    text = _csv(["# lab rig 3", "angle_deg,sample,cycle,time_s,stroke_mm,force_N,extra",
+                 "1.0,A,1,0.0,0.1,0.2,7", "", "5.0,B,1,0.0,0.3,0.4,8", "2.0,A,1,0.1,0.2,0.3,9"])
+    d = parse_csv(text)
+    assert list(d.sample) == ["A", "A", "B"]
+    np.testing.assert_array_equal(d.angle_deg, [1.0, 2.0, 5.0])
+    np.testing.assert_array_equal(d.extra["extra"], [7.0, 9.0, 8.0])
+
+
+@pytest.mark.parametrize("lines, line, words", [
+    ([HEADER.replace("angle_deg", "angle")] + GOOD[1:], 1, ["angle_deg", "'angle' -> 'angle_deg'"]),
+    ([HEADER.replace(",force_N", "")] + [",".join(r.split(",")[:4] + r.split(",")[5:]) for r in GOOD[1:]],
+     1, ["force_N"]),
+    (GOOD[:2] + ["A,1,0.1,abc,0.2,1.0"] + GOOD[3:], 3, ["stroke_mm", "abc"]),
+    (GOOD[:2] + ["A,1,0.1,0.1,,1.0"] + GOOD[3:], 3, ["force_N", "empty"]),
+    (GOOD[:3] + ["A,2,0.2,0.2,0.4,nan"], 4, ["angle_deg", "nan"]),
+    (GOOD[:2] + ["A,1,0.1,inf,0.2,1.0"] + GOOD[3:], 3, ["stroke_mm", "inf"]),
+    (GOOD[:2] + ["A,1,-0.5,0.1,0.2,1.0"] + GOOD[3:], 3, ["time_s", "backwards", "'A'"]),
+    (GOOD + ["A,1,0.3,0.3,0.5,3.0"], 5, ["cycle", "backwards"]),
+    (GOOD[:2] + ["A,1.5,0.1,0.1,0.2,1.0"] + GOOD[3:], 3, ["cycle", "whole number"]),
+    (GOOD[:2] + ["A,1,0.1,0.1,0.2"] + GOOD[3:], 3, ["5 cells", "6 columns"]),
+    (GOOD[:2] + [",1,0.1,0.1,0.2,1.0"] + GOOD[3:], 3, ["sample", "empty"]),
+    ([HEADER + ",cycle"] + [r + ",1" for r in GOOD[1:]], 1, ["duplicate", "cycle"]),
+    ([HEADER], 1, ["no data rows"]),
+])
+def test_bad_csv_names_file_and_line(tmp_path, lines, line, words):
+    path = tmp_path / "bad.csv"
+    path.write_text(_csv(lines))
+    with pytest.raises(DataError) as err:
+        load_csv(path)
+    msg = str(err.value)
+    assert f"{path}:{line}:" in msg, msg
+    for w in words:
+        assert w in msg, msg
+
+
+def test_time_backwards_is_checked_per_sample_only():
+    # sample B starts at t = 0 again after A: allowed
+    d = parse_csv(_csv(GOOD + ["B,1,0.0,0.0,0.0,0.0", "B,1,0.1,0.1,0.1,0.5"]))
+    assert d.samples == ["A", "B"]
+
+
+def test_empty_and_missing_files(tmp_path):
+    (tmp_path / "e.csv").write_text("\n# nothing\n")
+    with pytest.raises(DataError, match="empty"):
+        load_csv(tmp_path / "e.csv")
+    with pytest.raises(DataError, match="no such"):
+        load_csv(tmp_path / "missing.csv")
+
+
+def _cycles_data():
+    # sample A has cycles 1-50, sample B cycles 1-40
+    rows = [HEADER]
+    for smp, n in (("A", 50), ("B", 40)):
+        for c in range(1, n + 1):
+            rows.append(f"{smp},{c},{c},0.1,0.1,1.0")
+    return parse_csv(_csv(rows))
+
+
+@pytest.mark.parametrize("spec, a, b", [
+    ("last", [50], [40]),
+    ("last3", [48, 49, 50], [38, 39, 40]),
+    ("5", [5], [5]),
+    ("31-50", list(range(31, 51)), list(range(31, 41))),
+    ("2-", list(range(2, 51)), list(range(2, 41))),
+    ("-2", [1, 2], [1, 2]),
+    ("1, last", [1, 50], [1, 40]),
+    ("all", list(range(1, 51)), list(range(1, 41))),
+])
+def test_cycle_selection(spec, a, b):
+    d = select_cycles(_cycles_data(), spec)
+    got = {s: sorted(set(d.cycle[sl].tolist())) for s, sl in d.sample_slices()}
+    assert got == {"A": a, "B": b}
+
+
+@pytest.mark.parametrize("spec", ["lats", "5-2", "x-3", "1-2-3", "", "last0"])
+def test_bad_cycle_spec(spec):
+    with pytest.raises(DataError, match="cycle selection"):
+        parse_cycles(spec if spec else " , ")
+
+
+def test_cycle_selection_matching_nothing_says_what_exists():
+    with pytest.raises(DataError, match="1-50"):
+        select_cycles(_cycles_data(), "60-70")
+
+
+def test_branch_follows_stroke_direction(tube2):
+    d = synthesize(tube2, n_samples=1, n_cycles=2, slack_mm=0.0, seed=1)
+    up = select_branch(d, "loading")
+    down = select_branch(d, "unloading")
+    assert len(up) + len(down) == len(d)
+    for part, sign in ((up, 1), (down, -1)):
+        for _, sl in part.sample_slices():
+            ds = np.diff(part.stroke_mm[sl])
+            same_cycle = np.diff(part.cycle[sl]) == 0
+            # within a cycle and a contiguous branch, the stroke moves one way
+            assert np.all(sign * ds[same_cycle & (np.abs(ds) < 0.05)] > 0)
+    with pytest.raises(DataError, match="branch"):
+        select_branch(d, "up")
+
+
+@pytest.mark.parametrize("slack", [0.0, 0.05, 0.3])
+def test_slack_found_per_cycle(tube2, slack):
+    d = synthesize(tube2, n_samples=2, n_cycles=4, slack_mm=slack, seed=5)
+    found = find_slack(d)
+    assert sorted(found) == [(s, c) for s in ("1", "2") for c in range(1, 5)]
+    for v in found.values():
+        assert abs(v.stroke_mm - slack) < 0.006
+        assert 0.15 < v.noise_deg < 0.35  # the generator's 0.25 deg
+
+
+def test_remove_deadband_shifts_and_drops(tube2):
+    d = synthesize(tube2, n_samples=1, n_cycles=2, slack_mm=0.3, seed=2)
+    out = remove_deadband(d)
+    assert np.all(out.stroke_mm >= 0)
+    np.testing.assert_allclose(out.extra["slack_mm"], 0.3, atol=0.006)
+    assert len(out) < len(d)
+    # rows kept are those beyond the slack, with stroke shifted by it
+    kept = d.stroke_mm - 0.3 > 0.01
+    assert abs(int(kept.sum()) - len(out)) <= 8
+
+
+def test_prepare_defaults_are_the_papers_comparison(tube2):
+    d = synthesize(tube2, n_samples=2, n_cycles=3, slack_mm=0.1, seed=4)
+    rows = prepare(d)
+    assert set(rows.cycle.tolist()) == {3}
+    assert np.all(rows.direction == 1)
+    assert rows.stroke_mm.min() >= 0 and rows.stroke_mm.max() < 2.5 - 0.09
