@@ -1,0 +1,97 @@
+"""Smoke tests of ``camtube model synth`` and ``camtube model fit`` (files read back independently)."""
+from __future__ import annotations
+
+import csv
+import json
+
+import pytest
+
+from camtube.cli import build_parser, main
+from camtube.model.synth import noise_floor_deg
+from tests.conftest import PATTERNS
+
+TUBE2 = str(PATTERNS / "tube2.yaml")
+
+
+@pytest.fixture(scope="module")
+def data_csv(tmp_path_factory):
+    path = tmp_path_factory.mktemp("m") / "d.csv"
+    assert main(["model", "synth", "--pattern", TUBE2, "-o", str(path), "--cycles", "6", "-q"]) == 0
+    return path
+
+
+def test_synth_writes_a_csv_the_csv_module_reads(data_csv):
+    with open(data_csv, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert list(rows[0]) == ["sample", "cycle", "time_s", "stroke_mm", "force_N", "angle_deg"]
+    assert {r["sample"] for r in rows} == {"1", "2"}
+    assert {int(r["cycle"]) for r in rows} == set(range(1, 7))
+    assert max(float(r["stroke_mm"]) for r in rows) == pytest.approx(2.5, abs=0.02)
+
+
+def test_fit_prints_table_and_writes_json_and_plot(data_csv, tmp_path, capsys):
+    js, png = tmp_path / "f.json", tmp_path / "f.png"
+    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--json", str(js), "--plot", str(png)]) == 0
+    out = capsys.readouterr().out
+    assert "RMSE deg" in out and "E_t" in out and "GPa" in out
+    doc = json.loads(js.read_text())
+    assert set(doc["per_sample"]) == {"1", "2"}
+    assert doc["params"]["E_t"]["unit"] == "GPa" and doc["params"]["E_t"]["stderr"] > 0
+    assert abs(doc["params"]["E_t"]["value"] - 28.0) < 0.84
+    from camtube.design.loader import load_pattern
+
+    assert doc["rmse_deg"] == pytest.approx(noise_floor_deg(load_pattern(TUBE2)), rel=0.2)
+    assert doc["n_points"] > 300
+    import matplotlib.image as mpimg
+
+    img = mpimg.imread(png)
+    assert img.ndim == 3 and img.shape[0] > 300 and img.shape[1] > 600
+
+
+def test_fit_options_cycles_branch_fit_and_fix(data_csv, tmp_path):
+    js = tmp_path / "g.json"
+    argv = ["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--cycles", "2-", "--branch", "both",
+            "--fit", "E_t,arm_scale", "--fix", "L0=70", "--json", str(js)]
+    assert main(argv) == 0
+    doc = json.loads(js.read_text())
+    assert doc["params"]["arm_scale"]["fitted"] and doc["correlation"]["names"] == ["E_t", "arm_scale"]
+    assert doc["selection"] == {"cycles": "2-", "branch": "both", "deadband": True}
+
+
+def test_user_effect_file_and_effects(data_csv, tmp_path, capsys):
+    f = tmp_path / "my_effect.py"
+    f.write_text(
+        "from camtube.model.api import Effect, Param\n"
+        "zero = Effect('cli_test_zero', 'angle', (Param('bias_deg', 'deg', -5, 5, 0.0),),\n"
+        "              lambda ctx, a, p: a + p['bias_deg'])\n"
+    )
+    js = tmp_path / "h.json"
+    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--effect-file", str(f),
+                 "--effects", "cli_test_zero", "--fit", "E_t,cli_test_zero.bias_deg", "--json", str(js)]) == 0
+    doc = json.loads(js.read_text())
+    assert doc["effects"] == ["cli_test_zero"]
+    assert abs(doc["params"]["cli_test_zero.bias_deg"]["value"]) < 0.2
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--effects", "no_such_effect"], "unknown effect"),
+    (["--fit", "E_T"], "did you mean 'E_t'"),
+    (["--cycles", "lats"], "cycle selection"),
+    (["--fix", "L0"], "NAME=VALUE"),
+])
+def test_bad_options_exit_2_with_a_message(data_csv, capsys, extra, words):
+    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q"] + extra) == 2
+    assert words in capsys.readouterr().err
+
+
+def test_bad_csv_exit_2_with_line(tmp_path, capsys):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("sample,cycle,time_s,stroke_mm,force_N,angle_deg\nA,1,0,0,0,0\nA,1,1,x,0,0\n")
+    assert main(["model", "fit", str(bad), "--pattern", TUBE2, "-q"]) == 2
+    assert f"{bad}:3:" in capsys.readouterr().err
+
+
+def test_model_group_lists_its_subcommands():
+    parser = build_parser()
+    text = [a for a in parser._subparsers._group_actions][0].choices["model"].format_help()
+    assert "fit" in text and "synth" in text
