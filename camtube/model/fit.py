@@ -37,6 +37,7 @@ bound: their stderr is not meaningful), ``success``, ``message``, ``nfev``,
 """
 from __future__ import annotations
 
+import contextlib
 import difflib
 import math
 from dataclasses import dataclass, field
@@ -104,6 +105,20 @@ class FitResult:
         """Correlation coefficient of two fitted parameters."""
         i, j = self.fitted.index(a), self.fitted.index(b)
         return float(self.correlation[i, j])
+
+
+def _blas_single_thread():
+    """Limit BLAS to one thread while fitting, if threadpoolctl is installed.
+
+    The fit's linear algebra is tall and thin (n x p, p small): threads bring
+    nothing, and on a busy machine OpenBLAS threads waiting for a core make each
+    matrix-vector product a hundred times slower.
+    """
+    try:
+        from threadpoolctl import threadpool_limits
+    except ModuleNotFoundError:
+        return contextlib.nullcontext()
+    return threadpool_limits(1, user_api="blas")
 
 
 def rmse_by_sample(data: Dataset, residuals: np.ndarray) -> dict[str, float]:
@@ -193,46 +208,47 @@ def fit(
         raise FitError(f"the model gives a non-finite angle at row {k} with the starting values "
                        f"{ {nm: start[nm] for nm in names} }")
 
-    if p:
-        scale = np.maximum(np.abs(x0), 1e-3 * np.where(np.isfinite(span), span, 1.0))
-        scale = np.where(scale > 0, scale, 1.0)
-        sol = least_squares(residual, x0, bounds=(lo, hi), x_scale=scale, method="trf",
-                            max_nfev=max_nfev, xtol=1e-10, ftol=1e-10, gtol=1e-10)
-        x = sol.x
-        jac = np.atleast_2d(sol.jac)
-        success, message, nfev = bool(sol.success), str(sol.message), int(sol.nfev)
-    else:
-        x = x0
-        jac = np.zeros((n, 0))
-        success, message, nfev = True, "nothing to fit", 1
+    with _blas_single_thread():
+        if p:
+            scale = np.maximum(np.abs(x0), 1e-3 * np.where(np.isfinite(span), span, 1.0))
+            scale = np.where(scale > 0, scale, 1.0)
+            sol = least_squares(residual, x0, bounds=(lo, hi), x_scale=scale, method="trf",
+                                max_nfev=max_nfev, xtol=1e-10, ftol=1e-10, gtol=1e-10)
+            x = sol.x
+            jac = np.atleast_2d(sol.jac)
+            success, message, nfev = bool(sol.success), str(sol.message), int(sol.nfev)
+        else:
+            x = x0
+            jac = np.zeros((n, 0))
+            success, message, nfev = True, "nothing to fit", 1
 
-    final = dict(start)
-    final.update(zip(names, map(float, x)))
-    pred = model.predict(data, final)
-    res = measured - pred
-    sse = float(np.dot(res, res))
+        final = dict(start)
+        final.update(zip(names, map(float, x)))
+        pred = model.predict(data, final)
+        res = measured - pred
+        sse = float(np.dot(res, res))
 
-    cov = np.full((p, p), np.nan)
-    if p:
-        s2 = sse / (n - p)
-        _, sv, vt = np.linalg.svd(jac, full_matrices=False)
-        tol = sv.max() * max(jac.shape) * np.finfo(float).eps if sv.size else 0.0
-        inv = np.where(sv > tol, 1.0 / np.where(sv > tol, sv, 1.0) ** 2, np.inf)
-        with np.errstate(invalid="ignore"):
-            cov = (vt.T * inv) @ vt * s2
-        # a direction the data cannot see: infinite variance along it
-        for k in np.flatnonzero(~(sv > tol)):
-            dirn = np.abs(vt[k]) > 1e-12
-            cov[np.ix_(dirn, dirn)] = np.inf
-    var = np.diag(cov) if p else np.zeros(0)
-    stderr = {nm: float(math.sqrt(v)) if np.isfinite(v) and v >= 0 else math.inf
-              for nm, v in zip(names, var)}
-    with np.errstate(invalid="ignore", divide="ignore"):
-        sd = np.sqrt(var)
-        corr = cov / np.outer(sd, sd) if p else np.zeros((0, 0))
-    if p:
-        corr = np.where(np.isfinite(corr), corr, np.nan)
-        np.fill_diagonal(corr, 1.0)
+        cov = np.full((p, p), np.nan)
+        if p:
+            s2 = sse / (n - p)
+            _, sv, vt = np.linalg.svd(jac, full_matrices=False)
+            tol = sv.max() * max(jac.shape) * np.finfo(float).eps if sv.size else 0.0
+            inv = np.where(sv > tol, 1.0 / np.where(sv > tol, sv, 1.0) ** 2, np.inf)
+            with np.errstate(invalid="ignore"):
+                cov = (vt.T * inv) @ vt * s2
+            # a direction the data cannot see: infinite variance along it
+            for k in np.flatnonzero(~(sv > tol)):
+                dirn = np.abs(vt[k]) > 1e-12
+                cov[np.ix_(dirn, dirn)] = np.inf
+        var = np.diag(cov) if p else np.zeros(0)
+        stderr = {nm: float(math.sqrt(v)) if np.isfinite(v) and v >= 0 else math.inf
+                  for nm, v in zip(names, var)}
+        with np.errstate(invalid="ignore", divide="ignore"):
+            sd = np.sqrt(var)
+            corr = cov / np.outer(sd, sd) if p else np.zeros((0, 0))
+        if p:
+            corr = np.where(np.isfinite(corr), corr, np.nan)
+            np.fill_diagonal(corr, 1.0)
 
     tol_b = 1e-6 * np.where(np.isfinite(span), span, 1.0)
     at_bound = tuple(nm for nm, v, a, b, t in zip(names, x, lo, hi, tol_b) if v - a <= t or b - v <= t)
