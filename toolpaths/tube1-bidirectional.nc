@@ -5,7 +5,7 @@
 G21 G90 G17 G94
 M5
 G0 Z0
-; pass 0: cut 0 hole, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 0: cut 0 hole, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y0.150000
 M4 S200
 G1 X0.600000 Y0.150000 F1500.000
@@ -13,7 +13,7 @@ G1 X0.600000 Y-0.150000 F1500.000
 G1 X0.900000 Y-0.150000 F1500.000
 G1 X0.900000 Y0.150000 F1500.000
 M5
-; pass 1: cut 1 hole, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 1: cut 1 hole, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 M4 S200
 G1 X0.900000 Y2.506194 F1500.000
@@ -21,7 +21,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 2: cut 2 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 2: cut 2 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -29,7 +29,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 3: cut 3 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 3: cut 3 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.415000
 M4 S200
 G1 X2.500000 Y-1.415000 F1500.000
@@ -37,7 +37,7 @@ G1 X3.000000 Y-1.415000 F1500.000
 G1 X3.000000 Y1.415000 F1500.000
 G1 X2.500000 Y1.415000 F1500.000
 M5
-; pass 4: cut 4 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 4: cut 4 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -45,7 +45,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 5: cut 5 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 5: cut 5 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.415000
 M4 S200
 G1 X4.500000 Y-1.415000 F1500.000
@@ -53,7 +53,7 @@ G1 X5.000000 Y-1.415000 F1500.000
 G1 X5.000000 Y1.415000 F1500.000
 G1 X4.500000 Y1.415000 F1500.000
 M5
-; pass 6: cut 6 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 6: cut 6 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -61,7 +61,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 7: cut 7 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 7: cut 7 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.415000
 M4 S200
 G1 X6.500000 Y-1.415000 F1500.000
@@ -69,7 +69,7 @@ G1 X7.000000 Y-1.415000 F1500.000
 G1 X7.000000 Y1.415000 F1500.000
 G1 X6.500000 Y1.415000 F1500.000
 M5
-; pass 8: cut 8 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 8: cut 8 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -77,7 +77,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 9: cut 9 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 9: cut 9 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.415000
 M4 S200
 G1 X8.500000 Y-1.415000 F1500.000
@@ -85,7 +85,7 @@ G1 X9.000000 Y-1.415000 F1500.000
 G1 X9.000000 Y1.415000 F1500.000
 G1 X8.500000 Y1.415000 F1500.000
 M5
-; pass 10: cut 10 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 10: cut 10 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -93,7 +93,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 11: cut 11 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 11: cut 11 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.415000
 M4 S200
 G1 X10.500000 Y-1.415000 F1500.000
@@ -101,7 +101,7 @@ G1 X11.000000 Y-1.415000 F1500.000
 G1 X11.000000 Y1.415000 F1500.000
 G1 X10.500000 Y1.415000 F1500.000
 M5
-; pass 12: cut 12 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 12: cut 12 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X11.500000 Y0.941194
 M4 S200
 G1 X12.000000 Y0.941194 F1500.000
@@ -109,7 +109,7 @@ G1 X12.000000 Y3.771194 F1500.000
 G1 X11.500000 Y3.771194 F1500.000
 G1 X11.500000 Y0.941194 F1500.000
 M5
-; pass 13: cut 13 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 13: cut 13 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X12.500000 Y1.415000
 M4 S200
 G1 X12.500000 Y-1.415000 F1500.000
@@ -117,7 +117,7 @@ G1 X13.000000 Y-1.415000 F1500.000
 G1 X13.000000 Y1.415000 F1500.000
 G1 X12.500000 Y1.415000 F1500.000
 M5
-; pass 14: cut 14 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 14: cut 14 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X13.500000 Y0.941194
 M4 S200
 G1 X14.000000 Y0.941194 F1500.000
@@ -125,7 +125,7 @@ G1 X14.000000 Y3.771194 F1500.000
 G1 X13.500000 Y3.771194 F1500.000
 G1 X13.500000 Y0.941194 F1500.000
 M5
-; pass 15: cut 15 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 15: cut 15 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X14.500000 Y1.415000
 M4 S200
 G1 X14.500000 Y-1.415000 F1500.000
@@ -133,7 +133,7 @@ G1 X15.000000 Y-1.415000 F1500.000
 G1 X15.000000 Y1.415000 F1500.000
 G1 X14.500000 Y1.415000 F1500.000
 M5
-; pass 16: cut 16 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 16: cut 16 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X15.500000 Y0.941194
 M4 S200
 G1 X16.000000 Y0.941194 F1500.000
@@ -141,7 +141,7 @@ G1 X16.000000 Y3.771194 F1500.000
 G1 X15.500000 Y3.771194 F1500.000
 G1 X15.500000 Y0.941194 F1500.000
 M5
-; pass 17: cut 17 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 17: cut 17 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X16.500000 Y1.415000
 M4 S200
 G1 X16.500000 Y-1.415000 F1500.000
@@ -149,7 +149,7 @@ G1 X17.000000 Y-1.415000 F1500.000
 G1 X17.000000 Y1.415000 F1500.000
 G1 X16.500000 Y1.415000 F1500.000
 M5
-; pass 18: cut 17 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 18: cut 17 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X16.505000 Y1.410000
 M4 S200
 G1 X16.505000 Y-1.410000 F1500.000
@@ -157,7 +157,7 @@ G1 X16.995000 Y-1.410000 F1500.000
 G1 X16.995000 Y1.410000 F1500.000
 G1 X16.505000 Y1.410000 F1500.000
 M5
-; pass 19: cut 16 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 19: cut 16 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X15.995000 Y0.946194
 M4 S200
 G1 X15.995000 Y3.766194 F1500.000
@@ -165,7 +165,7 @@ G1 X15.505000 Y3.766194 F1500.000
 G1 X15.505000 Y0.946194 F1500.000
 G1 X15.995000 Y0.946194 F1500.000
 M5
-; pass 20: cut 15 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 20: cut 15 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X14.995000 Y1.410000
 M4 S200
 G1 X14.505000 Y1.410000 F1500.000
@@ -173,7 +173,7 @@ G1 X14.505000 Y-1.410000 F1500.000
 G1 X14.995000 Y-1.410000 F1500.000
 G1 X14.995000 Y1.410000 F1500.000
 M5
-; pass 21: cut 14 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 21: cut 14 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X13.995000 Y0.946194
 M4 S200
 G1 X13.995000 Y3.766194 F1500.000
@@ -181,7 +181,7 @@ G1 X13.505000 Y3.766194 F1500.000
 G1 X13.505000 Y0.946194 F1500.000
 G1 X13.995000 Y0.946194 F1500.000
 M5
-; pass 22: cut 13 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 22: cut 13 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X12.995000 Y1.410000
 M4 S200
 G1 X12.505000 Y1.410000 F1500.000
@@ -189,7 +189,7 @@ G1 X12.505000 Y-1.410000 F1500.000
 G1 X12.995000 Y-1.410000 F1500.000
 G1 X12.995000 Y1.410000 F1500.000
 M5
-; pass 23: cut 12 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 23: cut 12 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X11.995000 Y0.946194
 M4 S200
 G1 X11.995000 Y3.766194 F1500.000
@@ -197,7 +197,7 @@ G1 X11.505000 Y3.766194 F1500.000
 G1 X11.505000 Y0.946194 F1500.000
 G1 X11.995000 Y0.946194 F1500.000
 M5
-; pass 24: cut 11 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 24: cut 11 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.995000 Y1.410000
 M4 S200
 G1 X10.505000 Y1.410000 F1500.000
@@ -205,7 +205,7 @@ G1 X10.505000 Y-1.410000 F1500.000
 G1 X10.995000 Y-1.410000 F1500.000
 G1 X10.995000 Y1.410000 F1500.000
 M5
-; pass 25: cut 10 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 25: cut 10 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -213,7 +213,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 26: cut 9 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 26: cut 9 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.410000
 M4 S200
 G1 X8.505000 Y1.410000 F1500.000
@@ -221,7 +221,7 @@ G1 X8.505000 Y-1.410000 F1500.000
 G1 X8.995000 Y-1.410000 F1500.000
 G1 X8.995000 Y1.410000 F1500.000
 M5
-; pass 27: cut 8 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 27: cut 8 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -229,7 +229,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 28: cut 7 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 28: cut 7 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.410000
 M4 S200
 G1 X6.505000 Y1.410000 F1500.000
@@ -237,7 +237,7 @@ G1 X6.505000 Y-1.410000 F1500.000
 G1 X6.995000 Y-1.410000 F1500.000
 G1 X6.995000 Y1.410000 F1500.000
 M5
-; pass 29: cut 6 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 29: cut 6 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -245,7 +245,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 30: cut 5 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 30: cut 5 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.410000
 M4 S200
 G1 X4.505000 Y1.410000 F1500.000
@@ -253,7 +253,7 @@ G1 X4.505000 Y-1.410000 F1500.000
 G1 X4.995000 Y-1.410000 F1500.000
 G1 X4.995000 Y1.410000 F1500.000
 M5
-; pass 31: cut 4 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 31: cut 4 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -261,7 +261,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 32: cut 3 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 32: cut 3 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.410000
 M4 S200
 G1 X2.505000 Y1.410000 F1500.000
@@ -269,7 +269,7 @@ G1 X2.505000 Y-1.410000 F1500.000
 G1 X2.995000 Y-1.410000 F1500.000
 G1 X2.995000 Y1.410000 F1500.000
 M5
-; pass 33: cut 2 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 33: cut 2 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -277,7 +277,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 34: cut 1 hole, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 34: cut 1 hole, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -285,7 +285,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 35: cut 0 hole, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 35: cut 0 hole, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y0.145000
 M4 S200
 G1 X0.605000 Y0.145000 F1500.000
@@ -293,7 +293,7 @@ G1 X0.605000 Y-0.145000 F1500.000
 G1 X0.895000 Y-0.145000 F1500.000
 G1 X0.895000 Y0.145000 F1500.000
 M5
-; pass 36: cut 0 hole, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 36: cut 0 hole, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y0.140000
 M4 S200
 G1 X0.610000 Y0.140000 F1500.000
@@ -301,7 +301,7 @@ G1 X0.610000 Y-0.140000 F1500.000
 G1 X0.890000 Y-0.140000 F1500.000
 G1 X0.890000 Y0.140000 F1500.000
 M5
-; pass 37: cut 1 hole, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 37: cut 1 hole, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -309,7 +309,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 38: cut 2 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 38: cut 2 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -317,7 +317,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 39: cut 3 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 39: cut 3 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.405000
 M4 S200
 G1 X2.510000 Y-1.405000 F1500.000
@@ -325,7 +325,7 @@ G1 X2.990000 Y-1.405000 F1500.000
 G1 X2.990000 Y1.405000 F1500.000
 G1 X2.510000 Y1.405000 F1500.000
 M5
-; pass 40: cut 4 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 40: cut 4 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -333,7 +333,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 41: cut 5 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 41: cut 5 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.405000
 M4 S200
 G1 X4.510000 Y-1.405000 F1500.000
@@ -341,7 +341,7 @@ G1 X4.990000 Y-1.405000 F1500.000
 G1 X4.990000 Y1.405000 F1500.000
 G1 X4.510000 Y1.405000 F1500.000
 M5
-; pass 42: cut 6 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 42: cut 6 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -349,7 +349,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 43: cut 7 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 43: cut 7 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.405000
 M4 S200
 G1 X6.510000 Y-1.405000 F1500.000
@@ -357,7 +357,7 @@ G1 X6.990000 Y-1.405000 F1500.000
 G1 X6.990000 Y1.405000 F1500.000
 G1 X6.510000 Y1.405000 F1500.000
 M5
-; pass 44: cut 8 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 44: cut 8 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -365,7 +365,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 45: cut 9 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 45: cut 9 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.405000
 M4 S200
 G1 X8.510000 Y-1.405000 F1500.000
@@ -373,7 +373,7 @@ G1 X8.990000 Y-1.405000 F1500.000
 G1 X8.990000 Y1.405000 F1500.000
 G1 X8.510000 Y1.405000 F1500.000
 M5
-; pass 46: cut 10 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 46: cut 10 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -381,7 +381,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 47: cut 11 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 47: cut 11 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.405000
 M4 S200
 G1 X10.510000 Y-1.405000 F1500.000
@@ -389,7 +389,7 @@ G1 X10.990000 Y-1.405000 F1500.000
 G1 X10.990000 Y1.405000 F1500.000
 G1 X10.510000 Y1.405000 F1500.000
 M5
-; pass 48: cut 12 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 48: cut 12 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X11.510000 Y0.951194
 M4 S200
 G1 X11.990000 Y0.951194 F1500.000
@@ -397,7 +397,7 @@ G1 X11.990000 Y3.761194 F1500.000
 G1 X11.510000 Y3.761194 F1500.000
 G1 X11.510000 Y0.951194 F1500.000
 M5
-; pass 49: cut 13 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 49: cut 13 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X12.510000 Y1.405000
 M4 S200
 G1 X12.510000 Y-1.405000 F1500.000
@@ -405,7 +405,7 @@ G1 X12.990000 Y-1.405000 F1500.000
 G1 X12.990000 Y1.405000 F1500.000
 G1 X12.510000 Y1.405000 F1500.000
 M5
-; pass 50: cut 14 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 50: cut 14 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X13.510000 Y0.951194
 M4 S200
 G1 X13.990000 Y0.951194 F1500.000
@@ -413,7 +413,7 @@ G1 X13.990000 Y3.761194 F1500.000
 G1 X13.510000 Y3.761194 F1500.000
 G1 X13.510000 Y0.951194 F1500.000
 M5
-; pass 51: cut 15 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 51: cut 15 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X14.510000 Y1.405000
 M4 S200
 G1 X14.510000 Y-1.405000 F1500.000
@@ -421,7 +421,7 @@ G1 X14.990000 Y-1.405000 F1500.000
 G1 X14.990000 Y1.405000 F1500.000
 G1 X14.510000 Y1.405000 F1500.000
 M5
-; pass 52: cut 16 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 52: cut 16 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X15.510000 Y0.951194
 M4 S200
 G1 X15.990000 Y0.951194 F1500.000
@@ -429,7 +429,7 @@ G1 X15.990000 Y3.761194 F1500.000
 G1 X15.510000 Y3.761194 F1500.000
 G1 X15.510000 Y0.951194 F1500.000
 M5
-; pass 53: cut 17 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 53: cut 17 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X16.510000 Y1.405000
 M4 S200
 G1 X16.510000 Y-1.405000 F1500.000
@@ -437,7 +437,7 @@ G1 X16.990000 Y-1.405000 F1500.000
 G1 X16.990000 Y1.405000 F1500.000
 G1 X16.510000 Y1.405000 F1500.000
 M5
-; pass 54: cut 17 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 54: cut 17 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X16.515000 Y1.400000
 M4 S200
 G1 X16.515000 Y-1.400000 F1500.000
@@ -445,7 +445,7 @@ G1 X16.985000 Y-1.400000 F1500.000
 G1 X16.985000 Y1.400000 F1500.000
 G1 X16.515000 Y1.400000 F1500.000
 M5
-; pass 55: cut 16 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 55: cut 16 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X15.985000 Y0.956194
 M4 S200
 G1 X15.985000 Y3.756194 F1500.000
@@ -453,7 +453,7 @@ G1 X15.515000 Y3.756194 F1500.000
 G1 X15.515000 Y0.956194 F1500.000
 G1 X15.985000 Y0.956194 F1500.000
 M5
-; pass 56: cut 15 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 56: cut 15 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X14.985000 Y1.400000
 M4 S200
 G1 X14.515000 Y1.400000 F1500.000
@@ -461,7 +461,7 @@ G1 X14.515000 Y-1.400000 F1500.000
 G1 X14.985000 Y-1.400000 F1500.000
 G1 X14.985000 Y1.400000 F1500.000
 M5
-; pass 57: cut 14 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 57: cut 14 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X13.985000 Y0.956194
 M4 S200
 G1 X13.985000 Y3.756194 F1500.000
@@ -469,7 +469,7 @@ G1 X13.515000 Y3.756194 F1500.000
 G1 X13.515000 Y0.956194 F1500.000
 G1 X13.985000 Y0.956194 F1500.000
 M5
-; pass 58: cut 13 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 58: cut 13 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X12.985000 Y1.400000
 M4 S200
 G1 X12.515000 Y1.400000 F1500.000
@@ -477,7 +477,7 @@ G1 X12.515000 Y-1.400000 F1500.000
 G1 X12.985000 Y-1.400000 F1500.000
 G1 X12.985000 Y1.400000 F1500.000
 M5
-; pass 59: cut 12 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 59: cut 12 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X11.985000 Y0.956194
 M4 S200
 G1 X11.985000 Y3.756194 F1500.000
@@ -485,7 +485,7 @@ G1 X11.515000 Y3.756194 F1500.000
 G1 X11.515000 Y0.956194 F1500.000
 G1 X11.985000 Y0.956194 F1500.000
 M5
-; pass 60: cut 11 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 60: cut 11 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.985000 Y1.400000
 M4 S200
 G1 X10.515000 Y1.400000 F1500.000
@@ -493,7 +493,7 @@ G1 X10.515000 Y-1.400000 F1500.000
 G1 X10.985000 Y-1.400000 F1500.000
 G1 X10.985000 Y1.400000 F1500.000
 M5
-; pass 61: cut 10 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 61: cut 10 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -501,7 +501,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 62: cut 9 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 62: cut 9 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.400000
 M4 S200
 G1 X8.515000 Y1.400000 F1500.000
@@ -509,7 +509,7 @@ G1 X8.515000 Y-1.400000 F1500.000
 G1 X8.985000 Y-1.400000 F1500.000
 G1 X8.985000 Y1.400000 F1500.000
 M5
-; pass 63: cut 8 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 63: cut 8 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -517,7 +517,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 64: cut 7 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 64: cut 7 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.400000
 M4 S200
 G1 X6.515000 Y1.400000 F1500.000
@@ -525,7 +525,7 @@ G1 X6.515000 Y-1.400000 F1500.000
 G1 X6.985000 Y-1.400000 F1500.000
 G1 X6.985000 Y1.400000 F1500.000
 M5
-; pass 65: cut 6 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 65: cut 6 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -533,7 +533,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 66: cut 5 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 66: cut 5 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.400000
 M4 S200
 G1 X4.515000 Y1.400000 F1500.000
@@ -541,7 +541,7 @@ G1 X4.515000 Y-1.400000 F1500.000
 G1 X4.985000 Y-1.400000 F1500.000
 G1 X4.985000 Y1.400000 F1500.000
 M5
-; pass 67: cut 4 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 67: cut 4 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -549,7 +549,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 68: cut 3 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 68: cut 3 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.400000
 M4 S200
 G1 X2.515000 Y1.400000 F1500.000
@@ -557,7 +557,7 @@ G1 X2.515000 Y-1.400000 F1500.000
 G1 X2.985000 Y-1.400000 F1500.000
 G1 X2.985000 Y1.400000 F1500.000
 M5
-; pass 69: cut 2 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 69: cut 2 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -565,7 +565,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 70: cut 1 hole, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 70: cut 1 hole, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -573,7 +573,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 71: cut 0 hole, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 71: cut 0 hole, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y0.135000
 M4 S200
 G1 X0.615000 Y0.135000 F1500.000
@@ -581,7 +581,7 @@ G1 X0.615000 Y-0.135000 F1500.000
 G1 X0.885000 Y-0.135000 F1500.000
 G1 X0.885000 Y0.135000 F1500.000
 M5
-; pass 72: cut 0 hole, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 72: cut 0 hole, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y0.150000
 G0 Z-0.100000
 M4 S200
@@ -590,7 +590,7 @@ G1 X0.600000 Y-0.150000 F1500.000
 G1 X0.900000 Y-0.150000 F1500.000
 G1 X0.900000 Y0.150000 F1500.000
 M5
-; pass 73: cut 1 hole, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 73: cut 1 hole, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 M4 S200
 G1 X0.900000 Y2.506194 F1500.000
@@ -598,7 +598,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 74: cut 2 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 74: cut 2 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -606,7 +606,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 75: cut 3 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 75: cut 3 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.415000
 M4 S200
 G1 X2.500000 Y-1.415000 F1500.000
@@ -614,7 +614,7 @@ G1 X3.000000 Y-1.415000 F1500.000
 G1 X3.000000 Y1.415000 F1500.000
 G1 X2.500000 Y1.415000 F1500.000
 M5
-; pass 76: cut 4 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 76: cut 4 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -622,7 +622,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 77: cut 5 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 77: cut 5 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.415000
 M4 S200
 G1 X4.500000 Y-1.415000 F1500.000
@@ -630,7 +630,7 @@ G1 X5.000000 Y-1.415000 F1500.000
 G1 X5.000000 Y1.415000 F1500.000
 G1 X4.500000 Y1.415000 F1500.000
 M5
-; pass 78: cut 6 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 78: cut 6 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -638,7 +638,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 79: cut 7 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 79: cut 7 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.415000
 M4 S200
 G1 X6.500000 Y-1.415000 F1500.000
@@ -646,7 +646,7 @@ G1 X7.000000 Y-1.415000 F1500.000
 G1 X7.000000 Y1.415000 F1500.000
 G1 X6.500000 Y1.415000 F1500.000
 M5
-; pass 80: cut 8 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 80: cut 8 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -654,7 +654,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 81: cut 9 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 81: cut 9 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.415000
 M4 S200
 G1 X8.500000 Y-1.415000 F1500.000
@@ -662,7 +662,7 @@ G1 X9.000000 Y-1.415000 F1500.000
 G1 X9.000000 Y1.415000 F1500.000
 G1 X8.500000 Y1.415000 F1500.000
 M5
-; pass 82: cut 10 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 82: cut 10 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -670,7 +670,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 83: cut 11 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 83: cut 11 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.415000
 M4 S200
 G1 X10.500000 Y-1.415000 F1500.000
@@ -678,7 +678,7 @@ G1 X11.000000 Y-1.415000 F1500.000
 G1 X11.000000 Y1.415000 F1500.000
 G1 X10.500000 Y1.415000 F1500.000
 M5
-; pass 84: cut 12 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 84: cut 12 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X11.500000 Y0.941194
 M4 S200
 G1 X12.000000 Y0.941194 F1500.000
@@ -686,7 +686,7 @@ G1 X12.000000 Y3.771194 F1500.000
 G1 X11.500000 Y3.771194 F1500.000
 G1 X11.500000 Y0.941194 F1500.000
 M5
-; pass 85: cut 13 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 85: cut 13 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X12.500000 Y1.415000
 M4 S200
 G1 X12.500000 Y-1.415000 F1500.000
@@ -694,7 +694,7 @@ G1 X13.000000 Y-1.415000 F1500.000
 G1 X13.000000 Y1.415000 F1500.000
 G1 X12.500000 Y1.415000 F1500.000
 M5
-; pass 86: cut 14 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 86: cut 14 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X13.500000 Y0.941194
 M4 S200
 G1 X14.000000 Y0.941194 F1500.000
@@ -702,7 +702,7 @@ G1 X14.000000 Y3.771194 F1500.000
 G1 X13.500000 Y3.771194 F1500.000
 G1 X13.500000 Y0.941194 F1500.000
 M5
-; pass 87: cut 15 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 87: cut 15 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X14.500000 Y1.415000
 M4 S200
 G1 X14.500000 Y-1.415000 F1500.000
@@ -710,7 +710,7 @@ G1 X15.000000 Y-1.415000 F1500.000
 G1 X15.000000 Y1.415000 F1500.000
 G1 X14.500000 Y1.415000 F1500.000
 M5
-; pass 88: cut 16 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 88: cut 16 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X15.500000 Y0.941194
 M4 S200
 G1 X16.000000 Y0.941194 F1500.000
@@ -718,7 +718,7 @@ G1 X16.000000 Y3.771194 F1500.000
 G1 X15.500000 Y3.771194 F1500.000
 G1 X15.500000 Y0.941194 F1500.000
 M5
-; pass 89: cut 17 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 89: cut 17 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X16.500000 Y1.415000
 M4 S200
 G1 X16.500000 Y-1.415000 F1500.000
@@ -726,7 +726,7 @@ G1 X17.000000 Y-1.415000 F1500.000
 G1 X17.000000 Y1.415000 F1500.000
 G1 X16.500000 Y1.415000 F1500.000
 M5
-; pass 90: cut 17 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 90: cut 17 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X16.505000 Y1.410000
 M4 S200
 G1 X16.505000 Y-1.410000 F1500.000
@@ -734,7 +734,7 @@ G1 X16.995000 Y-1.410000 F1500.000
 G1 X16.995000 Y1.410000 F1500.000
 G1 X16.505000 Y1.410000 F1500.000
 M5
-; pass 91: cut 16 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 91: cut 16 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X15.995000 Y0.946194
 M4 S200
 G1 X15.995000 Y3.766194 F1500.000
@@ -742,7 +742,7 @@ G1 X15.505000 Y3.766194 F1500.000
 G1 X15.505000 Y0.946194 F1500.000
 G1 X15.995000 Y0.946194 F1500.000
 M5
-; pass 92: cut 15 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 92: cut 15 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X14.995000 Y1.410000
 M4 S200
 G1 X14.505000 Y1.410000 F1500.000
@@ -750,7 +750,7 @@ G1 X14.505000 Y-1.410000 F1500.000
 G1 X14.995000 Y-1.410000 F1500.000
 G1 X14.995000 Y1.410000 F1500.000
 M5
-; pass 93: cut 14 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 93: cut 14 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X13.995000 Y0.946194
 M4 S200
 G1 X13.995000 Y3.766194 F1500.000
@@ -758,7 +758,7 @@ G1 X13.505000 Y3.766194 F1500.000
 G1 X13.505000 Y0.946194 F1500.000
 G1 X13.995000 Y0.946194 F1500.000
 M5
-; pass 94: cut 13 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 94: cut 13 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X12.995000 Y1.410000
 M4 S200
 G1 X12.505000 Y1.410000 F1500.000
@@ -766,7 +766,7 @@ G1 X12.505000 Y-1.410000 F1500.000
 G1 X12.995000 Y-1.410000 F1500.000
 G1 X12.995000 Y1.410000 F1500.000
 M5
-; pass 95: cut 12 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 95: cut 12 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X11.995000 Y0.946194
 M4 S200
 G1 X11.995000 Y3.766194 F1500.000
@@ -774,7 +774,7 @@ G1 X11.505000 Y3.766194 F1500.000
 G1 X11.505000 Y0.946194 F1500.000
 G1 X11.995000 Y0.946194 F1500.000
 M5
-; pass 96: cut 11 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 96: cut 11 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.995000 Y1.410000
 M4 S200
 G1 X10.505000 Y1.410000 F1500.000
@@ -782,7 +782,7 @@ G1 X10.505000 Y-1.410000 F1500.000
 G1 X10.995000 Y-1.410000 F1500.000
 G1 X10.995000 Y1.410000 F1500.000
 M5
-; pass 97: cut 10 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 97: cut 10 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -790,7 +790,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 98: cut 9 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 98: cut 9 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.410000
 M4 S200
 G1 X8.505000 Y1.410000 F1500.000
@@ -798,7 +798,7 @@ G1 X8.505000 Y-1.410000 F1500.000
 G1 X8.995000 Y-1.410000 F1500.000
 G1 X8.995000 Y1.410000 F1500.000
 M5
-; pass 99: cut 8 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 99: cut 8 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -806,7 +806,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 100: cut 7 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 100: cut 7 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.410000
 M4 S200
 G1 X6.505000 Y1.410000 F1500.000
@@ -814,7 +814,7 @@ G1 X6.505000 Y-1.410000 F1500.000
 G1 X6.995000 Y-1.410000 F1500.000
 G1 X6.995000 Y1.410000 F1500.000
 M5
-; pass 101: cut 6 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 101: cut 6 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -822,7 +822,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 102: cut 5 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 102: cut 5 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.410000
 M4 S200
 G1 X4.505000 Y1.410000 F1500.000
@@ -830,7 +830,7 @@ G1 X4.505000 Y-1.410000 F1500.000
 G1 X4.995000 Y-1.410000 F1500.000
 G1 X4.995000 Y1.410000 F1500.000
 M5
-; pass 103: cut 4 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 103: cut 4 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -838,7 +838,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 104: cut 3 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 104: cut 3 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.410000
 M4 S200
 G1 X2.505000 Y1.410000 F1500.000
@@ -846,7 +846,7 @@ G1 X2.505000 Y-1.410000 F1500.000
 G1 X2.995000 Y-1.410000 F1500.000
 G1 X2.995000 Y1.410000 F1500.000
 M5
-; pass 105: cut 2 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 105: cut 2 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -854,7 +854,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 106: cut 1 hole, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 106: cut 1 hole, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -862,7 +862,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 107: cut 0 hole, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 107: cut 0 hole, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y0.145000
 M4 S200
 G1 X0.605000 Y0.145000 F1500.000
@@ -870,7 +870,7 @@ G1 X0.605000 Y-0.145000 F1500.000
 G1 X0.895000 Y-0.145000 F1500.000
 G1 X0.895000 Y0.145000 F1500.000
 M5
-; pass 108: cut 0 hole, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 108: cut 0 hole, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y0.140000
 M4 S200
 G1 X0.610000 Y0.140000 F1500.000
@@ -878,7 +878,7 @@ G1 X0.610000 Y-0.140000 F1500.000
 G1 X0.890000 Y-0.140000 F1500.000
 G1 X0.890000 Y0.140000 F1500.000
 M5
-; pass 109: cut 1 hole, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 109: cut 1 hole, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -886,7 +886,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 110: cut 2 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 110: cut 2 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -894,7 +894,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 111: cut 3 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 111: cut 3 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.405000
 M4 S200
 G1 X2.510000 Y-1.405000 F1500.000
@@ -902,7 +902,7 @@ G1 X2.990000 Y-1.405000 F1500.000
 G1 X2.990000 Y1.405000 F1500.000
 G1 X2.510000 Y1.405000 F1500.000
 M5
-; pass 112: cut 4 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 112: cut 4 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -910,7 +910,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 113: cut 5 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 113: cut 5 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.405000
 M4 S200
 G1 X4.510000 Y-1.405000 F1500.000
@@ -918,7 +918,7 @@ G1 X4.990000 Y-1.405000 F1500.000
 G1 X4.990000 Y1.405000 F1500.000
 G1 X4.510000 Y1.405000 F1500.000
 M5
-; pass 114: cut 6 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 114: cut 6 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -926,7 +926,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 115: cut 7 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 115: cut 7 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.405000
 M4 S200
 G1 X6.510000 Y-1.405000 F1500.000
@@ -934,7 +934,7 @@ G1 X6.990000 Y-1.405000 F1500.000
 G1 X6.990000 Y1.405000 F1500.000
 G1 X6.510000 Y1.405000 F1500.000
 M5
-; pass 116: cut 8 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 116: cut 8 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -942,7 +942,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 117: cut 9 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 117: cut 9 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.405000
 M4 S200
 G1 X8.510000 Y-1.405000 F1500.000
@@ -950,7 +950,7 @@ G1 X8.990000 Y-1.405000 F1500.000
 G1 X8.990000 Y1.405000 F1500.000
 G1 X8.510000 Y1.405000 F1500.000
 M5
-; pass 118: cut 10 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 118: cut 10 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -958,7 +958,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 119: cut 11 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 119: cut 11 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.405000
 M4 S200
 G1 X10.510000 Y-1.405000 F1500.000
@@ -966,7 +966,7 @@ G1 X10.990000 Y-1.405000 F1500.000
 G1 X10.990000 Y1.405000 F1500.000
 G1 X10.510000 Y1.405000 F1500.000
 M5
-; pass 120: cut 12 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 120: cut 12 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X11.510000 Y0.951194
 M4 S200
 G1 X11.990000 Y0.951194 F1500.000
@@ -974,7 +974,7 @@ G1 X11.990000 Y3.761194 F1500.000
 G1 X11.510000 Y3.761194 F1500.000
 G1 X11.510000 Y0.951194 F1500.000
 M5
-; pass 121: cut 13 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 121: cut 13 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X12.510000 Y1.405000
 M4 S200
 G1 X12.510000 Y-1.405000 F1500.000
@@ -982,7 +982,7 @@ G1 X12.990000 Y-1.405000 F1500.000
 G1 X12.990000 Y1.405000 F1500.000
 G1 X12.510000 Y1.405000 F1500.000
 M5
-; pass 122: cut 14 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 122: cut 14 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X13.510000 Y0.951194
 M4 S200
 G1 X13.990000 Y0.951194 F1500.000
@@ -990,7 +990,7 @@ G1 X13.990000 Y3.761194 F1500.000
 G1 X13.510000 Y3.761194 F1500.000
 G1 X13.510000 Y0.951194 F1500.000
 M5
-; pass 123: cut 15 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 123: cut 15 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X14.510000 Y1.405000
 M4 S200
 G1 X14.510000 Y-1.405000 F1500.000
@@ -998,7 +998,7 @@ G1 X14.990000 Y-1.405000 F1500.000
 G1 X14.990000 Y1.405000 F1500.000
 G1 X14.510000 Y1.405000 F1500.000
 M5
-; pass 124: cut 16 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 124: cut 16 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X15.510000 Y0.951194
 M4 S200
 G1 X15.990000 Y0.951194 F1500.000
@@ -1006,7 +1006,7 @@ G1 X15.990000 Y3.761194 F1500.000
 G1 X15.510000 Y3.761194 F1500.000
 G1 X15.510000 Y0.951194 F1500.000
 M5
-; pass 125: cut 17 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 125: cut 17 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X16.510000 Y1.405000
 M4 S200
 G1 X16.510000 Y-1.405000 F1500.000
@@ -1014,7 +1014,7 @@ G1 X16.990000 Y-1.405000 F1500.000
 G1 X16.990000 Y1.405000 F1500.000
 G1 X16.510000 Y1.405000 F1500.000
 M5
-; pass 126: cut 17 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 126: cut 17 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X16.515000 Y1.400000
 M4 S200
 G1 X16.515000 Y-1.400000 F1500.000
@@ -1022,7 +1022,7 @@ G1 X16.985000 Y-1.400000 F1500.000
 G1 X16.985000 Y1.400000 F1500.000
 G1 X16.515000 Y1.400000 F1500.000
 M5
-; pass 127: cut 16 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 127: cut 16 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X15.985000 Y0.956194
 M4 S200
 G1 X15.985000 Y3.756194 F1500.000
@@ -1030,7 +1030,7 @@ G1 X15.515000 Y3.756194 F1500.000
 G1 X15.515000 Y0.956194 F1500.000
 G1 X15.985000 Y0.956194 F1500.000
 M5
-; pass 128: cut 15 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 128: cut 15 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X14.985000 Y1.400000
 M4 S200
 G1 X14.515000 Y1.400000 F1500.000
@@ -1038,7 +1038,7 @@ G1 X14.515000 Y-1.400000 F1500.000
 G1 X14.985000 Y-1.400000 F1500.000
 G1 X14.985000 Y1.400000 F1500.000
 M5
-; pass 129: cut 14 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 129: cut 14 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X13.985000 Y0.956194
 M4 S200
 G1 X13.985000 Y3.756194 F1500.000
@@ -1046,7 +1046,7 @@ G1 X13.515000 Y3.756194 F1500.000
 G1 X13.515000 Y0.956194 F1500.000
 G1 X13.985000 Y0.956194 F1500.000
 M5
-; pass 130: cut 13 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 130: cut 13 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X12.985000 Y1.400000
 M4 S200
 G1 X12.515000 Y1.400000 F1500.000
@@ -1054,7 +1054,7 @@ G1 X12.515000 Y-1.400000 F1500.000
 G1 X12.985000 Y-1.400000 F1500.000
 G1 X12.985000 Y1.400000 F1500.000
 M5
-; pass 131: cut 12 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 131: cut 12 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X11.985000 Y0.956194
 M4 S200
 G1 X11.985000 Y3.756194 F1500.000
@@ -1062,7 +1062,7 @@ G1 X11.515000 Y3.756194 F1500.000
 G1 X11.515000 Y0.956194 F1500.000
 G1 X11.985000 Y0.956194 F1500.000
 M5
-; pass 132: cut 11 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 132: cut 11 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.985000 Y1.400000
 M4 S200
 G1 X10.515000 Y1.400000 F1500.000
@@ -1070,7 +1070,7 @@ G1 X10.515000 Y-1.400000 F1500.000
 G1 X10.985000 Y-1.400000 F1500.000
 G1 X10.985000 Y1.400000 F1500.000
 M5
-; pass 133: cut 10 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 133: cut 10 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -1078,7 +1078,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 134: cut 9 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 134: cut 9 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.400000
 M4 S200
 G1 X8.515000 Y1.400000 F1500.000
@@ -1086,7 +1086,7 @@ G1 X8.515000 Y-1.400000 F1500.000
 G1 X8.985000 Y-1.400000 F1500.000
 G1 X8.985000 Y1.400000 F1500.000
 M5
-; pass 135: cut 8 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 135: cut 8 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -1094,7 +1094,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 136: cut 7 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 136: cut 7 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.400000
 M4 S200
 G1 X6.515000 Y1.400000 F1500.000
@@ -1102,7 +1102,7 @@ G1 X6.515000 Y-1.400000 F1500.000
 G1 X6.985000 Y-1.400000 F1500.000
 G1 X6.985000 Y1.400000 F1500.000
 M5
-; pass 137: cut 6 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 137: cut 6 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -1110,7 +1110,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 138: cut 5 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 138: cut 5 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.400000
 M4 S200
 G1 X4.515000 Y1.400000 F1500.000
@@ -1118,7 +1118,7 @@ G1 X4.515000 Y-1.400000 F1500.000
 G1 X4.985000 Y-1.400000 F1500.000
 G1 X4.985000 Y1.400000 F1500.000
 M5
-; pass 139: cut 4 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 139: cut 4 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -1126,7 +1126,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 140: cut 3 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 140: cut 3 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.400000
 M4 S200
 G1 X2.515000 Y1.400000 F1500.000
@@ -1134,7 +1134,7 @@ G1 X2.515000 Y-1.400000 F1500.000
 G1 X2.985000 Y-1.400000 F1500.000
 G1 X2.985000 Y1.400000 F1500.000
 M5
-; pass 141: cut 2 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 141: cut 2 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -1142,7 +1142,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 142: cut 1 hole, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 142: cut 1 hole, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -1150,7 +1150,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 143: cut 0 hole, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 143: cut 0 hole, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y0.135000
 M4 S200
 G1 X0.615000 Y0.135000 F1500.000
@@ -1158,7 +1158,7 @@ G1 X0.615000 Y-0.135000 F1500.000
 G1 X0.885000 Y-0.135000 F1500.000
 G1 X0.885000 Y0.135000 F1500.000
 M5
-; pass 144: cut 0 hole, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 144: cut 0 hole, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y0.150000
 G0 Z0.000000
 M4 S200
@@ -1167,7 +1167,7 @@ G1 X0.600000 Y-0.150000 F1500.000
 G1 X0.900000 Y-0.150000 F1500.000
 G1 X0.900000 Y0.150000 F1500.000
 M5
-; pass 145: cut 1 hole, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 145: cut 1 hole, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 M4 S200
 G1 X0.900000 Y2.506194 F1500.000
@@ -1175,7 +1175,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 146: cut 2 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 146: cut 2 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -1183,7 +1183,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 147: cut 3 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 147: cut 3 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.415000
 M4 S200
 G1 X2.500000 Y-1.415000 F1500.000
@@ -1191,7 +1191,7 @@ G1 X3.000000 Y-1.415000 F1500.000
 G1 X3.000000 Y1.415000 F1500.000
 G1 X2.500000 Y1.415000 F1500.000
 M5
-; pass 148: cut 4 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 148: cut 4 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -1199,7 +1199,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 149: cut 5 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 149: cut 5 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.415000
 M4 S200
 G1 X4.500000 Y-1.415000 F1500.000
@@ -1207,7 +1207,7 @@ G1 X5.000000 Y-1.415000 F1500.000
 G1 X5.000000 Y1.415000 F1500.000
 G1 X4.500000 Y1.415000 F1500.000
 M5
-; pass 150: cut 6 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 150: cut 6 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -1215,7 +1215,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 151: cut 7 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 151: cut 7 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.415000
 M4 S200
 G1 X6.500000 Y-1.415000 F1500.000
@@ -1223,7 +1223,7 @@ G1 X7.000000 Y-1.415000 F1500.000
 G1 X7.000000 Y1.415000 F1500.000
 G1 X6.500000 Y1.415000 F1500.000
 M5
-; pass 152: cut 8 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 152: cut 8 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -1231,7 +1231,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 153: cut 9 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 153: cut 9 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.415000
 M4 S200
 G1 X8.500000 Y-1.415000 F1500.000
@@ -1239,7 +1239,7 @@ G1 X9.000000 Y-1.415000 F1500.000
 G1 X9.000000 Y1.415000 F1500.000
 G1 X8.500000 Y1.415000 F1500.000
 M5
-; pass 154: cut 10 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 154: cut 10 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -1247,7 +1247,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 155: cut 11 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 155: cut 11 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.415000
 M4 S200
 G1 X10.500000 Y-1.415000 F1500.000
@@ -1255,7 +1255,7 @@ G1 X11.000000 Y-1.415000 F1500.000
 G1 X11.000000 Y1.415000 F1500.000
 G1 X10.500000 Y1.415000 F1500.000
 M5
-; pass 156: cut 12 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 156: cut 12 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X11.500000 Y0.941194
 M4 S200
 G1 X12.000000 Y0.941194 F1500.000
@@ -1263,7 +1263,7 @@ G1 X12.000000 Y3.771194 F1500.000
 G1 X11.500000 Y3.771194 F1500.000
 G1 X11.500000 Y0.941194 F1500.000
 M5
-; pass 157: cut 13 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 157: cut 13 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X12.500000 Y1.415000
 M4 S200
 G1 X12.500000 Y-1.415000 F1500.000
@@ -1271,7 +1271,7 @@ G1 X13.000000 Y-1.415000 F1500.000
 G1 X13.000000 Y1.415000 F1500.000
 G1 X12.500000 Y1.415000 F1500.000
 M5
-; pass 158: cut 14 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 158: cut 14 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X13.500000 Y0.941194
 M4 S200
 G1 X14.000000 Y0.941194 F1500.000
@@ -1279,7 +1279,7 @@ G1 X14.000000 Y3.771194 F1500.000
 G1 X13.500000 Y3.771194 F1500.000
 G1 X13.500000 Y0.941194 F1500.000
 M5
-; pass 159: cut 15 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 159: cut 15 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X14.500000 Y1.415000
 M4 S200
 G1 X14.500000 Y-1.415000 F1500.000
@@ -1287,7 +1287,7 @@ G1 X15.000000 Y-1.415000 F1500.000
 G1 X15.000000 Y1.415000 F1500.000
 G1 X14.500000 Y1.415000 F1500.000
 M5
-; pass 160: cut 16 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 160: cut 16 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X15.500000 Y0.941194
 M4 S200
 G1 X16.000000 Y0.941194 F1500.000
@@ -1295,7 +1295,7 @@ G1 X16.000000 Y3.771194 F1500.000
 G1 X15.500000 Y3.771194 F1500.000
 G1 X15.500000 Y0.941194 F1500.000
 M5
-; pass 161: cut 17 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 161: cut 17 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X16.500000 Y1.415000
 M4 S200
 G1 X16.500000 Y-1.415000 F1500.000
@@ -1303,7 +1303,7 @@ G1 X17.000000 Y-1.415000 F1500.000
 G1 X17.000000 Y1.415000 F1500.000
 G1 X16.500000 Y1.415000 F1500.000
 M5
-; pass 162: cut 17 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 162: cut 17 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X16.505000 Y1.410000
 M4 S200
 G1 X16.505000 Y-1.410000 F1500.000
@@ -1311,7 +1311,7 @@ G1 X16.995000 Y-1.410000 F1500.000
 G1 X16.995000 Y1.410000 F1500.000
 G1 X16.505000 Y1.410000 F1500.000
 M5
-; pass 163: cut 16 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 163: cut 16 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X15.995000 Y0.946194
 M4 S200
 G1 X15.995000 Y3.766194 F1500.000
@@ -1319,7 +1319,7 @@ G1 X15.505000 Y3.766194 F1500.000
 G1 X15.505000 Y0.946194 F1500.000
 G1 X15.995000 Y0.946194 F1500.000
 M5
-; pass 164: cut 15 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 164: cut 15 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X14.995000 Y1.410000
 M4 S200
 G1 X14.505000 Y1.410000 F1500.000
@@ -1327,7 +1327,7 @@ G1 X14.505000 Y-1.410000 F1500.000
 G1 X14.995000 Y-1.410000 F1500.000
 G1 X14.995000 Y1.410000 F1500.000
 M5
-; pass 165: cut 14 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 165: cut 14 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X13.995000 Y0.946194
 M4 S200
 G1 X13.995000 Y3.766194 F1500.000
@@ -1335,7 +1335,7 @@ G1 X13.505000 Y3.766194 F1500.000
 G1 X13.505000 Y0.946194 F1500.000
 G1 X13.995000 Y0.946194 F1500.000
 M5
-; pass 166: cut 13 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 166: cut 13 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X12.995000 Y1.410000
 M4 S200
 G1 X12.505000 Y1.410000 F1500.000
@@ -1343,7 +1343,7 @@ G1 X12.505000 Y-1.410000 F1500.000
 G1 X12.995000 Y-1.410000 F1500.000
 G1 X12.995000 Y1.410000 F1500.000
 M5
-; pass 167: cut 12 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 167: cut 12 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X11.995000 Y0.946194
 M4 S200
 G1 X11.995000 Y3.766194 F1500.000
@@ -1351,7 +1351,7 @@ G1 X11.505000 Y3.766194 F1500.000
 G1 X11.505000 Y0.946194 F1500.000
 G1 X11.995000 Y0.946194 F1500.000
 M5
-; pass 168: cut 11 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 168: cut 11 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.995000 Y1.410000
 M4 S200
 G1 X10.505000 Y1.410000 F1500.000
@@ -1359,7 +1359,7 @@ G1 X10.505000 Y-1.410000 F1500.000
 G1 X10.995000 Y-1.410000 F1500.000
 G1 X10.995000 Y1.410000 F1500.000
 M5
-; pass 169: cut 10 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 169: cut 10 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -1367,7 +1367,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 170: cut 9 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 170: cut 9 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.410000
 M4 S200
 G1 X8.505000 Y1.410000 F1500.000
@@ -1375,7 +1375,7 @@ G1 X8.505000 Y-1.410000 F1500.000
 G1 X8.995000 Y-1.410000 F1500.000
 G1 X8.995000 Y1.410000 F1500.000
 M5
-; pass 171: cut 8 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 171: cut 8 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -1383,7 +1383,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 172: cut 7 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 172: cut 7 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.410000
 M4 S200
 G1 X6.505000 Y1.410000 F1500.000
@@ -1391,7 +1391,7 @@ G1 X6.505000 Y-1.410000 F1500.000
 G1 X6.995000 Y-1.410000 F1500.000
 G1 X6.995000 Y1.410000 F1500.000
 M5
-; pass 173: cut 6 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 173: cut 6 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -1399,7 +1399,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 174: cut 5 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 174: cut 5 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.410000
 M4 S200
 G1 X4.505000 Y1.410000 F1500.000
@@ -1407,7 +1407,7 @@ G1 X4.505000 Y-1.410000 F1500.000
 G1 X4.995000 Y-1.410000 F1500.000
 G1 X4.995000 Y1.410000 F1500.000
 M5
-; pass 175: cut 4 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 175: cut 4 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -1415,7 +1415,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 176: cut 3 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 176: cut 3 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.410000
 M4 S200
 G1 X2.505000 Y1.410000 F1500.000
@@ -1423,7 +1423,7 @@ G1 X2.505000 Y-1.410000 F1500.000
 G1 X2.995000 Y-1.410000 F1500.000
 G1 X2.995000 Y1.410000 F1500.000
 M5
-; pass 177: cut 2 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 177: cut 2 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -1431,7 +1431,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 178: cut 1 hole, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 178: cut 1 hole, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -1439,7 +1439,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 179: cut 0 hole, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 179: cut 0 hole, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y0.145000
 M4 S200
 G1 X0.605000 Y0.145000 F1500.000
@@ -1447,7 +1447,7 @@ G1 X0.605000 Y-0.145000 F1500.000
 G1 X0.895000 Y-0.145000 F1500.000
 G1 X0.895000 Y0.145000 F1500.000
 M5
-; pass 180: cut 0 hole, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 180: cut 0 hole, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y0.140000
 M4 S200
 G1 X0.610000 Y0.140000 F1500.000
@@ -1455,7 +1455,7 @@ G1 X0.610000 Y-0.140000 F1500.000
 G1 X0.890000 Y-0.140000 F1500.000
 G1 X0.890000 Y0.140000 F1500.000
 M5
-; pass 181: cut 1 hole, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 181: cut 1 hole, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -1463,7 +1463,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 182: cut 2 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 182: cut 2 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -1471,7 +1471,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 183: cut 3 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 183: cut 3 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.405000
 M4 S200
 G1 X2.510000 Y-1.405000 F1500.000
@@ -1479,7 +1479,7 @@ G1 X2.990000 Y-1.405000 F1500.000
 G1 X2.990000 Y1.405000 F1500.000
 G1 X2.510000 Y1.405000 F1500.000
 M5
-; pass 184: cut 4 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 184: cut 4 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -1487,7 +1487,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 185: cut 5 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 185: cut 5 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.405000
 M4 S200
 G1 X4.510000 Y-1.405000 F1500.000
@@ -1495,7 +1495,7 @@ G1 X4.990000 Y-1.405000 F1500.000
 G1 X4.990000 Y1.405000 F1500.000
 G1 X4.510000 Y1.405000 F1500.000
 M5
-; pass 186: cut 6 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 186: cut 6 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -1503,7 +1503,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 187: cut 7 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 187: cut 7 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.405000
 M4 S200
 G1 X6.510000 Y-1.405000 F1500.000
@@ -1511,7 +1511,7 @@ G1 X6.990000 Y-1.405000 F1500.000
 G1 X6.990000 Y1.405000 F1500.000
 G1 X6.510000 Y1.405000 F1500.000
 M5
-; pass 188: cut 8 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 188: cut 8 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -1519,7 +1519,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 189: cut 9 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 189: cut 9 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.405000
 M4 S200
 G1 X8.510000 Y-1.405000 F1500.000
@@ -1527,7 +1527,7 @@ G1 X8.990000 Y-1.405000 F1500.000
 G1 X8.990000 Y1.405000 F1500.000
 G1 X8.510000 Y1.405000 F1500.000
 M5
-; pass 190: cut 10 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 190: cut 10 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -1535,7 +1535,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 191: cut 11 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 191: cut 11 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.405000
 M4 S200
 G1 X10.510000 Y-1.405000 F1500.000
@@ -1543,7 +1543,7 @@ G1 X10.990000 Y-1.405000 F1500.000
 G1 X10.990000 Y1.405000 F1500.000
 G1 X10.510000 Y1.405000 F1500.000
 M5
-; pass 192: cut 12 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 192: cut 12 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X11.510000 Y0.951194
 M4 S200
 G1 X11.990000 Y0.951194 F1500.000
@@ -1551,7 +1551,7 @@ G1 X11.990000 Y3.761194 F1500.000
 G1 X11.510000 Y3.761194 F1500.000
 G1 X11.510000 Y0.951194 F1500.000
 M5
-; pass 193: cut 13 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 193: cut 13 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X12.510000 Y1.405000
 M4 S200
 G1 X12.510000 Y-1.405000 F1500.000
@@ -1559,7 +1559,7 @@ G1 X12.990000 Y-1.405000 F1500.000
 G1 X12.990000 Y1.405000 F1500.000
 G1 X12.510000 Y1.405000 F1500.000
 M5
-; pass 194: cut 14 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 194: cut 14 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X13.510000 Y0.951194
 M4 S200
 G1 X13.990000 Y0.951194 F1500.000
@@ -1567,7 +1567,7 @@ G1 X13.990000 Y3.761194 F1500.000
 G1 X13.510000 Y3.761194 F1500.000
 G1 X13.510000 Y0.951194 F1500.000
 M5
-; pass 195: cut 15 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 195: cut 15 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X14.510000 Y1.405000
 M4 S200
 G1 X14.510000 Y-1.405000 F1500.000
@@ -1575,7 +1575,7 @@ G1 X14.990000 Y-1.405000 F1500.000
 G1 X14.990000 Y1.405000 F1500.000
 G1 X14.510000 Y1.405000 F1500.000
 M5
-; pass 196: cut 16 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 196: cut 16 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X15.510000 Y0.951194
 M4 S200
 G1 X15.990000 Y0.951194 F1500.000
@@ -1583,7 +1583,7 @@ G1 X15.990000 Y3.761194 F1500.000
 G1 X15.510000 Y3.761194 F1500.000
 G1 X15.510000 Y0.951194 F1500.000
 M5
-; pass 197: cut 17 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 197: cut 17 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X16.510000 Y1.405000
 M4 S200
 G1 X16.510000 Y-1.405000 F1500.000
@@ -1591,7 +1591,7 @@ G1 X16.990000 Y-1.405000 F1500.000
 G1 X16.990000 Y1.405000 F1500.000
 G1 X16.510000 Y1.405000 F1500.000
 M5
-; pass 198: cut 17 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 198: cut 17 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X16.515000 Y1.400000
 M4 S200
 G1 X16.515000 Y-1.400000 F1500.000
@@ -1599,7 +1599,7 @@ G1 X16.985000 Y-1.400000 F1500.000
 G1 X16.985000 Y1.400000 F1500.000
 G1 X16.515000 Y1.400000 F1500.000
 M5
-; pass 199: cut 16 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 199: cut 16 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X15.985000 Y0.956194
 M4 S200
 G1 X15.985000 Y3.756194 F1500.000
@@ -1607,7 +1607,7 @@ G1 X15.515000 Y3.756194 F1500.000
 G1 X15.515000 Y0.956194 F1500.000
 G1 X15.985000 Y0.956194 F1500.000
 M5
-; pass 200: cut 15 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 200: cut 15 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X14.985000 Y1.400000
 M4 S200
 G1 X14.515000 Y1.400000 F1500.000
@@ -1615,7 +1615,7 @@ G1 X14.515000 Y-1.400000 F1500.000
 G1 X14.985000 Y-1.400000 F1500.000
 G1 X14.985000 Y1.400000 F1500.000
 M5
-; pass 201: cut 14 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 201: cut 14 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X13.985000 Y0.956194
 M4 S200
 G1 X13.985000 Y3.756194 F1500.000
@@ -1623,7 +1623,7 @@ G1 X13.515000 Y3.756194 F1500.000
 G1 X13.515000 Y0.956194 F1500.000
 G1 X13.985000 Y0.956194 F1500.000
 M5
-; pass 202: cut 13 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 202: cut 13 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X12.985000 Y1.400000
 M4 S200
 G1 X12.515000 Y1.400000 F1500.000
@@ -1631,7 +1631,7 @@ G1 X12.515000 Y-1.400000 F1500.000
 G1 X12.985000 Y-1.400000 F1500.000
 G1 X12.985000 Y1.400000 F1500.000
 M5
-; pass 203: cut 12 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 203: cut 12 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X11.985000 Y0.956194
 M4 S200
 G1 X11.985000 Y3.756194 F1500.000
@@ -1639,7 +1639,7 @@ G1 X11.515000 Y3.756194 F1500.000
 G1 X11.515000 Y0.956194 F1500.000
 G1 X11.985000 Y0.956194 F1500.000
 M5
-; pass 204: cut 11 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 204: cut 11 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.985000 Y1.400000
 M4 S200
 G1 X10.515000 Y1.400000 F1500.000
@@ -1647,7 +1647,7 @@ G1 X10.515000 Y-1.400000 F1500.000
 G1 X10.985000 Y-1.400000 F1500.000
 G1 X10.985000 Y1.400000 F1500.000
 M5
-; pass 205: cut 10 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 205: cut 10 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -1655,7 +1655,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 206: cut 9 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 206: cut 9 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.400000
 M4 S200
 G1 X8.515000 Y1.400000 F1500.000
@@ -1663,7 +1663,7 @@ G1 X8.515000 Y-1.400000 F1500.000
 G1 X8.985000 Y-1.400000 F1500.000
 G1 X8.985000 Y1.400000 F1500.000
 M5
-; pass 207: cut 8 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 207: cut 8 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -1671,7 +1671,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 208: cut 7 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 208: cut 7 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.400000
 M4 S200
 G1 X6.515000 Y1.400000 F1500.000
@@ -1679,7 +1679,7 @@ G1 X6.515000 Y-1.400000 F1500.000
 G1 X6.985000 Y-1.400000 F1500.000
 G1 X6.985000 Y1.400000 F1500.000
 M5
-; pass 209: cut 6 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 209: cut 6 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -1687,7 +1687,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 210: cut 5 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 210: cut 5 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.400000
 M4 S200
 G1 X4.515000 Y1.400000 F1500.000
@@ -1695,7 +1695,7 @@ G1 X4.515000 Y-1.400000 F1500.000
 G1 X4.985000 Y-1.400000 F1500.000
 G1 X4.985000 Y1.400000 F1500.000
 M5
-; pass 211: cut 4 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 211: cut 4 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -1703,7 +1703,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 212: cut 3 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 212: cut 3 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.400000
 M4 S200
 G1 X2.515000 Y1.400000 F1500.000
@@ -1711,7 +1711,7 @@ G1 X2.515000 Y-1.400000 F1500.000
 G1 X2.985000 Y-1.400000 F1500.000
 G1 X2.985000 Y1.400000 F1500.000
 M5
-; pass 213: cut 2 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 213: cut 2 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -1719,7 +1719,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 214: cut 1 hole, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 214: cut 1 hole, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -1727,7 +1727,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 215: cut 0 hole, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 215: cut 0 hole, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y0.135000
 M4 S200
 G1 X0.615000 Y0.135000 F1500.000
@@ -1735,7 +1735,7 @@ G1 X0.615000 Y-0.135000 F1500.000
 G1 X0.885000 Y-0.135000 F1500.000
 G1 X0.885000 Y0.135000 F1500.000
 M5
-; pass 216: cut 0 hole, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 216: cut 0 hole, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y0.150000
 G0 Z-0.100000
 M4 S200
@@ -1744,7 +1744,7 @@ G1 X0.600000 Y-0.150000 F1500.000
 G1 X0.900000 Y-0.150000 F1500.000
 G1 X0.900000 Y0.150000 F1500.000
 M5
-; pass 217: cut 1 hole, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 217: cut 1 hole, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 M4 S200
 G1 X0.900000 Y2.506194 F1500.000
@@ -1752,7 +1752,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 218: cut 2 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 218: cut 2 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -1760,7 +1760,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 219: cut 3 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 219: cut 3 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.415000
 M4 S200
 G1 X2.500000 Y-1.415000 F1500.000
@@ -1768,7 +1768,7 @@ G1 X3.000000 Y-1.415000 F1500.000
 G1 X3.000000 Y1.415000 F1500.000
 G1 X2.500000 Y1.415000 F1500.000
 M5
-; pass 220: cut 4 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 220: cut 4 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -1776,7 +1776,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 221: cut 5 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 221: cut 5 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.415000
 M4 S200
 G1 X4.500000 Y-1.415000 F1500.000
@@ -1784,7 +1784,7 @@ G1 X5.000000 Y-1.415000 F1500.000
 G1 X5.000000 Y1.415000 F1500.000
 G1 X4.500000 Y1.415000 F1500.000
 M5
-; pass 222: cut 6 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 222: cut 6 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -1792,7 +1792,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 223: cut 7 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 223: cut 7 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.415000
 M4 S200
 G1 X6.500000 Y-1.415000 F1500.000
@@ -1800,7 +1800,7 @@ G1 X7.000000 Y-1.415000 F1500.000
 G1 X7.000000 Y1.415000 F1500.000
 G1 X6.500000 Y1.415000 F1500.000
 M5
-; pass 224: cut 8 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 224: cut 8 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -1808,7 +1808,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 225: cut 9 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 225: cut 9 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.415000
 M4 S200
 G1 X8.500000 Y-1.415000 F1500.000
@@ -1816,7 +1816,7 @@ G1 X9.000000 Y-1.415000 F1500.000
 G1 X9.000000 Y1.415000 F1500.000
 G1 X8.500000 Y1.415000 F1500.000
 M5
-; pass 226: cut 10 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 226: cut 10 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -1824,7 +1824,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 227: cut 11 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 227: cut 11 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.415000
 M4 S200
 G1 X10.500000 Y-1.415000 F1500.000
@@ -1832,7 +1832,7 @@ G1 X11.000000 Y-1.415000 F1500.000
 G1 X11.000000 Y1.415000 F1500.000
 G1 X10.500000 Y1.415000 F1500.000
 M5
-; pass 228: cut 12 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 228: cut 12 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X11.500000 Y0.941194
 M4 S200
 G1 X12.000000 Y0.941194 F1500.000
@@ -1840,7 +1840,7 @@ G1 X12.000000 Y3.771194 F1500.000
 G1 X11.500000 Y3.771194 F1500.000
 G1 X11.500000 Y0.941194 F1500.000
 M5
-; pass 229: cut 13 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 229: cut 13 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X12.500000 Y1.415000
 M4 S200
 G1 X12.500000 Y-1.415000 F1500.000
@@ -1848,7 +1848,7 @@ G1 X13.000000 Y-1.415000 F1500.000
 G1 X13.000000 Y1.415000 F1500.000
 G1 X12.500000 Y1.415000 F1500.000
 M5
-; pass 230: cut 14 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 230: cut 14 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X13.500000 Y0.941194
 M4 S200
 G1 X14.000000 Y0.941194 F1500.000
@@ -1856,7 +1856,7 @@ G1 X14.000000 Y3.771194 F1500.000
 G1 X13.500000 Y3.771194 F1500.000
 G1 X13.500000 Y0.941194 F1500.000
 M5
-; pass 231: cut 15 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 231: cut 15 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X14.500000 Y1.415000
 M4 S200
 G1 X14.500000 Y-1.415000 F1500.000
@@ -1864,7 +1864,7 @@ G1 X15.000000 Y-1.415000 F1500.000
 G1 X15.000000 Y1.415000 F1500.000
 G1 X14.500000 Y1.415000 F1500.000
 M5
-; pass 232: cut 16 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 232: cut 16 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X15.500000 Y0.941194
 M4 S200
 G1 X16.000000 Y0.941194 F1500.000
@@ -1872,7 +1872,7 @@ G1 X16.000000 Y3.771194 F1500.000
 G1 X15.500000 Y3.771194 F1500.000
 G1 X15.500000 Y0.941194 F1500.000
 M5
-; pass 233: cut 17 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 233: cut 17 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X16.500000 Y1.415000
 M4 S200
 G1 X16.500000 Y-1.415000 F1500.000
@@ -1880,7 +1880,7 @@ G1 X17.000000 Y-1.415000 F1500.000
 G1 X17.000000 Y1.415000 F1500.000
 G1 X16.500000 Y1.415000 F1500.000
 M5
-; pass 234: cut 17 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 234: cut 17 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X16.505000 Y1.410000
 M4 S200
 G1 X16.505000 Y-1.410000 F1500.000
@@ -1888,7 +1888,7 @@ G1 X16.995000 Y-1.410000 F1500.000
 G1 X16.995000 Y1.410000 F1500.000
 G1 X16.505000 Y1.410000 F1500.000
 M5
-; pass 235: cut 16 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 235: cut 16 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X15.995000 Y0.946194
 M4 S200
 G1 X15.995000 Y3.766194 F1500.000
@@ -1896,7 +1896,7 @@ G1 X15.505000 Y3.766194 F1500.000
 G1 X15.505000 Y0.946194 F1500.000
 G1 X15.995000 Y0.946194 F1500.000
 M5
-; pass 236: cut 15 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 236: cut 15 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X14.995000 Y1.410000
 M4 S200
 G1 X14.505000 Y1.410000 F1500.000
@@ -1904,7 +1904,7 @@ G1 X14.505000 Y-1.410000 F1500.000
 G1 X14.995000 Y-1.410000 F1500.000
 G1 X14.995000 Y1.410000 F1500.000
 M5
-; pass 237: cut 14 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 237: cut 14 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X13.995000 Y0.946194
 M4 S200
 G1 X13.995000 Y3.766194 F1500.000
@@ -1912,7 +1912,7 @@ G1 X13.505000 Y3.766194 F1500.000
 G1 X13.505000 Y0.946194 F1500.000
 G1 X13.995000 Y0.946194 F1500.000
 M5
-; pass 238: cut 13 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 238: cut 13 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X12.995000 Y1.410000
 M4 S200
 G1 X12.505000 Y1.410000 F1500.000
@@ -1920,7 +1920,7 @@ G1 X12.505000 Y-1.410000 F1500.000
 G1 X12.995000 Y-1.410000 F1500.000
 G1 X12.995000 Y1.410000 F1500.000
 M5
-; pass 239: cut 12 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 239: cut 12 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X11.995000 Y0.946194
 M4 S200
 G1 X11.995000 Y3.766194 F1500.000
@@ -1928,7 +1928,7 @@ G1 X11.505000 Y3.766194 F1500.000
 G1 X11.505000 Y0.946194 F1500.000
 G1 X11.995000 Y0.946194 F1500.000
 M5
-; pass 240: cut 11 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 240: cut 11 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.995000 Y1.410000
 M4 S200
 G1 X10.505000 Y1.410000 F1500.000
@@ -1936,7 +1936,7 @@ G1 X10.505000 Y-1.410000 F1500.000
 G1 X10.995000 Y-1.410000 F1500.000
 G1 X10.995000 Y1.410000 F1500.000
 M5
-; pass 241: cut 10 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 241: cut 10 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -1944,7 +1944,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 242: cut 9 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 242: cut 9 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.410000
 M4 S200
 G1 X8.505000 Y1.410000 F1500.000
@@ -1952,7 +1952,7 @@ G1 X8.505000 Y-1.410000 F1500.000
 G1 X8.995000 Y-1.410000 F1500.000
 G1 X8.995000 Y1.410000 F1500.000
 M5
-; pass 243: cut 8 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 243: cut 8 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -1960,7 +1960,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 244: cut 7 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 244: cut 7 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.410000
 M4 S200
 G1 X6.505000 Y1.410000 F1500.000
@@ -1968,7 +1968,7 @@ G1 X6.505000 Y-1.410000 F1500.000
 G1 X6.995000 Y-1.410000 F1500.000
 G1 X6.995000 Y1.410000 F1500.000
 M5
-; pass 245: cut 6 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 245: cut 6 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -1976,7 +1976,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 246: cut 5 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 246: cut 5 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.410000
 M4 S200
 G1 X4.505000 Y1.410000 F1500.000
@@ -1984,7 +1984,7 @@ G1 X4.505000 Y-1.410000 F1500.000
 G1 X4.995000 Y-1.410000 F1500.000
 G1 X4.995000 Y1.410000 F1500.000
 M5
-; pass 247: cut 4 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 247: cut 4 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -1992,7 +1992,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 248: cut 3 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 248: cut 3 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.410000
 M4 S200
 G1 X2.505000 Y1.410000 F1500.000
@@ -2000,7 +2000,7 @@ G1 X2.505000 Y-1.410000 F1500.000
 G1 X2.995000 Y-1.410000 F1500.000
 G1 X2.995000 Y1.410000 F1500.000
 M5
-; pass 249: cut 2 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 249: cut 2 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -2008,7 +2008,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 250: cut 1 hole, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 250: cut 1 hole, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -2016,7 +2016,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 251: cut 0 hole, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 251: cut 0 hole, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y0.145000
 M4 S200
 G1 X0.605000 Y0.145000 F1500.000
@@ -2024,7 +2024,7 @@ G1 X0.605000 Y-0.145000 F1500.000
 G1 X0.895000 Y-0.145000 F1500.000
 G1 X0.895000 Y0.145000 F1500.000
 M5
-; pass 252: cut 0 hole, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 252: cut 0 hole, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y0.140000
 M4 S200
 G1 X0.610000 Y0.140000 F1500.000
@@ -2032,7 +2032,7 @@ G1 X0.610000 Y-0.140000 F1500.000
 G1 X0.890000 Y-0.140000 F1500.000
 G1 X0.890000 Y0.140000 F1500.000
 M5
-; pass 253: cut 1 hole, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 253: cut 1 hole, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -2040,7 +2040,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 254: cut 2 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 254: cut 2 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -2048,7 +2048,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 255: cut 3 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 255: cut 3 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.405000
 M4 S200
 G1 X2.510000 Y-1.405000 F1500.000
@@ -2056,7 +2056,7 @@ G1 X2.990000 Y-1.405000 F1500.000
 G1 X2.990000 Y1.405000 F1500.000
 G1 X2.510000 Y1.405000 F1500.000
 M5
-; pass 256: cut 4 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 256: cut 4 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -2064,7 +2064,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 257: cut 5 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 257: cut 5 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.405000
 M4 S200
 G1 X4.510000 Y-1.405000 F1500.000
@@ -2072,7 +2072,7 @@ G1 X4.990000 Y-1.405000 F1500.000
 G1 X4.990000 Y1.405000 F1500.000
 G1 X4.510000 Y1.405000 F1500.000
 M5
-; pass 258: cut 6 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 258: cut 6 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -2080,7 +2080,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 259: cut 7 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 259: cut 7 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.405000
 M4 S200
 G1 X6.510000 Y-1.405000 F1500.000
@@ -2088,7 +2088,7 @@ G1 X6.990000 Y-1.405000 F1500.000
 G1 X6.990000 Y1.405000 F1500.000
 G1 X6.510000 Y1.405000 F1500.000
 M5
-; pass 260: cut 8 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 260: cut 8 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -2096,7 +2096,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 261: cut 9 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 261: cut 9 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.405000
 M4 S200
 G1 X8.510000 Y-1.405000 F1500.000
@@ -2104,7 +2104,7 @@ G1 X8.990000 Y-1.405000 F1500.000
 G1 X8.990000 Y1.405000 F1500.000
 G1 X8.510000 Y1.405000 F1500.000
 M5
-; pass 262: cut 10 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 262: cut 10 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -2112,7 +2112,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 263: cut 11 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 263: cut 11 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.405000
 M4 S200
 G1 X10.510000 Y-1.405000 F1500.000
@@ -2120,7 +2120,7 @@ G1 X10.990000 Y-1.405000 F1500.000
 G1 X10.990000 Y1.405000 F1500.000
 G1 X10.510000 Y1.405000 F1500.000
 M5
-; pass 264: cut 12 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 264: cut 12 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X11.510000 Y0.951194
 M4 S200
 G1 X11.990000 Y0.951194 F1500.000
@@ -2128,7 +2128,7 @@ G1 X11.990000 Y3.761194 F1500.000
 G1 X11.510000 Y3.761194 F1500.000
 G1 X11.510000 Y0.951194 F1500.000
 M5
-; pass 265: cut 13 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 265: cut 13 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X12.510000 Y1.405000
 M4 S200
 G1 X12.510000 Y-1.405000 F1500.000
@@ -2136,7 +2136,7 @@ G1 X12.990000 Y-1.405000 F1500.000
 G1 X12.990000 Y1.405000 F1500.000
 G1 X12.510000 Y1.405000 F1500.000
 M5
-; pass 266: cut 14 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 266: cut 14 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X13.510000 Y0.951194
 M4 S200
 G1 X13.990000 Y0.951194 F1500.000
@@ -2144,7 +2144,7 @@ G1 X13.990000 Y3.761194 F1500.000
 G1 X13.510000 Y3.761194 F1500.000
 G1 X13.510000 Y0.951194 F1500.000
 M5
-; pass 267: cut 15 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 267: cut 15 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X14.510000 Y1.405000
 M4 S200
 G1 X14.510000 Y-1.405000 F1500.000
@@ -2152,7 +2152,7 @@ G1 X14.990000 Y-1.405000 F1500.000
 G1 X14.990000 Y1.405000 F1500.000
 G1 X14.510000 Y1.405000 F1500.000
 M5
-; pass 268: cut 16 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 268: cut 16 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X15.510000 Y0.951194
 M4 S200
 G1 X15.990000 Y0.951194 F1500.000
@@ -2160,7 +2160,7 @@ G1 X15.990000 Y3.761194 F1500.000
 G1 X15.510000 Y3.761194 F1500.000
 G1 X15.510000 Y0.951194 F1500.000
 M5
-; pass 269: cut 17 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 269: cut 17 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X16.510000 Y1.405000
 M4 S200
 G1 X16.510000 Y-1.405000 F1500.000
@@ -2168,7 +2168,7 @@ G1 X16.990000 Y-1.405000 F1500.000
 G1 X16.990000 Y1.405000 F1500.000
 G1 X16.510000 Y1.405000 F1500.000
 M5
-; pass 270: cut 17 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 270: cut 17 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X16.515000 Y1.400000
 M4 S200
 G1 X16.515000 Y-1.400000 F1500.000
@@ -2176,7 +2176,7 @@ G1 X16.985000 Y-1.400000 F1500.000
 G1 X16.985000 Y1.400000 F1500.000
 G1 X16.515000 Y1.400000 F1500.000
 M5
-; pass 271: cut 16 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 271: cut 16 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X15.985000 Y0.956194
 M4 S200
 G1 X15.985000 Y3.756194 F1500.000
@@ -2184,7 +2184,7 @@ G1 X15.515000 Y3.756194 F1500.000
 G1 X15.515000 Y0.956194 F1500.000
 G1 X15.985000 Y0.956194 F1500.000
 M5
-; pass 272: cut 15 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 272: cut 15 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X14.985000 Y1.400000
 M4 S200
 G1 X14.515000 Y1.400000 F1500.000
@@ -2192,7 +2192,7 @@ G1 X14.515000 Y-1.400000 F1500.000
 G1 X14.985000 Y-1.400000 F1500.000
 G1 X14.985000 Y1.400000 F1500.000
 M5
-; pass 273: cut 14 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 273: cut 14 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X13.985000 Y0.956194
 M4 S200
 G1 X13.985000 Y3.756194 F1500.000
@@ -2200,7 +2200,7 @@ G1 X13.515000 Y3.756194 F1500.000
 G1 X13.515000 Y0.956194 F1500.000
 G1 X13.985000 Y0.956194 F1500.000
 M5
-; pass 274: cut 13 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 274: cut 13 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X12.985000 Y1.400000
 M4 S200
 G1 X12.515000 Y1.400000 F1500.000
@@ -2208,7 +2208,7 @@ G1 X12.515000 Y-1.400000 F1500.000
 G1 X12.985000 Y-1.400000 F1500.000
 G1 X12.985000 Y1.400000 F1500.000
 M5
-; pass 275: cut 12 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 275: cut 12 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X11.985000 Y0.956194
 M4 S200
 G1 X11.985000 Y3.756194 F1500.000
@@ -2216,7 +2216,7 @@ G1 X11.515000 Y3.756194 F1500.000
 G1 X11.515000 Y0.956194 F1500.000
 G1 X11.985000 Y0.956194 F1500.000
 M5
-; pass 276: cut 11 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 276: cut 11 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.985000 Y1.400000
 M4 S200
 G1 X10.515000 Y1.400000 F1500.000
@@ -2224,7 +2224,7 @@ G1 X10.515000 Y-1.400000 F1500.000
 G1 X10.985000 Y-1.400000 F1500.000
 G1 X10.985000 Y1.400000 F1500.000
 M5
-; pass 277: cut 10 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 277: cut 10 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -2232,7 +2232,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 278: cut 9 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 278: cut 9 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.400000
 M4 S200
 G1 X8.515000 Y1.400000 F1500.000
@@ -2240,7 +2240,7 @@ G1 X8.515000 Y-1.400000 F1500.000
 G1 X8.985000 Y-1.400000 F1500.000
 G1 X8.985000 Y1.400000 F1500.000
 M5
-; pass 279: cut 8 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 279: cut 8 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -2248,7 +2248,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 280: cut 7 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 280: cut 7 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.400000
 M4 S200
 G1 X6.515000 Y1.400000 F1500.000
@@ -2256,7 +2256,7 @@ G1 X6.515000 Y-1.400000 F1500.000
 G1 X6.985000 Y-1.400000 F1500.000
 G1 X6.985000 Y1.400000 F1500.000
 M5
-; pass 281: cut 6 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 281: cut 6 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -2264,7 +2264,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 282: cut 5 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 282: cut 5 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.400000
 M4 S200
 G1 X4.515000 Y1.400000 F1500.000
@@ -2272,7 +2272,7 @@ G1 X4.515000 Y-1.400000 F1500.000
 G1 X4.985000 Y-1.400000 F1500.000
 G1 X4.985000 Y1.400000 F1500.000
 M5
-; pass 283: cut 4 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 283: cut 4 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -2280,7 +2280,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 284: cut 3 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 284: cut 3 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.400000
 M4 S200
 G1 X2.515000 Y1.400000 F1500.000
@@ -2288,7 +2288,7 @@ G1 X2.515000 Y-1.400000 F1500.000
 G1 X2.985000 Y-1.400000 F1500.000
 G1 X2.985000 Y1.400000 F1500.000
 M5
-; pass 285: cut 2 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 285: cut 2 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -2296,7 +2296,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 286: cut 1 hole, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 286: cut 1 hole, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -2304,7 +2304,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 287: cut 0 hole, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 287: cut 0 hole, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y0.135000
 M4 S200
 G1 X0.615000 Y0.135000 F1500.000
@@ -2312,7 +2312,7 @@ G1 X0.615000 Y-0.135000 F1500.000
 G1 X0.885000 Y-0.135000 F1500.000
 G1 X0.885000 Y0.135000 F1500.000
 M5
-; pass 288: cut 0 hole, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 288: cut 0 hole, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y0.150000
 G0 Z0.000000
 M4 S200
@@ -2321,7 +2321,7 @@ G1 X0.600000 Y-0.150000 F1500.000
 G1 X0.900000 Y-0.150000 F1500.000
 G1 X0.900000 Y0.150000 F1500.000
 M5
-; pass 289: cut 1 hole, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 289: cut 1 hole, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 M4 S200
 G1 X0.900000 Y2.506194 F1500.000
@@ -2329,7 +2329,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 290: cut 2 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 290: cut 2 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -2337,7 +2337,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 291: cut 3 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 291: cut 3 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.415000
 M4 S200
 G1 X2.500000 Y-1.415000 F1500.000
@@ -2345,7 +2345,7 @@ G1 X3.000000 Y-1.415000 F1500.000
 G1 X3.000000 Y1.415000 F1500.000
 G1 X2.500000 Y1.415000 F1500.000
 M5
-; pass 292: cut 4 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 292: cut 4 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -2353,7 +2353,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 293: cut 5 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 293: cut 5 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.415000
 M4 S200
 G1 X4.500000 Y-1.415000 F1500.000
@@ -2361,7 +2361,7 @@ G1 X5.000000 Y-1.415000 F1500.000
 G1 X5.000000 Y1.415000 F1500.000
 G1 X4.500000 Y1.415000 F1500.000
 M5
-; pass 294: cut 6 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 294: cut 6 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -2369,7 +2369,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 295: cut 7 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 295: cut 7 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.415000
 M4 S200
 G1 X6.500000 Y-1.415000 F1500.000
@@ -2377,7 +2377,7 @@ G1 X7.000000 Y-1.415000 F1500.000
 G1 X7.000000 Y1.415000 F1500.000
 G1 X6.500000 Y1.415000 F1500.000
 M5
-; pass 296: cut 8 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 296: cut 8 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -2385,7 +2385,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 297: cut 9 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 297: cut 9 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.415000
 M4 S200
 G1 X8.500000 Y-1.415000 F1500.000
@@ -2393,7 +2393,7 @@ G1 X9.000000 Y-1.415000 F1500.000
 G1 X9.000000 Y1.415000 F1500.000
 G1 X8.500000 Y1.415000 F1500.000
 M5
-; pass 298: cut 10 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 298: cut 10 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -2401,7 +2401,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 299: cut 11 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 299: cut 11 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.415000
 M4 S200
 G1 X10.500000 Y-1.415000 F1500.000
@@ -2409,7 +2409,7 @@ G1 X11.000000 Y-1.415000 F1500.000
 G1 X11.000000 Y1.415000 F1500.000
 G1 X10.500000 Y1.415000 F1500.000
 M5
-; pass 300: cut 12 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 300: cut 12 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X11.500000 Y0.941194
 M4 S200
 G1 X12.000000 Y0.941194 F1500.000
@@ -2417,7 +2417,7 @@ G1 X12.000000 Y3.771194 F1500.000
 G1 X11.500000 Y3.771194 F1500.000
 G1 X11.500000 Y0.941194 F1500.000
 M5
-; pass 301: cut 13 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 301: cut 13 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X12.500000 Y1.415000
 M4 S200
 G1 X12.500000 Y-1.415000 F1500.000
@@ -2425,7 +2425,7 @@ G1 X13.000000 Y-1.415000 F1500.000
 G1 X13.000000 Y1.415000 F1500.000
 G1 X12.500000 Y1.415000 F1500.000
 M5
-; pass 302: cut 14 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 302: cut 14 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X13.500000 Y0.941194
 M4 S200
 G1 X14.000000 Y0.941194 F1500.000
@@ -2433,7 +2433,7 @@ G1 X14.000000 Y3.771194 F1500.000
 G1 X13.500000 Y3.771194 F1500.000
 G1 X13.500000 Y0.941194 F1500.000
 M5
-; pass 303: cut 15 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 303: cut 15 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X14.500000 Y1.415000
 M4 S200
 G1 X14.500000 Y-1.415000 F1500.000
@@ -2441,7 +2441,7 @@ G1 X15.000000 Y-1.415000 F1500.000
 G1 X15.000000 Y1.415000 F1500.000
 G1 X14.500000 Y1.415000 F1500.000
 M5
-; pass 304: cut 16 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 304: cut 16 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X15.500000 Y0.941194
 M4 S200
 G1 X16.000000 Y0.941194 F1500.000
@@ -2449,7 +2449,7 @@ G1 X16.000000 Y3.771194 F1500.000
 G1 X15.500000 Y3.771194 F1500.000
 G1 X15.500000 Y0.941194 F1500.000
 M5
-; pass 305: cut 17 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 305: cut 17 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X16.500000 Y1.415000
 M4 S200
 G1 X16.500000 Y-1.415000 F1500.000
@@ -2457,7 +2457,7 @@ G1 X17.000000 Y-1.415000 F1500.000
 G1 X17.000000 Y1.415000 F1500.000
 G1 X16.500000 Y1.415000 F1500.000
 M5
-; pass 306: cut 17 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 306: cut 17 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X16.505000 Y1.410000
 M4 S200
 G1 X16.505000 Y-1.410000 F1500.000
@@ -2465,7 +2465,7 @@ G1 X16.995000 Y-1.410000 F1500.000
 G1 X16.995000 Y1.410000 F1500.000
 G1 X16.505000 Y1.410000 F1500.000
 M5
-; pass 307: cut 16 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 307: cut 16 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X15.995000 Y0.946194
 M4 S200
 G1 X15.995000 Y3.766194 F1500.000
@@ -2473,7 +2473,7 @@ G1 X15.505000 Y3.766194 F1500.000
 G1 X15.505000 Y0.946194 F1500.000
 G1 X15.995000 Y0.946194 F1500.000
 M5
-; pass 308: cut 15 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 308: cut 15 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X14.995000 Y1.410000
 M4 S200
 G1 X14.505000 Y1.410000 F1500.000
@@ -2481,7 +2481,7 @@ G1 X14.505000 Y-1.410000 F1500.000
 G1 X14.995000 Y-1.410000 F1500.000
 G1 X14.995000 Y1.410000 F1500.000
 M5
-; pass 309: cut 14 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 309: cut 14 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X13.995000 Y0.946194
 M4 S200
 G1 X13.995000 Y3.766194 F1500.000
@@ -2489,7 +2489,7 @@ G1 X13.505000 Y3.766194 F1500.000
 G1 X13.505000 Y0.946194 F1500.000
 G1 X13.995000 Y0.946194 F1500.000
 M5
-; pass 310: cut 13 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 310: cut 13 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X12.995000 Y1.410000
 M4 S200
 G1 X12.505000 Y1.410000 F1500.000
@@ -2497,7 +2497,7 @@ G1 X12.505000 Y-1.410000 F1500.000
 G1 X12.995000 Y-1.410000 F1500.000
 G1 X12.995000 Y1.410000 F1500.000
 M5
-; pass 311: cut 12 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 311: cut 12 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X11.995000 Y0.946194
 M4 S200
 G1 X11.995000 Y3.766194 F1500.000
@@ -2505,7 +2505,7 @@ G1 X11.505000 Y3.766194 F1500.000
 G1 X11.505000 Y0.946194 F1500.000
 G1 X11.995000 Y0.946194 F1500.000
 M5
-; pass 312: cut 11 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 312: cut 11 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.995000 Y1.410000
 M4 S200
 G1 X10.505000 Y1.410000 F1500.000
@@ -2513,7 +2513,7 @@ G1 X10.505000 Y-1.410000 F1500.000
 G1 X10.995000 Y-1.410000 F1500.000
 G1 X10.995000 Y1.410000 F1500.000
 M5
-; pass 313: cut 10 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 313: cut 10 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -2521,7 +2521,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 314: cut 9 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 314: cut 9 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.410000
 M4 S200
 G1 X8.505000 Y1.410000 F1500.000
@@ -2529,7 +2529,7 @@ G1 X8.505000 Y-1.410000 F1500.000
 G1 X8.995000 Y-1.410000 F1500.000
 G1 X8.995000 Y1.410000 F1500.000
 M5
-; pass 315: cut 8 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 315: cut 8 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -2537,7 +2537,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 316: cut 7 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 316: cut 7 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.410000
 M4 S200
 G1 X6.505000 Y1.410000 F1500.000
@@ -2545,7 +2545,7 @@ G1 X6.505000 Y-1.410000 F1500.000
 G1 X6.995000 Y-1.410000 F1500.000
 G1 X6.995000 Y1.410000 F1500.000
 M5
-; pass 317: cut 6 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 317: cut 6 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -2553,7 +2553,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 318: cut 5 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 318: cut 5 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.410000
 M4 S200
 G1 X4.505000 Y1.410000 F1500.000
@@ -2561,7 +2561,7 @@ G1 X4.505000 Y-1.410000 F1500.000
 G1 X4.995000 Y-1.410000 F1500.000
 G1 X4.995000 Y1.410000 F1500.000
 M5
-; pass 319: cut 4 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 319: cut 4 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -2569,7 +2569,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 320: cut 3 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 320: cut 3 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.410000
 M4 S200
 G1 X2.505000 Y1.410000 F1500.000
@@ -2577,7 +2577,7 @@ G1 X2.505000 Y-1.410000 F1500.000
 G1 X2.995000 Y-1.410000 F1500.000
 G1 X2.995000 Y1.410000 F1500.000
 M5
-; pass 321: cut 2 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 321: cut 2 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -2585,7 +2585,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 322: cut 1 hole, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 322: cut 1 hole, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -2593,7 +2593,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 323: cut 0 hole, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 323: cut 0 hole, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y0.145000
 M4 S200
 G1 X0.605000 Y0.145000 F1500.000
@@ -2601,7 +2601,7 @@ G1 X0.605000 Y-0.145000 F1500.000
 G1 X0.895000 Y-0.145000 F1500.000
 G1 X0.895000 Y0.145000 F1500.000
 M5
-; pass 324: cut 0 hole, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 324: cut 0 hole, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y0.140000
 M4 S200
 G1 X0.610000 Y0.140000 F1500.000
@@ -2609,7 +2609,7 @@ G1 X0.610000 Y-0.140000 F1500.000
 G1 X0.890000 Y-0.140000 F1500.000
 G1 X0.890000 Y0.140000 F1500.000
 M5
-; pass 325: cut 1 hole, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 325: cut 1 hole, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -2617,7 +2617,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 326: cut 2 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 326: cut 2 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -2625,7 +2625,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 327: cut 3 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 327: cut 3 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.405000
 M4 S200
 G1 X2.510000 Y-1.405000 F1500.000
@@ -2633,7 +2633,7 @@ G1 X2.990000 Y-1.405000 F1500.000
 G1 X2.990000 Y1.405000 F1500.000
 G1 X2.510000 Y1.405000 F1500.000
 M5
-; pass 328: cut 4 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 328: cut 4 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -2641,7 +2641,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 329: cut 5 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 329: cut 5 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.405000
 M4 S200
 G1 X4.510000 Y-1.405000 F1500.000
@@ -2649,7 +2649,7 @@ G1 X4.990000 Y-1.405000 F1500.000
 G1 X4.990000 Y1.405000 F1500.000
 G1 X4.510000 Y1.405000 F1500.000
 M5
-; pass 330: cut 6 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 330: cut 6 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -2657,7 +2657,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 331: cut 7 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 331: cut 7 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.405000
 M4 S200
 G1 X6.510000 Y-1.405000 F1500.000
@@ -2665,7 +2665,7 @@ G1 X6.990000 Y-1.405000 F1500.000
 G1 X6.990000 Y1.405000 F1500.000
 G1 X6.510000 Y1.405000 F1500.000
 M5
-; pass 332: cut 8 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 332: cut 8 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -2673,7 +2673,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 333: cut 9 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 333: cut 9 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.405000
 M4 S200
 G1 X8.510000 Y-1.405000 F1500.000
@@ -2681,7 +2681,7 @@ G1 X8.990000 Y-1.405000 F1500.000
 G1 X8.990000 Y1.405000 F1500.000
 G1 X8.510000 Y1.405000 F1500.000
 M5
-; pass 334: cut 10 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 334: cut 10 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -2689,7 +2689,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 335: cut 11 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 335: cut 11 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.405000
 M4 S200
 G1 X10.510000 Y-1.405000 F1500.000
@@ -2697,7 +2697,7 @@ G1 X10.990000 Y-1.405000 F1500.000
 G1 X10.990000 Y1.405000 F1500.000
 G1 X10.510000 Y1.405000 F1500.000
 M5
-; pass 336: cut 12 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 336: cut 12 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X11.510000 Y0.951194
 M4 S200
 G1 X11.990000 Y0.951194 F1500.000
@@ -2705,7 +2705,7 @@ G1 X11.990000 Y3.761194 F1500.000
 G1 X11.510000 Y3.761194 F1500.000
 G1 X11.510000 Y0.951194 F1500.000
 M5
-; pass 337: cut 13 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 337: cut 13 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X12.510000 Y1.405000
 M4 S200
 G1 X12.510000 Y-1.405000 F1500.000
@@ -2713,7 +2713,7 @@ G1 X12.990000 Y-1.405000 F1500.000
 G1 X12.990000 Y1.405000 F1500.000
 G1 X12.510000 Y1.405000 F1500.000
 M5
-; pass 338: cut 14 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 338: cut 14 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X13.510000 Y0.951194
 M4 S200
 G1 X13.990000 Y0.951194 F1500.000
@@ -2721,7 +2721,7 @@ G1 X13.990000 Y3.761194 F1500.000
 G1 X13.510000 Y3.761194 F1500.000
 G1 X13.510000 Y0.951194 F1500.000
 M5
-; pass 339: cut 15 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 339: cut 15 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X14.510000 Y1.405000
 M4 S200
 G1 X14.510000 Y-1.405000 F1500.000
@@ -2729,7 +2729,7 @@ G1 X14.990000 Y-1.405000 F1500.000
 G1 X14.990000 Y1.405000 F1500.000
 G1 X14.510000 Y1.405000 F1500.000
 M5
-; pass 340: cut 16 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 340: cut 16 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X15.510000 Y0.951194
 M4 S200
 G1 X15.990000 Y0.951194 F1500.000
@@ -2737,7 +2737,7 @@ G1 X15.990000 Y3.761194 F1500.000
 G1 X15.510000 Y3.761194 F1500.000
 G1 X15.510000 Y0.951194 F1500.000
 M5
-; pass 341: cut 17 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 341: cut 17 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X16.510000 Y1.405000
 M4 S200
 G1 X16.510000 Y-1.405000 F1500.000
@@ -2745,7 +2745,7 @@ G1 X16.990000 Y-1.405000 F1500.000
 G1 X16.990000 Y1.405000 F1500.000
 G1 X16.510000 Y1.405000 F1500.000
 M5
-; pass 342: cut 17 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 342: cut 17 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X16.515000 Y1.400000
 M4 S200
 G1 X16.515000 Y-1.400000 F1500.000
@@ -2753,7 +2753,7 @@ G1 X16.985000 Y-1.400000 F1500.000
 G1 X16.985000 Y1.400000 F1500.000
 G1 X16.515000 Y1.400000 F1500.000
 M5
-; pass 343: cut 16 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 343: cut 16 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X15.985000 Y0.956194
 M4 S200
 G1 X15.985000 Y3.756194 F1500.000
@@ -2761,7 +2761,7 @@ G1 X15.515000 Y3.756194 F1500.000
 G1 X15.515000 Y0.956194 F1500.000
 G1 X15.985000 Y0.956194 F1500.000
 M5
-; pass 344: cut 15 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 344: cut 15 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X14.985000 Y1.400000
 M4 S200
 G1 X14.515000 Y1.400000 F1500.000
@@ -2769,7 +2769,7 @@ G1 X14.515000 Y-1.400000 F1500.000
 G1 X14.985000 Y-1.400000 F1500.000
 G1 X14.985000 Y1.400000 F1500.000
 M5
-; pass 345: cut 14 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 345: cut 14 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X13.985000 Y0.956194
 M4 S200
 G1 X13.985000 Y3.756194 F1500.000
@@ -2777,7 +2777,7 @@ G1 X13.515000 Y3.756194 F1500.000
 G1 X13.515000 Y0.956194 F1500.000
 G1 X13.985000 Y0.956194 F1500.000
 M5
-; pass 346: cut 13 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 346: cut 13 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X12.985000 Y1.400000
 M4 S200
 G1 X12.515000 Y1.400000 F1500.000
@@ -2785,7 +2785,7 @@ G1 X12.515000 Y-1.400000 F1500.000
 G1 X12.985000 Y-1.400000 F1500.000
 G1 X12.985000 Y1.400000 F1500.000
 M5
-; pass 347: cut 12 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 347: cut 12 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X11.985000 Y0.956194
 M4 S200
 G1 X11.985000 Y3.756194 F1500.000
@@ -2793,7 +2793,7 @@ G1 X11.515000 Y3.756194 F1500.000
 G1 X11.515000 Y0.956194 F1500.000
 G1 X11.985000 Y0.956194 F1500.000
 M5
-; pass 348: cut 11 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 348: cut 11 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.985000 Y1.400000
 M4 S200
 G1 X10.515000 Y1.400000 F1500.000
@@ -2801,7 +2801,7 @@ G1 X10.515000 Y-1.400000 F1500.000
 G1 X10.985000 Y-1.400000 F1500.000
 G1 X10.985000 Y1.400000 F1500.000
 M5
-; pass 349: cut 10 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 349: cut 10 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -2809,7 +2809,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 350: cut 9 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 350: cut 9 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.400000
 M4 S200
 G1 X8.515000 Y1.400000 F1500.000
@@ -2817,7 +2817,7 @@ G1 X8.515000 Y-1.400000 F1500.000
 G1 X8.985000 Y-1.400000 F1500.000
 G1 X8.985000 Y1.400000 F1500.000
 M5
-; pass 351: cut 8 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 351: cut 8 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -2825,7 +2825,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 352: cut 7 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 352: cut 7 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.400000
 M4 S200
 G1 X6.515000 Y1.400000 F1500.000
@@ -2833,7 +2833,7 @@ G1 X6.515000 Y-1.400000 F1500.000
 G1 X6.985000 Y-1.400000 F1500.000
 G1 X6.985000 Y1.400000 F1500.000
 M5
-; pass 353: cut 6 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 353: cut 6 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -2841,7 +2841,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 354: cut 5 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 354: cut 5 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.400000
 M4 S200
 G1 X4.515000 Y1.400000 F1500.000
@@ -2849,7 +2849,7 @@ G1 X4.515000 Y-1.400000 F1500.000
 G1 X4.985000 Y-1.400000 F1500.000
 G1 X4.985000 Y1.400000 F1500.000
 M5
-; pass 355: cut 4 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 355: cut 4 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -2857,7 +2857,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 356: cut 3 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 356: cut 3 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.400000
 M4 S200
 G1 X2.515000 Y1.400000 F1500.000
@@ -2865,7 +2865,7 @@ G1 X2.515000 Y-1.400000 F1500.000
 G1 X2.985000 Y-1.400000 F1500.000
 G1 X2.985000 Y1.400000 F1500.000
 M5
-; pass 357: cut 2 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 357: cut 2 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -2873,7 +2873,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 358: cut 1 hole, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 358: cut 1 hole, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -2881,7 +2881,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 359: cut 0 hole, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 359: cut 0 hole, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y0.135000
 M4 S200
 G1 X0.615000 Y0.135000 F1500.000
@@ -2889,7 +2889,7 @@ G1 X0.615000 Y-0.135000 F1500.000
 G1 X0.885000 Y-0.135000 F1500.000
 G1 X0.885000 Y0.135000 F1500.000
 M5
-; pass 360: cut 0 hole, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 360: cut 0 hole, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y0.150000
 G0 Z-0.100000
 M4 S200
@@ -2898,7 +2898,7 @@ G1 X0.600000 Y-0.150000 F1500.000
 G1 X0.900000 Y-0.150000 F1500.000
 G1 X0.900000 Y0.150000 F1500.000
 M5
-; pass 361: cut 1 hole, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 361: cut 1 hole, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 M4 S200
 G1 X0.900000 Y2.506194 F1500.000
@@ -2906,7 +2906,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 362: cut 2 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 362: cut 2 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -2914,7 +2914,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 363: cut 3 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 363: cut 3 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.415000
 M4 S200
 G1 X2.500000 Y-1.415000 F1500.000
@@ -2922,7 +2922,7 @@ G1 X3.000000 Y-1.415000 F1500.000
 G1 X3.000000 Y1.415000 F1500.000
 G1 X2.500000 Y1.415000 F1500.000
 M5
-; pass 364: cut 4 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 364: cut 4 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -2930,7 +2930,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 365: cut 5 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 365: cut 5 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.415000
 M4 S200
 G1 X4.500000 Y-1.415000 F1500.000
@@ -2938,7 +2938,7 @@ G1 X5.000000 Y-1.415000 F1500.000
 G1 X5.000000 Y1.415000 F1500.000
 G1 X4.500000 Y1.415000 F1500.000
 M5
-; pass 366: cut 6 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 366: cut 6 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -2946,7 +2946,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 367: cut 7 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 367: cut 7 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.415000
 M4 S200
 G1 X6.500000 Y-1.415000 F1500.000
@@ -2954,7 +2954,7 @@ G1 X7.000000 Y-1.415000 F1500.000
 G1 X7.000000 Y1.415000 F1500.000
 G1 X6.500000 Y1.415000 F1500.000
 M5
-; pass 368: cut 8 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 368: cut 8 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -2962,7 +2962,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 369: cut 9 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 369: cut 9 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.415000
 M4 S200
 G1 X8.500000 Y-1.415000 F1500.000
@@ -2970,7 +2970,7 @@ G1 X9.000000 Y-1.415000 F1500.000
 G1 X9.000000 Y1.415000 F1500.000
 G1 X8.500000 Y1.415000 F1500.000
 M5
-; pass 370: cut 10 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 370: cut 10 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -2978,7 +2978,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 371: cut 11 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 371: cut 11 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.415000
 M4 S200
 G1 X10.500000 Y-1.415000 F1500.000
@@ -2986,7 +2986,7 @@ G1 X11.000000 Y-1.415000 F1500.000
 G1 X11.000000 Y1.415000 F1500.000
 G1 X10.500000 Y1.415000 F1500.000
 M5
-; pass 372: cut 12 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 372: cut 12 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X11.500000 Y0.941194
 M4 S200
 G1 X12.000000 Y0.941194 F1500.000
@@ -2994,7 +2994,7 @@ G1 X12.000000 Y3.771194 F1500.000
 G1 X11.500000 Y3.771194 F1500.000
 G1 X11.500000 Y0.941194 F1500.000
 M5
-; pass 373: cut 13 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 373: cut 13 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X12.500000 Y1.415000
 M4 S200
 G1 X12.500000 Y-1.415000 F1500.000
@@ -3002,7 +3002,7 @@ G1 X13.000000 Y-1.415000 F1500.000
 G1 X13.000000 Y1.415000 F1500.000
 G1 X12.500000 Y1.415000 F1500.000
 M5
-; pass 374: cut 14 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 374: cut 14 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X13.500000 Y0.941194
 M4 S200
 G1 X14.000000 Y0.941194 F1500.000
@@ -3010,7 +3010,7 @@ G1 X14.000000 Y3.771194 F1500.000
 G1 X13.500000 Y3.771194 F1500.000
 G1 X13.500000 Y0.941194 F1500.000
 M5
-; pass 375: cut 15 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 375: cut 15 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X14.500000 Y1.415000
 M4 S200
 G1 X14.500000 Y-1.415000 F1500.000
@@ -3018,7 +3018,7 @@ G1 X15.000000 Y-1.415000 F1500.000
 G1 X15.000000 Y1.415000 F1500.000
 G1 X14.500000 Y1.415000 F1500.000
 M5
-; pass 376: cut 16 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 376: cut 16 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X15.500000 Y0.941194
 M4 S200
 G1 X16.000000 Y0.941194 F1500.000
@@ -3026,7 +3026,7 @@ G1 X16.000000 Y3.771194 F1500.000
 G1 X15.500000 Y3.771194 F1500.000
 G1 X15.500000 Y0.941194 F1500.000
 M5
-; pass 377: cut 17 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 377: cut 17 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X16.500000 Y1.415000
 M4 S200
 G1 X16.500000 Y-1.415000 F1500.000
@@ -3034,7 +3034,7 @@ G1 X17.000000 Y-1.415000 F1500.000
 G1 X17.000000 Y1.415000 F1500.000
 G1 X16.500000 Y1.415000 F1500.000
 M5
-; pass 378: cut 17 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 378: cut 17 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X16.505000 Y1.410000
 M4 S200
 G1 X16.505000 Y-1.410000 F1500.000
@@ -3042,7 +3042,7 @@ G1 X16.995000 Y-1.410000 F1500.000
 G1 X16.995000 Y1.410000 F1500.000
 G1 X16.505000 Y1.410000 F1500.000
 M5
-; pass 379: cut 16 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 379: cut 16 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X15.995000 Y0.946194
 M4 S200
 G1 X15.995000 Y3.766194 F1500.000
@@ -3050,7 +3050,7 @@ G1 X15.505000 Y3.766194 F1500.000
 G1 X15.505000 Y0.946194 F1500.000
 G1 X15.995000 Y0.946194 F1500.000
 M5
-; pass 380: cut 15 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 380: cut 15 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X14.995000 Y1.410000
 M4 S200
 G1 X14.505000 Y1.410000 F1500.000
@@ -3058,7 +3058,7 @@ G1 X14.505000 Y-1.410000 F1500.000
 G1 X14.995000 Y-1.410000 F1500.000
 G1 X14.995000 Y1.410000 F1500.000
 M5
-; pass 381: cut 14 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 381: cut 14 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X13.995000 Y0.946194
 M4 S200
 G1 X13.995000 Y3.766194 F1500.000
@@ -3066,7 +3066,7 @@ G1 X13.505000 Y3.766194 F1500.000
 G1 X13.505000 Y0.946194 F1500.000
 G1 X13.995000 Y0.946194 F1500.000
 M5
-; pass 382: cut 13 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 382: cut 13 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X12.995000 Y1.410000
 M4 S200
 G1 X12.505000 Y1.410000 F1500.000
@@ -3074,7 +3074,7 @@ G1 X12.505000 Y-1.410000 F1500.000
 G1 X12.995000 Y-1.410000 F1500.000
 G1 X12.995000 Y1.410000 F1500.000
 M5
-; pass 383: cut 12 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 383: cut 12 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X11.995000 Y0.946194
 M4 S200
 G1 X11.995000 Y3.766194 F1500.000
@@ -3082,7 +3082,7 @@ G1 X11.505000 Y3.766194 F1500.000
 G1 X11.505000 Y0.946194 F1500.000
 G1 X11.995000 Y0.946194 F1500.000
 M5
-; pass 384: cut 11 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 384: cut 11 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.995000 Y1.410000
 M4 S200
 G1 X10.505000 Y1.410000 F1500.000
@@ -3090,7 +3090,7 @@ G1 X10.505000 Y-1.410000 F1500.000
 G1 X10.995000 Y-1.410000 F1500.000
 G1 X10.995000 Y1.410000 F1500.000
 M5
-; pass 385: cut 10 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 385: cut 10 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -3098,7 +3098,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 386: cut 9 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 386: cut 9 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.410000
 M4 S200
 G1 X8.505000 Y1.410000 F1500.000
@@ -3106,7 +3106,7 @@ G1 X8.505000 Y-1.410000 F1500.000
 G1 X8.995000 Y-1.410000 F1500.000
 G1 X8.995000 Y1.410000 F1500.000
 M5
-; pass 387: cut 8 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 387: cut 8 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -3114,7 +3114,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 388: cut 7 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 388: cut 7 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.410000
 M4 S200
 G1 X6.505000 Y1.410000 F1500.000
@@ -3122,7 +3122,7 @@ G1 X6.505000 Y-1.410000 F1500.000
 G1 X6.995000 Y-1.410000 F1500.000
 G1 X6.995000 Y1.410000 F1500.000
 M5
-; pass 389: cut 6 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 389: cut 6 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -3130,7 +3130,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 390: cut 5 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 390: cut 5 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.410000
 M4 S200
 G1 X4.505000 Y1.410000 F1500.000
@@ -3138,7 +3138,7 @@ G1 X4.505000 Y-1.410000 F1500.000
 G1 X4.995000 Y-1.410000 F1500.000
 G1 X4.995000 Y1.410000 F1500.000
 M5
-; pass 391: cut 4 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 391: cut 4 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -3146,7 +3146,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 392: cut 3 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 392: cut 3 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.410000
 M4 S200
 G1 X2.505000 Y1.410000 F1500.000
@@ -3154,7 +3154,7 @@ G1 X2.505000 Y-1.410000 F1500.000
 G1 X2.995000 Y-1.410000 F1500.000
 G1 X2.995000 Y1.410000 F1500.000
 M5
-; pass 393: cut 2 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 393: cut 2 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -3162,7 +3162,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 394: cut 1 hole, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 394: cut 1 hole, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -3170,7 +3170,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 395: cut 0 hole, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 395: cut 0 hole, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y0.145000
 M4 S200
 G1 X0.605000 Y0.145000 F1500.000
@@ -3178,7 +3178,7 @@ G1 X0.605000 Y-0.145000 F1500.000
 G1 X0.895000 Y-0.145000 F1500.000
 G1 X0.895000 Y0.145000 F1500.000
 M5
-; pass 396: cut 0 hole, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 396: cut 0 hole, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y0.140000
 M4 S200
 G1 X0.610000 Y0.140000 F1500.000
@@ -3186,7 +3186,7 @@ G1 X0.610000 Y-0.140000 F1500.000
 G1 X0.890000 Y-0.140000 F1500.000
 G1 X0.890000 Y0.140000 F1500.000
 M5
-; pass 397: cut 1 hole, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 397: cut 1 hole, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -3194,7 +3194,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 398: cut 2 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 398: cut 2 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -3202,7 +3202,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 399: cut 3 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 399: cut 3 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.405000
 M4 S200
 G1 X2.510000 Y-1.405000 F1500.000
@@ -3210,7 +3210,7 @@ G1 X2.990000 Y-1.405000 F1500.000
 G1 X2.990000 Y1.405000 F1500.000
 G1 X2.510000 Y1.405000 F1500.000
 M5
-; pass 400: cut 4 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 400: cut 4 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -3218,7 +3218,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 401: cut 5 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 401: cut 5 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.405000
 M4 S200
 G1 X4.510000 Y-1.405000 F1500.000
@@ -3226,7 +3226,7 @@ G1 X4.990000 Y-1.405000 F1500.000
 G1 X4.990000 Y1.405000 F1500.000
 G1 X4.510000 Y1.405000 F1500.000
 M5
-; pass 402: cut 6 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 402: cut 6 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -3234,7 +3234,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 403: cut 7 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 403: cut 7 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.405000
 M4 S200
 G1 X6.510000 Y-1.405000 F1500.000
@@ -3242,7 +3242,7 @@ G1 X6.990000 Y-1.405000 F1500.000
 G1 X6.990000 Y1.405000 F1500.000
 G1 X6.510000 Y1.405000 F1500.000
 M5
-; pass 404: cut 8 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 404: cut 8 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -3250,7 +3250,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 405: cut 9 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 405: cut 9 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.405000
 M4 S200
 G1 X8.510000 Y-1.405000 F1500.000
@@ -3258,7 +3258,7 @@ G1 X8.990000 Y-1.405000 F1500.000
 G1 X8.990000 Y1.405000 F1500.000
 G1 X8.510000 Y1.405000 F1500.000
 M5
-; pass 406: cut 10 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 406: cut 10 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -3266,7 +3266,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 407: cut 11 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 407: cut 11 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.405000
 M4 S200
 G1 X10.510000 Y-1.405000 F1500.000
@@ -3274,7 +3274,7 @@ G1 X10.990000 Y-1.405000 F1500.000
 G1 X10.990000 Y1.405000 F1500.000
 G1 X10.510000 Y1.405000 F1500.000
 M5
-; pass 408: cut 12 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 408: cut 12 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X11.510000 Y0.951194
 M4 S200
 G1 X11.990000 Y0.951194 F1500.000
@@ -3282,7 +3282,7 @@ G1 X11.990000 Y3.761194 F1500.000
 G1 X11.510000 Y3.761194 F1500.000
 G1 X11.510000 Y0.951194 F1500.000
 M5
-; pass 409: cut 13 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 409: cut 13 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X12.510000 Y1.405000
 M4 S200
 G1 X12.510000 Y-1.405000 F1500.000
@@ -3290,7 +3290,7 @@ G1 X12.990000 Y-1.405000 F1500.000
 G1 X12.990000 Y1.405000 F1500.000
 G1 X12.510000 Y1.405000 F1500.000
 M5
-; pass 410: cut 14 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 410: cut 14 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X13.510000 Y0.951194
 M4 S200
 G1 X13.990000 Y0.951194 F1500.000
@@ -3298,7 +3298,7 @@ G1 X13.990000 Y3.761194 F1500.000
 G1 X13.510000 Y3.761194 F1500.000
 G1 X13.510000 Y0.951194 F1500.000
 M5
-; pass 411: cut 15 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 411: cut 15 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X14.510000 Y1.405000
 M4 S200
 G1 X14.510000 Y-1.405000 F1500.000
@@ -3306,7 +3306,7 @@ G1 X14.990000 Y-1.405000 F1500.000
 G1 X14.990000 Y1.405000 F1500.000
 G1 X14.510000 Y1.405000 F1500.000
 M5
-; pass 412: cut 16 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 412: cut 16 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X15.510000 Y0.951194
 M4 S200
 G1 X15.990000 Y0.951194 F1500.000
@@ -3314,7 +3314,7 @@ G1 X15.990000 Y3.761194 F1500.000
 G1 X15.510000 Y3.761194 F1500.000
 G1 X15.510000 Y0.951194 F1500.000
 M5
-; pass 413: cut 17 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 413: cut 17 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X16.510000 Y1.405000
 M4 S200
 G1 X16.510000 Y-1.405000 F1500.000
@@ -3322,7 +3322,7 @@ G1 X16.990000 Y-1.405000 F1500.000
 G1 X16.990000 Y1.405000 F1500.000
 G1 X16.510000 Y1.405000 F1500.000
 M5
-; pass 414: cut 17 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 414: cut 17 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X16.515000 Y1.400000
 M4 S200
 G1 X16.515000 Y-1.400000 F1500.000
@@ -3330,7 +3330,7 @@ G1 X16.985000 Y-1.400000 F1500.000
 G1 X16.985000 Y1.400000 F1500.000
 G1 X16.515000 Y1.400000 F1500.000
 M5
-; pass 415: cut 16 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 415: cut 16 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X15.985000 Y0.956194
 M4 S200
 G1 X15.985000 Y3.756194 F1500.000
@@ -3338,7 +3338,7 @@ G1 X15.515000 Y3.756194 F1500.000
 G1 X15.515000 Y0.956194 F1500.000
 G1 X15.985000 Y0.956194 F1500.000
 M5
-; pass 416: cut 15 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 416: cut 15 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X14.985000 Y1.400000
 M4 S200
 G1 X14.515000 Y1.400000 F1500.000
@@ -3346,7 +3346,7 @@ G1 X14.515000 Y-1.400000 F1500.000
 G1 X14.985000 Y-1.400000 F1500.000
 G1 X14.985000 Y1.400000 F1500.000
 M5
-; pass 417: cut 14 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 417: cut 14 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X13.985000 Y0.956194
 M4 S200
 G1 X13.985000 Y3.756194 F1500.000
@@ -3354,7 +3354,7 @@ G1 X13.515000 Y3.756194 F1500.000
 G1 X13.515000 Y0.956194 F1500.000
 G1 X13.985000 Y0.956194 F1500.000
 M5
-; pass 418: cut 13 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 418: cut 13 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X12.985000 Y1.400000
 M4 S200
 G1 X12.515000 Y1.400000 F1500.000
@@ -3362,7 +3362,7 @@ G1 X12.515000 Y-1.400000 F1500.000
 G1 X12.985000 Y-1.400000 F1500.000
 G1 X12.985000 Y1.400000 F1500.000
 M5
-; pass 419: cut 12 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 419: cut 12 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X11.985000 Y0.956194
 M4 S200
 G1 X11.985000 Y3.756194 F1500.000
@@ -3370,7 +3370,7 @@ G1 X11.515000 Y3.756194 F1500.000
 G1 X11.515000 Y0.956194 F1500.000
 G1 X11.985000 Y0.956194 F1500.000
 M5
-; pass 420: cut 11 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 420: cut 11 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.985000 Y1.400000
 M4 S200
 G1 X10.515000 Y1.400000 F1500.000
@@ -3378,7 +3378,7 @@ G1 X10.515000 Y-1.400000 F1500.000
 G1 X10.985000 Y-1.400000 F1500.000
 G1 X10.985000 Y1.400000 F1500.000
 M5
-; pass 421: cut 10 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 421: cut 10 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -3386,7 +3386,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 422: cut 9 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 422: cut 9 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.400000
 M4 S200
 G1 X8.515000 Y1.400000 F1500.000
@@ -3394,7 +3394,7 @@ G1 X8.515000 Y-1.400000 F1500.000
 G1 X8.985000 Y-1.400000 F1500.000
 G1 X8.985000 Y1.400000 F1500.000
 M5
-; pass 423: cut 8 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 423: cut 8 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -3402,7 +3402,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 424: cut 7 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 424: cut 7 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.400000
 M4 S200
 G1 X6.515000 Y1.400000 F1500.000
@@ -3410,7 +3410,7 @@ G1 X6.515000 Y-1.400000 F1500.000
 G1 X6.985000 Y-1.400000 F1500.000
 G1 X6.985000 Y1.400000 F1500.000
 M5
-; pass 425: cut 6 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 425: cut 6 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -3418,7 +3418,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 426: cut 5 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 426: cut 5 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.400000
 M4 S200
 G1 X4.515000 Y1.400000 F1500.000
@@ -3426,7 +3426,7 @@ G1 X4.515000 Y-1.400000 F1500.000
 G1 X4.985000 Y-1.400000 F1500.000
 G1 X4.985000 Y1.400000 F1500.000
 M5
-; pass 427: cut 4 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 427: cut 4 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -3434,7 +3434,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 428: cut 3 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 428: cut 3 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.400000
 M4 S200
 G1 X2.515000 Y1.400000 F1500.000
@@ -3442,7 +3442,7 @@ G1 X2.515000 Y-1.400000 F1500.000
 G1 X2.985000 Y-1.400000 F1500.000
 G1 X2.985000 Y1.400000 F1500.000
 M5
-; pass 429: cut 2 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 429: cut 2 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -3450,7 +3450,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 430: cut 1 hole, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 430: cut 1 hole, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -3458,7 +3458,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 431: cut 0 hole, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 431: cut 0 hole, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y0.135000
 M4 S200
 G1 X0.615000 Y0.135000 F1500.000
@@ -3466,7 +3466,7 @@ G1 X0.615000 Y-0.135000 F1500.000
 G1 X0.885000 Y-0.135000 F1500.000
 G1 X0.885000 Y0.135000 F1500.000
 M5
-; pass 432: cut 0 hole, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 432: cut 0 hole, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y0.150000
 G0 Z0.000000
 M4 S200
@@ -3475,7 +3475,7 @@ G1 X0.600000 Y-0.150000 F1500.000
 G1 X0.900000 Y-0.150000 F1500.000
 G1 X0.900000 Y0.150000 F1500.000
 M5
-; pass 433: cut 1 hole, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 433: cut 1 hole, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 M4 S200
 G1 X0.900000 Y2.506194 F1500.000
@@ -3483,7 +3483,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 434: cut 2 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 434: cut 2 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -3491,7 +3491,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 435: cut 3 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 435: cut 3 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.415000
 M4 S200
 G1 X2.500000 Y-1.415000 F1500.000
@@ -3499,7 +3499,7 @@ G1 X3.000000 Y-1.415000 F1500.000
 G1 X3.000000 Y1.415000 F1500.000
 G1 X2.500000 Y1.415000 F1500.000
 M5
-; pass 436: cut 4 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 436: cut 4 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -3507,7 +3507,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 437: cut 5 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 437: cut 5 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.415000
 M4 S200
 G1 X4.500000 Y-1.415000 F1500.000
@@ -3515,7 +3515,7 @@ G1 X5.000000 Y-1.415000 F1500.000
 G1 X5.000000 Y1.415000 F1500.000
 G1 X4.500000 Y1.415000 F1500.000
 M5
-; pass 438: cut 6 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 438: cut 6 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -3523,7 +3523,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 439: cut 7 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 439: cut 7 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.415000
 M4 S200
 G1 X6.500000 Y-1.415000 F1500.000
@@ -3531,7 +3531,7 @@ G1 X7.000000 Y-1.415000 F1500.000
 G1 X7.000000 Y1.415000 F1500.000
 G1 X6.500000 Y1.415000 F1500.000
 M5
-; pass 440: cut 8 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 440: cut 8 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -3539,7 +3539,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 441: cut 9 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 441: cut 9 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.415000
 M4 S200
 G1 X8.500000 Y-1.415000 F1500.000
@@ -3547,7 +3547,7 @@ G1 X9.000000 Y-1.415000 F1500.000
 G1 X9.000000 Y1.415000 F1500.000
 G1 X8.500000 Y1.415000 F1500.000
 M5
-; pass 442: cut 10 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 442: cut 10 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -3555,7 +3555,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 443: cut 11 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 443: cut 11 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.415000
 M4 S200
 G1 X10.500000 Y-1.415000 F1500.000
@@ -3563,7 +3563,7 @@ G1 X11.000000 Y-1.415000 F1500.000
 G1 X11.000000 Y1.415000 F1500.000
 G1 X10.500000 Y1.415000 F1500.000
 M5
-; pass 444: cut 12 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 444: cut 12 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X11.500000 Y0.941194
 M4 S200
 G1 X12.000000 Y0.941194 F1500.000
@@ -3571,7 +3571,7 @@ G1 X12.000000 Y3.771194 F1500.000
 G1 X11.500000 Y3.771194 F1500.000
 G1 X11.500000 Y0.941194 F1500.000
 M5
-; pass 445: cut 13 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 445: cut 13 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X12.500000 Y1.415000
 M4 S200
 G1 X12.500000 Y-1.415000 F1500.000
@@ -3579,7 +3579,7 @@ G1 X13.000000 Y-1.415000 F1500.000
 G1 X13.000000 Y1.415000 F1500.000
 G1 X12.500000 Y1.415000 F1500.000
 M5
-; pass 446: cut 14 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 446: cut 14 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X13.500000 Y0.941194
 M4 S200
 G1 X14.000000 Y0.941194 F1500.000
@@ -3587,7 +3587,7 @@ G1 X14.000000 Y3.771194 F1500.000
 G1 X13.500000 Y3.771194 F1500.000
 G1 X13.500000 Y0.941194 F1500.000
 M5
-; pass 447: cut 15 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 447: cut 15 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X14.500000 Y1.415000
 M4 S200
 G1 X14.500000 Y-1.415000 F1500.000
@@ -3595,7 +3595,7 @@ G1 X15.000000 Y-1.415000 F1500.000
 G1 X15.000000 Y1.415000 F1500.000
 G1 X14.500000 Y1.415000 F1500.000
 M5
-; pass 448: cut 16 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 448: cut 16 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X15.500000 Y0.941194
 M4 S200
 G1 X16.000000 Y0.941194 F1500.000
@@ -3603,7 +3603,7 @@ G1 X16.000000 Y3.771194 F1500.000
 G1 X15.500000 Y3.771194 F1500.000
 G1 X15.500000 Y0.941194 F1500.000
 M5
-; pass 449: cut 17 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 449: cut 17 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X16.500000 Y1.415000
 M4 S200
 G1 X16.500000 Y-1.415000 F1500.000
@@ -3611,7 +3611,7 @@ G1 X17.000000 Y-1.415000 F1500.000
 G1 X17.000000 Y1.415000 F1500.000
 G1 X16.500000 Y1.415000 F1500.000
 M5
-; pass 450: cut 17 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 450: cut 17 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X16.505000 Y1.410000
 M4 S200
 G1 X16.505000 Y-1.410000 F1500.000
@@ -3619,7 +3619,7 @@ G1 X16.995000 Y-1.410000 F1500.000
 G1 X16.995000 Y1.410000 F1500.000
 G1 X16.505000 Y1.410000 F1500.000
 M5
-; pass 451: cut 16 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 451: cut 16 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X15.995000 Y0.946194
 M4 S200
 G1 X15.995000 Y3.766194 F1500.000
@@ -3627,7 +3627,7 @@ G1 X15.505000 Y3.766194 F1500.000
 G1 X15.505000 Y0.946194 F1500.000
 G1 X15.995000 Y0.946194 F1500.000
 M5
-; pass 452: cut 15 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 452: cut 15 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X14.995000 Y1.410000
 M4 S200
 G1 X14.505000 Y1.410000 F1500.000
@@ -3635,7 +3635,7 @@ G1 X14.505000 Y-1.410000 F1500.000
 G1 X14.995000 Y-1.410000 F1500.000
 G1 X14.995000 Y1.410000 F1500.000
 M5
-; pass 453: cut 14 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 453: cut 14 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X13.995000 Y0.946194
 M4 S200
 G1 X13.995000 Y3.766194 F1500.000
@@ -3643,7 +3643,7 @@ G1 X13.505000 Y3.766194 F1500.000
 G1 X13.505000 Y0.946194 F1500.000
 G1 X13.995000 Y0.946194 F1500.000
 M5
-; pass 454: cut 13 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 454: cut 13 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X12.995000 Y1.410000
 M4 S200
 G1 X12.505000 Y1.410000 F1500.000
@@ -3651,7 +3651,7 @@ G1 X12.505000 Y-1.410000 F1500.000
 G1 X12.995000 Y-1.410000 F1500.000
 G1 X12.995000 Y1.410000 F1500.000
 M5
-; pass 455: cut 12 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 455: cut 12 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X11.995000 Y0.946194
 M4 S200
 G1 X11.995000 Y3.766194 F1500.000
@@ -3659,7 +3659,7 @@ G1 X11.505000 Y3.766194 F1500.000
 G1 X11.505000 Y0.946194 F1500.000
 G1 X11.995000 Y0.946194 F1500.000
 M5
-; pass 456: cut 11 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 456: cut 11 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.995000 Y1.410000
 M4 S200
 G1 X10.505000 Y1.410000 F1500.000
@@ -3667,7 +3667,7 @@ G1 X10.505000 Y-1.410000 F1500.000
 G1 X10.995000 Y-1.410000 F1500.000
 G1 X10.995000 Y1.410000 F1500.000
 M5
-; pass 457: cut 10 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 457: cut 10 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -3675,7 +3675,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 458: cut 9 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 458: cut 9 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.410000
 M4 S200
 G1 X8.505000 Y1.410000 F1500.000
@@ -3683,7 +3683,7 @@ G1 X8.505000 Y-1.410000 F1500.000
 G1 X8.995000 Y-1.410000 F1500.000
 G1 X8.995000 Y1.410000 F1500.000
 M5
-; pass 459: cut 8 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 459: cut 8 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -3691,7 +3691,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 460: cut 7 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 460: cut 7 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.410000
 M4 S200
 G1 X6.505000 Y1.410000 F1500.000
@@ -3699,7 +3699,7 @@ G1 X6.505000 Y-1.410000 F1500.000
 G1 X6.995000 Y-1.410000 F1500.000
 G1 X6.995000 Y1.410000 F1500.000
 M5
-; pass 461: cut 6 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 461: cut 6 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -3707,7 +3707,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 462: cut 5 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 462: cut 5 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.410000
 M4 S200
 G1 X4.505000 Y1.410000 F1500.000
@@ -3715,7 +3715,7 @@ G1 X4.505000 Y-1.410000 F1500.000
 G1 X4.995000 Y-1.410000 F1500.000
 G1 X4.995000 Y1.410000 F1500.000
 M5
-; pass 463: cut 4 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 463: cut 4 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -3723,7 +3723,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 464: cut 3 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 464: cut 3 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.410000
 M4 S200
 G1 X2.505000 Y1.410000 F1500.000
@@ -3731,7 +3731,7 @@ G1 X2.505000 Y-1.410000 F1500.000
 G1 X2.995000 Y-1.410000 F1500.000
 G1 X2.995000 Y1.410000 F1500.000
 M5
-; pass 465: cut 2 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 465: cut 2 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -3739,7 +3739,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 466: cut 1 hole, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 466: cut 1 hole, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -3747,7 +3747,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 467: cut 0 hole, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 467: cut 0 hole, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y0.145000
 M4 S200
 G1 X0.605000 Y0.145000 F1500.000
@@ -3755,7 +3755,7 @@ G1 X0.605000 Y-0.145000 F1500.000
 G1 X0.895000 Y-0.145000 F1500.000
 G1 X0.895000 Y0.145000 F1500.000
 M5
-; pass 468: cut 0 hole, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 468: cut 0 hole, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y0.140000
 M4 S200
 G1 X0.610000 Y0.140000 F1500.000
@@ -3763,7 +3763,7 @@ G1 X0.610000 Y-0.140000 F1500.000
 G1 X0.890000 Y-0.140000 F1500.000
 G1 X0.890000 Y0.140000 F1500.000
 M5
-; pass 469: cut 1 hole, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 469: cut 1 hole, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -3771,7 +3771,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 470: cut 2 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 470: cut 2 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -3779,7 +3779,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 471: cut 3 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 471: cut 3 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.405000
 M4 S200
 G1 X2.510000 Y-1.405000 F1500.000
@@ -3787,7 +3787,7 @@ G1 X2.990000 Y-1.405000 F1500.000
 G1 X2.990000 Y1.405000 F1500.000
 G1 X2.510000 Y1.405000 F1500.000
 M5
-; pass 472: cut 4 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 472: cut 4 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -3795,7 +3795,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 473: cut 5 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 473: cut 5 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.405000
 M4 S200
 G1 X4.510000 Y-1.405000 F1500.000
@@ -3803,7 +3803,7 @@ G1 X4.990000 Y-1.405000 F1500.000
 G1 X4.990000 Y1.405000 F1500.000
 G1 X4.510000 Y1.405000 F1500.000
 M5
-; pass 474: cut 6 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 474: cut 6 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -3811,7 +3811,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 475: cut 7 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 475: cut 7 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.405000
 M4 S200
 G1 X6.510000 Y-1.405000 F1500.000
@@ -3819,7 +3819,7 @@ G1 X6.990000 Y-1.405000 F1500.000
 G1 X6.990000 Y1.405000 F1500.000
 G1 X6.510000 Y1.405000 F1500.000
 M5
-; pass 476: cut 8 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 476: cut 8 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -3827,7 +3827,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 477: cut 9 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 477: cut 9 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.405000
 M4 S200
 G1 X8.510000 Y-1.405000 F1500.000
@@ -3835,7 +3835,7 @@ G1 X8.990000 Y-1.405000 F1500.000
 G1 X8.990000 Y1.405000 F1500.000
 G1 X8.510000 Y1.405000 F1500.000
 M5
-; pass 478: cut 10 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 478: cut 10 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -3843,7 +3843,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 479: cut 11 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 479: cut 11 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.405000
 M4 S200
 G1 X10.510000 Y-1.405000 F1500.000
@@ -3851,7 +3851,7 @@ G1 X10.990000 Y-1.405000 F1500.000
 G1 X10.990000 Y1.405000 F1500.000
 G1 X10.510000 Y1.405000 F1500.000
 M5
-; pass 480: cut 12 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 480: cut 12 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X11.510000 Y0.951194
 M4 S200
 G1 X11.990000 Y0.951194 F1500.000
@@ -3859,7 +3859,7 @@ G1 X11.990000 Y3.761194 F1500.000
 G1 X11.510000 Y3.761194 F1500.000
 G1 X11.510000 Y0.951194 F1500.000
 M5
-; pass 481: cut 13 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 481: cut 13 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X12.510000 Y1.405000
 M4 S200
 G1 X12.510000 Y-1.405000 F1500.000
@@ -3867,7 +3867,7 @@ G1 X12.990000 Y-1.405000 F1500.000
 G1 X12.990000 Y1.405000 F1500.000
 G1 X12.510000 Y1.405000 F1500.000
 M5
-; pass 482: cut 14 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 482: cut 14 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X13.510000 Y0.951194
 M4 S200
 G1 X13.990000 Y0.951194 F1500.000
@@ -3875,7 +3875,7 @@ G1 X13.990000 Y3.761194 F1500.000
 G1 X13.510000 Y3.761194 F1500.000
 G1 X13.510000 Y0.951194 F1500.000
 M5
-; pass 483: cut 15 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 483: cut 15 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X14.510000 Y1.405000
 M4 S200
 G1 X14.510000 Y-1.405000 F1500.000
@@ -3883,7 +3883,7 @@ G1 X14.990000 Y-1.405000 F1500.000
 G1 X14.990000 Y1.405000 F1500.000
 G1 X14.510000 Y1.405000 F1500.000
 M5
-; pass 484: cut 16 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 484: cut 16 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X15.510000 Y0.951194
 M4 S200
 G1 X15.990000 Y0.951194 F1500.000
@@ -3891,7 +3891,7 @@ G1 X15.990000 Y3.761194 F1500.000
 G1 X15.510000 Y3.761194 F1500.000
 G1 X15.510000 Y0.951194 F1500.000
 M5
-; pass 485: cut 17 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 485: cut 17 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X16.510000 Y1.405000
 M4 S200
 G1 X16.510000 Y-1.405000 F1500.000
@@ -3899,7 +3899,7 @@ G1 X16.990000 Y-1.405000 F1500.000
 G1 X16.990000 Y1.405000 F1500.000
 G1 X16.510000 Y1.405000 F1500.000
 M5
-; pass 486: cut 17 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 486: cut 17 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X16.515000 Y1.400000
 M4 S200
 G1 X16.515000 Y-1.400000 F1500.000
@@ -3907,7 +3907,7 @@ G1 X16.985000 Y-1.400000 F1500.000
 G1 X16.985000 Y1.400000 F1500.000
 G1 X16.515000 Y1.400000 F1500.000
 M5
-; pass 487: cut 16 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 487: cut 16 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X15.985000 Y0.956194
 M4 S200
 G1 X15.985000 Y3.756194 F1500.000
@@ -3915,7 +3915,7 @@ G1 X15.515000 Y3.756194 F1500.000
 G1 X15.515000 Y0.956194 F1500.000
 G1 X15.985000 Y0.956194 F1500.000
 M5
-; pass 488: cut 15 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 488: cut 15 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X14.985000 Y1.400000
 M4 S200
 G1 X14.515000 Y1.400000 F1500.000
@@ -3923,7 +3923,7 @@ G1 X14.515000 Y-1.400000 F1500.000
 G1 X14.985000 Y-1.400000 F1500.000
 G1 X14.985000 Y1.400000 F1500.000
 M5
-; pass 489: cut 14 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 489: cut 14 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X13.985000 Y0.956194
 M4 S200
 G1 X13.985000 Y3.756194 F1500.000
@@ -3931,7 +3931,7 @@ G1 X13.515000 Y3.756194 F1500.000
 G1 X13.515000 Y0.956194 F1500.000
 G1 X13.985000 Y0.956194 F1500.000
 M5
-; pass 490: cut 13 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 490: cut 13 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X12.985000 Y1.400000
 M4 S200
 G1 X12.515000 Y1.400000 F1500.000
@@ -3939,7 +3939,7 @@ G1 X12.515000 Y-1.400000 F1500.000
 G1 X12.985000 Y-1.400000 F1500.000
 G1 X12.985000 Y1.400000 F1500.000
 M5
-; pass 491: cut 12 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 491: cut 12 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X11.985000 Y0.956194
 M4 S200
 G1 X11.985000 Y3.756194 F1500.000
@@ -3947,7 +3947,7 @@ G1 X11.515000 Y3.756194 F1500.000
 G1 X11.515000 Y0.956194 F1500.000
 G1 X11.985000 Y0.956194 F1500.000
 M5
-; pass 492: cut 11 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 492: cut 11 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.985000 Y1.400000
 M4 S200
 G1 X10.515000 Y1.400000 F1500.000
@@ -3955,7 +3955,7 @@ G1 X10.515000 Y-1.400000 F1500.000
 G1 X10.985000 Y-1.400000 F1500.000
 G1 X10.985000 Y1.400000 F1500.000
 M5
-; pass 493: cut 10 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 493: cut 10 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -3963,7 +3963,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 494: cut 9 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 494: cut 9 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.400000
 M4 S200
 G1 X8.515000 Y1.400000 F1500.000
@@ -3971,7 +3971,7 @@ G1 X8.515000 Y-1.400000 F1500.000
 G1 X8.985000 Y-1.400000 F1500.000
 G1 X8.985000 Y1.400000 F1500.000
 M5
-; pass 495: cut 8 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 495: cut 8 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -3979,7 +3979,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 496: cut 7 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 496: cut 7 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.400000
 M4 S200
 G1 X6.515000 Y1.400000 F1500.000
@@ -3987,7 +3987,7 @@ G1 X6.515000 Y-1.400000 F1500.000
 G1 X6.985000 Y-1.400000 F1500.000
 G1 X6.985000 Y1.400000 F1500.000
 M5
-; pass 497: cut 6 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 497: cut 6 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -3995,7 +3995,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 498: cut 5 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 498: cut 5 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.400000
 M4 S200
 G1 X4.515000 Y1.400000 F1500.000
@@ -4003,7 +4003,7 @@ G1 X4.515000 Y-1.400000 F1500.000
 G1 X4.985000 Y-1.400000 F1500.000
 G1 X4.985000 Y1.400000 F1500.000
 M5
-; pass 499: cut 4 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 499: cut 4 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -4011,7 +4011,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 500: cut 3 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 500: cut 3 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.400000
 M4 S200
 G1 X2.515000 Y1.400000 F1500.000
@@ -4019,7 +4019,7 @@ G1 X2.515000 Y-1.400000 F1500.000
 G1 X2.985000 Y-1.400000 F1500.000
 G1 X2.985000 Y1.400000 F1500.000
 M5
-; pass 501: cut 2 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 501: cut 2 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -4027,7 +4027,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 502: cut 1 hole, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 502: cut 1 hole, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -4035,7 +4035,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 503: cut 0 hole, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 503: cut 0 hole, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y0.135000
 M4 S200
 G1 X0.615000 Y0.135000 F1500.000
@@ -4043,7 +4043,7 @@ G1 X0.615000 Y-0.135000 F1500.000
 G1 X0.885000 Y-0.135000 F1500.000
 G1 X0.885000 Y0.135000 F1500.000
 M5
-; pass 504: cut 0 hole, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 504: cut 0 hole, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y0.150000
 G0 Z-0.100000
 M4 S200
@@ -4052,7 +4052,7 @@ G1 X0.600000 Y-0.150000 F1500.000
 G1 X0.900000 Y-0.150000 F1500.000
 G1 X0.900000 Y0.150000 F1500.000
 M5
-; pass 505: cut 1 hole, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 505: cut 1 hole, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 M4 S200
 G1 X0.900000 Y2.506194 F1500.000
@@ -4060,7 +4060,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 506: cut 2 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 506: cut 2 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -4068,7 +4068,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 507: cut 3 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 507: cut 3 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.415000
 M4 S200
 G1 X2.500000 Y-1.415000 F1500.000
@@ -4076,7 +4076,7 @@ G1 X3.000000 Y-1.415000 F1500.000
 G1 X3.000000 Y1.415000 F1500.000
 G1 X2.500000 Y1.415000 F1500.000
 M5
-; pass 508: cut 4 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 508: cut 4 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -4084,7 +4084,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 509: cut 5 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 509: cut 5 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.415000
 M4 S200
 G1 X4.500000 Y-1.415000 F1500.000
@@ -4092,7 +4092,7 @@ G1 X5.000000 Y-1.415000 F1500.000
 G1 X5.000000 Y1.415000 F1500.000
 G1 X4.500000 Y1.415000 F1500.000
 M5
-; pass 510: cut 6 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 510: cut 6 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -4100,7 +4100,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 511: cut 7 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 511: cut 7 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.415000
 M4 S200
 G1 X6.500000 Y-1.415000 F1500.000
@@ -4108,7 +4108,7 @@ G1 X7.000000 Y-1.415000 F1500.000
 G1 X7.000000 Y1.415000 F1500.000
 G1 X6.500000 Y1.415000 F1500.000
 M5
-; pass 512: cut 8 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 512: cut 8 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -4116,7 +4116,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 513: cut 9 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 513: cut 9 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.415000
 M4 S200
 G1 X8.500000 Y-1.415000 F1500.000
@@ -4124,7 +4124,7 @@ G1 X9.000000 Y-1.415000 F1500.000
 G1 X9.000000 Y1.415000 F1500.000
 G1 X8.500000 Y1.415000 F1500.000
 M5
-; pass 514: cut 10 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 514: cut 10 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -4132,7 +4132,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 515: cut 11 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 515: cut 11 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.415000
 M4 S200
 G1 X10.500000 Y-1.415000 F1500.000
@@ -4140,7 +4140,7 @@ G1 X11.000000 Y-1.415000 F1500.000
 G1 X11.000000 Y1.415000 F1500.000
 G1 X10.500000 Y1.415000 F1500.000
 M5
-; pass 516: cut 12 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 516: cut 12 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X11.500000 Y0.941194
 M4 S200
 G1 X12.000000 Y0.941194 F1500.000
@@ -4148,7 +4148,7 @@ G1 X12.000000 Y3.771194 F1500.000
 G1 X11.500000 Y3.771194 F1500.000
 G1 X11.500000 Y0.941194 F1500.000
 M5
-; pass 517: cut 13 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 517: cut 13 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X12.500000 Y1.415000
 M4 S200
 G1 X12.500000 Y-1.415000 F1500.000
@@ -4156,7 +4156,7 @@ G1 X13.000000 Y-1.415000 F1500.000
 G1 X13.000000 Y1.415000 F1500.000
 G1 X12.500000 Y1.415000 F1500.000
 M5
-; pass 518: cut 14 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 518: cut 14 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X13.500000 Y0.941194
 M4 S200
 G1 X14.000000 Y0.941194 F1500.000
@@ -4164,7 +4164,7 @@ G1 X14.000000 Y3.771194 F1500.000
 G1 X13.500000 Y3.771194 F1500.000
 G1 X13.500000 Y0.941194 F1500.000
 M5
-; pass 519: cut 15 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 519: cut 15 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X14.500000 Y1.415000
 M4 S200
 G1 X14.500000 Y-1.415000 F1500.000
@@ -4172,7 +4172,7 @@ G1 X15.000000 Y-1.415000 F1500.000
 G1 X15.000000 Y1.415000 F1500.000
 G1 X14.500000 Y1.415000 F1500.000
 M5
-; pass 520: cut 16 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 520: cut 16 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X15.500000 Y0.941194
 M4 S200
 G1 X16.000000 Y0.941194 F1500.000
@@ -4180,7 +4180,7 @@ G1 X16.000000 Y3.771194 F1500.000
 G1 X15.500000 Y3.771194 F1500.000
 G1 X15.500000 Y0.941194 F1500.000
 M5
-; pass 521: cut 17 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 521: cut 17 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X16.500000 Y1.415000
 M4 S200
 G1 X16.500000 Y-1.415000 F1500.000
@@ -4188,7 +4188,7 @@ G1 X17.000000 Y-1.415000 F1500.000
 G1 X17.000000 Y1.415000 F1500.000
 G1 X16.500000 Y1.415000 F1500.000
 M5
-; pass 522: cut 17 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 522: cut 17 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X16.505000 Y1.410000
 M4 S200
 G1 X16.505000 Y-1.410000 F1500.000
@@ -4196,7 +4196,7 @@ G1 X16.995000 Y-1.410000 F1500.000
 G1 X16.995000 Y1.410000 F1500.000
 G1 X16.505000 Y1.410000 F1500.000
 M5
-; pass 523: cut 16 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 523: cut 16 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X15.995000 Y0.946194
 M4 S200
 G1 X15.995000 Y3.766194 F1500.000
@@ -4204,7 +4204,7 @@ G1 X15.505000 Y3.766194 F1500.000
 G1 X15.505000 Y0.946194 F1500.000
 G1 X15.995000 Y0.946194 F1500.000
 M5
-; pass 524: cut 15 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 524: cut 15 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X14.995000 Y1.410000
 M4 S200
 G1 X14.505000 Y1.410000 F1500.000
@@ -4212,7 +4212,7 @@ G1 X14.505000 Y-1.410000 F1500.000
 G1 X14.995000 Y-1.410000 F1500.000
 G1 X14.995000 Y1.410000 F1500.000
 M5
-; pass 525: cut 14 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 525: cut 14 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X13.995000 Y0.946194
 M4 S200
 G1 X13.995000 Y3.766194 F1500.000
@@ -4220,7 +4220,7 @@ G1 X13.505000 Y3.766194 F1500.000
 G1 X13.505000 Y0.946194 F1500.000
 G1 X13.995000 Y0.946194 F1500.000
 M5
-; pass 526: cut 13 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 526: cut 13 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X12.995000 Y1.410000
 M4 S200
 G1 X12.505000 Y1.410000 F1500.000
@@ -4228,7 +4228,7 @@ G1 X12.505000 Y-1.410000 F1500.000
 G1 X12.995000 Y-1.410000 F1500.000
 G1 X12.995000 Y1.410000 F1500.000
 M5
-; pass 527: cut 12 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 527: cut 12 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X11.995000 Y0.946194
 M4 S200
 G1 X11.995000 Y3.766194 F1500.000
@@ -4236,7 +4236,7 @@ G1 X11.505000 Y3.766194 F1500.000
 G1 X11.505000 Y0.946194 F1500.000
 G1 X11.995000 Y0.946194 F1500.000
 M5
-; pass 528: cut 11 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 528: cut 11 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.995000 Y1.410000
 M4 S200
 G1 X10.505000 Y1.410000 F1500.000
@@ -4244,7 +4244,7 @@ G1 X10.505000 Y-1.410000 F1500.000
 G1 X10.995000 Y-1.410000 F1500.000
 G1 X10.995000 Y1.410000 F1500.000
 M5
-; pass 529: cut 10 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 529: cut 10 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -4252,7 +4252,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 530: cut 9 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 530: cut 9 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.410000
 M4 S200
 G1 X8.505000 Y1.410000 F1500.000
@@ -4260,7 +4260,7 @@ G1 X8.505000 Y-1.410000 F1500.000
 G1 X8.995000 Y-1.410000 F1500.000
 G1 X8.995000 Y1.410000 F1500.000
 M5
-; pass 531: cut 8 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 531: cut 8 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -4268,7 +4268,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 532: cut 7 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 532: cut 7 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.410000
 M4 S200
 G1 X6.505000 Y1.410000 F1500.000
@@ -4276,7 +4276,7 @@ G1 X6.505000 Y-1.410000 F1500.000
 G1 X6.995000 Y-1.410000 F1500.000
 G1 X6.995000 Y1.410000 F1500.000
 M5
-; pass 533: cut 6 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 533: cut 6 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -4284,7 +4284,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 534: cut 5 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 534: cut 5 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.410000
 M4 S200
 G1 X4.505000 Y1.410000 F1500.000
@@ -4292,7 +4292,7 @@ G1 X4.505000 Y-1.410000 F1500.000
 G1 X4.995000 Y-1.410000 F1500.000
 G1 X4.995000 Y1.410000 F1500.000
 M5
-; pass 535: cut 4 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 535: cut 4 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -4300,7 +4300,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 536: cut 3 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 536: cut 3 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.410000
 M4 S200
 G1 X2.505000 Y1.410000 F1500.000
@@ -4308,7 +4308,7 @@ G1 X2.505000 Y-1.410000 F1500.000
 G1 X2.995000 Y-1.410000 F1500.000
 G1 X2.995000 Y1.410000 F1500.000
 M5
-; pass 537: cut 2 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 537: cut 2 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -4316,7 +4316,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 538: cut 1 hole, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 538: cut 1 hole, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -4324,7 +4324,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 539: cut 0 hole, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 539: cut 0 hole, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y0.145000
 M4 S200
 G1 X0.605000 Y0.145000 F1500.000
@@ -4332,7 +4332,7 @@ G1 X0.605000 Y-0.145000 F1500.000
 G1 X0.895000 Y-0.145000 F1500.000
 G1 X0.895000 Y0.145000 F1500.000
 M5
-; pass 540: cut 0 hole, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 540: cut 0 hole, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y0.140000
 M4 S200
 G1 X0.610000 Y0.140000 F1500.000
@@ -4340,7 +4340,7 @@ G1 X0.610000 Y-0.140000 F1500.000
 G1 X0.890000 Y-0.140000 F1500.000
 G1 X0.890000 Y0.140000 F1500.000
 M5
-; pass 541: cut 1 hole, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 541: cut 1 hole, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -4348,7 +4348,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 542: cut 2 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 542: cut 2 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -4356,7 +4356,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 543: cut 3 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 543: cut 3 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.405000
 M4 S200
 G1 X2.510000 Y-1.405000 F1500.000
@@ -4364,7 +4364,7 @@ G1 X2.990000 Y-1.405000 F1500.000
 G1 X2.990000 Y1.405000 F1500.000
 G1 X2.510000 Y1.405000 F1500.000
 M5
-; pass 544: cut 4 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 544: cut 4 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -4372,7 +4372,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 545: cut 5 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 545: cut 5 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.405000
 M4 S200
 G1 X4.510000 Y-1.405000 F1500.000
@@ -4380,7 +4380,7 @@ G1 X4.990000 Y-1.405000 F1500.000
 G1 X4.990000 Y1.405000 F1500.000
 G1 X4.510000 Y1.405000 F1500.000
 M5
-; pass 546: cut 6 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 546: cut 6 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -4388,7 +4388,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 547: cut 7 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 547: cut 7 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.405000
 M4 S200
 G1 X6.510000 Y-1.405000 F1500.000
@@ -4396,7 +4396,7 @@ G1 X6.990000 Y-1.405000 F1500.000
 G1 X6.990000 Y1.405000 F1500.000
 G1 X6.510000 Y1.405000 F1500.000
 M5
-; pass 548: cut 8 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 548: cut 8 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -4404,7 +4404,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 549: cut 9 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 549: cut 9 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.405000
 M4 S200
 G1 X8.510000 Y-1.405000 F1500.000
@@ -4412,7 +4412,7 @@ G1 X8.990000 Y-1.405000 F1500.000
 G1 X8.990000 Y1.405000 F1500.000
 G1 X8.510000 Y1.405000 F1500.000
 M5
-; pass 550: cut 10 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 550: cut 10 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -4420,7 +4420,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 551: cut 11 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 551: cut 11 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.405000
 M4 S200
 G1 X10.510000 Y-1.405000 F1500.000
@@ -4428,7 +4428,7 @@ G1 X10.990000 Y-1.405000 F1500.000
 G1 X10.990000 Y1.405000 F1500.000
 G1 X10.510000 Y1.405000 F1500.000
 M5
-; pass 552: cut 12 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 552: cut 12 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X11.510000 Y0.951194
 M4 S200
 G1 X11.990000 Y0.951194 F1500.000
@@ -4436,7 +4436,7 @@ G1 X11.990000 Y3.761194 F1500.000
 G1 X11.510000 Y3.761194 F1500.000
 G1 X11.510000 Y0.951194 F1500.000
 M5
-; pass 553: cut 13 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 553: cut 13 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X12.510000 Y1.405000
 M4 S200
 G1 X12.510000 Y-1.405000 F1500.000
@@ -4444,7 +4444,7 @@ G1 X12.990000 Y-1.405000 F1500.000
 G1 X12.990000 Y1.405000 F1500.000
 G1 X12.510000 Y1.405000 F1500.000
 M5
-; pass 554: cut 14 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 554: cut 14 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X13.510000 Y0.951194
 M4 S200
 G1 X13.990000 Y0.951194 F1500.000
@@ -4452,7 +4452,7 @@ G1 X13.990000 Y3.761194 F1500.000
 G1 X13.510000 Y3.761194 F1500.000
 G1 X13.510000 Y0.951194 F1500.000
 M5
-; pass 555: cut 15 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 555: cut 15 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X14.510000 Y1.405000
 M4 S200
 G1 X14.510000 Y-1.405000 F1500.000
@@ -4460,7 +4460,7 @@ G1 X14.990000 Y-1.405000 F1500.000
 G1 X14.990000 Y1.405000 F1500.000
 G1 X14.510000 Y1.405000 F1500.000
 M5
-; pass 556: cut 16 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 556: cut 16 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X15.510000 Y0.951194
 M4 S200
 G1 X15.990000 Y0.951194 F1500.000
@@ -4468,7 +4468,7 @@ G1 X15.990000 Y3.761194 F1500.000
 G1 X15.510000 Y3.761194 F1500.000
 G1 X15.510000 Y0.951194 F1500.000
 M5
-; pass 557: cut 17 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 557: cut 17 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X16.510000 Y1.405000
 M4 S200
 G1 X16.510000 Y-1.405000 F1500.000
@@ -4476,7 +4476,7 @@ G1 X16.990000 Y-1.405000 F1500.000
 G1 X16.990000 Y1.405000 F1500.000
 G1 X16.510000 Y1.405000 F1500.000
 M5
-; pass 558: cut 17 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 558: cut 17 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X16.515000 Y1.400000
 M4 S200
 G1 X16.515000 Y-1.400000 F1500.000
@@ -4484,7 +4484,7 @@ G1 X16.985000 Y-1.400000 F1500.000
 G1 X16.985000 Y1.400000 F1500.000
 G1 X16.515000 Y1.400000 F1500.000
 M5
-; pass 559: cut 16 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 559: cut 16 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X15.985000 Y0.956194
 M4 S200
 G1 X15.985000 Y3.756194 F1500.000
@@ -4492,7 +4492,7 @@ G1 X15.515000 Y3.756194 F1500.000
 G1 X15.515000 Y0.956194 F1500.000
 G1 X15.985000 Y0.956194 F1500.000
 M5
-; pass 560: cut 15 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 560: cut 15 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X14.985000 Y1.400000
 M4 S200
 G1 X14.515000 Y1.400000 F1500.000
@@ -4500,7 +4500,7 @@ G1 X14.515000 Y-1.400000 F1500.000
 G1 X14.985000 Y-1.400000 F1500.000
 G1 X14.985000 Y1.400000 F1500.000
 M5
-; pass 561: cut 14 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 561: cut 14 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X13.985000 Y0.956194
 M4 S200
 G1 X13.985000 Y3.756194 F1500.000
@@ -4508,7 +4508,7 @@ G1 X13.515000 Y3.756194 F1500.000
 G1 X13.515000 Y0.956194 F1500.000
 G1 X13.985000 Y0.956194 F1500.000
 M5
-; pass 562: cut 13 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 562: cut 13 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X12.985000 Y1.400000
 M4 S200
 G1 X12.515000 Y1.400000 F1500.000
@@ -4516,7 +4516,7 @@ G1 X12.515000 Y-1.400000 F1500.000
 G1 X12.985000 Y-1.400000 F1500.000
 G1 X12.985000 Y1.400000 F1500.000
 M5
-; pass 563: cut 12 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 563: cut 12 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X11.985000 Y0.956194
 M4 S200
 G1 X11.985000 Y3.756194 F1500.000
@@ -4524,7 +4524,7 @@ G1 X11.515000 Y3.756194 F1500.000
 G1 X11.515000 Y0.956194 F1500.000
 G1 X11.985000 Y0.956194 F1500.000
 M5
-; pass 564: cut 11 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 564: cut 11 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.985000 Y1.400000
 M4 S200
 G1 X10.515000 Y1.400000 F1500.000
@@ -4532,7 +4532,7 @@ G1 X10.515000 Y-1.400000 F1500.000
 G1 X10.985000 Y-1.400000 F1500.000
 G1 X10.985000 Y1.400000 F1500.000
 M5
-; pass 565: cut 10 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 565: cut 10 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -4540,7 +4540,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 566: cut 9 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 566: cut 9 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.400000
 M4 S200
 G1 X8.515000 Y1.400000 F1500.000
@@ -4548,7 +4548,7 @@ G1 X8.515000 Y-1.400000 F1500.000
 G1 X8.985000 Y-1.400000 F1500.000
 G1 X8.985000 Y1.400000 F1500.000
 M5
-; pass 567: cut 8 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 567: cut 8 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -4556,7 +4556,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 568: cut 7 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 568: cut 7 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.400000
 M4 S200
 G1 X6.515000 Y1.400000 F1500.000
@@ -4564,7 +4564,7 @@ G1 X6.515000 Y-1.400000 F1500.000
 G1 X6.985000 Y-1.400000 F1500.000
 G1 X6.985000 Y1.400000 F1500.000
 M5
-; pass 569: cut 6 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 569: cut 6 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -4572,7 +4572,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 570: cut 5 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 570: cut 5 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.400000
 M4 S200
 G1 X4.515000 Y1.400000 F1500.000
@@ -4580,7 +4580,7 @@ G1 X4.515000 Y-1.400000 F1500.000
 G1 X4.985000 Y-1.400000 F1500.000
 G1 X4.985000 Y1.400000 F1500.000
 M5
-; pass 571: cut 4 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 571: cut 4 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -4588,7 +4588,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 572: cut 3 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 572: cut 3 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.400000
 M4 S200
 G1 X2.515000 Y1.400000 F1500.000
@@ -4596,7 +4596,7 @@ G1 X2.515000 Y-1.400000 F1500.000
 G1 X2.985000 Y-1.400000 F1500.000
 G1 X2.985000 Y1.400000 F1500.000
 M5
-; pass 573: cut 2 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 573: cut 2 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -4604,7 +4604,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 574: cut 1 hole, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 574: cut 1 hole, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -4612,7 +4612,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 575: cut 0 hole, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 575: cut 0 hole, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y0.135000
 M4 S200
 G1 X0.615000 Y0.135000 F1500.000

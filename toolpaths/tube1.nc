@@ -5,7 +5,7 @@
 G21 G90 G17 G94
 M5
 G0 Z0
-; pass 0: cut 0 hole, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 0: cut 0 hole, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 M4 S200
 G1 X0.900000 Y2.506194 F1500.000
@@ -13,7 +13,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 1: cut 1 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 1: cut 1 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -21,7 +21,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 2: cut 2 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 2: cut 2 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y0.941194
 M4 S200
 G1 X3.000000 Y0.941194 F1500.000
@@ -29,7 +29,7 @@ G1 X3.000000 Y3.771194 F1500.000
 G1 X2.500000 Y3.771194 F1500.000
 G1 X2.500000 Y0.941194 F1500.000
 M5
-; pass 3: cut 3 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 3: cut 3 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -37,7 +37,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 4: cut 4 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 4: cut 4 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y0.941194
 M4 S200
 G1 X5.000000 Y0.941194 F1500.000
@@ -45,7 +45,7 @@ G1 X5.000000 Y3.771194 F1500.000
 G1 X4.500000 Y3.771194 F1500.000
 G1 X4.500000 Y0.941194 F1500.000
 M5
-; pass 5: cut 5 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 5: cut 5 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -53,7 +53,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 6: cut 6 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 6: cut 6 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y0.941194
 M4 S200
 G1 X7.000000 Y0.941194 F1500.000
@@ -61,7 +61,7 @@ G1 X7.000000 Y3.771194 F1500.000
 G1 X6.500000 Y3.771194 F1500.000
 G1 X6.500000 Y0.941194 F1500.000
 M5
-; pass 7: cut 7 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 7: cut 7 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -69,7 +69,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 8: cut 8 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 8: cut 8 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y0.941194
 M4 S200
 G1 X9.000000 Y0.941194 F1500.000
@@ -77,7 +77,7 @@ G1 X9.000000 Y3.771194 F1500.000
 G1 X8.500000 Y3.771194 F1500.000
 G1 X8.500000 Y0.941194 F1500.000
 M5
-; pass 9: cut 9 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 9: cut 9 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -85,7 +85,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 10: cut 10 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 10: cut 10 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y0.941194
 M4 S200
 G1 X11.000000 Y0.941194 F1500.000
@@ -93,7 +93,7 @@ G1 X11.000000 Y3.771194 F1500.000
 G1 X10.500000 Y3.771194 F1500.000
 G1 X10.500000 Y0.941194 F1500.000
 M5
-; pass 11: cut 10 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 11: cut 10 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y0.946194
 M4 S200
 G1 X10.995000 Y0.946194 F1500.000
@@ -101,7 +101,7 @@ G1 X10.995000 Y3.766194 F1500.000
 G1 X10.505000 Y3.766194 F1500.000
 G1 X10.505000 Y0.946194 F1500.000
 M5
-; pass 12: cut 9 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 12: cut 9 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -109,7 +109,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 13: cut 8 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 13: cut 8 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y0.946194
 M4 S200
 G1 X8.995000 Y3.766194 F1500.000
@@ -117,7 +117,7 @@ G1 X8.505000 Y3.766194 F1500.000
 G1 X8.505000 Y0.946194 F1500.000
 G1 X8.995000 Y0.946194 F1500.000
 M5
-; pass 14: cut 7 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 14: cut 7 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -125,7 +125,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 15: cut 6 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 15: cut 6 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y0.946194
 M4 S200
 G1 X6.995000 Y3.766194 F1500.000
@@ -133,7 +133,7 @@ G1 X6.505000 Y3.766194 F1500.000
 G1 X6.505000 Y0.946194 F1500.000
 G1 X6.995000 Y0.946194 F1500.000
 M5
-; pass 16: cut 5 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 16: cut 5 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -141,7 +141,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 17: cut 4 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 17: cut 4 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y0.946194
 M4 S200
 G1 X4.995000 Y3.766194 F1500.000
@@ -149,7 +149,7 @@ G1 X4.505000 Y3.766194 F1500.000
 G1 X4.505000 Y0.946194 F1500.000
 G1 X4.995000 Y0.946194 F1500.000
 M5
-; pass 18: cut 3 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 18: cut 3 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -157,7 +157,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 19: cut 2 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 19: cut 2 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y0.946194
 M4 S200
 G1 X2.995000 Y3.766194 F1500.000
@@ -165,7 +165,7 @@ G1 X2.505000 Y3.766194 F1500.000
 G1 X2.505000 Y0.946194 F1500.000
 G1 X2.995000 Y0.946194 F1500.000
 M5
-; pass 20: cut 1 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 20: cut 1 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -173,7 +173,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 21: cut 0 hole, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 21: cut 0 hole, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -181,7 +181,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 22: cut 0 hole, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 22: cut 0 hole, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -189,7 +189,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 23: cut 1 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 23: cut 1 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -197,7 +197,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 24: cut 2 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 24: cut 2 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y0.951194
 M4 S200
 G1 X2.990000 Y0.951194 F1500.000
@@ -205,7 +205,7 @@ G1 X2.990000 Y3.761194 F1500.000
 G1 X2.510000 Y3.761194 F1500.000
 G1 X2.510000 Y0.951194 F1500.000
 M5
-; pass 25: cut 3 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 25: cut 3 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -213,7 +213,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 26: cut 4 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 26: cut 4 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y0.951194
 M4 S200
 G1 X4.990000 Y0.951194 F1500.000
@@ -221,7 +221,7 @@ G1 X4.990000 Y3.761194 F1500.000
 G1 X4.510000 Y3.761194 F1500.000
 G1 X4.510000 Y0.951194 F1500.000
 M5
-; pass 27: cut 5 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 27: cut 5 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -229,7 +229,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 28: cut 6 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 28: cut 6 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y0.951194
 M4 S200
 G1 X6.990000 Y0.951194 F1500.000
@@ -237,7 +237,7 @@ G1 X6.990000 Y3.761194 F1500.000
 G1 X6.510000 Y3.761194 F1500.000
 G1 X6.510000 Y0.951194 F1500.000
 M5
-; pass 29: cut 7 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 29: cut 7 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -245,7 +245,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 30: cut 8 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 30: cut 8 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y0.951194
 M4 S200
 G1 X8.990000 Y0.951194 F1500.000
@@ -253,7 +253,7 @@ G1 X8.990000 Y3.761194 F1500.000
 G1 X8.510000 Y3.761194 F1500.000
 G1 X8.510000 Y0.951194 F1500.000
 M5
-; pass 31: cut 9 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 31: cut 9 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -261,7 +261,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 32: cut 10 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 32: cut 10 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y0.951194
 M4 S200
 G1 X10.990000 Y0.951194 F1500.000
@@ -269,7 +269,7 @@ G1 X10.990000 Y3.761194 F1500.000
 G1 X10.510000 Y3.761194 F1500.000
 G1 X10.510000 Y0.951194 F1500.000
 M5
-; pass 33: cut 10 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 33: cut 10 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y0.956194
 M4 S200
 G1 X10.985000 Y0.956194 F1500.000
@@ -277,7 +277,7 @@ G1 X10.985000 Y3.756194 F1500.000
 G1 X10.515000 Y3.756194 F1500.000
 G1 X10.515000 Y0.956194 F1500.000
 M5
-; pass 34: cut 9 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 34: cut 9 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -285,7 +285,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 35: cut 8 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 35: cut 8 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y0.956194
 M4 S200
 G1 X8.985000 Y3.756194 F1500.000
@@ -293,7 +293,7 @@ G1 X8.515000 Y3.756194 F1500.000
 G1 X8.515000 Y0.956194 F1500.000
 G1 X8.985000 Y0.956194 F1500.000
 M5
-; pass 36: cut 7 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 36: cut 7 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -301,7 +301,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 37: cut 6 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 37: cut 6 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y0.956194
 M4 S200
 G1 X6.985000 Y3.756194 F1500.000
@@ -309,7 +309,7 @@ G1 X6.515000 Y3.756194 F1500.000
 G1 X6.515000 Y0.956194 F1500.000
 G1 X6.985000 Y0.956194 F1500.000
 M5
-; pass 38: cut 5 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 38: cut 5 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -317,7 +317,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 39: cut 4 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 39: cut 4 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y0.956194
 M4 S200
 G1 X4.985000 Y3.756194 F1500.000
@@ -325,7 +325,7 @@ G1 X4.515000 Y3.756194 F1500.000
 G1 X4.515000 Y0.956194 F1500.000
 G1 X4.985000 Y0.956194 F1500.000
 M5
-; pass 40: cut 3 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 40: cut 3 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -333,7 +333,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 41: cut 2 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 41: cut 2 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y0.956194
 M4 S200
 G1 X2.985000 Y3.756194 F1500.000
@@ -341,7 +341,7 @@ G1 X2.515000 Y3.756194 F1500.000
 G1 X2.515000 Y0.956194 F1500.000
 G1 X2.985000 Y0.956194 F1500.000
 M5
-; pass 42: cut 1 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 42: cut 1 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -349,7 +349,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 43: cut 0 hole, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 43: cut 0 hole, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -357,7 +357,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 44: cut 0 hole, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 44: cut 0 hole, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 G0 Z-0.100000
 M4 S200
@@ -366,7 +366,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 45: cut 1 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 45: cut 1 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -374,7 +374,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 46: cut 2 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 46: cut 2 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y0.941194
 M4 S200
 G1 X3.000000 Y0.941194 F1500.000
@@ -382,7 +382,7 @@ G1 X3.000000 Y3.771194 F1500.000
 G1 X2.500000 Y3.771194 F1500.000
 G1 X2.500000 Y0.941194 F1500.000
 M5
-; pass 47: cut 3 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 47: cut 3 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -390,7 +390,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 48: cut 4 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 48: cut 4 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y0.941194
 M4 S200
 G1 X5.000000 Y0.941194 F1500.000
@@ -398,7 +398,7 @@ G1 X5.000000 Y3.771194 F1500.000
 G1 X4.500000 Y3.771194 F1500.000
 G1 X4.500000 Y0.941194 F1500.000
 M5
-; pass 49: cut 5 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 49: cut 5 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -406,7 +406,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 50: cut 6 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 50: cut 6 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y0.941194
 M4 S200
 G1 X7.000000 Y0.941194 F1500.000
@@ -414,7 +414,7 @@ G1 X7.000000 Y3.771194 F1500.000
 G1 X6.500000 Y3.771194 F1500.000
 G1 X6.500000 Y0.941194 F1500.000
 M5
-; pass 51: cut 7 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 51: cut 7 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -422,7 +422,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 52: cut 8 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 52: cut 8 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y0.941194
 M4 S200
 G1 X9.000000 Y0.941194 F1500.000
@@ -430,7 +430,7 @@ G1 X9.000000 Y3.771194 F1500.000
 G1 X8.500000 Y3.771194 F1500.000
 G1 X8.500000 Y0.941194 F1500.000
 M5
-; pass 53: cut 9 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 53: cut 9 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -438,7 +438,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 54: cut 10 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 54: cut 10 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y0.941194
 M4 S200
 G1 X11.000000 Y0.941194 F1500.000
@@ -446,7 +446,7 @@ G1 X11.000000 Y3.771194 F1500.000
 G1 X10.500000 Y3.771194 F1500.000
 G1 X10.500000 Y0.941194 F1500.000
 M5
-; pass 55: cut 10 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 55: cut 10 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y0.946194
 M4 S200
 G1 X10.995000 Y0.946194 F1500.000
@@ -454,7 +454,7 @@ G1 X10.995000 Y3.766194 F1500.000
 G1 X10.505000 Y3.766194 F1500.000
 G1 X10.505000 Y0.946194 F1500.000
 M5
-; pass 56: cut 9 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 56: cut 9 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -462,7 +462,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 57: cut 8 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 57: cut 8 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y0.946194
 M4 S200
 G1 X8.995000 Y3.766194 F1500.000
@@ -470,7 +470,7 @@ G1 X8.505000 Y3.766194 F1500.000
 G1 X8.505000 Y0.946194 F1500.000
 G1 X8.995000 Y0.946194 F1500.000
 M5
-; pass 58: cut 7 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 58: cut 7 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -478,7 +478,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 59: cut 6 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 59: cut 6 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y0.946194
 M4 S200
 G1 X6.995000 Y3.766194 F1500.000
@@ -486,7 +486,7 @@ G1 X6.505000 Y3.766194 F1500.000
 G1 X6.505000 Y0.946194 F1500.000
 G1 X6.995000 Y0.946194 F1500.000
 M5
-; pass 60: cut 5 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 60: cut 5 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -494,7 +494,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 61: cut 4 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 61: cut 4 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y0.946194
 M4 S200
 G1 X4.995000 Y3.766194 F1500.000
@@ -502,7 +502,7 @@ G1 X4.505000 Y3.766194 F1500.000
 G1 X4.505000 Y0.946194 F1500.000
 G1 X4.995000 Y0.946194 F1500.000
 M5
-; pass 62: cut 3 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 62: cut 3 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -510,7 +510,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 63: cut 2 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 63: cut 2 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y0.946194
 M4 S200
 G1 X2.995000 Y3.766194 F1500.000
@@ -518,7 +518,7 @@ G1 X2.505000 Y3.766194 F1500.000
 G1 X2.505000 Y0.946194 F1500.000
 G1 X2.995000 Y0.946194 F1500.000
 M5
-; pass 64: cut 1 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 64: cut 1 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -526,7 +526,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 65: cut 0 hole, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 65: cut 0 hole, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -534,7 +534,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 66: cut 0 hole, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 66: cut 0 hole, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -542,7 +542,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 67: cut 1 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 67: cut 1 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -550,7 +550,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 68: cut 2 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 68: cut 2 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y0.951194
 M4 S200
 G1 X2.990000 Y0.951194 F1500.000
@@ -558,7 +558,7 @@ G1 X2.990000 Y3.761194 F1500.000
 G1 X2.510000 Y3.761194 F1500.000
 G1 X2.510000 Y0.951194 F1500.000
 M5
-; pass 69: cut 3 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 69: cut 3 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -566,7 +566,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 70: cut 4 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 70: cut 4 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y0.951194
 M4 S200
 G1 X4.990000 Y0.951194 F1500.000
@@ -574,7 +574,7 @@ G1 X4.990000 Y3.761194 F1500.000
 G1 X4.510000 Y3.761194 F1500.000
 G1 X4.510000 Y0.951194 F1500.000
 M5
-; pass 71: cut 5 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 71: cut 5 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -582,7 +582,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 72: cut 6 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 72: cut 6 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y0.951194
 M4 S200
 G1 X6.990000 Y0.951194 F1500.000
@@ -590,7 +590,7 @@ G1 X6.990000 Y3.761194 F1500.000
 G1 X6.510000 Y3.761194 F1500.000
 G1 X6.510000 Y0.951194 F1500.000
 M5
-; pass 73: cut 7 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 73: cut 7 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -598,7 +598,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 74: cut 8 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 74: cut 8 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y0.951194
 M4 S200
 G1 X8.990000 Y0.951194 F1500.000
@@ -606,7 +606,7 @@ G1 X8.990000 Y3.761194 F1500.000
 G1 X8.510000 Y3.761194 F1500.000
 G1 X8.510000 Y0.951194 F1500.000
 M5
-; pass 75: cut 9 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 75: cut 9 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -614,7 +614,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 76: cut 10 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 76: cut 10 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y0.951194
 M4 S200
 G1 X10.990000 Y0.951194 F1500.000
@@ -622,7 +622,7 @@ G1 X10.990000 Y3.761194 F1500.000
 G1 X10.510000 Y3.761194 F1500.000
 G1 X10.510000 Y0.951194 F1500.000
 M5
-; pass 77: cut 10 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 77: cut 10 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y0.956194
 M4 S200
 G1 X10.985000 Y0.956194 F1500.000
@@ -630,7 +630,7 @@ G1 X10.985000 Y3.756194 F1500.000
 G1 X10.515000 Y3.756194 F1500.000
 G1 X10.515000 Y0.956194 F1500.000
 M5
-; pass 78: cut 9 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 78: cut 9 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -638,7 +638,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 79: cut 8 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 79: cut 8 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y0.956194
 M4 S200
 G1 X8.985000 Y3.756194 F1500.000
@@ -646,7 +646,7 @@ G1 X8.515000 Y3.756194 F1500.000
 G1 X8.515000 Y0.956194 F1500.000
 G1 X8.985000 Y0.956194 F1500.000
 M5
-; pass 80: cut 7 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 80: cut 7 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -654,7 +654,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 81: cut 6 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 81: cut 6 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y0.956194
 M4 S200
 G1 X6.985000 Y3.756194 F1500.000
@@ -662,7 +662,7 @@ G1 X6.515000 Y3.756194 F1500.000
 G1 X6.515000 Y0.956194 F1500.000
 G1 X6.985000 Y0.956194 F1500.000
 M5
-; pass 82: cut 5 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 82: cut 5 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -670,7 +670,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 83: cut 4 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 83: cut 4 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y0.956194
 M4 S200
 G1 X4.985000 Y3.756194 F1500.000
@@ -678,7 +678,7 @@ G1 X4.515000 Y3.756194 F1500.000
 G1 X4.515000 Y0.956194 F1500.000
 G1 X4.985000 Y0.956194 F1500.000
 M5
-; pass 84: cut 3 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 84: cut 3 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -686,7 +686,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 85: cut 2 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 85: cut 2 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y0.956194
 M4 S200
 G1 X2.985000 Y3.756194 F1500.000
@@ -694,7 +694,7 @@ G1 X2.515000 Y3.756194 F1500.000
 G1 X2.515000 Y0.956194 F1500.000
 G1 X2.985000 Y0.956194 F1500.000
 M5
-; pass 86: cut 1 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 86: cut 1 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -702,7 +702,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 87: cut 0 hole, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 87: cut 0 hole, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -710,7 +710,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 88: cut 0 hole, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 88: cut 0 hole, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 G0 Z0.000000
 M4 S200
@@ -719,7 +719,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 89: cut 1 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 89: cut 1 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -727,7 +727,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 90: cut 2 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 90: cut 2 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y0.941194
 M4 S200
 G1 X3.000000 Y0.941194 F1500.000
@@ -735,7 +735,7 @@ G1 X3.000000 Y3.771194 F1500.000
 G1 X2.500000 Y3.771194 F1500.000
 G1 X2.500000 Y0.941194 F1500.000
 M5
-; pass 91: cut 3 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 91: cut 3 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -743,7 +743,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 92: cut 4 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 92: cut 4 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y0.941194
 M4 S200
 G1 X5.000000 Y0.941194 F1500.000
@@ -751,7 +751,7 @@ G1 X5.000000 Y3.771194 F1500.000
 G1 X4.500000 Y3.771194 F1500.000
 G1 X4.500000 Y0.941194 F1500.000
 M5
-; pass 93: cut 5 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 93: cut 5 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -759,7 +759,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 94: cut 6 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 94: cut 6 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y0.941194
 M4 S200
 G1 X7.000000 Y0.941194 F1500.000
@@ -767,7 +767,7 @@ G1 X7.000000 Y3.771194 F1500.000
 G1 X6.500000 Y3.771194 F1500.000
 G1 X6.500000 Y0.941194 F1500.000
 M5
-; pass 95: cut 7 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 95: cut 7 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -775,7 +775,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 96: cut 8 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 96: cut 8 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y0.941194
 M4 S200
 G1 X9.000000 Y0.941194 F1500.000
@@ -783,7 +783,7 @@ G1 X9.000000 Y3.771194 F1500.000
 G1 X8.500000 Y3.771194 F1500.000
 G1 X8.500000 Y0.941194 F1500.000
 M5
-; pass 97: cut 9 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 97: cut 9 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -791,7 +791,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 98: cut 10 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 98: cut 10 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y0.941194
 M4 S200
 G1 X11.000000 Y0.941194 F1500.000
@@ -799,7 +799,7 @@ G1 X11.000000 Y3.771194 F1500.000
 G1 X10.500000 Y3.771194 F1500.000
 G1 X10.500000 Y0.941194 F1500.000
 M5
-; pass 99: cut 10 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 99: cut 10 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y0.946194
 M4 S200
 G1 X10.995000 Y0.946194 F1500.000
@@ -807,7 +807,7 @@ G1 X10.995000 Y3.766194 F1500.000
 G1 X10.505000 Y3.766194 F1500.000
 G1 X10.505000 Y0.946194 F1500.000
 M5
-; pass 100: cut 9 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 100: cut 9 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -815,7 +815,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 101: cut 8 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 101: cut 8 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y0.946194
 M4 S200
 G1 X8.995000 Y3.766194 F1500.000
@@ -823,7 +823,7 @@ G1 X8.505000 Y3.766194 F1500.000
 G1 X8.505000 Y0.946194 F1500.000
 G1 X8.995000 Y0.946194 F1500.000
 M5
-; pass 102: cut 7 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 102: cut 7 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -831,7 +831,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 103: cut 6 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 103: cut 6 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y0.946194
 M4 S200
 G1 X6.995000 Y3.766194 F1500.000
@@ -839,7 +839,7 @@ G1 X6.505000 Y3.766194 F1500.000
 G1 X6.505000 Y0.946194 F1500.000
 G1 X6.995000 Y0.946194 F1500.000
 M5
-; pass 104: cut 5 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 104: cut 5 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -847,7 +847,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 105: cut 4 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 105: cut 4 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y0.946194
 M4 S200
 G1 X4.995000 Y3.766194 F1500.000
@@ -855,7 +855,7 @@ G1 X4.505000 Y3.766194 F1500.000
 G1 X4.505000 Y0.946194 F1500.000
 G1 X4.995000 Y0.946194 F1500.000
 M5
-; pass 106: cut 3 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 106: cut 3 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -863,7 +863,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 107: cut 2 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 107: cut 2 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y0.946194
 M4 S200
 G1 X2.995000 Y3.766194 F1500.000
@@ -871,7 +871,7 @@ G1 X2.505000 Y3.766194 F1500.000
 G1 X2.505000 Y0.946194 F1500.000
 G1 X2.995000 Y0.946194 F1500.000
 M5
-; pass 108: cut 1 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 108: cut 1 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -879,7 +879,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 109: cut 0 hole, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 109: cut 0 hole, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -887,7 +887,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 110: cut 0 hole, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 110: cut 0 hole, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -895,7 +895,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 111: cut 1 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 111: cut 1 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -903,7 +903,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 112: cut 2 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 112: cut 2 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y0.951194
 M4 S200
 G1 X2.990000 Y0.951194 F1500.000
@@ -911,7 +911,7 @@ G1 X2.990000 Y3.761194 F1500.000
 G1 X2.510000 Y3.761194 F1500.000
 G1 X2.510000 Y0.951194 F1500.000
 M5
-; pass 113: cut 3 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 113: cut 3 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -919,7 +919,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 114: cut 4 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 114: cut 4 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y0.951194
 M4 S200
 G1 X4.990000 Y0.951194 F1500.000
@@ -927,7 +927,7 @@ G1 X4.990000 Y3.761194 F1500.000
 G1 X4.510000 Y3.761194 F1500.000
 G1 X4.510000 Y0.951194 F1500.000
 M5
-; pass 115: cut 5 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 115: cut 5 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -935,7 +935,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 116: cut 6 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 116: cut 6 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y0.951194
 M4 S200
 G1 X6.990000 Y0.951194 F1500.000
@@ -943,7 +943,7 @@ G1 X6.990000 Y3.761194 F1500.000
 G1 X6.510000 Y3.761194 F1500.000
 G1 X6.510000 Y0.951194 F1500.000
 M5
-; pass 117: cut 7 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 117: cut 7 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -951,7 +951,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 118: cut 8 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 118: cut 8 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y0.951194
 M4 S200
 G1 X8.990000 Y0.951194 F1500.000
@@ -959,7 +959,7 @@ G1 X8.990000 Y3.761194 F1500.000
 G1 X8.510000 Y3.761194 F1500.000
 G1 X8.510000 Y0.951194 F1500.000
 M5
-; pass 119: cut 9 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 119: cut 9 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -967,7 +967,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 120: cut 10 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 120: cut 10 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y0.951194
 M4 S200
 G1 X10.990000 Y0.951194 F1500.000
@@ -975,7 +975,7 @@ G1 X10.990000 Y3.761194 F1500.000
 G1 X10.510000 Y3.761194 F1500.000
 G1 X10.510000 Y0.951194 F1500.000
 M5
-; pass 121: cut 10 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 121: cut 10 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y0.956194
 M4 S200
 G1 X10.985000 Y0.956194 F1500.000
@@ -983,7 +983,7 @@ G1 X10.985000 Y3.756194 F1500.000
 G1 X10.515000 Y3.756194 F1500.000
 G1 X10.515000 Y0.956194 F1500.000
 M5
-; pass 122: cut 9 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 122: cut 9 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -991,7 +991,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 123: cut 8 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 123: cut 8 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y0.956194
 M4 S200
 G1 X8.985000 Y3.756194 F1500.000
@@ -999,7 +999,7 @@ G1 X8.515000 Y3.756194 F1500.000
 G1 X8.515000 Y0.956194 F1500.000
 G1 X8.985000 Y0.956194 F1500.000
 M5
-; pass 124: cut 7 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 124: cut 7 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -1007,7 +1007,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 125: cut 6 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 125: cut 6 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y0.956194
 M4 S200
 G1 X6.985000 Y3.756194 F1500.000
@@ -1015,7 +1015,7 @@ G1 X6.515000 Y3.756194 F1500.000
 G1 X6.515000 Y0.956194 F1500.000
 G1 X6.985000 Y0.956194 F1500.000
 M5
-; pass 126: cut 5 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 126: cut 5 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -1023,7 +1023,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 127: cut 4 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 127: cut 4 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y0.956194
 M4 S200
 G1 X4.985000 Y3.756194 F1500.000
@@ -1031,7 +1031,7 @@ G1 X4.515000 Y3.756194 F1500.000
 G1 X4.515000 Y0.956194 F1500.000
 G1 X4.985000 Y0.956194 F1500.000
 M5
-; pass 128: cut 3 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 128: cut 3 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -1039,7 +1039,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 129: cut 2 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 129: cut 2 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y0.956194
 M4 S200
 G1 X2.985000 Y3.756194 F1500.000
@@ -1047,7 +1047,7 @@ G1 X2.515000 Y3.756194 F1500.000
 G1 X2.515000 Y0.956194 F1500.000
 G1 X2.985000 Y0.956194 F1500.000
 M5
-; pass 130: cut 1 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 130: cut 1 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -1055,7 +1055,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 131: cut 0 hole, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 131: cut 0 hole, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -1063,7 +1063,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 132: cut 0 hole, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 132: cut 0 hole, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 G0 Z-0.100000
 M4 S200
@@ -1072,7 +1072,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 133: cut 1 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 133: cut 1 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -1080,7 +1080,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 134: cut 2 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 134: cut 2 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y0.941194
 M4 S200
 G1 X3.000000 Y0.941194 F1500.000
@@ -1088,7 +1088,7 @@ G1 X3.000000 Y3.771194 F1500.000
 G1 X2.500000 Y3.771194 F1500.000
 G1 X2.500000 Y0.941194 F1500.000
 M5
-; pass 135: cut 3 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 135: cut 3 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -1096,7 +1096,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 136: cut 4 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 136: cut 4 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y0.941194
 M4 S200
 G1 X5.000000 Y0.941194 F1500.000
@@ -1104,7 +1104,7 @@ G1 X5.000000 Y3.771194 F1500.000
 G1 X4.500000 Y3.771194 F1500.000
 G1 X4.500000 Y0.941194 F1500.000
 M5
-; pass 137: cut 5 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 137: cut 5 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -1112,7 +1112,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 138: cut 6 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 138: cut 6 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y0.941194
 M4 S200
 G1 X7.000000 Y0.941194 F1500.000
@@ -1120,7 +1120,7 @@ G1 X7.000000 Y3.771194 F1500.000
 G1 X6.500000 Y3.771194 F1500.000
 G1 X6.500000 Y0.941194 F1500.000
 M5
-; pass 139: cut 7 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 139: cut 7 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -1128,7 +1128,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 140: cut 8 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 140: cut 8 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y0.941194
 M4 S200
 G1 X9.000000 Y0.941194 F1500.000
@@ -1136,7 +1136,7 @@ G1 X9.000000 Y3.771194 F1500.000
 G1 X8.500000 Y3.771194 F1500.000
 G1 X8.500000 Y0.941194 F1500.000
 M5
-; pass 141: cut 9 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 141: cut 9 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -1144,7 +1144,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 142: cut 10 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 142: cut 10 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y0.941194
 M4 S200
 G1 X11.000000 Y0.941194 F1500.000
@@ -1152,7 +1152,7 @@ G1 X11.000000 Y3.771194 F1500.000
 G1 X10.500000 Y3.771194 F1500.000
 G1 X10.500000 Y0.941194 F1500.000
 M5
-; pass 143: cut 10 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 143: cut 10 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y0.946194
 M4 S200
 G1 X10.995000 Y0.946194 F1500.000
@@ -1160,7 +1160,7 @@ G1 X10.995000 Y3.766194 F1500.000
 G1 X10.505000 Y3.766194 F1500.000
 G1 X10.505000 Y0.946194 F1500.000
 M5
-; pass 144: cut 9 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 144: cut 9 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -1168,7 +1168,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 145: cut 8 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 145: cut 8 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y0.946194
 M4 S200
 G1 X8.995000 Y3.766194 F1500.000
@@ -1176,7 +1176,7 @@ G1 X8.505000 Y3.766194 F1500.000
 G1 X8.505000 Y0.946194 F1500.000
 G1 X8.995000 Y0.946194 F1500.000
 M5
-; pass 146: cut 7 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 146: cut 7 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -1184,7 +1184,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 147: cut 6 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 147: cut 6 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y0.946194
 M4 S200
 G1 X6.995000 Y3.766194 F1500.000
@@ -1192,7 +1192,7 @@ G1 X6.505000 Y3.766194 F1500.000
 G1 X6.505000 Y0.946194 F1500.000
 G1 X6.995000 Y0.946194 F1500.000
 M5
-; pass 148: cut 5 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 148: cut 5 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -1200,7 +1200,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 149: cut 4 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 149: cut 4 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y0.946194
 M4 S200
 G1 X4.995000 Y3.766194 F1500.000
@@ -1208,7 +1208,7 @@ G1 X4.505000 Y3.766194 F1500.000
 G1 X4.505000 Y0.946194 F1500.000
 G1 X4.995000 Y0.946194 F1500.000
 M5
-; pass 150: cut 3 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 150: cut 3 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -1216,7 +1216,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 151: cut 2 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 151: cut 2 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y0.946194
 M4 S200
 G1 X2.995000 Y3.766194 F1500.000
@@ -1224,7 +1224,7 @@ G1 X2.505000 Y3.766194 F1500.000
 G1 X2.505000 Y0.946194 F1500.000
 G1 X2.995000 Y0.946194 F1500.000
 M5
-; pass 152: cut 1 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 152: cut 1 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -1232,7 +1232,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 153: cut 0 hole, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 153: cut 0 hole, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -1240,7 +1240,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 154: cut 0 hole, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 154: cut 0 hole, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -1248,7 +1248,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 155: cut 1 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 155: cut 1 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -1256,7 +1256,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 156: cut 2 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 156: cut 2 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y0.951194
 M4 S200
 G1 X2.990000 Y0.951194 F1500.000
@@ -1264,7 +1264,7 @@ G1 X2.990000 Y3.761194 F1500.000
 G1 X2.510000 Y3.761194 F1500.000
 G1 X2.510000 Y0.951194 F1500.000
 M5
-; pass 157: cut 3 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 157: cut 3 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -1272,7 +1272,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 158: cut 4 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 158: cut 4 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y0.951194
 M4 S200
 G1 X4.990000 Y0.951194 F1500.000
@@ -1280,7 +1280,7 @@ G1 X4.990000 Y3.761194 F1500.000
 G1 X4.510000 Y3.761194 F1500.000
 G1 X4.510000 Y0.951194 F1500.000
 M5
-; pass 159: cut 5 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 159: cut 5 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -1288,7 +1288,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 160: cut 6 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 160: cut 6 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y0.951194
 M4 S200
 G1 X6.990000 Y0.951194 F1500.000
@@ -1296,7 +1296,7 @@ G1 X6.990000 Y3.761194 F1500.000
 G1 X6.510000 Y3.761194 F1500.000
 G1 X6.510000 Y0.951194 F1500.000
 M5
-; pass 161: cut 7 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 161: cut 7 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -1304,7 +1304,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 162: cut 8 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 162: cut 8 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y0.951194
 M4 S200
 G1 X8.990000 Y0.951194 F1500.000
@@ -1312,7 +1312,7 @@ G1 X8.990000 Y3.761194 F1500.000
 G1 X8.510000 Y3.761194 F1500.000
 G1 X8.510000 Y0.951194 F1500.000
 M5
-; pass 163: cut 9 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 163: cut 9 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -1320,7 +1320,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 164: cut 10 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 164: cut 10 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y0.951194
 M4 S200
 G1 X10.990000 Y0.951194 F1500.000
@@ -1328,7 +1328,7 @@ G1 X10.990000 Y3.761194 F1500.000
 G1 X10.510000 Y3.761194 F1500.000
 G1 X10.510000 Y0.951194 F1500.000
 M5
-; pass 165: cut 10 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 165: cut 10 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y0.956194
 M4 S200
 G1 X10.985000 Y0.956194 F1500.000
@@ -1336,7 +1336,7 @@ G1 X10.985000 Y3.756194 F1500.000
 G1 X10.515000 Y3.756194 F1500.000
 G1 X10.515000 Y0.956194 F1500.000
 M5
-; pass 166: cut 9 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 166: cut 9 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -1344,7 +1344,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 167: cut 8 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 167: cut 8 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y0.956194
 M4 S200
 G1 X8.985000 Y3.756194 F1500.000
@@ -1352,7 +1352,7 @@ G1 X8.515000 Y3.756194 F1500.000
 G1 X8.515000 Y0.956194 F1500.000
 G1 X8.985000 Y0.956194 F1500.000
 M5
-; pass 168: cut 7 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 168: cut 7 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -1360,7 +1360,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 169: cut 6 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 169: cut 6 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y0.956194
 M4 S200
 G1 X6.985000 Y3.756194 F1500.000
@@ -1368,7 +1368,7 @@ G1 X6.515000 Y3.756194 F1500.000
 G1 X6.515000 Y0.956194 F1500.000
 G1 X6.985000 Y0.956194 F1500.000
 M5
-; pass 170: cut 5 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 170: cut 5 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -1376,7 +1376,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 171: cut 4 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 171: cut 4 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y0.956194
 M4 S200
 G1 X4.985000 Y3.756194 F1500.000
@@ -1384,7 +1384,7 @@ G1 X4.515000 Y3.756194 F1500.000
 G1 X4.515000 Y0.956194 F1500.000
 G1 X4.985000 Y0.956194 F1500.000
 M5
-; pass 172: cut 3 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 172: cut 3 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -1392,7 +1392,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 173: cut 2 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 173: cut 2 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y0.956194
 M4 S200
 G1 X2.985000 Y3.756194 F1500.000
@@ -1400,7 +1400,7 @@ G1 X2.515000 Y3.756194 F1500.000
 G1 X2.515000 Y0.956194 F1500.000
 G1 X2.985000 Y0.956194 F1500.000
 M5
-; pass 174: cut 1 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 174: cut 1 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -1408,7 +1408,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 175: cut 0 hole, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 175: cut 0 hole, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -1416,7 +1416,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 176: cut 0 hole, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 176: cut 0 hole, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 G0 Z0.000000
 M4 S200
@@ -1425,7 +1425,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 177: cut 1 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 177: cut 1 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -1433,7 +1433,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 178: cut 2 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 178: cut 2 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y0.941194
 M4 S200
 G1 X3.000000 Y0.941194 F1500.000
@@ -1441,7 +1441,7 @@ G1 X3.000000 Y3.771194 F1500.000
 G1 X2.500000 Y3.771194 F1500.000
 G1 X2.500000 Y0.941194 F1500.000
 M5
-; pass 179: cut 3 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 179: cut 3 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -1449,7 +1449,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 180: cut 4 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 180: cut 4 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y0.941194
 M4 S200
 G1 X5.000000 Y0.941194 F1500.000
@@ -1457,7 +1457,7 @@ G1 X5.000000 Y3.771194 F1500.000
 G1 X4.500000 Y3.771194 F1500.000
 G1 X4.500000 Y0.941194 F1500.000
 M5
-; pass 181: cut 5 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 181: cut 5 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -1465,7 +1465,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 182: cut 6 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 182: cut 6 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y0.941194
 M4 S200
 G1 X7.000000 Y0.941194 F1500.000
@@ -1473,7 +1473,7 @@ G1 X7.000000 Y3.771194 F1500.000
 G1 X6.500000 Y3.771194 F1500.000
 G1 X6.500000 Y0.941194 F1500.000
 M5
-; pass 183: cut 7 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 183: cut 7 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -1481,7 +1481,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 184: cut 8 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 184: cut 8 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y0.941194
 M4 S200
 G1 X9.000000 Y0.941194 F1500.000
@@ -1489,7 +1489,7 @@ G1 X9.000000 Y3.771194 F1500.000
 G1 X8.500000 Y3.771194 F1500.000
 G1 X8.500000 Y0.941194 F1500.000
 M5
-; pass 185: cut 9 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 185: cut 9 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -1497,7 +1497,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 186: cut 10 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 186: cut 10 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y0.941194
 M4 S200
 G1 X11.000000 Y0.941194 F1500.000
@@ -1505,7 +1505,7 @@ G1 X11.000000 Y3.771194 F1500.000
 G1 X10.500000 Y3.771194 F1500.000
 G1 X10.500000 Y0.941194 F1500.000
 M5
-; pass 187: cut 10 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 187: cut 10 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y0.946194
 M4 S200
 G1 X10.995000 Y0.946194 F1500.000
@@ -1513,7 +1513,7 @@ G1 X10.995000 Y3.766194 F1500.000
 G1 X10.505000 Y3.766194 F1500.000
 G1 X10.505000 Y0.946194 F1500.000
 M5
-; pass 188: cut 9 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 188: cut 9 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -1521,7 +1521,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 189: cut 8 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 189: cut 8 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y0.946194
 M4 S200
 G1 X8.995000 Y3.766194 F1500.000
@@ -1529,7 +1529,7 @@ G1 X8.505000 Y3.766194 F1500.000
 G1 X8.505000 Y0.946194 F1500.000
 G1 X8.995000 Y0.946194 F1500.000
 M5
-; pass 190: cut 7 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 190: cut 7 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -1537,7 +1537,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 191: cut 6 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 191: cut 6 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y0.946194
 M4 S200
 G1 X6.995000 Y3.766194 F1500.000
@@ -1545,7 +1545,7 @@ G1 X6.505000 Y3.766194 F1500.000
 G1 X6.505000 Y0.946194 F1500.000
 G1 X6.995000 Y0.946194 F1500.000
 M5
-; pass 192: cut 5 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 192: cut 5 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -1553,7 +1553,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 193: cut 4 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 193: cut 4 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y0.946194
 M4 S200
 G1 X4.995000 Y3.766194 F1500.000
@@ -1561,7 +1561,7 @@ G1 X4.505000 Y3.766194 F1500.000
 G1 X4.505000 Y0.946194 F1500.000
 G1 X4.995000 Y0.946194 F1500.000
 M5
-; pass 194: cut 3 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 194: cut 3 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -1569,7 +1569,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 195: cut 2 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 195: cut 2 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y0.946194
 M4 S200
 G1 X2.995000 Y3.766194 F1500.000
@@ -1577,7 +1577,7 @@ G1 X2.505000 Y3.766194 F1500.000
 G1 X2.505000 Y0.946194 F1500.000
 G1 X2.995000 Y0.946194 F1500.000
 M5
-; pass 196: cut 1 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 196: cut 1 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -1585,7 +1585,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 197: cut 0 hole, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 197: cut 0 hole, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -1593,7 +1593,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 198: cut 0 hole, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 198: cut 0 hole, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -1601,7 +1601,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 199: cut 1 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 199: cut 1 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -1609,7 +1609,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 200: cut 2 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 200: cut 2 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y0.951194
 M4 S200
 G1 X2.990000 Y0.951194 F1500.000
@@ -1617,7 +1617,7 @@ G1 X2.990000 Y3.761194 F1500.000
 G1 X2.510000 Y3.761194 F1500.000
 G1 X2.510000 Y0.951194 F1500.000
 M5
-; pass 201: cut 3 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 201: cut 3 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -1625,7 +1625,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 202: cut 4 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 202: cut 4 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y0.951194
 M4 S200
 G1 X4.990000 Y0.951194 F1500.000
@@ -1633,7 +1633,7 @@ G1 X4.990000 Y3.761194 F1500.000
 G1 X4.510000 Y3.761194 F1500.000
 G1 X4.510000 Y0.951194 F1500.000
 M5
-; pass 203: cut 5 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 203: cut 5 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -1641,7 +1641,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 204: cut 6 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 204: cut 6 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y0.951194
 M4 S200
 G1 X6.990000 Y0.951194 F1500.000
@@ -1649,7 +1649,7 @@ G1 X6.990000 Y3.761194 F1500.000
 G1 X6.510000 Y3.761194 F1500.000
 G1 X6.510000 Y0.951194 F1500.000
 M5
-; pass 205: cut 7 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 205: cut 7 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -1657,7 +1657,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 206: cut 8 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 206: cut 8 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y0.951194
 M4 S200
 G1 X8.990000 Y0.951194 F1500.000
@@ -1665,7 +1665,7 @@ G1 X8.990000 Y3.761194 F1500.000
 G1 X8.510000 Y3.761194 F1500.000
 G1 X8.510000 Y0.951194 F1500.000
 M5
-; pass 207: cut 9 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 207: cut 9 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -1673,7 +1673,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 208: cut 10 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 208: cut 10 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y0.951194
 M4 S200
 G1 X10.990000 Y0.951194 F1500.000
@@ -1681,7 +1681,7 @@ G1 X10.990000 Y3.761194 F1500.000
 G1 X10.510000 Y3.761194 F1500.000
 G1 X10.510000 Y0.951194 F1500.000
 M5
-; pass 209: cut 10 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 209: cut 10 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y0.956194
 M4 S200
 G1 X10.985000 Y0.956194 F1500.000
@@ -1689,7 +1689,7 @@ G1 X10.985000 Y3.756194 F1500.000
 G1 X10.515000 Y3.756194 F1500.000
 G1 X10.515000 Y0.956194 F1500.000
 M5
-; pass 210: cut 9 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 210: cut 9 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -1697,7 +1697,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 211: cut 8 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 211: cut 8 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y0.956194
 M4 S200
 G1 X8.985000 Y3.756194 F1500.000
@@ -1705,7 +1705,7 @@ G1 X8.515000 Y3.756194 F1500.000
 G1 X8.515000 Y0.956194 F1500.000
 G1 X8.985000 Y0.956194 F1500.000
 M5
-; pass 212: cut 7 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 212: cut 7 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -1713,7 +1713,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 213: cut 6 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 213: cut 6 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y0.956194
 M4 S200
 G1 X6.985000 Y3.756194 F1500.000
@@ -1721,7 +1721,7 @@ G1 X6.515000 Y3.756194 F1500.000
 G1 X6.515000 Y0.956194 F1500.000
 G1 X6.985000 Y0.956194 F1500.000
 M5
-; pass 214: cut 5 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 214: cut 5 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -1729,7 +1729,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 215: cut 4 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 215: cut 4 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y0.956194
 M4 S200
 G1 X4.985000 Y3.756194 F1500.000
@@ -1737,7 +1737,7 @@ G1 X4.515000 Y3.756194 F1500.000
 G1 X4.515000 Y0.956194 F1500.000
 G1 X4.985000 Y0.956194 F1500.000
 M5
-; pass 216: cut 3 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 216: cut 3 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -1745,7 +1745,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 217: cut 2 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 217: cut 2 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y0.956194
 M4 S200
 G1 X2.985000 Y3.756194 F1500.000
@@ -1753,7 +1753,7 @@ G1 X2.515000 Y3.756194 F1500.000
 G1 X2.515000 Y0.956194 F1500.000
 G1 X2.985000 Y0.956194 F1500.000
 M5
-; pass 218: cut 1 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 218: cut 1 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -1761,7 +1761,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 219: cut 0 hole, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 219: cut 0 hole, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -1769,7 +1769,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 220: cut 0 hole, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 220: cut 0 hole, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 G0 Z-0.100000
 M4 S200
@@ -1778,7 +1778,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 221: cut 1 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 221: cut 1 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -1786,7 +1786,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 222: cut 2 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 222: cut 2 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y0.941194
 M4 S200
 G1 X3.000000 Y0.941194 F1500.000
@@ -1794,7 +1794,7 @@ G1 X3.000000 Y3.771194 F1500.000
 G1 X2.500000 Y3.771194 F1500.000
 G1 X2.500000 Y0.941194 F1500.000
 M5
-; pass 223: cut 3 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 223: cut 3 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -1802,7 +1802,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 224: cut 4 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 224: cut 4 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y0.941194
 M4 S200
 G1 X5.000000 Y0.941194 F1500.000
@@ -1810,7 +1810,7 @@ G1 X5.000000 Y3.771194 F1500.000
 G1 X4.500000 Y3.771194 F1500.000
 G1 X4.500000 Y0.941194 F1500.000
 M5
-; pass 225: cut 5 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 225: cut 5 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -1818,7 +1818,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 226: cut 6 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 226: cut 6 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y0.941194
 M4 S200
 G1 X7.000000 Y0.941194 F1500.000
@@ -1826,7 +1826,7 @@ G1 X7.000000 Y3.771194 F1500.000
 G1 X6.500000 Y3.771194 F1500.000
 G1 X6.500000 Y0.941194 F1500.000
 M5
-; pass 227: cut 7 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 227: cut 7 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -1834,7 +1834,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 228: cut 8 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 228: cut 8 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y0.941194
 M4 S200
 G1 X9.000000 Y0.941194 F1500.000
@@ -1842,7 +1842,7 @@ G1 X9.000000 Y3.771194 F1500.000
 G1 X8.500000 Y3.771194 F1500.000
 G1 X8.500000 Y0.941194 F1500.000
 M5
-; pass 229: cut 9 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 229: cut 9 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -1850,7 +1850,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 230: cut 10 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 230: cut 10 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y0.941194
 M4 S200
 G1 X11.000000 Y0.941194 F1500.000
@@ -1858,7 +1858,7 @@ G1 X11.000000 Y3.771194 F1500.000
 G1 X10.500000 Y3.771194 F1500.000
 G1 X10.500000 Y0.941194 F1500.000
 M5
-; pass 231: cut 10 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 231: cut 10 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y0.946194
 M4 S200
 G1 X10.995000 Y0.946194 F1500.000
@@ -1866,7 +1866,7 @@ G1 X10.995000 Y3.766194 F1500.000
 G1 X10.505000 Y3.766194 F1500.000
 G1 X10.505000 Y0.946194 F1500.000
 M5
-; pass 232: cut 9 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 232: cut 9 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -1874,7 +1874,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 233: cut 8 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 233: cut 8 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y0.946194
 M4 S200
 G1 X8.995000 Y3.766194 F1500.000
@@ -1882,7 +1882,7 @@ G1 X8.505000 Y3.766194 F1500.000
 G1 X8.505000 Y0.946194 F1500.000
 G1 X8.995000 Y0.946194 F1500.000
 M5
-; pass 234: cut 7 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 234: cut 7 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -1890,7 +1890,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 235: cut 6 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 235: cut 6 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y0.946194
 M4 S200
 G1 X6.995000 Y3.766194 F1500.000
@@ -1898,7 +1898,7 @@ G1 X6.505000 Y3.766194 F1500.000
 G1 X6.505000 Y0.946194 F1500.000
 G1 X6.995000 Y0.946194 F1500.000
 M5
-; pass 236: cut 5 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 236: cut 5 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -1906,7 +1906,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 237: cut 4 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 237: cut 4 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y0.946194
 M4 S200
 G1 X4.995000 Y3.766194 F1500.000
@@ -1914,7 +1914,7 @@ G1 X4.505000 Y3.766194 F1500.000
 G1 X4.505000 Y0.946194 F1500.000
 G1 X4.995000 Y0.946194 F1500.000
 M5
-; pass 238: cut 3 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 238: cut 3 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -1922,7 +1922,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 239: cut 2 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 239: cut 2 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y0.946194
 M4 S200
 G1 X2.995000 Y3.766194 F1500.000
@@ -1930,7 +1930,7 @@ G1 X2.505000 Y3.766194 F1500.000
 G1 X2.505000 Y0.946194 F1500.000
 G1 X2.995000 Y0.946194 F1500.000
 M5
-; pass 240: cut 1 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 240: cut 1 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -1938,7 +1938,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 241: cut 0 hole, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 241: cut 0 hole, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -1946,7 +1946,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 242: cut 0 hole, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 242: cut 0 hole, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -1954,7 +1954,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 243: cut 1 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 243: cut 1 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -1962,7 +1962,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 244: cut 2 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 244: cut 2 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y0.951194
 M4 S200
 G1 X2.990000 Y0.951194 F1500.000
@@ -1970,7 +1970,7 @@ G1 X2.990000 Y3.761194 F1500.000
 G1 X2.510000 Y3.761194 F1500.000
 G1 X2.510000 Y0.951194 F1500.000
 M5
-; pass 245: cut 3 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 245: cut 3 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -1978,7 +1978,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 246: cut 4 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 246: cut 4 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y0.951194
 M4 S200
 G1 X4.990000 Y0.951194 F1500.000
@@ -1986,7 +1986,7 @@ G1 X4.990000 Y3.761194 F1500.000
 G1 X4.510000 Y3.761194 F1500.000
 G1 X4.510000 Y0.951194 F1500.000
 M5
-; pass 247: cut 5 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 247: cut 5 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -1994,7 +1994,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 248: cut 6 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 248: cut 6 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y0.951194
 M4 S200
 G1 X6.990000 Y0.951194 F1500.000
@@ -2002,7 +2002,7 @@ G1 X6.990000 Y3.761194 F1500.000
 G1 X6.510000 Y3.761194 F1500.000
 G1 X6.510000 Y0.951194 F1500.000
 M5
-; pass 249: cut 7 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 249: cut 7 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -2010,7 +2010,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 250: cut 8 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 250: cut 8 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y0.951194
 M4 S200
 G1 X8.990000 Y0.951194 F1500.000
@@ -2018,7 +2018,7 @@ G1 X8.990000 Y3.761194 F1500.000
 G1 X8.510000 Y3.761194 F1500.000
 G1 X8.510000 Y0.951194 F1500.000
 M5
-; pass 251: cut 9 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 251: cut 9 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -2026,7 +2026,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 252: cut 10 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 252: cut 10 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y0.951194
 M4 S200
 G1 X10.990000 Y0.951194 F1500.000
@@ -2034,7 +2034,7 @@ G1 X10.990000 Y3.761194 F1500.000
 G1 X10.510000 Y3.761194 F1500.000
 G1 X10.510000 Y0.951194 F1500.000
 M5
-; pass 253: cut 10 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 253: cut 10 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y0.956194
 M4 S200
 G1 X10.985000 Y0.956194 F1500.000
@@ -2042,7 +2042,7 @@ G1 X10.985000 Y3.756194 F1500.000
 G1 X10.515000 Y3.756194 F1500.000
 G1 X10.515000 Y0.956194 F1500.000
 M5
-; pass 254: cut 9 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 254: cut 9 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -2050,7 +2050,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 255: cut 8 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 255: cut 8 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y0.956194
 M4 S200
 G1 X8.985000 Y3.756194 F1500.000
@@ -2058,7 +2058,7 @@ G1 X8.515000 Y3.756194 F1500.000
 G1 X8.515000 Y0.956194 F1500.000
 G1 X8.985000 Y0.956194 F1500.000
 M5
-; pass 256: cut 7 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 256: cut 7 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -2066,7 +2066,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 257: cut 6 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 257: cut 6 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y0.956194
 M4 S200
 G1 X6.985000 Y3.756194 F1500.000
@@ -2074,7 +2074,7 @@ G1 X6.515000 Y3.756194 F1500.000
 G1 X6.515000 Y0.956194 F1500.000
 G1 X6.985000 Y0.956194 F1500.000
 M5
-; pass 258: cut 5 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 258: cut 5 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -2082,7 +2082,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 259: cut 4 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 259: cut 4 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y0.956194
 M4 S200
 G1 X4.985000 Y3.756194 F1500.000
@@ -2090,7 +2090,7 @@ G1 X4.515000 Y3.756194 F1500.000
 G1 X4.515000 Y0.956194 F1500.000
 G1 X4.985000 Y0.956194 F1500.000
 M5
-; pass 260: cut 3 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 260: cut 3 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -2098,7 +2098,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 261: cut 2 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 261: cut 2 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y0.956194
 M4 S200
 G1 X2.985000 Y3.756194 F1500.000
@@ -2106,7 +2106,7 @@ G1 X2.515000 Y3.756194 F1500.000
 G1 X2.515000 Y0.956194 F1500.000
 G1 X2.985000 Y0.956194 F1500.000
 M5
-; pass 262: cut 1 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 262: cut 1 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -2114,7 +2114,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 263: cut 0 hole, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 263: cut 0 hole, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -2122,7 +2122,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 264: cut 0 hole, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 264: cut 0 hole, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 G0 Z0.000000
 M4 S200
@@ -2131,7 +2131,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 265: cut 1 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 265: cut 1 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -2139,7 +2139,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 266: cut 2 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 266: cut 2 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y0.941194
 M4 S200
 G1 X3.000000 Y0.941194 F1500.000
@@ -2147,7 +2147,7 @@ G1 X3.000000 Y3.771194 F1500.000
 G1 X2.500000 Y3.771194 F1500.000
 G1 X2.500000 Y0.941194 F1500.000
 M5
-; pass 267: cut 3 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 267: cut 3 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -2155,7 +2155,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 268: cut 4 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 268: cut 4 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y0.941194
 M4 S200
 G1 X5.000000 Y0.941194 F1500.000
@@ -2163,7 +2163,7 @@ G1 X5.000000 Y3.771194 F1500.000
 G1 X4.500000 Y3.771194 F1500.000
 G1 X4.500000 Y0.941194 F1500.000
 M5
-; pass 269: cut 5 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 269: cut 5 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -2171,7 +2171,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 270: cut 6 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 270: cut 6 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y0.941194
 M4 S200
 G1 X7.000000 Y0.941194 F1500.000
@@ -2179,7 +2179,7 @@ G1 X7.000000 Y3.771194 F1500.000
 G1 X6.500000 Y3.771194 F1500.000
 G1 X6.500000 Y0.941194 F1500.000
 M5
-; pass 271: cut 7 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 271: cut 7 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -2187,7 +2187,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 272: cut 8 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 272: cut 8 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y0.941194
 M4 S200
 G1 X9.000000 Y0.941194 F1500.000
@@ -2195,7 +2195,7 @@ G1 X9.000000 Y3.771194 F1500.000
 G1 X8.500000 Y3.771194 F1500.000
 G1 X8.500000 Y0.941194 F1500.000
 M5
-; pass 273: cut 9 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 273: cut 9 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -2203,7 +2203,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 274: cut 10 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 274: cut 10 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y0.941194
 M4 S200
 G1 X11.000000 Y0.941194 F1500.000
@@ -2211,7 +2211,7 @@ G1 X11.000000 Y3.771194 F1500.000
 G1 X10.500000 Y3.771194 F1500.000
 G1 X10.500000 Y0.941194 F1500.000
 M5
-; pass 275: cut 10 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 275: cut 10 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y0.946194
 M4 S200
 G1 X10.995000 Y0.946194 F1500.000
@@ -2219,7 +2219,7 @@ G1 X10.995000 Y3.766194 F1500.000
 G1 X10.505000 Y3.766194 F1500.000
 G1 X10.505000 Y0.946194 F1500.000
 M5
-; pass 276: cut 9 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 276: cut 9 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -2227,7 +2227,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 277: cut 8 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 277: cut 8 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y0.946194
 M4 S200
 G1 X8.995000 Y3.766194 F1500.000
@@ -2235,7 +2235,7 @@ G1 X8.505000 Y3.766194 F1500.000
 G1 X8.505000 Y0.946194 F1500.000
 G1 X8.995000 Y0.946194 F1500.000
 M5
-; pass 278: cut 7 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 278: cut 7 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -2243,7 +2243,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 279: cut 6 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 279: cut 6 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y0.946194
 M4 S200
 G1 X6.995000 Y3.766194 F1500.000
@@ -2251,7 +2251,7 @@ G1 X6.505000 Y3.766194 F1500.000
 G1 X6.505000 Y0.946194 F1500.000
 G1 X6.995000 Y0.946194 F1500.000
 M5
-; pass 280: cut 5 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 280: cut 5 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -2259,7 +2259,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 281: cut 4 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 281: cut 4 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y0.946194
 M4 S200
 G1 X4.995000 Y3.766194 F1500.000
@@ -2267,7 +2267,7 @@ G1 X4.505000 Y3.766194 F1500.000
 G1 X4.505000 Y0.946194 F1500.000
 G1 X4.995000 Y0.946194 F1500.000
 M5
-; pass 282: cut 3 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 282: cut 3 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -2275,7 +2275,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 283: cut 2 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 283: cut 2 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y0.946194
 M4 S200
 G1 X2.995000 Y3.766194 F1500.000
@@ -2283,7 +2283,7 @@ G1 X2.505000 Y3.766194 F1500.000
 G1 X2.505000 Y0.946194 F1500.000
 G1 X2.995000 Y0.946194 F1500.000
 M5
-; pass 284: cut 1 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 284: cut 1 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -2291,7 +2291,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 285: cut 0 hole, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 285: cut 0 hole, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -2299,7 +2299,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 286: cut 0 hole, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 286: cut 0 hole, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -2307,7 +2307,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 287: cut 1 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 287: cut 1 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -2315,7 +2315,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 288: cut 2 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 288: cut 2 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y0.951194
 M4 S200
 G1 X2.990000 Y0.951194 F1500.000
@@ -2323,7 +2323,7 @@ G1 X2.990000 Y3.761194 F1500.000
 G1 X2.510000 Y3.761194 F1500.000
 G1 X2.510000 Y0.951194 F1500.000
 M5
-; pass 289: cut 3 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 289: cut 3 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -2331,7 +2331,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 290: cut 4 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 290: cut 4 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y0.951194
 M4 S200
 G1 X4.990000 Y0.951194 F1500.000
@@ -2339,7 +2339,7 @@ G1 X4.990000 Y3.761194 F1500.000
 G1 X4.510000 Y3.761194 F1500.000
 G1 X4.510000 Y0.951194 F1500.000
 M5
-; pass 291: cut 5 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 291: cut 5 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -2347,7 +2347,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 292: cut 6 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 292: cut 6 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y0.951194
 M4 S200
 G1 X6.990000 Y0.951194 F1500.000
@@ -2355,7 +2355,7 @@ G1 X6.990000 Y3.761194 F1500.000
 G1 X6.510000 Y3.761194 F1500.000
 G1 X6.510000 Y0.951194 F1500.000
 M5
-; pass 293: cut 7 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 293: cut 7 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -2363,7 +2363,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 294: cut 8 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 294: cut 8 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y0.951194
 M4 S200
 G1 X8.990000 Y0.951194 F1500.000
@@ -2371,7 +2371,7 @@ G1 X8.990000 Y3.761194 F1500.000
 G1 X8.510000 Y3.761194 F1500.000
 G1 X8.510000 Y0.951194 F1500.000
 M5
-; pass 295: cut 9 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 295: cut 9 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -2379,7 +2379,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 296: cut 10 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 296: cut 10 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y0.951194
 M4 S200
 G1 X10.990000 Y0.951194 F1500.000
@@ -2387,7 +2387,7 @@ G1 X10.990000 Y3.761194 F1500.000
 G1 X10.510000 Y3.761194 F1500.000
 G1 X10.510000 Y0.951194 F1500.000
 M5
-; pass 297: cut 10 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 297: cut 10 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y0.956194
 M4 S200
 G1 X10.985000 Y0.956194 F1500.000
@@ -2395,7 +2395,7 @@ G1 X10.985000 Y3.756194 F1500.000
 G1 X10.515000 Y3.756194 F1500.000
 G1 X10.515000 Y0.956194 F1500.000
 M5
-; pass 298: cut 9 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 298: cut 9 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -2403,7 +2403,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 299: cut 8 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 299: cut 8 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y0.956194
 M4 S200
 G1 X8.985000 Y3.756194 F1500.000
@@ -2411,7 +2411,7 @@ G1 X8.515000 Y3.756194 F1500.000
 G1 X8.515000 Y0.956194 F1500.000
 G1 X8.985000 Y0.956194 F1500.000
 M5
-; pass 300: cut 7 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 300: cut 7 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -2419,7 +2419,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 301: cut 6 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 301: cut 6 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y0.956194
 M4 S200
 G1 X6.985000 Y3.756194 F1500.000
@@ -2427,7 +2427,7 @@ G1 X6.515000 Y3.756194 F1500.000
 G1 X6.515000 Y0.956194 F1500.000
 G1 X6.985000 Y0.956194 F1500.000
 M5
-; pass 302: cut 5 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 302: cut 5 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -2435,7 +2435,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 303: cut 4 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 303: cut 4 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y0.956194
 M4 S200
 G1 X4.985000 Y3.756194 F1500.000
@@ -2443,7 +2443,7 @@ G1 X4.515000 Y3.756194 F1500.000
 G1 X4.515000 Y0.956194 F1500.000
 G1 X4.985000 Y0.956194 F1500.000
 M5
-; pass 304: cut 3 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 304: cut 3 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -2451,7 +2451,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 305: cut 2 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 305: cut 2 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y0.956194
 M4 S200
 G1 X2.985000 Y3.756194 F1500.000
@@ -2459,7 +2459,7 @@ G1 X2.515000 Y3.756194 F1500.000
 G1 X2.515000 Y0.956194 F1500.000
 G1 X2.985000 Y0.956194 F1500.000
 M5
-; pass 306: cut 1 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 306: cut 1 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -2467,7 +2467,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 307: cut 0 hole, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 307: cut 0 hole, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000
@@ -2475,7 +2475,7 @@ G1 X0.615000 Y2.491194 F1500.000
 G1 X0.615000 Y2.221194 F1500.000
 G1 X0.885000 Y2.221194 F1500.000
 M5
-; pass 308: cut 0 hole, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 308: cut 0 hole, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y2.206194
 G0 Z-0.100000
 M4 S200
@@ -2484,7 +2484,7 @@ G1 X0.600000 Y2.506194 F1500.000
 G1 X0.600000 Y2.206194 F1500.000
 G1 X0.900000 Y2.206194 F1500.000
 M5
-; pass 309: cut 1 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 309: cut 1 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y0.941194
 M4 S200
 G1 X2.000000 Y0.941194 F1500.000
@@ -2492,7 +2492,7 @@ G1 X2.000000 Y3.771194 F1500.000
 G1 X1.500000 Y3.771194 F1500.000
 G1 X1.500000 Y0.941194 F1500.000
 M5
-; pass 310: cut 2 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 310: cut 2 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y0.941194
 M4 S200
 G1 X3.000000 Y0.941194 F1500.000
@@ -2500,7 +2500,7 @@ G1 X3.000000 Y3.771194 F1500.000
 G1 X2.500000 Y3.771194 F1500.000
 G1 X2.500000 Y0.941194 F1500.000
 M5
-; pass 311: cut 3 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 311: cut 3 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y0.941194
 M4 S200
 G1 X4.000000 Y0.941194 F1500.000
@@ -2508,7 +2508,7 @@ G1 X4.000000 Y3.771194 F1500.000
 G1 X3.500000 Y3.771194 F1500.000
 G1 X3.500000 Y0.941194 F1500.000
 M5
-; pass 312: cut 4 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 312: cut 4 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y0.941194
 M4 S200
 G1 X5.000000 Y0.941194 F1500.000
@@ -2516,7 +2516,7 @@ G1 X5.000000 Y3.771194 F1500.000
 G1 X4.500000 Y3.771194 F1500.000
 G1 X4.500000 Y0.941194 F1500.000
 M5
-; pass 313: cut 5 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 313: cut 5 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y0.941194
 M4 S200
 G1 X6.000000 Y0.941194 F1500.000
@@ -2524,7 +2524,7 @@ G1 X6.000000 Y3.771194 F1500.000
 G1 X5.500000 Y3.771194 F1500.000
 G1 X5.500000 Y0.941194 F1500.000
 M5
-; pass 314: cut 6 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 314: cut 6 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y0.941194
 M4 S200
 G1 X7.000000 Y0.941194 F1500.000
@@ -2532,7 +2532,7 @@ G1 X7.000000 Y3.771194 F1500.000
 G1 X6.500000 Y3.771194 F1500.000
 G1 X6.500000 Y0.941194 F1500.000
 M5
-; pass 315: cut 7 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 315: cut 7 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y0.941194
 M4 S200
 G1 X8.000000 Y0.941194 F1500.000
@@ -2540,7 +2540,7 @@ G1 X8.000000 Y3.771194 F1500.000
 G1 X7.500000 Y3.771194 F1500.000
 G1 X7.500000 Y0.941194 F1500.000
 M5
-; pass 316: cut 8 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 316: cut 8 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y0.941194
 M4 S200
 G1 X9.000000 Y0.941194 F1500.000
@@ -2548,7 +2548,7 @@ G1 X9.000000 Y3.771194 F1500.000
 G1 X8.500000 Y3.771194 F1500.000
 G1 X8.500000 Y0.941194 F1500.000
 M5
-; pass 317: cut 9 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 317: cut 9 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y0.941194
 M4 S200
 G1 X10.000000 Y0.941194 F1500.000
@@ -2556,7 +2556,7 @@ G1 X10.000000 Y3.771194 F1500.000
 G1 X9.500000 Y3.771194 F1500.000
 G1 X9.500000 Y0.941194 F1500.000
 M5
-; pass 318: cut 10 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 318: cut 10 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y0.941194
 M4 S200
 G1 X11.000000 Y0.941194 F1500.000
@@ -2564,7 +2564,7 @@ G1 X11.000000 Y3.771194 F1500.000
 G1 X10.500000 Y3.771194 F1500.000
 G1 X10.500000 Y0.941194 F1500.000
 M5
-; pass 319: cut 10 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 319: cut 10 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y0.946194
 M4 S200
 G1 X10.995000 Y0.946194 F1500.000
@@ -2572,7 +2572,7 @@ G1 X10.995000 Y3.766194 F1500.000
 G1 X10.505000 Y3.766194 F1500.000
 G1 X10.505000 Y0.946194 F1500.000
 M5
-; pass 320: cut 9 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 320: cut 9 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y0.946194
 M4 S200
 G1 X9.995000 Y3.766194 F1500.000
@@ -2580,7 +2580,7 @@ G1 X9.505000 Y3.766194 F1500.000
 G1 X9.505000 Y0.946194 F1500.000
 G1 X9.995000 Y0.946194 F1500.000
 M5
-; pass 321: cut 8 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 321: cut 8 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y0.946194
 M4 S200
 G1 X8.995000 Y3.766194 F1500.000
@@ -2588,7 +2588,7 @@ G1 X8.505000 Y3.766194 F1500.000
 G1 X8.505000 Y0.946194 F1500.000
 G1 X8.995000 Y0.946194 F1500.000
 M5
-; pass 322: cut 7 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 322: cut 7 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y0.946194
 M4 S200
 G1 X7.995000 Y3.766194 F1500.000
@@ -2596,7 +2596,7 @@ G1 X7.505000 Y3.766194 F1500.000
 G1 X7.505000 Y0.946194 F1500.000
 G1 X7.995000 Y0.946194 F1500.000
 M5
-; pass 323: cut 6 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 323: cut 6 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y0.946194
 M4 S200
 G1 X6.995000 Y3.766194 F1500.000
@@ -2604,7 +2604,7 @@ G1 X6.505000 Y3.766194 F1500.000
 G1 X6.505000 Y0.946194 F1500.000
 G1 X6.995000 Y0.946194 F1500.000
 M5
-; pass 324: cut 5 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 324: cut 5 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y0.946194
 M4 S200
 G1 X5.995000 Y3.766194 F1500.000
@@ -2612,7 +2612,7 @@ G1 X5.505000 Y3.766194 F1500.000
 G1 X5.505000 Y0.946194 F1500.000
 G1 X5.995000 Y0.946194 F1500.000
 M5
-; pass 325: cut 4 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 325: cut 4 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y0.946194
 M4 S200
 G1 X4.995000 Y3.766194 F1500.000
@@ -2620,7 +2620,7 @@ G1 X4.505000 Y3.766194 F1500.000
 G1 X4.505000 Y0.946194 F1500.000
 G1 X4.995000 Y0.946194 F1500.000
 M5
-; pass 326: cut 3 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 326: cut 3 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y0.946194
 M4 S200
 G1 X3.995000 Y3.766194 F1500.000
@@ -2628,7 +2628,7 @@ G1 X3.505000 Y3.766194 F1500.000
 G1 X3.505000 Y0.946194 F1500.000
 G1 X3.995000 Y0.946194 F1500.000
 M5
-; pass 327: cut 2 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 327: cut 2 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y0.946194
 M4 S200
 G1 X2.995000 Y3.766194 F1500.000
@@ -2636,7 +2636,7 @@ G1 X2.505000 Y3.766194 F1500.000
 G1 X2.505000 Y0.946194 F1500.000
 G1 X2.995000 Y0.946194 F1500.000
 M5
-; pass 328: cut 1 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 328: cut 1 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y0.946194
 M4 S200
 G1 X1.995000 Y3.766194 F1500.000
@@ -2644,7 +2644,7 @@ G1 X1.505000 Y3.766194 F1500.000
 G1 X1.505000 Y0.946194 F1500.000
 G1 X1.995000 Y0.946194 F1500.000
 M5
-; pass 329: cut 0 hole, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 329: cut 0 hole, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y2.211194
 M4 S200
 G1 X0.895000 Y2.501194 F1500.000
@@ -2652,7 +2652,7 @@ G1 X0.605000 Y2.501194 F1500.000
 G1 X0.605000 Y2.211194 F1500.000
 G1 X0.895000 Y2.211194 F1500.000
 M5
-; pass 330: cut 0 hole, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 330: cut 0 hole, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y2.216194
 M4 S200
 G1 X0.890000 Y2.496194 F1500.000
@@ -2660,7 +2660,7 @@ G1 X0.610000 Y2.496194 F1500.000
 G1 X0.610000 Y2.216194 F1500.000
 G1 X0.890000 Y2.216194 F1500.000
 M5
-; pass 331: cut 1 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 331: cut 1 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y0.951194
 M4 S200
 G1 X1.990000 Y0.951194 F1500.000
@@ -2668,7 +2668,7 @@ G1 X1.990000 Y3.761194 F1500.000
 G1 X1.510000 Y3.761194 F1500.000
 G1 X1.510000 Y0.951194 F1500.000
 M5
-; pass 332: cut 2 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 332: cut 2 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y0.951194
 M4 S200
 G1 X2.990000 Y0.951194 F1500.000
@@ -2676,7 +2676,7 @@ G1 X2.990000 Y3.761194 F1500.000
 G1 X2.510000 Y3.761194 F1500.000
 G1 X2.510000 Y0.951194 F1500.000
 M5
-; pass 333: cut 3 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 333: cut 3 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y0.951194
 M4 S200
 G1 X3.990000 Y0.951194 F1500.000
@@ -2684,7 +2684,7 @@ G1 X3.990000 Y3.761194 F1500.000
 G1 X3.510000 Y3.761194 F1500.000
 G1 X3.510000 Y0.951194 F1500.000
 M5
-; pass 334: cut 4 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 334: cut 4 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y0.951194
 M4 S200
 G1 X4.990000 Y0.951194 F1500.000
@@ -2692,7 +2692,7 @@ G1 X4.990000 Y3.761194 F1500.000
 G1 X4.510000 Y3.761194 F1500.000
 G1 X4.510000 Y0.951194 F1500.000
 M5
-; pass 335: cut 5 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 335: cut 5 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y0.951194
 M4 S200
 G1 X5.990000 Y0.951194 F1500.000
@@ -2700,7 +2700,7 @@ G1 X5.990000 Y3.761194 F1500.000
 G1 X5.510000 Y3.761194 F1500.000
 G1 X5.510000 Y0.951194 F1500.000
 M5
-; pass 336: cut 6 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 336: cut 6 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y0.951194
 M4 S200
 G1 X6.990000 Y0.951194 F1500.000
@@ -2708,7 +2708,7 @@ G1 X6.990000 Y3.761194 F1500.000
 G1 X6.510000 Y3.761194 F1500.000
 G1 X6.510000 Y0.951194 F1500.000
 M5
-; pass 337: cut 7 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 337: cut 7 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y0.951194
 M4 S200
 G1 X7.990000 Y0.951194 F1500.000
@@ -2716,7 +2716,7 @@ G1 X7.990000 Y3.761194 F1500.000
 G1 X7.510000 Y3.761194 F1500.000
 G1 X7.510000 Y0.951194 F1500.000
 M5
-; pass 338: cut 8 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 338: cut 8 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y0.951194
 M4 S200
 G1 X8.990000 Y0.951194 F1500.000
@@ -2724,7 +2724,7 @@ G1 X8.990000 Y3.761194 F1500.000
 G1 X8.510000 Y3.761194 F1500.000
 G1 X8.510000 Y0.951194 F1500.000
 M5
-; pass 339: cut 9 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 339: cut 9 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y0.951194
 M4 S200
 G1 X9.990000 Y0.951194 F1500.000
@@ -2732,7 +2732,7 @@ G1 X9.990000 Y3.761194 F1500.000
 G1 X9.510000 Y3.761194 F1500.000
 G1 X9.510000 Y0.951194 F1500.000
 M5
-; pass 340: cut 10 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 340: cut 10 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y0.951194
 M4 S200
 G1 X10.990000 Y0.951194 F1500.000
@@ -2740,7 +2740,7 @@ G1 X10.990000 Y3.761194 F1500.000
 G1 X10.510000 Y3.761194 F1500.000
 G1 X10.510000 Y0.951194 F1500.000
 M5
-; pass 341: cut 10 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 341: cut 10 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y0.956194
 M4 S200
 G1 X10.985000 Y0.956194 F1500.000
@@ -2748,7 +2748,7 @@ G1 X10.985000 Y3.756194 F1500.000
 G1 X10.515000 Y3.756194 F1500.000
 G1 X10.515000 Y0.956194 F1500.000
 M5
-; pass 342: cut 9 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 342: cut 9 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y0.956194
 M4 S200
 G1 X9.985000 Y3.756194 F1500.000
@@ -2756,7 +2756,7 @@ G1 X9.515000 Y3.756194 F1500.000
 G1 X9.515000 Y0.956194 F1500.000
 G1 X9.985000 Y0.956194 F1500.000
 M5
-; pass 343: cut 8 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 343: cut 8 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y0.956194
 M4 S200
 G1 X8.985000 Y3.756194 F1500.000
@@ -2764,7 +2764,7 @@ G1 X8.515000 Y3.756194 F1500.000
 G1 X8.515000 Y0.956194 F1500.000
 G1 X8.985000 Y0.956194 F1500.000
 M5
-; pass 344: cut 7 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 344: cut 7 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y0.956194
 M4 S200
 G1 X7.985000 Y3.756194 F1500.000
@@ -2772,7 +2772,7 @@ G1 X7.515000 Y3.756194 F1500.000
 G1 X7.515000 Y0.956194 F1500.000
 G1 X7.985000 Y0.956194 F1500.000
 M5
-; pass 345: cut 6 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 345: cut 6 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y0.956194
 M4 S200
 G1 X6.985000 Y3.756194 F1500.000
@@ -2780,7 +2780,7 @@ G1 X6.515000 Y3.756194 F1500.000
 G1 X6.515000 Y0.956194 F1500.000
 G1 X6.985000 Y0.956194 F1500.000
 M5
-; pass 346: cut 5 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 346: cut 5 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y0.956194
 M4 S200
 G1 X5.985000 Y3.756194 F1500.000
@@ -2788,7 +2788,7 @@ G1 X5.515000 Y3.756194 F1500.000
 G1 X5.515000 Y0.956194 F1500.000
 G1 X5.985000 Y0.956194 F1500.000
 M5
-; pass 347: cut 4 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 347: cut 4 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y0.956194
 M4 S200
 G1 X4.985000 Y3.756194 F1500.000
@@ -2796,7 +2796,7 @@ G1 X4.515000 Y3.756194 F1500.000
 G1 X4.515000 Y0.956194 F1500.000
 G1 X4.985000 Y0.956194 F1500.000
 M5
-; pass 348: cut 3 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 348: cut 3 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y0.956194
 M4 S200
 G1 X3.985000 Y3.756194 F1500.000
@@ -2804,7 +2804,7 @@ G1 X3.515000 Y3.756194 F1500.000
 G1 X3.515000 Y0.956194 F1500.000
 G1 X3.985000 Y0.956194 F1500.000
 M5
-; pass 349: cut 2 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 349: cut 2 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y0.956194
 M4 S200
 G1 X2.985000 Y3.756194 F1500.000
@@ -2812,7 +2812,7 @@ G1 X2.515000 Y3.756194 F1500.000
 G1 X2.515000 Y0.956194 F1500.000
 G1 X2.985000 Y0.956194 F1500.000
 M5
-; pass 350: cut 1 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 350: cut 1 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y0.956194
 M4 S200
 G1 X1.985000 Y3.756194 F1500.000
@@ -2820,7 +2820,7 @@ G1 X1.515000 Y3.756194 F1500.000
 G1 X1.515000 Y0.956194 F1500.000
 G1 X1.985000 Y0.956194 F1500.000
 M5
-; pass 351: cut 0 hole, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 351: cut 0 hole, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y2.221194
 M4 S200
 G1 X0.885000 Y2.491194 F1500.000

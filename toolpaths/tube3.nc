@@ -5,7 +5,7 @@
 G21 G90 G17 G94
 M5
 G0 Z0
-; pass 0: cut 0 hole, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 0: cut 0 hole, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 M4 S200
 G1 X0.900000 Y4.076991 F1500.000
@@ -13,7 +13,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 1: cut 1 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 1: cut 1 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -21,7 +21,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 2: cut 2 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 2: cut 2 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -29,7 +29,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 3: cut 3 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 3: cut 3 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -37,7 +37,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 4: cut 4 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 4: cut 4 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -45,7 +45,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 5: cut 5 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 5: cut 5 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -53,7 +53,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 6: cut 6 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 6: cut 6 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -61,7 +61,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 7: cut 7 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 7: cut 7 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -69,7 +69,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 8: cut 8 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 8: cut 8 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -77,7 +77,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 9: cut 9 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 9: cut 9 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -85,7 +85,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 10: cut 10 notch, repeat 0, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 10: cut 10 notch, repeat 0, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -93,7 +93,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 11: cut 10 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 11: cut 10 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -101,7 +101,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 12: cut 9 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 12: cut 9 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -109,7 +109,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 13: cut 8 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 13: cut 8 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -117,7 +117,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 14: cut 7 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 14: cut 7 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -125,7 +125,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 15: cut 6 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 15: cut 6 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -133,7 +133,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 16: cut 5 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 16: cut 5 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -141,7 +141,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 17: cut 4 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 17: cut 4 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -149,7 +149,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 18: cut 3 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 18: cut 3 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -157,7 +157,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 19: cut 2 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 19: cut 2 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -165,7 +165,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 20: cut 1 notch, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 20: cut 1 notch, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -173,7 +173,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 21: cut 0 hole, repeat 0, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 21: cut 0 hole, repeat 0, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -181,7 +181,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 22: cut 0 hole, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 22: cut 0 hole, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -189,7 +189,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 23: cut 1 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 23: cut 1 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -197,7 +197,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 24: cut 2 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 24: cut 2 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -205,7 +205,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 25: cut 3 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 25: cut 3 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -213,7 +213,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 26: cut 4 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 26: cut 4 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -221,7 +221,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 27: cut 5 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 27: cut 5 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -229,7 +229,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 28: cut 6 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 28: cut 6 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -237,7 +237,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 29: cut 7 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 29: cut 7 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -245,7 +245,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 30: cut 8 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 30: cut 8 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -253,7 +253,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 31: cut 9 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 31: cut 9 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -261,7 +261,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 32: cut 10 notch, repeat 0, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 32: cut 10 notch, repeat 0, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -269,7 +269,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 33: cut 10 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 33: cut 10 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -277,7 +277,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 34: cut 9 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 34: cut 9 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -285,7 +285,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 35: cut 8 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 35: cut 8 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -293,7 +293,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 36: cut 7 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 36: cut 7 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -301,7 +301,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 37: cut 6 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 37: cut 6 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -309,7 +309,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 38: cut 5 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 38: cut 5 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -317,7 +317,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 39: cut 4 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 39: cut 4 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -325,7 +325,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 40: cut 3 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 40: cut 3 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -333,7 +333,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 41: cut 2 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 41: cut 2 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -341,7 +341,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 42: cut 1 notch, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 42: cut 1 notch, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -349,7 +349,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 43: cut 0 hole, repeat 0, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 43: cut 0 hole, repeat 0, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -357,7 +357,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 44: cut 0 hole, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 44: cut 0 hole, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z-0.100000
 M4 S200
@@ -366,7 +366,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 45: cut 1 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 45: cut 1 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -374,7 +374,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 46: cut 2 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 46: cut 2 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -382,7 +382,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 47: cut 3 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 47: cut 3 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -390,7 +390,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 48: cut 4 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 48: cut 4 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -398,7 +398,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 49: cut 5 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 49: cut 5 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -406,7 +406,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 50: cut 6 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 50: cut 6 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -414,7 +414,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 51: cut 7 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 51: cut 7 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -422,7 +422,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 52: cut 8 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 52: cut 8 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -430,7 +430,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 53: cut 9 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 53: cut 9 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -438,7 +438,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 54: cut 10 notch, repeat 0, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 54: cut 10 notch, repeat 0, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -446,7 +446,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 55: cut 10 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 55: cut 10 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -454,7 +454,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 56: cut 9 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 56: cut 9 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -462,7 +462,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 57: cut 8 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 57: cut 8 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -470,7 +470,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 58: cut 7 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 58: cut 7 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -478,7 +478,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 59: cut 6 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 59: cut 6 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -486,7 +486,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 60: cut 5 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 60: cut 5 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -494,7 +494,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 61: cut 4 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 61: cut 4 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -502,7 +502,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 62: cut 3 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 62: cut 3 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -510,7 +510,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 63: cut 2 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 63: cut 2 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -518,7 +518,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 64: cut 1 notch, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 64: cut 1 notch, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -526,7 +526,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 65: cut 0 hole, repeat 0, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 65: cut 0 hole, repeat 0, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -534,7 +534,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 66: cut 0 hole, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 66: cut 0 hole, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -542,7 +542,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 67: cut 1 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 67: cut 1 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -550,7 +550,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 68: cut 2 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 68: cut 2 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -558,7 +558,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 69: cut 3 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 69: cut 3 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -566,7 +566,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 70: cut 4 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 70: cut 4 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -574,7 +574,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 71: cut 5 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 71: cut 5 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -582,7 +582,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 72: cut 6 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 72: cut 6 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -590,7 +590,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 73: cut 7 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 73: cut 7 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -598,7 +598,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 74: cut 8 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 74: cut 8 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -606,7 +606,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 75: cut 9 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 75: cut 9 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -614,7 +614,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 76: cut 10 notch, repeat 0, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 76: cut 10 notch, repeat 0, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -622,7 +622,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 77: cut 10 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 77: cut 10 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -630,7 +630,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 78: cut 9 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 78: cut 9 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -638,7 +638,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 79: cut 8 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 79: cut 8 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -646,7 +646,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 80: cut 7 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 80: cut 7 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -654,7 +654,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 81: cut 6 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 81: cut 6 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -662,7 +662,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 82: cut 5 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 82: cut 5 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -670,7 +670,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 83: cut 4 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 83: cut 4 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -678,7 +678,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 84: cut 3 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 84: cut 3 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -686,7 +686,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 85: cut 2 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 85: cut 2 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -694,7 +694,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 86: cut 1 notch, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 86: cut 1 notch, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -702,7 +702,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 87: cut 0 hole, repeat 0, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 87: cut 0 hole, repeat 0, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -710,7 +710,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 88: cut 0 hole, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 88: cut 0 hole, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z0.000000
 M4 S200
@@ -719,7 +719,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 89: cut 1 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 89: cut 1 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -727,7 +727,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 90: cut 2 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 90: cut 2 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -735,7 +735,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 91: cut 3 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 91: cut 3 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -743,7 +743,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 92: cut 4 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 92: cut 4 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -751,7 +751,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 93: cut 5 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 93: cut 5 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -759,7 +759,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 94: cut 6 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 94: cut 6 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -767,7 +767,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 95: cut 7 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 95: cut 7 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -775,7 +775,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 96: cut 8 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 96: cut 8 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -783,7 +783,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 97: cut 9 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 97: cut 9 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -791,7 +791,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 98: cut 10 notch, repeat 1, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 98: cut 10 notch, repeat 1, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -799,7 +799,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 99: cut 10 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 99: cut 10 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -807,7 +807,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 100: cut 9 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 100: cut 9 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -815,7 +815,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 101: cut 8 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 101: cut 8 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -823,7 +823,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 102: cut 7 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 102: cut 7 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -831,7 +831,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 103: cut 6 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 103: cut 6 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -839,7 +839,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 104: cut 5 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 104: cut 5 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -847,7 +847,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 105: cut 4 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 105: cut 4 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -855,7 +855,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 106: cut 3 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 106: cut 3 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -863,7 +863,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 107: cut 2 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 107: cut 2 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -871,7 +871,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 108: cut 1 notch, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 108: cut 1 notch, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -879,7 +879,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 109: cut 0 hole, repeat 1, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 109: cut 0 hole, repeat 1, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -887,7 +887,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 110: cut 0 hole, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 110: cut 0 hole, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -895,7 +895,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 111: cut 1 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 111: cut 1 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -903,7 +903,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 112: cut 2 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 112: cut 2 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -911,7 +911,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 113: cut 3 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 113: cut 3 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -919,7 +919,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 114: cut 4 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 114: cut 4 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -927,7 +927,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 115: cut 5 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 115: cut 5 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -935,7 +935,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 116: cut 6 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 116: cut 6 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -943,7 +943,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 117: cut 7 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 117: cut 7 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -951,7 +951,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 118: cut 8 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 118: cut 8 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -959,7 +959,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 119: cut 9 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 119: cut 9 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -967,7 +967,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 120: cut 10 notch, repeat 1, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 120: cut 10 notch, repeat 1, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -975,7 +975,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 121: cut 10 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 121: cut 10 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -983,7 +983,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 122: cut 9 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 122: cut 9 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -991,7 +991,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 123: cut 8 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 123: cut 8 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -999,7 +999,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 124: cut 7 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 124: cut 7 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -1007,7 +1007,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 125: cut 6 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 125: cut 6 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -1015,7 +1015,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 126: cut 5 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 126: cut 5 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -1023,7 +1023,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 127: cut 4 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 127: cut 4 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -1031,7 +1031,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 128: cut 3 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 128: cut 3 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -1039,7 +1039,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 129: cut 2 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 129: cut 2 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -1047,7 +1047,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 130: cut 1 notch, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 130: cut 1 notch, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -1055,7 +1055,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 131: cut 0 hole, repeat 1, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 131: cut 0 hole, repeat 1, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -1063,7 +1063,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 132: cut 0 hole, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 132: cut 0 hole, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z-0.100000
 M4 S200
@@ -1072,7 +1072,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 133: cut 1 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 133: cut 1 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -1080,7 +1080,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 134: cut 2 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 134: cut 2 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -1088,7 +1088,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 135: cut 3 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 135: cut 3 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -1096,7 +1096,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 136: cut 4 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 136: cut 4 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -1104,7 +1104,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 137: cut 5 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 137: cut 5 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -1112,7 +1112,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 138: cut 6 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 138: cut 6 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -1120,7 +1120,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 139: cut 7 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 139: cut 7 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -1128,7 +1128,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 140: cut 8 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 140: cut 8 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -1136,7 +1136,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 141: cut 9 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 141: cut 9 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -1144,7 +1144,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 142: cut 10 notch, repeat 1, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 142: cut 10 notch, repeat 1, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -1152,7 +1152,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 143: cut 10 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 143: cut 10 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -1160,7 +1160,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 144: cut 9 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 144: cut 9 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -1168,7 +1168,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 145: cut 8 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 145: cut 8 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -1176,7 +1176,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 146: cut 7 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 146: cut 7 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -1184,7 +1184,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 147: cut 6 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 147: cut 6 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -1192,7 +1192,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 148: cut 5 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 148: cut 5 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -1200,7 +1200,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 149: cut 4 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 149: cut 4 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -1208,7 +1208,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 150: cut 3 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 150: cut 3 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -1216,7 +1216,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 151: cut 2 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 151: cut 2 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -1224,7 +1224,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 152: cut 1 notch, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 152: cut 1 notch, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -1232,7 +1232,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 153: cut 0 hole, repeat 1, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 153: cut 0 hole, repeat 1, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -1240,7 +1240,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 154: cut 0 hole, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 154: cut 0 hole, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -1248,7 +1248,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 155: cut 1 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 155: cut 1 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -1256,7 +1256,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 156: cut 2 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 156: cut 2 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -1264,7 +1264,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 157: cut 3 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 157: cut 3 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -1272,7 +1272,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 158: cut 4 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 158: cut 4 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -1280,7 +1280,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 159: cut 5 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 159: cut 5 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -1288,7 +1288,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 160: cut 6 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 160: cut 6 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -1296,7 +1296,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 161: cut 7 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 161: cut 7 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -1304,7 +1304,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 162: cut 8 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 162: cut 8 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -1312,7 +1312,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 163: cut 9 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 163: cut 9 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -1320,7 +1320,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 164: cut 10 notch, repeat 1, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 164: cut 10 notch, repeat 1, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -1328,7 +1328,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 165: cut 10 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 165: cut 10 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -1336,7 +1336,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 166: cut 9 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 166: cut 9 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -1344,7 +1344,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 167: cut 8 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 167: cut 8 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -1352,7 +1352,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 168: cut 7 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 168: cut 7 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -1360,7 +1360,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 169: cut 6 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 169: cut 6 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -1368,7 +1368,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 170: cut 5 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 170: cut 5 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -1376,7 +1376,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 171: cut 4 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 171: cut 4 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -1384,7 +1384,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 172: cut 3 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 172: cut 3 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -1392,7 +1392,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 173: cut 2 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 173: cut 2 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -1400,7 +1400,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 174: cut 1 notch, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 174: cut 1 notch, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -1408,7 +1408,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 175: cut 0 hole, repeat 1, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 175: cut 0 hole, repeat 1, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -1416,7 +1416,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 176: cut 0 hole, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 176: cut 0 hole, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z0.000000
 M4 S200
@@ -1425,7 +1425,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 177: cut 1 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 177: cut 1 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -1433,7 +1433,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 178: cut 2 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 178: cut 2 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -1441,7 +1441,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 179: cut 3 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 179: cut 3 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -1449,7 +1449,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 180: cut 4 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 180: cut 4 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -1457,7 +1457,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 181: cut 5 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 181: cut 5 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -1465,7 +1465,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 182: cut 6 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 182: cut 6 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -1473,7 +1473,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 183: cut 7 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 183: cut 7 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -1481,7 +1481,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 184: cut 8 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 184: cut 8 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -1489,7 +1489,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 185: cut 9 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 185: cut 9 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -1497,7 +1497,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 186: cut 10 notch, repeat 2, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 186: cut 10 notch, repeat 2, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -1505,7 +1505,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 187: cut 10 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 187: cut 10 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -1513,7 +1513,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 188: cut 9 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 188: cut 9 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -1521,7 +1521,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 189: cut 8 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 189: cut 8 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -1529,7 +1529,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 190: cut 7 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 190: cut 7 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -1537,7 +1537,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 191: cut 6 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 191: cut 6 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -1545,7 +1545,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 192: cut 5 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 192: cut 5 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -1553,7 +1553,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 193: cut 4 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 193: cut 4 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -1561,7 +1561,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 194: cut 3 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 194: cut 3 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -1569,7 +1569,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 195: cut 2 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 195: cut 2 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -1577,7 +1577,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 196: cut 1 notch, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 196: cut 1 notch, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -1585,7 +1585,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 197: cut 0 hole, repeat 2, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 197: cut 0 hole, repeat 2, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -1593,7 +1593,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 198: cut 0 hole, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 198: cut 0 hole, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -1601,7 +1601,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 199: cut 1 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 199: cut 1 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -1609,7 +1609,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 200: cut 2 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 200: cut 2 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -1617,7 +1617,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 201: cut 3 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 201: cut 3 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -1625,7 +1625,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 202: cut 4 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 202: cut 4 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -1633,7 +1633,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 203: cut 5 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 203: cut 5 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -1641,7 +1641,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 204: cut 6 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 204: cut 6 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -1649,7 +1649,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 205: cut 7 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 205: cut 7 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -1657,7 +1657,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 206: cut 8 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 206: cut 8 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -1665,7 +1665,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 207: cut 9 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 207: cut 9 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -1673,7 +1673,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 208: cut 10 notch, repeat 2, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 208: cut 10 notch, repeat 2, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -1681,7 +1681,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 209: cut 10 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 209: cut 10 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -1689,7 +1689,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 210: cut 9 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 210: cut 9 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -1697,7 +1697,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 211: cut 8 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 211: cut 8 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -1705,7 +1705,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 212: cut 7 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 212: cut 7 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -1713,7 +1713,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 213: cut 6 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 213: cut 6 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -1721,7 +1721,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 214: cut 5 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 214: cut 5 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -1729,7 +1729,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 215: cut 4 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 215: cut 4 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -1737,7 +1737,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 216: cut 3 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 216: cut 3 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -1745,7 +1745,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 217: cut 2 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 217: cut 2 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -1753,7 +1753,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 218: cut 1 notch, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 218: cut 1 notch, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -1761,7 +1761,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 219: cut 0 hole, repeat 2, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 219: cut 0 hole, repeat 2, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -1769,7 +1769,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 220: cut 0 hole, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 220: cut 0 hole, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z-0.100000
 M4 S200
@@ -1778,7 +1778,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 221: cut 1 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 221: cut 1 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -1786,7 +1786,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 222: cut 2 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 222: cut 2 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -1794,7 +1794,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 223: cut 3 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 223: cut 3 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -1802,7 +1802,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 224: cut 4 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 224: cut 4 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -1810,7 +1810,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 225: cut 5 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 225: cut 5 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -1818,7 +1818,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 226: cut 6 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 226: cut 6 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -1826,7 +1826,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 227: cut 7 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 227: cut 7 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -1834,7 +1834,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 228: cut 8 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 228: cut 8 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -1842,7 +1842,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 229: cut 9 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 229: cut 9 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -1850,7 +1850,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 230: cut 10 notch, repeat 2, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 230: cut 10 notch, repeat 2, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -1858,7 +1858,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 231: cut 10 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 231: cut 10 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -1866,7 +1866,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 232: cut 9 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 232: cut 9 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -1874,7 +1874,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 233: cut 8 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 233: cut 8 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -1882,7 +1882,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 234: cut 7 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 234: cut 7 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -1890,7 +1890,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 235: cut 6 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 235: cut 6 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -1898,7 +1898,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 236: cut 5 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 236: cut 5 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -1906,7 +1906,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 237: cut 4 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 237: cut 4 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -1914,7 +1914,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 238: cut 3 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 238: cut 3 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -1922,7 +1922,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 239: cut 2 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 239: cut 2 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -1930,7 +1930,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 240: cut 1 notch, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 240: cut 1 notch, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -1938,7 +1938,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 241: cut 0 hole, repeat 2, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 241: cut 0 hole, repeat 2, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -1946,7 +1946,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 242: cut 0 hole, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 242: cut 0 hole, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -1954,7 +1954,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 243: cut 1 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 243: cut 1 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -1962,7 +1962,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 244: cut 2 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 244: cut 2 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -1970,7 +1970,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 245: cut 3 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 245: cut 3 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -1978,7 +1978,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 246: cut 4 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 246: cut 4 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -1986,7 +1986,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 247: cut 5 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 247: cut 5 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -1994,7 +1994,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 248: cut 6 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 248: cut 6 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -2002,7 +2002,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 249: cut 7 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 249: cut 7 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -2010,7 +2010,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 250: cut 8 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 250: cut 8 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -2018,7 +2018,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 251: cut 9 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 251: cut 9 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -2026,7 +2026,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 252: cut 10 notch, repeat 2, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 252: cut 10 notch, repeat 2, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -2034,7 +2034,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 253: cut 10 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 253: cut 10 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -2042,7 +2042,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 254: cut 9 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 254: cut 9 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -2050,7 +2050,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 255: cut 8 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 255: cut 8 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -2058,7 +2058,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 256: cut 7 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 256: cut 7 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -2066,7 +2066,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 257: cut 6 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 257: cut 6 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -2074,7 +2074,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 258: cut 5 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 258: cut 5 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -2082,7 +2082,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 259: cut 4 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 259: cut 4 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -2090,7 +2090,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 260: cut 3 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 260: cut 3 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -2098,7 +2098,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 261: cut 2 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 261: cut 2 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -2106,7 +2106,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 262: cut 1 notch, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 262: cut 1 notch, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -2114,7 +2114,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 263: cut 0 hole, repeat 2, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 263: cut 0 hole, repeat 2, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -2122,7 +2122,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 264: cut 0 hole, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 264: cut 0 hole, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z0.000000
 M4 S200
@@ -2131,7 +2131,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 265: cut 1 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 265: cut 1 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -2139,7 +2139,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 266: cut 2 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 266: cut 2 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -2147,7 +2147,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 267: cut 3 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 267: cut 3 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -2155,7 +2155,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 268: cut 4 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 268: cut 4 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -2163,7 +2163,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 269: cut 5 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 269: cut 5 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -2171,7 +2171,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 270: cut 6 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 270: cut 6 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -2179,7 +2179,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 271: cut 7 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 271: cut 7 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -2187,7 +2187,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 272: cut 8 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 272: cut 8 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -2195,7 +2195,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 273: cut 9 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 273: cut 9 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -2203,7 +2203,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 274: cut 10 notch, repeat 3, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 274: cut 10 notch, repeat 3, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -2211,7 +2211,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 275: cut 10 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 275: cut 10 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -2219,7 +2219,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 276: cut 9 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 276: cut 9 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -2227,7 +2227,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 277: cut 8 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 277: cut 8 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -2235,7 +2235,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 278: cut 7 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 278: cut 7 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -2243,7 +2243,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 279: cut 6 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 279: cut 6 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -2251,7 +2251,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 280: cut 5 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 280: cut 5 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -2259,7 +2259,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 281: cut 4 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 281: cut 4 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -2267,7 +2267,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 282: cut 3 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 282: cut 3 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -2275,7 +2275,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 283: cut 2 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 283: cut 2 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -2283,7 +2283,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 284: cut 1 notch, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 284: cut 1 notch, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -2291,7 +2291,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 285: cut 0 hole, repeat 3, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 285: cut 0 hole, repeat 3, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -2299,7 +2299,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 286: cut 0 hole, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 286: cut 0 hole, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -2307,7 +2307,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 287: cut 1 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 287: cut 1 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -2315,7 +2315,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 288: cut 2 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 288: cut 2 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -2323,7 +2323,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 289: cut 3 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 289: cut 3 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -2331,7 +2331,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 290: cut 4 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 290: cut 4 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -2339,7 +2339,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 291: cut 5 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 291: cut 5 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -2347,7 +2347,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 292: cut 6 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 292: cut 6 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -2355,7 +2355,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 293: cut 7 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 293: cut 7 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -2363,7 +2363,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 294: cut 8 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 294: cut 8 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -2371,7 +2371,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 295: cut 9 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 295: cut 9 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -2379,7 +2379,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 296: cut 10 notch, repeat 3, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 296: cut 10 notch, repeat 3, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -2387,7 +2387,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 297: cut 10 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 297: cut 10 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -2395,7 +2395,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 298: cut 9 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 298: cut 9 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -2403,7 +2403,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 299: cut 8 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 299: cut 8 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -2411,7 +2411,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 300: cut 7 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 300: cut 7 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -2419,7 +2419,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 301: cut 6 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 301: cut 6 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -2427,7 +2427,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 302: cut 5 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 302: cut 5 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -2435,7 +2435,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 303: cut 4 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 303: cut 4 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -2443,7 +2443,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 304: cut 3 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 304: cut 3 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -2451,7 +2451,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 305: cut 2 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 305: cut 2 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -2459,7 +2459,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 306: cut 1 notch, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 306: cut 1 notch, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -2467,7 +2467,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 307: cut 0 hole, repeat 3, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 307: cut 0 hole, repeat 3, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -2475,7 +2475,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 308: cut 0 hole, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 308: cut 0 hole, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z-0.100000
 M4 S200
@@ -2484,7 +2484,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 309: cut 1 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 309: cut 1 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -2492,7 +2492,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 310: cut 2 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 310: cut 2 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -2500,7 +2500,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 311: cut 3 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 311: cut 3 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -2508,7 +2508,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 312: cut 4 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 312: cut 4 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -2516,7 +2516,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 313: cut 5 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 313: cut 5 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -2524,7 +2524,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 314: cut 6 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 314: cut 6 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -2532,7 +2532,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 315: cut 7 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 315: cut 7 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -2540,7 +2540,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 316: cut 8 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 316: cut 8 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -2548,7 +2548,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 317: cut 9 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 317: cut 9 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -2556,7 +2556,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 318: cut 10 notch, repeat 3, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 318: cut 10 notch, repeat 3, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -2564,7 +2564,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 319: cut 10 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 319: cut 10 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -2572,7 +2572,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 320: cut 9 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 320: cut 9 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -2580,7 +2580,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 321: cut 8 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 321: cut 8 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -2588,7 +2588,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 322: cut 7 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 322: cut 7 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -2596,7 +2596,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 323: cut 6 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 323: cut 6 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -2604,7 +2604,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 324: cut 5 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 324: cut 5 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -2612,7 +2612,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 325: cut 4 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 325: cut 4 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -2620,7 +2620,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 326: cut 3 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 326: cut 3 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -2628,7 +2628,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 327: cut 2 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 327: cut 2 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -2636,7 +2636,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 328: cut 1 notch, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 328: cut 1 notch, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -2644,7 +2644,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 329: cut 0 hole, repeat 3, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 329: cut 0 hole, repeat 3, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -2652,7 +2652,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 330: cut 0 hole, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 330: cut 0 hole, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -2660,7 +2660,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 331: cut 1 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 331: cut 1 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -2668,7 +2668,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 332: cut 2 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 332: cut 2 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -2676,7 +2676,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 333: cut 3 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 333: cut 3 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -2684,7 +2684,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 334: cut 4 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 334: cut 4 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -2692,7 +2692,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 335: cut 5 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 335: cut 5 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -2700,7 +2700,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 336: cut 6 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 336: cut 6 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -2708,7 +2708,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 337: cut 7 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 337: cut 7 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -2716,7 +2716,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 338: cut 8 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 338: cut 8 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -2724,7 +2724,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 339: cut 9 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 339: cut 9 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -2732,7 +2732,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 340: cut 10 notch, repeat 3, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 340: cut 10 notch, repeat 3, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -2740,7 +2740,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 341: cut 10 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 341: cut 10 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -2748,7 +2748,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 342: cut 9 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 342: cut 9 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -2756,7 +2756,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 343: cut 8 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 343: cut 8 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -2764,7 +2764,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 344: cut 7 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 344: cut 7 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -2772,7 +2772,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 345: cut 6 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 345: cut 6 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -2780,7 +2780,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 346: cut 5 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 346: cut 5 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -2788,7 +2788,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 347: cut 4 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 347: cut 4 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -2796,7 +2796,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 348: cut 3 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 348: cut 3 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -2804,7 +2804,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 349: cut 2 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 349: cut 2 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -2812,7 +2812,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 350: cut 1 notch, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 350: cut 1 notch, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -2820,7 +2820,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 351: cut 0 hole, repeat 3, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 351: cut 0 hole, repeat 3, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -2828,7 +2828,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 352: cut 0 hole, repeat 4, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 352: cut 0 hole, repeat 4, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z0.000000
 M4 S200
@@ -2837,7 +2837,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 353: cut 1 notch, repeat 4, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 353: cut 1 notch, repeat 4, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -2845,7 +2845,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 354: cut 2 notch, repeat 4, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 354: cut 2 notch, repeat 4, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -2853,7 +2853,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 355: cut 3 notch, repeat 4, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 355: cut 3 notch, repeat 4, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -2861,7 +2861,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 356: cut 4 notch, repeat 4, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 356: cut 4 notch, repeat 4, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -2869,7 +2869,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 357: cut 5 notch, repeat 4, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 357: cut 5 notch, repeat 4, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -2877,7 +2877,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 358: cut 6 notch, repeat 4, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 358: cut 6 notch, repeat 4, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -2885,7 +2885,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 359: cut 7 notch, repeat 4, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 359: cut 7 notch, repeat 4, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -2893,7 +2893,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 360: cut 8 notch, repeat 4, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 360: cut 8 notch, repeat 4, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -2901,7 +2901,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 361: cut 9 notch, repeat 4, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 361: cut 9 notch, repeat 4, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -2909,7 +2909,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 362: cut 10 notch, repeat 4, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 362: cut 10 notch, repeat 4, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -2917,7 +2917,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 363: cut 10 notch, repeat 4, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 363: cut 10 notch, repeat 4, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -2925,7 +2925,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 364: cut 9 notch, repeat 4, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 364: cut 9 notch, repeat 4, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -2933,7 +2933,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 365: cut 8 notch, repeat 4, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 365: cut 8 notch, repeat 4, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -2941,7 +2941,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 366: cut 7 notch, repeat 4, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 366: cut 7 notch, repeat 4, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -2949,7 +2949,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 367: cut 6 notch, repeat 4, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 367: cut 6 notch, repeat 4, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -2957,7 +2957,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 368: cut 5 notch, repeat 4, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 368: cut 5 notch, repeat 4, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -2965,7 +2965,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 369: cut 4 notch, repeat 4, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 369: cut 4 notch, repeat 4, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -2973,7 +2973,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 370: cut 3 notch, repeat 4, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 370: cut 3 notch, repeat 4, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -2981,7 +2981,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 371: cut 2 notch, repeat 4, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 371: cut 2 notch, repeat 4, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -2989,7 +2989,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 372: cut 1 notch, repeat 4, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 372: cut 1 notch, repeat 4, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -2997,7 +2997,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 373: cut 0 hole, repeat 4, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 373: cut 0 hole, repeat 4, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -3005,7 +3005,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 374: cut 0 hole, repeat 4, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 374: cut 0 hole, repeat 4, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -3013,7 +3013,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 375: cut 1 notch, repeat 4, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 375: cut 1 notch, repeat 4, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -3021,7 +3021,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 376: cut 2 notch, repeat 4, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 376: cut 2 notch, repeat 4, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -3029,7 +3029,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 377: cut 3 notch, repeat 4, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 377: cut 3 notch, repeat 4, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -3037,7 +3037,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 378: cut 4 notch, repeat 4, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 378: cut 4 notch, repeat 4, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -3045,7 +3045,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 379: cut 5 notch, repeat 4, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 379: cut 5 notch, repeat 4, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -3053,7 +3053,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 380: cut 6 notch, repeat 4, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 380: cut 6 notch, repeat 4, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -3061,7 +3061,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 381: cut 7 notch, repeat 4, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 381: cut 7 notch, repeat 4, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -3069,7 +3069,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 382: cut 8 notch, repeat 4, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 382: cut 8 notch, repeat 4, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -3077,7 +3077,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 383: cut 9 notch, repeat 4, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 383: cut 9 notch, repeat 4, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -3085,7 +3085,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 384: cut 10 notch, repeat 4, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 384: cut 10 notch, repeat 4, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -3093,7 +3093,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 385: cut 10 notch, repeat 4, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 385: cut 10 notch, repeat 4, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -3101,7 +3101,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 386: cut 9 notch, repeat 4, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 386: cut 9 notch, repeat 4, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -3109,7 +3109,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 387: cut 8 notch, repeat 4, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 387: cut 8 notch, repeat 4, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -3117,7 +3117,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 388: cut 7 notch, repeat 4, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 388: cut 7 notch, repeat 4, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -3125,7 +3125,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 389: cut 6 notch, repeat 4, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 389: cut 6 notch, repeat 4, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -3133,7 +3133,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 390: cut 5 notch, repeat 4, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 390: cut 5 notch, repeat 4, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -3141,7 +3141,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 391: cut 4 notch, repeat 4, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 391: cut 4 notch, repeat 4, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -3149,7 +3149,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 392: cut 3 notch, repeat 4, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 392: cut 3 notch, repeat 4, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -3157,7 +3157,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 393: cut 2 notch, repeat 4, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 393: cut 2 notch, repeat 4, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -3165,7 +3165,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 394: cut 1 notch, repeat 4, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 394: cut 1 notch, repeat 4, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -3173,7 +3173,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 395: cut 0 hole, repeat 4, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 395: cut 0 hole, repeat 4, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -3181,7 +3181,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 396: cut 0 hole, repeat 4, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 396: cut 0 hole, repeat 4, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z-0.100000
 M4 S200
@@ -3190,7 +3190,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 397: cut 1 notch, repeat 4, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 397: cut 1 notch, repeat 4, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -3198,7 +3198,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 398: cut 2 notch, repeat 4, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 398: cut 2 notch, repeat 4, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -3206,7 +3206,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 399: cut 3 notch, repeat 4, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 399: cut 3 notch, repeat 4, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -3214,7 +3214,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 400: cut 4 notch, repeat 4, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 400: cut 4 notch, repeat 4, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -3222,7 +3222,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 401: cut 5 notch, repeat 4, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 401: cut 5 notch, repeat 4, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -3230,7 +3230,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 402: cut 6 notch, repeat 4, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 402: cut 6 notch, repeat 4, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -3238,7 +3238,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 403: cut 7 notch, repeat 4, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 403: cut 7 notch, repeat 4, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -3246,7 +3246,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 404: cut 8 notch, repeat 4, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 404: cut 8 notch, repeat 4, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -3254,7 +3254,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 405: cut 9 notch, repeat 4, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 405: cut 9 notch, repeat 4, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -3262,7 +3262,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 406: cut 10 notch, repeat 4, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 406: cut 10 notch, repeat 4, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -3270,7 +3270,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 407: cut 10 notch, repeat 4, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 407: cut 10 notch, repeat 4, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -3278,7 +3278,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 408: cut 9 notch, repeat 4, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 408: cut 9 notch, repeat 4, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -3286,7 +3286,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 409: cut 8 notch, repeat 4, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 409: cut 8 notch, repeat 4, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -3294,7 +3294,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 410: cut 7 notch, repeat 4, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 410: cut 7 notch, repeat 4, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -3302,7 +3302,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 411: cut 6 notch, repeat 4, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 411: cut 6 notch, repeat 4, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -3310,7 +3310,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 412: cut 5 notch, repeat 4, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 412: cut 5 notch, repeat 4, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -3318,7 +3318,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 413: cut 4 notch, repeat 4, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 413: cut 4 notch, repeat 4, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -3326,7 +3326,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 414: cut 3 notch, repeat 4, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 414: cut 3 notch, repeat 4, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -3334,7 +3334,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 415: cut 2 notch, repeat 4, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 415: cut 2 notch, repeat 4, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -3342,7 +3342,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 416: cut 1 notch, repeat 4, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 416: cut 1 notch, repeat 4, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -3350,7 +3350,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 417: cut 0 hole, repeat 4, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 417: cut 0 hole, repeat 4, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -3358,7 +3358,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 418: cut 0 hole, repeat 4, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 418: cut 0 hole, repeat 4, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -3366,7 +3366,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 419: cut 1 notch, repeat 4, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 419: cut 1 notch, repeat 4, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -3374,7 +3374,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 420: cut 2 notch, repeat 4, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 420: cut 2 notch, repeat 4, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -3382,7 +3382,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 421: cut 3 notch, repeat 4, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 421: cut 3 notch, repeat 4, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -3390,7 +3390,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 422: cut 4 notch, repeat 4, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 422: cut 4 notch, repeat 4, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -3398,7 +3398,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 423: cut 5 notch, repeat 4, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 423: cut 5 notch, repeat 4, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -3406,7 +3406,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 424: cut 6 notch, repeat 4, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 424: cut 6 notch, repeat 4, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -3414,7 +3414,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 425: cut 7 notch, repeat 4, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 425: cut 7 notch, repeat 4, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -3422,7 +3422,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 426: cut 8 notch, repeat 4, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 426: cut 8 notch, repeat 4, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -3430,7 +3430,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 427: cut 9 notch, repeat 4, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 427: cut 9 notch, repeat 4, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -3438,7 +3438,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 428: cut 10 notch, repeat 4, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 428: cut 10 notch, repeat 4, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -3446,7 +3446,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 429: cut 10 notch, repeat 4, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 429: cut 10 notch, repeat 4, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -3454,7 +3454,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 430: cut 9 notch, repeat 4, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 430: cut 9 notch, repeat 4, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -3462,7 +3462,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 431: cut 8 notch, repeat 4, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 431: cut 8 notch, repeat 4, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -3470,7 +3470,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 432: cut 7 notch, repeat 4, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 432: cut 7 notch, repeat 4, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -3478,7 +3478,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 433: cut 6 notch, repeat 4, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 433: cut 6 notch, repeat 4, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -3486,7 +3486,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 434: cut 5 notch, repeat 4, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 434: cut 5 notch, repeat 4, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -3494,7 +3494,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 435: cut 4 notch, repeat 4, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 435: cut 4 notch, repeat 4, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -3502,7 +3502,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 436: cut 3 notch, repeat 4, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 436: cut 3 notch, repeat 4, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -3510,7 +3510,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 437: cut 2 notch, repeat 4, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 437: cut 2 notch, repeat 4, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -3518,7 +3518,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 438: cut 1 notch, repeat 4, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 438: cut 1 notch, repeat 4, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -3526,7 +3526,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 439: cut 0 hole, repeat 4, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 439: cut 0 hole, repeat 4, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -3534,7 +3534,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 440: cut 0 hole, repeat 5, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 440: cut 0 hole, repeat 5, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z0.000000
 M4 S200
@@ -3543,7 +3543,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 441: cut 1 notch, repeat 5, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 441: cut 1 notch, repeat 5, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -3551,7 +3551,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 442: cut 2 notch, repeat 5, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 442: cut 2 notch, repeat 5, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -3559,7 +3559,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 443: cut 3 notch, repeat 5, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 443: cut 3 notch, repeat 5, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -3567,7 +3567,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 444: cut 4 notch, repeat 5, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 444: cut 4 notch, repeat 5, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -3575,7 +3575,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 445: cut 5 notch, repeat 5, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 445: cut 5 notch, repeat 5, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -3583,7 +3583,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 446: cut 6 notch, repeat 5, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 446: cut 6 notch, repeat 5, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -3591,7 +3591,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 447: cut 7 notch, repeat 5, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 447: cut 7 notch, repeat 5, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -3599,7 +3599,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 448: cut 8 notch, repeat 5, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 448: cut 8 notch, repeat 5, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -3607,7 +3607,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 449: cut 9 notch, repeat 5, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 449: cut 9 notch, repeat 5, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -3615,7 +3615,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 450: cut 10 notch, repeat 5, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 450: cut 10 notch, repeat 5, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -3623,7 +3623,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 451: cut 10 notch, repeat 5, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 451: cut 10 notch, repeat 5, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -3631,7 +3631,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 452: cut 9 notch, repeat 5, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 452: cut 9 notch, repeat 5, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -3639,7 +3639,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 453: cut 8 notch, repeat 5, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 453: cut 8 notch, repeat 5, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -3647,7 +3647,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 454: cut 7 notch, repeat 5, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 454: cut 7 notch, repeat 5, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -3655,7 +3655,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 455: cut 6 notch, repeat 5, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 455: cut 6 notch, repeat 5, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -3663,7 +3663,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 456: cut 5 notch, repeat 5, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 456: cut 5 notch, repeat 5, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -3671,7 +3671,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 457: cut 4 notch, repeat 5, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 457: cut 4 notch, repeat 5, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -3679,7 +3679,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 458: cut 3 notch, repeat 5, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 458: cut 3 notch, repeat 5, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -3687,7 +3687,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 459: cut 2 notch, repeat 5, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 459: cut 2 notch, repeat 5, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -3695,7 +3695,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 460: cut 1 notch, repeat 5, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 460: cut 1 notch, repeat 5, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -3703,7 +3703,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 461: cut 0 hole, repeat 5, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 461: cut 0 hole, repeat 5, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -3711,7 +3711,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 462: cut 0 hole, repeat 5, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 462: cut 0 hole, repeat 5, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -3719,7 +3719,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 463: cut 1 notch, repeat 5, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 463: cut 1 notch, repeat 5, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -3727,7 +3727,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 464: cut 2 notch, repeat 5, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 464: cut 2 notch, repeat 5, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -3735,7 +3735,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 465: cut 3 notch, repeat 5, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 465: cut 3 notch, repeat 5, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -3743,7 +3743,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 466: cut 4 notch, repeat 5, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 466: cut 4 notch, repeat 5, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -3751,7 +3751,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 467: cut 5 notch, repeat 5, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 467: cut 5 notch, repeat 5, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -3759,7 +3759,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 468: cut 6 notch, repeat 5, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 468: cut 6 notch, repeat 5, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -3767,7 +3767,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 469: cut 7 notch, repeat 5, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 469: cut 7 notch, repeat 5, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -3775,7 +3775,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 470: cut 8 notch, repeat 5, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 470: cut 8 notch, repeat 5, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -3783,7 +3783,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 471: cut 9 notch, repeat 5, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 471: cut 9 notch, repeat 5, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -3791,7 +3791,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 472: cut 10 notch, repeat 5, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 472: cut 10 notch, repeat 5, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -3799,7 +3799,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 473: cut 10 notch, repeat 5, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 473: cut 10 notch, repeat 5, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -3807,7 +3807,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 474: cut 9 notch, repeat 5, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 474: cut 9 notch, repeat 5, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -3815,7 +3815,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 475: cut 8 notch, repeat 5, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 475: cut 8 notch, repeat 5, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -3823,7 +3823,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 476: cut 7 notch, repeat 5, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 476: cut 7 notch, repeat 5, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -3831,7 +3831,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 477: cut 6 notch, repeat 5, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 477: cut 6 notch, repeat 5, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -3839,7 +3839,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 478: cut 5 notch, repeat 5, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 478: cut 5 notch, repeat 5, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -3847,7 +3847,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 479: cut 4 notch, repeat 5, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 479: cut 4 notch, repeat 5, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -3855,7 +3855,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 480: cut 3 notch, repeat 5, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 480: cut 3 notch, repeat 5, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -3863,7 +3863,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 481: cut 2 notch, repeat 5, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 481: cut 2 notch, repeat 5, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -3871,7 +3871,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 482: cut 1 notch, repeat 5, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 482: cut 1 notch, repeat 5, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -3879,7 +3879,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 483: cut 0 hole, repeat 5, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 483: cut 0 hole, repeat 5, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -3887,7 +3887,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 484: cut 0 hole, repeat 5, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 484: cut 0 hole, repeat 5, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z-0.100000
 M4 S200
@@ -3896,7 +3896,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 485: cut 1 notch, repeat 5, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 485: cut 1 notch, repeat 5, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -3904,7 +3904,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 486: cut 2 notch, repeat 5, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 486: cut 2 notch, repeat 5, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -3912,7 +3912,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 487: cut 3 notch, repeat 5, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 487: cut 3 notch, repeat 5, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -3920,7 +3920,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 488: cut 4 notch, repeat 5, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 488: cut 4 notch, repeat 5, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -3928,7 +3928,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 489: cut 5 notch, repeat 5, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 489: cut 5 notch, repeat 5, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -3936,7 +3936,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 490: cut 6 notch, repeat 5, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 490: cut 6 notch, repeat 5, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -3944,7 +3944,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 491: cut 7 notch, repeat 5, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 491: cut 7 notch, repeat 5, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -3952,7 +3952,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 492: cut 8 notch, repeat 5, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 492: cut 8 notch, repeat 5, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -3960,7 +3960,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 493: cut 9 notch, repeat 5, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 493: cut 9 notch, repeat 5, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -3968,7 +3968,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 494: cut 10 notch, repeat 5, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 494: cut 10 notch, repeat 5, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -3976,7 +3976,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 495: cut 10 notch, repeat 5, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 495: cut 10 notch, repeat 5, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -3984,7 +3984,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 496: cut 9 notch, repeat 5, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 496: cut 9 notch, repeat 5, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -3992,7 +3992,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 497: cut 8 notch, repeat 5, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 497: cut 8 notch, repeat 5, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -4000,7 +4000,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 498: cut 7 notch, repeat 5, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 498: cut 7 notch, repeat 5, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -4008,7 +4008,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 499: cut 6 notch, repeat 5, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 499: cut 6 notch, repeat 5, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -4016,7 +4016,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 500: cut 5 notch, repeat 5, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 500: cut 5 notch, repeat 5, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -4024,7 +4024,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 501: cut 4 notch, repeat 5, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 501: cut 4 notch, repeat 5, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -4032,7 +4032,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 502: cut 3 notch, repeat 5, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 502: cut 3 notch, repeat 5, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -4040,7 +4040,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 503: cut 2 notch, repeat 5, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 503: cut 2 notch, repeat 5, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -4048,7 +4048,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 504: cut 1 notch, repeat 5, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 504: cut 1 notch, repeat 5, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -4056,7 +4056,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 505: cut 0 hole, repeat 5, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 505: cut 0 hole, repeat 5, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -4064,7 +4064,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 506: cut 0 hole, repeat 5, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 506: cut 0 hole, repeat 5, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -4072,7 +4072,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 507: cut 1 notch, repeat 5, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 507: cut 1 notch, repeat 5, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -4080,7 +4080,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 508: cut 2 notch, repeat 5, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 508: cut 2 notch, repeat 5, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -4088,7 +4088,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 509: cut 3 notch, repeat 5, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 509: cut 3 notch, repeat 5, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -4096,7 +4096,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 510: cut 4 notch, repeat 5, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 510: cut 4 notch, repeat 5, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -4104,7 +4104,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 511: cut 5 notch, repeat 5, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 511: cut 5 notch, repeat 5, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -4112,7 +4112,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 512: cut 6 notch, repeat 5, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 512: cut 6 notch, repeat 5, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -4120,7 +4120,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 513: cut 7 notch, repeat 5, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 513: cut 7 notch, repeat 5, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -4128,7 +4128,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 514: cut 8 notch, repeat 5, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 514: cut 8 notch, repeat 5, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -4136,7 +4136,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 515: cut 9 notch, repeat 5, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 515: cut 9 notch, repeat 5, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -4144,7 +4144,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 516: cut 10 notch, repeat 5, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 516: cut 10 notch, repeat 5, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -4152,7 +4152,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 517: cut 10 notch, repeat 5, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 517: cut 10 notch, repeat 5, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -4160,7 +4160,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 518: cut 9 notch, repeat 5, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 518: cut 9 notch, repeat 5, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -4168,7 +4168,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 519: cut 8 notch, repeat 5, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 519: cut 8 notch, repeat 5, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -4176,7 +4176,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 520: cut 7 notch, repeat 5, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 520: cut 7 notch, repeat 5, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -4184,7 +4184,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 521: cut 6 notch, repeat 5, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 521: cut 6 notch, repeat 5, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -4192,7 +4192,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 522: cut 5 notch, repeat 5, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 522: cut 5 notch, repeat 5, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -4200,7 +4200,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 523: cut 4 notch, repeat 5, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 523: cut 4 notch, repeat 5, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -4208,7 +4208,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 524: cut 3 notch, repeat 5, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 524: cut 3 notch, repeat 5, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -4216,7 +4216,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 525: cut 2 notch, repeat 5, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 525: cut 2 notch, repeat 5, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -4224,7 +4224,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 526: cut 1 notch, repeat 5, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 526: cut 1 notch, repeat 5, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -4232,7 +4232,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 527: cut 0 hole, repeat 5, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 527: cut 0 hole, repeat 5, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -4240,7 +4240,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 528: cut 0 hole, repeat 6, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 528: cut 0 hole, repeat 6, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z0.000000
 M4 S200
@@ -4249,7 +4249,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 529: cut 1 notch, repeat 6, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 529: cut 1 notch, repeat 6, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -4257,7 +4257,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 530: cut 2 notch, repeat 6, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 530: cut 2 notch, repeat 6, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -4265,7 +4265,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 531: cut 3 notch, repeat 6, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 531: cut 3 notch, repeat 6, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -4273,7 +4273,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 532: cut 4 notch, repeat 6, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 532: cut 4 notch, repeat 6, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -4281,7 +4281,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 533: cut 5 notch, repeat 6, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 533: cut 5 notch, repeat 6, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -4289,7 +4289,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 534: cut 6 notch, repeat 6, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 534: cut 6 notch, repeat 6, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -4297,7 +4297,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 535: cut 7 notch, repeat 6, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 535: cut 7 notch, repeat 6, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -4305,7 +4305,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 536: cut 8 notch, repeat 6, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 536: cut 8 notch, repeat 6, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -4313,7 +4313,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 537: cut 9 notch, repeat 6, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 537: cut 9 notch, repeat 6, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -4321,7 +4321,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 538: cut 10 notch, repeat 6, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 538: cut 10 notch, repeat 6, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -4329,7 +4329,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 539: cut 10 notch, repeat 6, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 539: cut 10 notch, repeat 6, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -4337,7 +4337,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 540: cut 9 notch, repeat 6, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 540: cut 9 notch, repeat 6, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -4345,7 +4345,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 541: cut 8 notch, repeat 6, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 541: cut 8 notch, repeat 6, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -4353,7 +4353,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 542: cut 7 notch, repeat 6, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 542: cut 7 notch, repeat 6, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -4361,7 +4361,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 543: cut 6 notch, repeat 6, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 543: cut 6 notch, repeat 6, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -4369,7 +4369,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 544: cut 5 notch, repeat 6, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 544: cut 5 notch, repeat 6, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -4377,7 +4377,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 545: cut 4 notch, repeat 6, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 545: cut 4 notch, repeat 6, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -4385,7 +4385,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 546: cut 3 notch, repeat 6, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 546: cut 3 notch, repeat 6, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -4393,7 +4393,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 547: cut 2 notch, repeat 6, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 547: cut 2 notch, repeat 6, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -4401,7 +4401,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 548: cut 1 notch, repeat 6, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 548: cut 1 notch, repeat 6, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -4409,7 +4409,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 549: cut 0 hole, repeat 6, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 549: cut 0 hole, repeat 6, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -4417,7 +4417,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 550: cut 0 hole, repeat 6, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 550: cut 0 hole, repeat 6, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -4425,7 +4425,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 551: cut 1 notch, repeat 6, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 551: cut 1 notch, repeat 6, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -4433,7 +4433,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 552: cut 2 notch, repeat 6, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 552: cut 2 notch, repeat 6, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -4441,7 +4441,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 553: cut 3 notch, repeat 6, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 553: cut 3 notch, repeat 6, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -4449,7 +4449,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 554: cut 4 notch, repeat 6, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 554: cut 4 notch, repeat 6, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -4457,7 +4457,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 555: cut 5 notch, repeat 6, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 555: cut 5 notch, repeat 6, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -4465,7 +4465,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 556: cut 6 notch, repeat 6, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 556: cut 6 notch, repeat 6, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -4473,7 +4473,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 557: cut 7 notch, repeat 6, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 557: cut 7 notch, repeat 6, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -4481,7 +4481,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 558: cut 8 notch, repeat 6, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 558: cut 8 notch, repeat 6, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -4489,7 +4489,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 559: cut 9 notch, repeat 6, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 559: cut 9 notch, repeat 6, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -4497,7 +4497,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 560: cut 10 notch, repeat 6, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 560: cut 10 notch, repeat 6, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -4505,7 +4505,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 561: cut 10 notch, repeat 6, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 561: cut 10 notch, repeat 6, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -4513,7 +4513,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 562: cut 9 notch, repeat 6, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 562: cut 9 notch, repeat 6, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -4521,7 +4521,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 563: cut 8 notch, repeat 6, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 563: cut 8 notch, repeat 6, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -4529,7 +4529,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 564: cut 7 notch, repeat 6, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 564: cut 7 notch, repeat 6, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -4537,7 +4537,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 565: cut 6 notch, repeat 6, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 565: cut 6 notch, repeat 6, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -4545,7 +4545,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 566: cut 5 notch, repeat 6, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 566: cut 5 notch, repeat 6, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -4553,7 +4553,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 567: cut 4 notch, repeat 6, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 567: cut 4 notch, repeat 6, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -4561,7 +4561,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 568: cut 3 notch, repeat 6, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 568: cut 3 notch, repeat 6, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -4569,7 +4569,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 569: cut 2 notch, repeat 6, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 569: cut 2 notch, repeat 6, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -4577,7 +4577,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 570: cut 1 notch, repeat 6, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 570: cut 1 notch, repeat 6, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -4585,7 +4585,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 571: cut 0 hole, repeat 6, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 571: cut 0 hole, repeat 6, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -4593,7 +4593,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 572: cut 0 hole, repeat 6, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 572: cut 0 hole, repeat 6, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z-0.100000
 M4 S200
@@ -4602,7 +4602,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 573: cut 1 notch, repeat 6, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 573: cut 1 notch, repeat 6, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -4610,7 +4610,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 574: cut 2 notch, repeat 6, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 574: cut 2 notch, repeat 6, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -4618,7 +4618,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 575: cut 3 notch, repeat 6, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 575: cut 3 notch, repeat 6, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -4626,7 +4626,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 576: cut 4 notch, repeat 6, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 576: cut 4 notch, repeat 6, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -4634,7 +4634,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 577: cut 5 notch, repeat 6, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 577: cut 5 notch, repeat 6, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -4642,7 +4642,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 578: cut 6 notch, repeat 6, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 578: cut 6 notch, repeat 6, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -4650,7 +4650,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 579: cut 7 notch, repeat 6, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 579: cut 7 notch, repeat 6, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -4658,7 +4658,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 580: cut 8 notch, repeat 6, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 580: cut 8 notch, repeat 6, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -4666,7 +4666,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 581: cut 9 notch, repeat 6, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 581: cut 9 notch, repeat 6, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -4674,7 +4674,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 582: cut 10 notch, repeat 6, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 582: cut 10 notch, repeat 6, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -4682,7 +4682,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 583: cut 10 notch, repeat 6, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 583: cut 10 notch, repeat 6, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -4690,7 +4690,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 584: cut 9 notch, repeat 6, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 584: cut 9 notch, repeat 6, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -4698,7 +4698,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 585: cut 8 notch, repeat 6, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 585: cut 8 notch, repeat 6, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -4706,7 +4706,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 586: cut 7 notch, repeat 6, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 586: cut 7 notch, repeat 6, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -4714,7 +4714,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 587: cut 6 notch, repeat 6, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 587: cut 6 notch, repeat 6, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -4722,7 +4722,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 588: cut 5 notch, repeat 6, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 588: cut 5 notch, repeat 6, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -4730,7 +4730,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 589: cut 4 notch, repeat 6, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 589: cut 4 notch, repeat 6, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -4738,7 +4738,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 590: cut 3 notch, repeat 6, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 590: cut 3 notch, repeat 6, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -4746,7 +4746,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 591: cut 2 notch, repeat 6, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 591: cut 2 notch, repeat 6, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -4754,7 +4754,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 592: cut 1 notch, repeat 6, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 592: cut 1 notch, repeat 6, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -4762,7 +4762,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 593: cut 0 hole, repeat 6, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 593: cut 0 hole, repeat 6, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -4770,7 +4770,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 594: cut 0 hole, repeat 6, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 594: cut 0 hole, repeat 6, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -4778,7 +4778,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 595: cut 1 notch, repeat 6, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 595: cut 1 notch, repeat 6, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -4786,7 +4786,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 596: cut 2 notch, repeat 6, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 596: cut 2 notch, repeat 6, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -4794,7 +4794,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 597: cut 3 notch, repeat 6, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 597: cut 3 notch, repeat 6, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -4802,7 +4802,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 598: cut 4 notch, repeat 6, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 598: cut 4 notch, repeat 6, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -4810,7 +4810,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 599: cut 5 notch, repeat 6, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 599: cut 5 notch, repeat 6, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -4818,7 +4818,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 600: cut 6 notch, repeat 6, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 600: cut 6 notch, repeat 6, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -4826,7 +4826,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 601: cut 7 notch, repeat 6, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 601: cut 7 notch, repeat 6, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -4834,7 +4834,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 602: cut 8 notch, repeat 6, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 602: cut 8 notch, repeat 6, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -4842,7 +4842,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 603: cut 9 notch, repeat 6, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 603: cut 9 notch, repeat 6, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -4850,7 +4850,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 604: cut 10 notch, repeat 6, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 604: cut 10 notch, repeat 6, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -4858,7 +4858,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 605: cut 10 notch, repeat 6, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 605: cut 10 notch, repeat 6, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -4866,7 +4866,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 606: cut 9 notch, repeat 6, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 606: cut 9 notch, repeat 6, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -4874,7 +4874,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 607: cut 8 notch, repeat 6, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 607: cut 8 notch, repeat 6, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -4882,7 +4882,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 608: cut 7 notch, repeat 6, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 608: cut 7 notch, repeat 6, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -4890,7 +4890,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 609: cut 6 notch, repeat 6, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 609: cut 6 notch, repeat 6, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -4898,7 +4898,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 610: cut 5 notch, repeat 6, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 610: cut 5 notch, repeat 6, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -4906,7 +4906,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 611: cut 4 notch, repeat 6, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 611: cut 4 notch, repeat 6, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -4914,7 +4914,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 612: cut 3 notch, repeat 6, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 612: cut 3 notch, repeat 6, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -4922,7 +4922,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 613: cut 2 notch, repeat 6, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 613: cut 2 notch, repeat 6, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -4930,7 +4930,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 614: cut 1 notch, repeat 6, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 614: cut 1 notch, repeat 6, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -4938,7 +4938,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 615: cut 0 hole, repeat 6, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 615: cut 0 hole, repeat 6, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -4946,7 +4946,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 616: cut 0 hole, repeat 7, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 616: cut 0 hole, repeat 7, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z0.000000
 M4 S200
@@ -4955,7 +4955,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 617: cut 1 notch, repeat 7, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 617: cut 1 notch, repeat 7, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -4963,7 +4963,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 618: cut 2 notch, repeat 7, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 618: cut 2 notch, repeat 7, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -4971,7 +4971,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 619: cut 3 notch, repeat 7, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 619: cut 3 notch, repeat 7, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -4979,7 +4979,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 620: cut 4 notch, repeat 7, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 620: cut 4 notch, repeat 7, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -4987,7 +4987,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 621: cut 5 notch, repeat 7, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 621: cut 5 notch, repeat 7, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -4995,7 +4995,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 622: cut 6 notch, repeat 7, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 622: cut 6 notch, repeat 7, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -5003,7 +5003,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 623: cut 7 notch, repeat 7, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 623: cut 7 notch, repeat 7, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -5011,7 +5011,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 624: cut 8 notch, repeat 7, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 624: cut 8 notch, repeat 7, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -5019,7 +5019,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 625: cut 9 notch, repeat 7, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 625: cut 9 notch, repeat 7, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -5027,7 +5027,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 626: cut 10 notch, repeat 7, focus 0 (0 mm), drill 0 (offset 0.0000 mm)
+; pass 626: cut 10 notch, repeat 7, focus 0 at 0 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -5035,7 +5035,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 627: cut 10 notch, repeat 7, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 627: cut 10 notch, repeat 7, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -5043,7 +5043,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 628: cut 9 notch, repeat 7, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 628: cut 9 notch, repeat 7, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -5051,7 +5051,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 629: cut 8 notch, repeat 7, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 629: cut 8 notch, repeat 7, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -5059,7 +5059,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 630: cut 7 notch, repeat 7, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 630: cut 7 notch, repeat 7, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -5067,7 +5067,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 631: cut 6 notch, repeat 7, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 631: cut 6 notch, repeat 7, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -5075,7 +5075,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 632: cut 5 notch, repeat 7, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 632: cut 5 notch, repeat 7, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -5083,7 +5083,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 633: cut 4 notch, repeat 7, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 633: cut 4 notch, repeat 7, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -5091,7 +5091,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 634: cut 3 notch, repeat 7, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 634: cut 3 notch, repeat 7, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -5099,7 +5099,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 635: cut 2 notch, repeat 7, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 635: cut 2 notch, repeat 7, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -5107,7 +5107,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 636: cut 1 notch, repeat 7, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 636: cut 1 notch, repeat 7, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -5115,7 +5115,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 637: cut 0 hole, repeat 7, focus 0 (0 mm), drill 1 (offset 0.0050 mm)
+; pass 637: cut 0 hole, repeat 7, focus 0 at 0 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -5123,7 +5123,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 638: cut 0 hole, repeat 7, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 638: cut 0 hole, repeat 7, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -5131,7 +5131,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 639: cut 1 notch, repeat 7, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 639: cut 1 notch, repeat 7, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -5139,7 +5139,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 640: cut 2 notch, repeat 7, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 640: cut 2 notch, repeat 7, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -5147,7 +5147,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 641: cut 3 notch, repeat 7, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 641: cut 3 notch, repeat 7, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -5155,7 +5155,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 642: cut 4 notch, repeat 7, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 642: cut 4 notch, repeat 7, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -5163,7 +5163,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 643: cut 5 notch, repeat 7, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 643: cut 5 notch, repeat 7, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -5171,7 +5171,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 644: cut 6 notch, repeat 7, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 644: cut 6 notch, repeat 7, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -5179,7 +5179,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 645: cut 7 notch, repeat 7, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 645: cut 7 notch, repeat 7, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -5187,7 +5187,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 646: cut 8 notch, repeat 7, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 646: cut 8 notch, repeat 7, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -5195,7 +5195,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 647: cut 9 notch, repeat 7, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 647: cut 9 notch, repeat 7, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -5203,7 +5203,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 648: cut 10 notch, repeat 7, focus 0 (0 mm), drill 2 (offset 0.0100 mm)
+; pass 648: cut 10 notch, repeat 7, focus 0 at 0 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -5211,7 +5211,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 649: cut 10 notch, repeat 7, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 649: cut 10 notch, repeat 7, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -5219,7 +5219,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 650: cut 9 notch, repeat 7, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 650: cut 9 notch, repeat 7, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -5227,7 +5227,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 651: cut 8 notch, repeat 7, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 651: cut 8 notch, repeat 7, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -5235,7 +5235,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 652: cut 7 notch, repeat 7, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 652: cut 7 notch, repeat 7, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -5243,7 +5243,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 653: cut 6 notch, repeat 7, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 653: cut 6 notch, repeat 7, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -5251,7 +5251,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 654: cut 5 notch, repeat 7, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 654: cut 5 notch, repeat 7, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -5259,7 +5259,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 655: cut 4 notch, repeat 7, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 655: cut 4 notch, repeat 7, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -5267,7 +5267,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 656: cut 3 notch, repeat 7, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 656: cut 3 notch, repeat 7, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -5275,7 +5275,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 657: cut 2 notch, repeat 7, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 657: cut 2 notch, repeat 7, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -5283,7 +5283,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 658: cut 1 notch, repeat 7, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 658: cut 1 notch, repeat 7, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -5291,7 +5291,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 659: cut 0 hole, repeat 7, focus 0 (0 mm), drill 3 (offset 0.0150 mm)
+; pass 659: cut 0 hole, repeat 7, focus 0 at 0 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000
@@ -5299,7 +5299,7 @@ G1 X0.615000 Y4.061991 F1500.000
 G1 X0.615000 Y3.791991 F1500.000
 G1 X0.885000 Y3.791991 F1500.000
 M5
-; pass 660: cut 0 hole, repeat 7, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 660: cut 0 hole, repeat 7, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X0.900000 Y3.776991
 G0 Z-0.100000
 M4 S200
@@ -5308,7 +5308,7 @@ G1 X0.600000 Y4.076991 F1500.000
 G1 X0.600000 Y3.776991 F1500.000
 G1 X0.900000 Y3.776991 F1500.000
 M5
-; pass 661: cut 1 notch, repeat 7, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 661: cut 1 notch, repeat 7, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X1.500000 Y1.571991
 M4 S200
 G1 X2.000000 Y1.571991 F1500.000
@@ -5316,7 +5316,7 @@ G1 X2.000000 Y6.281991 F1500.000
 G1 X1.500000 Y6.281991 F1500.000
 G1 X1.500000 Y1.571991 F1500.000
 M5
-; pass 662: cut 2 notch, repeat 7, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 662: cut 2 notch, repeat 7, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X2.500000 Y1.571991
 M4 S200
 G1 X3.000000 Y1.571991 F1500.000
@@ -5324,7 +5324,7 @@ G1 X3.000000 Y6.281991 F1500.000
 G1 X2.500000 Y6.281991 F1500.000
 G1 X2.500000 Y1.571991 F1500.000
 M5
-; pass 663: cut 3 notch, repeat 7, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 663: cut 3 notch, repeat 7, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X3.500000 Y1.571991
 M4 S200
 G1 X4.000000 Y1.571991 F1500.000
@@ -5332,7 +5332,7 @@ G1 X4.000000 Y6.281991 F1500.000
 G1 X3.500000 Y6.281991 F1500.000
 G1 X3.500000 Y1.571991 F1500.000
 M5
-; pass 664: cut 4 notch, repeat 7, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 664: cut 4 notch, repeat 7, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X4.500000 Y1.571991
 M4 S200
 G1 X5.000000 Y1.571991 F1500.000
@@ -5340,7 +5340,7 @@ G1 X5.000000 Y6.281991 F1500.000
 G1 X4.500000 Y6.281991 F1500.000
 G1 X4.500000 Y1.571991 F1500.000
 M5
-; pass 665: cut 5 notch, repeat 7, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 665: cut 5 notch, repeat 7, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X5.500000 Y1.571991
 M4 S200
 G1 X6.000000 Y1.571991 F1500.000
@@ -5348,7 +5348,7 @@ G1 X6.000000 Y6.281991 F1500.000
 G1 X5.500000 Y6.281991 F1500.000
 G1 X5.500000 Y1.571991 F1500.000
 M5
-; pass 666: cut 6 notch, repeat 7, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 666: cut 6 notch, repeat 7, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X6.500000 Y1.571991
 M4 S200
 G1 X7.000000 Y1.571991 F1500.000
@@ -5356,7 +5356,7 @@ G1 X7.000000 Y6.281991 F1500.000
 G1 X6.500000 Y6.281991 F1500.000
 G1 X6.500000 Y1.571991 F1500.000
 M5
-; pass 667: cut 7 notch, repeat 7, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 667: cut 7 notch, repeat 7, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X7.500000 Y1.571991
 M4 S200
 G1 X8.000000 Y1.571991 F1500.000
@@ -5364,7 +5364,7 @@ G1 X8.000000 Y6.281991 F1500.000
 G1 X7.500000 Y6.281991 F1500.000
 G1 X7.500000 Y1.571991 F1500.000
 M5
-; pass 668: cut 8 notch, repeat 7, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 668: cut 8 notch, repeat 7, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X8.500000 Y1.571991
 M4 S200
 G1 X9.000000 Y1.571991 F1500.000
@@ -5372,7 +5372,7 @@ G1 X9.000000 Y6.281991 F1500.000
 G1 X8.500000 Y6.281991 F1500.000
 G1 X8.500000 Y1.571991 F1500.000
 M5
-; pass 669: cut 9 notch, repeat 7, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 669: cut 9 notch, repeat 7, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X9.500000 Y1.571991
 M4 S200
 G1 X10.000000 Y1.571991 F1500.000
@@ -5380,7 +5380,7 @@ G1 X10.000000 Y6.281991 F1500.000
 G1 X9.500000 Y6.281991 F1500.000
 G1 X9.500000 Y1.571991 F1500.000
 M5
-; pass 670: cut 10 notch, repeat 7, focus 1 (0.1 mm), drill 0 (offset 0.0000 mm)
+; pass 670: cut 10 notch, repeat 7, focus 1 at 0.1 mm, drill 0 offset 0.0000 mm
 G0 X10.500000 Y1.571991
 M4 S200
 G1 X11.000000 Y1.571991 F1500.000
@@ -5388,7 +5388,7 @@ G1 X11.000000 Y6.281991 F1500.000
 G1 X10.500000 Y6.281991 F1500.000
 G1 X10.500000 Y1.571991 F1500.000
 M5
-; pass 671: cut 10 notch, repeat 7, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 671: cut 10 notch, repeat 7, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X10.505000 Y1.576991
 M4 S200
 G1 X10.995000 Y1.576991 F1500.000
@@ -5396,7 +5396,7 @@ G1 X10.995000 Y6.276991 F1500.000
 G1 X10.505000 Y6.276991 F1500.000
 G1 X10.505000 Y1.576991 F1500.000
 M5
-; pass 672: cut 9 notch, repeat 7, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 672: cut 9 notch, repeat 7, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X9.995000 Y1.576991
 M4 S200
 G1 X9.995000 Y6.276991 F1500.000
@@ -5404,7 +5404,7 @@ G1 X9.505000 Y6.276991 F1500.000
 G1 X9.505000 Y1.576991 F1500.000
 G1 X9.995000 Y1.576991 F1500.000
 M5
-; pass 673: cut 8 notch, repeat 7, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 673: cut 8 notch, repeat 7, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X8.995000 Y1.576991
 M4 S200
 G1 X8.995000 Y6.276991 F1500.000
@@ -5412,7 +5412,7 @@ G1 X8.505000 Y6.276991 F1500.000
 G1 X8.505000 Y1.576991 F1500.000
 G1 X8.995000 Y1.576991 F1500.000
 M5
-; pass 674: cut 7 notch, repeat 7, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 674: cut 7 notch, repeat 7, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X7.995000 Y1.576991
 M4 S200
 G1 X7.995000 Y6.276991 F1500.000
@@ -5420,7 +5420,7 @@ G1 X7.505000 Y6.276991 F1500.000
 G1 X7.505000 Y1.576991 F1500.000
 G1 X7.995000 Y1.576991 F1500.000
 M5
-; pass 675: cut 6 notch, repeat 7, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 675: cut 6 notch, repeat 7, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X6.995000 Y1.576991
 M4 S200
 G1 X6.995000 Y6.276991 F1500.000
@@ -5428,7 +5428,7 @@ G1 X6.505000 Y6.276991 F1500.000
 G1 X6.505000 Y1.576991 F1500.000
 G1 X6.995000 Y1.576991 F1500.000
 M5
-; pass 676: cut 5 notch, repeat 7, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 676: cut 5 notch, repeat 7, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X5.995000 Y1.576991
 M4 S200
 G1 X5.995000 Y6.276991 F1500.000
@@ -5436,7 +5436,7 @@ G1 X5.505000 Y6.276991 F1500.000
 G1 X5.505000 Y1.576991 F1500.000
 G1 X5.995000 Y1.576991 F1500.000
 M5
-; pass 677: cut 4 notch, repeat 7, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 677: cut 4 notch, repeat 7, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X4.995000 Y1.576991
 M4 S200
 G1 X4.995000 Y6.276991 F1500.000
@@ -5444,7 +5444,7 @@ G1 X4.505000 Y6.276991 F1500.000
 G1 X4.505000 Y1.576991 F1500.000
 G1 X4.995000 Y1.576991 F1500.000
 M5
-; pass 678: cut 3 notch, repeat 7, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 678: cut 3 notch, repeat 7, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X3.995000 Y1.576991
 M4 S200
 G1 X3.995000 Y6.276991 F1500.000
@@ -5452,7 +5452,7 @@ G1 X3.505000 Y6.276991 F1500.000
 G1 X3.505000 Y1.576991 F1500.000
 G1 X3.995000 Y1.576991 F1500.000
 M5
-; pass 679: cut 2 notch, repeat 7, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 679: cut 2 notch, repeat 7, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X2.995000 Y1.576991
 M4 S200
 G1 X2.995000 Y6.276991 F1500.000
@@ -5460,7 +5460,7 @@ G1 X2.505000 Y6.276991 F1500.000
 G1 X2.505000 Y1.576991 F1500.000
 G1 X2.995000 Y1.576991 F1500.000
 M5
-; pass 680: cut 1 notch, repeat 7, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 680: cut 1 notch, repeat 7, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X1.995000 Y1.576991
 M4 S200
 G1 X1.995000 Y6.276991 F1500.000
@@ -5468,7 +5468,7 @@ G1 X1.505000 Y6.276991 F1500.000
 G1 X1.505000 Y1.576991 F1500.000
 G1 X1.995000 Y1.576991 F1500.000
 M5
-; pass 681: cut 0 hole, repeat 7, focus 1 (0.1 mm), drill 1 (offset 0.0050 mm)
+; pass 681: cut 0 hole, repeat 7, focus 1 at 0.1 mm, drill 1 offset 0.0050 mm
 G0 X0.895000 Y3.781991
 M4 S200
 G1 X0.895000 Y4.071991 F1500.000
@@ -5476,7 +5476,7 @@ G1 X0.605000 Y4.071991 F1500.000
 G1 X0.605000 Y3.781991 F1500.000
 G1 X0.895000 Y3.781991 F1500.000
 M5
-; pass 682: cut 0 hole, repeat 7, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 682: cut 0 hole, repeat 7, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X0.890000 Y3.786991
 M4 S200
 G1 X0.890000 Y4.066991 F1500.000
@@ -5484,7 +5484,7 @@ G1 X0.610000 Y4.066991 F1500.000
 G1 X0.610000 Y3.786991 F1500.000
 G1 X0.890000 Y3.786991 F1500.000
 M5
-; pass 683: cut 1 notch, repeat 7, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 683: cut 1 notch, repeat 7, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X1.510000 Y1.581991
 M4 S200
 G1 X1.990000 Y1.581991 F1500.000
@@ -5492,7 +5492,7 @@ G1 X1.990000 Y6.271991 F1500.000
 G1 X1.510000 Y6.271991 F1500.000
 G1 X1.510000 Y1.581991 F1500.000
 M5
-; pass 684: cut 2 notch, repeat 7, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 684: cut 2 notch, repeat 7, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X2.510000 Y1.581991
 M4 S200
 G1 X2.990000 Y1.581991 F1500.000
@@ -5500,7 +5500,7 @@ G1 X2.990000 Y6.271991 F1500.000
 G1 X2.510000 Y6.271991 F1500.000
 G1 X2.510000 Y1.581991 F1500.000
 M5
-; pass 685: cut 3 notch, repeat 7, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 685: cut 3 notch, repeat 7, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X3.510000 Y1.581991
 M4 S200
 G1 X3.990000 Y1.581991 F1500.000
@@ -5508,7 +5508,7 @@ G1 X3.990000 Y6.271991 F1500.000
 G1 X3.510000 Y6.271991 F1500.000
 G1 X3.510000 Y1.581991 F1500.000
 M5
-; pass 686: cut 4 notch, repeat 7, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 686: cut 4 notch, repeat 7, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X4.510000 Y1.581991
 M4 S200
 G1 X4.990000 Y1.581991 F1500.000
@@ -5516,7 +5516,7 @@ G1 X4.990000 Y6.271991 F1500.000
 G1 X4.510000 Y6.271991 F1500.000
 G1 X4.510000 Y1.581991 F1500.000
 M5
-; pass 687: cut 5 notch, repeat 7, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 687: cut 5 notch, repeat 7, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X5.510000 Y1.581991
 M4 S200
 G1 X5.990000 Y1.581991 F1500.000
@@ -5524,7 +5524,7 @@ G1 X5.990000 Y6.271991 F1500.000
 G1 X5.510000 Y6.271991 F1500.000
 G1 X5.510000 Y1.581991 F1500.000
 M5
-; pass 688: cut 6 notch, repeat 7, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 688: cut 6 notch, repeat 7, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X6.510000 Y1.581991
 M4 S200
 G1 X6.990000 Y1.581991 F1500.000
@@ -5532,7 +5532,7 @@ G1 X6.990000 Y6.271991 F1500.000
 G1 X6.510000 Y6.271991 F1500.000
 G1 X6.510000 Y1.581991 F1500.000
 M5
-; pass 689: cut 7 notch, repeat 7, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 689: cut 7 notch, repeat 7, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X7.510000 Y1.581991
 M4 S200
 G1 X7.990000 Y1.581991 F1500.000
@@ -5540,7 +5540,7 @@ G1 X7.990000 Y6.271991 F1500.000
 G1 X7.510000 Y6.271991 F1500.000
 G1 X7.510000 Y1.581991 F1500.000
 M5
-; pass 690: cut 8 notch, repeat 7, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 690: cut 8 notch, repeat 7, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X8.510000 Y1.581991
 M4 S200
 G1 X8.990000 Y1.581991 F1500.000
@@ -5548,7 +5548,7 @@ G1 X8.990000 Y6.271991 F1500.000
 G1 X8.510000 Y6.271991 F1500.000
 G1 X8.510000 Y1.581991 F1500.000
 M5
-; pass 691: cut 9 notch, repeat 7, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 691: cut 9 notch, repeat 7, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X9.510000 Y1.581991
 M4 S200
 G1 X9.990000 Y1.581991 F1500.000
@@ -5556,7 +5556,7 @@ G1 X9.990000 Y6.271991 F1500.000
 G1 X9.510000 Y6.271991 F1500.000
 G1 X9.510000 Y1.581991 F1500.000
 M5
-; pass 692: cut 10 notch, repeat 7, focus 1 (0.1 mm), drill 2 (offset 0.0100 mm)
+; pass 692: cut 10 notch, repeat 7, focus 1 at 0.1 mm, drill 2 offset 0.0100 mm
 G0 X10.510000 Y1.581991
 M4 S200
 G1 X10.990000 Y1.581991 F1500.000
@@ -5564,7 +5564,7 @@ G1 X10.990000 Y6.271991 F1500.000
 G1 X10.510000 Y6.271991 F1500.000
 G1 X10.510000 Y1.581991 F1500.000
 M5
-; pass 693: cut 10 notch, repeat 7, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 693: cut 10 notch, repeat 7, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X10.515000 Y1.586991
 M4 S200
 G1 X10.985000 Y1.586991 F1500.000
@@ -5572,7 +5572,7 @@ G1 X10.985000 Y6.266991 F1500.000
 G1 X10.515000 Y6.266991 F1500.000
 G1 X10.515000 Y1.586991 F1500.000
 M5
-; pass 694: cut 9 notch, repeat 7, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 694: cut 9 notch, repeat 7, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X9.985000 Y1.586991
 M4 S200
 G1 X9.985000 Y6.266991 F1500.000
@@ -5580,7 +5580,7 @@ G1 X9.515000 Y6.266991 F1500.000
 G1 X9.515000 Y1.586991 F1500.000
 G1 X9.985000 Y1.586991 F1500.000
 M5
-; pass 695: cut 8 notch, repeat 7, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 695: cut 8 notch, repeat 7, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X8.985000 Y1.586991
 M4 S200
 G1 X8.985000 Y6.266991 F1500.000
@@ -5588,7 +5588,7 @@ G1 X8.515000 Y6.266991 F1500.000
 G1 X8.515000 Y1.586991 F1500.000
 G1 X8.985000 Y1.586991 F1500.000
 M5
-; pass 696: cut 7 notch, repeat 7, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 696: cut 7 notch, repeat 7, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X7.985000 Y1.586991
 M4 S200
 G1 X7.985000 Y6.266991 F1500.000
@@ -5596,7 +5596,7 @@ G1 X7.515000 Y6.266991 F1500.000
 G1 X7.515000 Y1.586991 F1500.000
 G1 X7.985000 Y1.586991 F1500.000
 M5
-; pass 697: cut 6 notch, repeat 7, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 697: cut 6 notch, repeat 7, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X6.985000 Y1.586991
 M4 S200
 G1 X6.985000 Y6.266991 F1500.000
@@ -5604,7 +5604,7 @@ G1 X6.515000 Y6.266991 F1500.000
 G1 X6.515000 Y1.586991 F1500.000
 G1 X6.985000 Y1.586991 F1500.000
 M5
-; pass 698: cut 5 notch, repeat 7, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 698: cut 5 notch, repeat 7, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X5.985000 Y1.586991
 M4 S200
 G1 X5.985000 Y6.266991 F1500.000
@@ -5612,7 +5612,7 @@ G1 X5.515000 Y6.266991 F1500.000
 G1 X5.515000 Y1.586991 F1500.000
 G1 X5.985000 Y1.586991 F1500.000
 M5
-; pass 699: cut 4 notch, repeat 7, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 699: cut 4 notch, repeat 7, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X4.985000 Y1.586991
 M4 S200
 G1 X4.985000 Y6.266991 F1500.000
@@ -5620,7 +5620,7 @@ G1 X4.515000 Y6.266991 F1500.000
 G1 X4.515000 Y1.586991 F1500.000
 G1 X4.985000 Y1.586991 F1500.000
 M5
-; pass 700: cut 3 notch, repeat 7, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 700: cut 3 notch, repeat 7, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X3.985000 Y1.586991
 M4 S200
 G1 X3.985000 Y6.266991 F1500.000
@@ -5628,7 +5628,7 @@ G1 X3.515000 Y6.266991 F1500.000
 G1 X3.515000 Y1.586991 F1500.000
 G1 X3.985000 Y1.586991 F1500.000
 M5
-; pass 701: cut 2 notch, repeat 7, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 701: cut 2 notch, repeat 7, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X2.985000 Y1.586991
 M4 S200
 G1 X2.985000 Y6.266991 F1500.000
@@ -5636,7 +5636,7 @@ G1 X2.515000 Y6.266991 F1500.000
 G1 X2.515000 Y1.586991 F1500.000
 G1 X2.985000 Y1.586991 F1500.000
 M5
-; pass 702: cut 1 notch, repeat 7, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 702: cut 1 notch, repeat 7, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X1.985000 Y1.586991
 M4 S200
 G1 X1.985000 Y6.266991 F1500.000
@@ -5644,7 +5644,7 @@ G1 X1.515000 Y6.266991 F1500.000
 G1 X1.515000 Y1.586991 F1500.000
 G1 X1.985000 Y1.586991 F1500.000
 M5
-; pass 703: cut 0 hole, repeat 7, focus 1 (0.1 mm), drill 3 (offset 0.0150 mm)
+; pass 703: cut 0 hole, repeat 7, focus 1 at 0.1 mm, drill 3 offset 0.0150 mm
 G0 X0.885000 Y3.791991
 M4 S200
 G1 X0.885000 Y4.061991 F1500.000

@@ -119,43 +119,53 @@ def emit(job, mm: MachineMoves, memo: bool = True, progress: Callable[[int, int]
     focus = f"G0 {az}{f}".format
     cut = f"G1 {ax}{f} {ay}{f} F{ff}".format
     X, Y, Z, F = mm.ax.tolist(), mm.ay.tolist(), mm.az.tolist(), mm.feed.tolist()
-    kind = n.kind
+    kind = n.kind.tolist()
     rows = n.pass_rows().tolist()
     pk = job.packed
     geom, speed = pk.pass_geom.tolist(), pk.pass_speed.tolist()
     out = _header(job, dialect, mm)
     out.extend(d.preamble)
-    blocks: dict[tuple[int, float], str] = {}
-    settings = None
-    c = d.comment_line
-    off = d.laser_off
+    # the pass comment holds no parentheses, so it needs no escaping in either comment style
+    lead, tail = ("(", ")") if d.comment == "paren" else ("; ", "")
+    head = (lead + "pass {}: cut {} {}, repeat {}, focus {} at {:g} mm, drill {} offset {:.4f} mm" + tail
+            + "\nG0 " + ax + f + " " + ay + f + "{}\n{}\n{}\n" + d.laser_off).format
     passes = job.passes
     total = len(passes)
-    for p in range(total):
-        ps = passes[p]
-        r0, r1 = rows[p], rows[p + 1]
-        out.append(c(f"pass {p}: cut {ps.cut_index} {ps.kind}, repeat {ps.repeat}, focus {ps.focus_level} "
-                     f"({ps.focus_offset_mm:g} mm), drill {ps.drill_index} (offset {ps.offset_mm:.4f} mm)"))
-        out.append(rapid(X[r0], Y[r0]))
-        k = r0 + 1
-        if kind[k] == FOCUS:
-            out.append(focus(Z[k]))
-            k += 1
-        fields = d.fields(ps.power_w, ps.frequency_khz)
+    # per-pass focus line ("" when the focus does not change)
+    r0s = rows[:-1]
+    focus_txt = ["\n" + focus(Z[r + 1]) if kind[r + 1] == FOCUS else "" for r in r0s]
+    # gate and settings lines per (power, frequency), settings only where they change
+    gates: dict[tuple[float, float], tuple[str, str]] = {}
+    pre: list[str] = []
+    prev = None
+    for ps in passes:
         key = (ps.power_w, ps.frequency_khz)
-        if d.settings and key != settings:
-            out.extend(s.format(**fields) for s in d.settings)
-        settings = key
-        out.append(d.laser_on.format(**fields))
-        bkey = (geom[p], speed[p])
-        blk = blocks.get(bkey) if memo else None
-        if blk is None:
-            blk = "\n".join([cut(X[i], Y[i], F[i]) for i in range(k, r1)])
-            blocks[bkey] = blk
-        out.append(blk)
-        out.append(off)
-        if progress is not None and (p % 4096 == 4095 or p == total - 1):
-            progress(p + 1, total)
+        if key not in gates:
+            fields = d.fields(*key)
+            gates[key] = ("".join(x.format(**fields) + "\n" for x in d.settings), d.laser_on.format(**fields))
+        pre.append((gates[key][0] if key != prev else "") + gates[key][1])
+        prev = key
+    blocks: dict[tuple[int, float], str] = {}
+
+    def block(p: int) -> str:
+        start = rows[p] + (2 if focus_txt[p] else 1)
+        if memo:
+            bkey = (geom[p], speed[p])
+            blk = blocks.get(bkey)
+            if blk is None:
+                blk = blocks[bkey] = "\n".join([cut(X[i], Y[i], F[i]) for i in range(start, rows[p + 1])])
+            return blk
+        return "\n".join([cut(X[i], Y[i], F[i]) for i in range(start, rows[p + 1])])
+
+    step = 4096
+    for lo in range(0, total, step):
+        hi = min(total, lo + step)
+        out.extend([
+            head(p, ps.cut_index, ps.kind, ps.repeat, ps.focus_level, ps.focus_offset_mm, ps.drill_index,
+                 ps.offset_mm, X[rows[p]], Y[rows[p]], focus_txt[p], pre[p], block(p))
+            for p, ps in zip(range(lo, hi), passes[lo:hi])])
+        if progress is not None:
+            progress(hi, total)
     out.extend(d.postamble)
     out.append("")
     return "\n".join(out)
