@@ -436,11 +436,8 @@ def find_slack(data: Dataset, threshold_deg: float | None = None) -> dict[tuple[
     return out
 
 
-def remove_deadband(data: Dataset, threshold_deg: float | None = None) -> Dataset:
-    """Subtract each cycle's slack from its stroke and drop the rows inside the deadband.
-
-    The slack per row is kept in ``extra["slack_mm"]`` (mm). See :func:`find_slack`.
-    """
+def _deadband(data: Dataset, threshold_deg: float | None) -> tuple[Dataset, np.ndarray]:
+    """``data`` with the slack subtracted (all rows) and the (n,) bool mask of rows past the slack."""
     slack = find_slack(data, threshold_deg)
     per_row = np.empty(len(data))
     for smp, sl in data.sample_slices():
@@ -449,10 +446,19 @@ def remove_deadband(data: Dataset, threshold_deg: float | None = None) -> Datase
         per_row[sl] = np.vectorize(lut.__getitem__, otypes=[float])(cyc)
     shifted = np.asarray(data.stroke_mm, float) - per_row
     keep = shifted >= 0.0
-    out = Dataset(data.sample, data.cycle, data.time_s, shifted, data.force_N, data.angle_deg,
-                  {**data.extra, "slack_mm": per_row})
     if not keep.any():
         raise DataError("every row lies inside the slack deadband; try --no-deadband")
+    out = Dataset(data.sample, data.cycle, data.time_s, shifted, data.force_N, data.angle_deg,
+                  {**data.extra, "slack_mm": per_row})
+    return out, keep
+
+
+def remove_deadband(data: Dataset, threshold_deg: float | None = None) -> Dataset:
+    """Subtract each cycle's slack from its stroke and drop the rows inside the deadband.
+
+    The slack per row is kept in ``extra["slack_mm"]`` (mm). See :func:`find_slack`.
+    """
+    out, keep = _deadband(data, threshold_deg)
     return out.take(keep)
 
 
@@ -460,10 +466,19 @@ def prepare(data: Dataset, cycles: str | CycleSpec | None = "last", branch: str 
             deadband: bool = True, threshold_deg: float | None = None) -> Dataset:
     """The rows a comparison uses: cycles, then deadband removal, then branch.
 
+    The branch is taken from the stroke direction *before* the deadband rows
+    are dropped (so the first row past the slack keeps its true direction).
     The defaults are the paper's comparison: the last loading cycle of each
     sample with the slack deadband removed.
     """
+    if branch not in BRANCHES:
+        raise DataError(f"branch {branch!r}: use one of {', '.join(BRANCHES)}")
     d = select_cycles(data, cycles)
+    keep = np.ones(len(d), bool)
     if deadband:
-        d = remove_deadband(d, threshold_deg)
-    return select_branch(d, branch)
+        d, keep = _deadband(d, threshold_deg)
+    if branch != "both":
+        keep &= d.direction == (1 if branch == "loading" else -1)
+        if not keep.any():
+            raise DataError(f"the selected rows have no {branch} part")
+    return d if keep.all() else d.take(keep)

@@ -169,3 +169,14 @@ def test_prepare_defaults_are_the_papers_comparison(tube2):
     assert set(rows.cycle.tolist()) == {3}
     assert np.all(rows.direction == 1)
     assert rows.stroke_mm.min() >= 0 and rows.stroke_mm.max() < 2.5 - 0.09
+
+
+def test_prepare_unloading_and_both_partition_the_rows(tube2):
+    d = synthesize(tube2, n_samples=1, n_cycles=3, slack_mm=0.1, seed=6)
+    up = prepare(d, "all", "loading")
+    down = prepare(d, "all", "unloading")
+    both = prepare(d, "all", "both")
+    assert len(up) + len(down) == len(both)
+    assert up.stroke_mm.max() > 2.3 and down.stroke_mm.max() > 2.3
+    with pytest.raises(DataError, match="branch"):
+        prepare(d, branch="sideways")
