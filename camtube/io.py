@@ -11,6 +11,18 @@ import tempfile
 from pathlib import Path
 
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def _publish(tmp: str, path: Path) -> None:
+    """Give the temporary file ordinary permissions (0666 less the umask) and move it into place."""
+    os.chmod(tmp, 0o666 & ~_umask())
+    os.replace(tmp, path)
+
+
 def write_atomic(path: str | os.PathLike, data: str | bytes) -> Path:
     """Write ``data`` to ``path`` atomically and return the path.
 
@@ -26,7 +38,7 @@ def write_atomic(path: str | os.PathLike, data: str | bytes) -> Path:
             fh.write(payload)
             fh.flush()
             os.fsync(fh.fileno())
-        os.replace(tmp, path)
+        _publish(tmp, path)
     except BaseException:
         try:
             os.unlink(tmp)
@@ -51,7 +63,7 @@ def write_atomic_with(path: str | os.PathLike, writer) -> Path:
         writer(tmp)
         if not os.path.exists(tmp) or os.path.getsize(tmp) == 0:
             raise OSError(f"writer produced no output for {path}")
-        os.replace(tmp, path)
+        _publish(tmp, path)
     except BaseException:
         try:
             os.unlink(tmp)

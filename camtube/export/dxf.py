@@ -69,6 +69,7 @@ def to_string(doc: Drawing) -> str:
     writes fixed ones instead (ezdxf's own switch for reproducible output), so
     users can diff drawings.
     """
+    _fix_class_order(doc)
     stream = io.StringIO()
     saved = ezdxf.options.write_fixed_meta_data_for_testing
     ezdxf.options.write_fixed_meta_data_for_testing = True
@@ -81,6 +82,19 @@ def to_string(doc: Drawing) -> str:
     finally:
         ezdxf.options.write_fixed_meta_data_for_testing = saved
     return stream.getvalue()
+
+
+def _fix_class_order(doc: Drawing) -> None:
+    """Register the CLASSES entries now, in sorted order.
+
+    ezdxf 1.x registers some classes (LAYOUT, ACDBPLACEHOLDER for R2013) in an
+    order that varies between processes (string hashing); sorting them before
+    writing fixes the bytes. ``write`` only appends classes still missing.
+    """
+    from collections import OrderedDict
+
+    doc.classes.add_required_classes(doc.dxfversion)
+    doc.classes.classes = OrderedDict(sorted(doc.classes.classes.items()))
 
 
 def design_dxf(pattern: Pattern) -> str:

@@ -46,22 +46,7 @@ def toolpath_document(job):
     add_contour(msp, rectangle(0.0, 0.0, job.length_mm, circ), "CONSTRUCTION-OUTLINE")  # last: read_contours' size
     for p in job.passes:
         add_contour(msp, p.contour, layer_name(p.focus_level, p.drill_index))
-    _fix_class_order(doc)
     return doc
-
-
-def _fix_class_order(doc) -> None:
-    """Register the CLASSES entries now, in sorted order.
-
-    ezdxf 1.x registers some classes (LAYOUT, ACDBPLACEHOLDER for R2013) in an
-    order that varies from run to run (string hashing), which would make the
-    same job give different bytes. Registering them sorted before writing
-    fixes the order; ``write`` only appends classes that are still missing.
-    """
-    from collections import OrderedDict
-
-    doc.classes.add_required_classes(doc.dxfversion)
-    doc.classes.classes = OrderedDict(sorted(doc.classes.classes.items()))
 
 
 def toolpath_dxf(job) -> str:

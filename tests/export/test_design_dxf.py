@@ -191,3 +191,17 @@ def _read_ppm(path) -> np.ndarray:
     assert fields[0] == b"P6"
     w, h = int(fields[1]), int(fields[2])
     return np.frombuffer(raw[pos + 1:pos + 1 + w * h * 3], dtype=np.uint8).reshape(h, w, 3)
+
+
+def test_dxf_is_identical_across_processes():
+    """ezdxf's class registration order depends on string hashing: the bytes must not."""
+    import hashlib
+    import sys
+
+    code = ("import hashlib; from camtube.design import load_pattern; from camtube.export.dxf import design_dxf; "
+            f"print(hashlib.sha256(design_dxf(load_pattern({str(PATTERNS / 'tube1.yaml')!r})).encode()).hexdigest())")
+    digests = {subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                              env={**__import__("os").environ, "PYTHONHASHSEED": str(seed)}).stdout
+               for seed in (1, 2, 3)}
+    assert len(digests) == 1
+    assert digests.pop().strip() == hashlib.sha256(design_dxf(load_pattern(PATTERNS / "tube1.yaml")).encode()).hexdigest()
