@@ -24,8 +24,22 @@ import numpy as np
 from camtube.design.contour import Contour, cut_contours
 from camtube.design.pattern import Pattern
 
-#: Sides of the polygonal inner and outer circles of the tube mesh.
+#: Sides of the polygonal inner and outer circles of the tube mesh (volume error 1.0e-4).
 DEFAULT_SEGMENTS = 256
+#: Sides used for long patterns (more than :data:`LONG_PATTERN_CUTS` cuts; volume error 4.0e-4):
+#: the boolean's cost grows with the output's triangles (~ segments x cuts).
+PREVIEW_SEGMENTS = 128
+LONG_PATTERN_CUTS = 64
+
+
+def auto_segments(n_cuts: int) -> int:
+    """Polygon sides for a pattern of ``n_cuts`` cuts: exact enough for the checks, fast for long patterns.
+
+    Cut walls lie at their exact angles whatever the polygon, so the backbone
+    angle measured from a section does not depend on it; the volume error of
+    an inscribed polygon is ``(2 pi / segments)^2 / 6``.
+    """
+    return DEFAULT_SEGMENTS if n_cuts <= LONG_PATTERN_CUTS else PREVIEW_SEGMENTS
 
 
 def _rings(region) -> list[np.ndarray]:
@@ -116,10 +130,14 @@ def design_regions(pattern: Pattern) -> Sequence[Contour]:
     return cut_contours(pattern)
 
 
-def design_mesh(pattern: Pattern, segments: int = DEFAULT_SEGMENTS):
-    """Mesh of the tube as designed: notches and holes as radial-walled annular sectors."""
+def design_mesh(pattern: Pattern, segments: int | None = None):
+    """Mesh of the tube as designed: notches and holes as radial-walled annular sectors.
+
+    ``segments`` defaults to :func:`auto_segments` of the number of cuts.
+    """
     t = pattern.tube
-    return tube_mesh(t.outer_radius_mm, t.inner_radius_mm, t.length_mm, design_regions(pattern), segments)
+    seg = segments or auto_segments(len(pattern.cuts))
+    return tube_mesh(t.outer_radius_mm, t.inner_radius_mm, t.length_mm, design_regions(pattern), seg)
 
 
 def stl_bytes(mesh) -> bytes:

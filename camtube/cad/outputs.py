@@ -48,9 +48,9 @@ def cad_models(pattern: Pattern, job=None, *, step: bool = True, segments: int |
     ``job`` defaults to ``camtube.plan.plan_job(pattern)``.
     """
     from camtube.cad.ascut import simulate
-    from camtube.cad.mesh import DEFAULT_SEGMENTS, design_mesh, tube_mesh
+    from camtube.cad.mesh import auto_segments, design_mesh, tube_mesh
 
-    seg = segments or DEFAULT_SEGMENTS
+    seg = segments or auto_segments(len(pattern.cuts))
     if job is None:
         from camtube.plan import plan_job
 

@@ -114,11 +114,11 @@ def verify(pattern: Pattern, *, design_mesh=None, ascut=None, ascut_mesh=None, s
     solid_volume_mm3, step_volume_mm3 : float, optional
         Volume of the build123d solid, and of its STEP file read back.
     segments : int, optional
-        Sides of the meshes' polygonal circles (default :data:`camtube.cad.mesh.DEFAULT_SEGMENTS`).
+        Sides of the meshes' polygonal circles (default :func:`camtube.cad.mesh.auto_segments`).
     """
-    from camtube.cad.mesh import DEFAULT_SEGMENTS
+    from camtube.cad.mesh import auto_segments
 
-    seg = segments or DEFAULT_SEGMENTS
+    seg = segments or auto_segments(len(pattern.cuts))
     t = pattern.tube
     ro, ri = t.outer_radius_mm, t.inner_radius_mm
     v_ana = analytic_volume_mm3(pattern)
