@@ -223,15 +223,24 @@ def _periodic(g, circumference_mm: float):
                               affinity.translate(g, 0.0, -circumference_mm)])
 
 
-def _max_distance(piece, to, step_mm: float) -> tuple[float, tuple[float, float]]:
-    """Largest distance from the boundary points of ``piece`` (densified) to ``to``, and that point."""
+def _max_distance(piece, to_parts: list, to_tree, step_mm: float) -> tuple[float, tuple[float, float]]:
+    """Largest distance from the boundary points of ``piece`` (densified every ``step_mm``) to the
+    union of ``to_parts`` (indexed by the STRtree ``to_tree``), and the point where it occurs.
+
+    Only parts within the piece's bounding-box diagonal are considered (the piece touches or
+    lies within that reach of its own cut); if there are none, all are.
+    """
     import shapely
 
     pts = shapely.get_coordinates(shapely.segmentize(piece.boundary, step_mm))
-    if len(pts) == 0 or to.is_empty:
+    if len(pts) == 0 or not to_parts:
         c = piece.centroid
         return 0.0, (float(c.x), float(c.y))
-    d = shapely.distance(shapely.points(pts), to)
+    x0, y0, x1, y1 = piece.bounds
+    reach = math.hypot(x1 - x0, y1 - y0)
+    near = to_tree.query(piece, predicate="dwithin", distance=reach)
+    local = shapely.union_all([to_parts[int(k)] for k in near]) if len(near) else shapely.union_all(to_parts)
+    d = shapely.distance(shapely.points(pts), local)
     k = int(np.argmax(d))
     return float(d[k]), (float(pts[k, 0]), float(pts[k, 1]))
 
@@ -320,6 +329,8 @@ def simulate(job, moves=None, kerf_mm: float | None = None) -> AsCut:
 
     def regions(kind, geom, owners, depth_to):
         tree = STRtree(owners)
+        parts = _polys(depth_to)
+        to_tree = STRtree(parts) if parts else None
         out = []
         for p in _polys(geom):
             if p.area <= AREA_EPS_MM2:
@@ -329,7 +340,7 @@ def simulate(job, moves=None, kerf_mm: float | None = None) -> AsCut:
             if owner is None or owners[owner].intersection(p).area <= 0.0:
                 owner = int(tree.query_nearest(p)[0])
             c = p.centroid
-            depth, deepest = _max_distance(p, depth_to, step)
+            depth, deepest = _max_distance(p, parts, to_tree, step)
             out.append(Region(kind, int(owner), float(p.area), tuple(float(v) for v in p.bounds),
                               (float(c.x), float(c.y)), depth, deepest,
                               math.degrees(float(c.y) / ro) % 360.0))
