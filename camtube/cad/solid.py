@@ -16,7 +16,7 @@ import os
 import re
 import tempfile
 
-from camtube.design.pattern import Cut, Pattern
+from camtube.design.pattern import Pattern
 
 #: Fixed STEP header timestamp, so the same pattern gives a byte-identical file.
 STEP_TIMESTAMP = "2000-01-01T00:00:00"
@@ -88,7 +88,3 @@ def import_step_volume(path) -> float:
     from build123d import import_step
 
     return float(import_step(str(path)).volume)
-
-
-def cut_of(pattern: Pattern, index: int) -> Cut:
-    return pattern.cuts[index]
