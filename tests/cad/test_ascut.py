@@ -10,7 +10,7 @@ import pytest
 from camtube.cad.ascut import DEFAULT_SIM_KERF_MM, simulate
 from camtube.design.contour import Contour
 from camtube.plan import job_moves
-from tests.cad.conftest import job_of, preset
+from tests.cad.conftest import job_of
 
 
 def _rebuilt(job, passes):
