@@ -110,7 +110,7 @@ def _cad_outputs(pattern, job, outdir) -> list:
         from camtube.cad import build_outputs
     except ImportError:
         return []
-    return list(build_outputs(pattern, job, outdir) or [])
+    return list(build_outputs(pattern, job, outdir, log=print) or [])  # prints the verification verdict
 
 
 def cmd_toolpath(args: argparse.Namespace) -> int:
