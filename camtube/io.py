@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 
 
@@ -23,21 +24,13 @@ def _publish(tmp: str, path: Path) -> None:
     os.replace(tmp, path)
 
 
-def write_atomic(path: str | os.PathLike, data: str | bytes) -> Path:
-    """Write ``data`` to ``path`` atomically and return the path.
-
-    ``str`` is encoded as UTF-8 with ``\\n`` line endings, unchanged.
-    Parent directories are created.
-    """
-    path = Path(path)
+@contextmanager
+def _staged(path: Path, prefix: str, suffix: str):
+    """Yield ``(fd, tmp)`` of a temporary file beside ``path``; publish it on success, remove it on failure."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    payload = data.encode("utf-8") if isinstance(data, str) else bytes(data)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=path.parent)
     try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(payload)
-            fh.flush()
-            os.fsync(fh.fileno())
+        yield fd, tmp
         _publish(tmp, path)
     except BaseException:
         try:
@@ -45,6 +38,21 @@ def write_atomic(path: str | os.PathLike, data: str | bytes) -> Path:
         except FileNotFoundError:
             pass
         raise
+
+
+def write_atomic(path: str | os.PathLike, data: str | bytes) -> Path:
+    """Write ``data`` to ``path`` atomically and return the path.
+
+    ``str`` is encoded as UTF-8 with ``\\n`` line endings, unchanged.
+    Parent directories are created.
+    """
+    path = Path(path)
+    payload = data.encode("utf-8") if isinstance(data, str) else bytes(data)
+    with _staged(path, f".{path.name}.", ".tmp") as (fd, _tmp):
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(payload)
+            fh.flush()
+            os.fsync(fh.fileno())
     return path
 
 
@@ -56,18 +64,9 @@ def write_atomic_with(path: str | os.PathLike, writer) -> Path:
     Used for STEP/STL exporters that take a filename.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    try:
+    with _staged(path, f".{path.stem}.", path.suffix) as (fd, tmp):
+        os.close(fd)
         writer(tmp)
-        if not os.path.exists(tmp) or os.path.getsize(tmp) == 0:
+        if os.path.getsize(tmp) == 0:
             raise OSError(f"writer produced no output for {path}")
-        _publish(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
     return path
