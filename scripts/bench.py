@@ -16,16 +16,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "scripts"))
 
-
-def best_of(fn, repeat: int = 5) -> float:
-    """Best wall time of ``repeat`` calls (s)."""
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
+from benchutil import best_of  # noqa: E402
 
 
 def bench_design() -> None:
@@ -36,9 +29,9 @@ def bench_design() -> None:
     print("== design stage ==")
     for name in ("tube1", "tube2", "tube3"):
         path = ROOT / "patterns" / f"{name}.yaml"
-        t_load = best_of(lambda: load(path))
+        t_load = best_of(lambda: load(path), 5)[0]
         pattern = load(path).pattern
-        t_dxf = best_of(lambda: design_dxf(pattern))
+        t_dxf = best_of(lambda: design_dxf(pattern), 5)[0]
         print(f"{name}: load+rules {t_load * 1e3:7.2f} ms   design DXF {t_dxf * 1e3:7.2f} ms")
 
     raw, _, _ = read_yaml(ROOT / "patterns" / "tube1.yaml")
@@ -46,9 +39,9 @@ def bench_design() -> None:
     times = {}
     for n in (1000, 10000):
         r = dict(raw, notch=dict(raw["notch"], count=n), tube=dict(raw["tube"], length=1.5 + n * 1.0 + 1.0))
-        t_build = best_of(lambda: build(r), repeat=3)
+        t_build = best_of(lambda: build(r))[0]
         pattern = build(r).pattern
-        t_dxf = best_of(lambda: design_dxf(pattern), repeat=3)
+        t_dxf = best_of(lambda: design_dxf(pattern))[0]
         times[n] = t_build + t_dxf
         print(f"{n:>6} notches: load+rules {t_build:6.3f} s   design DXF {t_dxf:6.3f} s")
     print(f"scaling 10k/1k = {times[10000] / times[1000]:.1f} (linear = 10)")

@@ -17,17 +17,12 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from benchutil import best_of  # noqa: E402
+
 
 TARGET_FIT_S = 0.5
-
-
-def best_of(fn, repeat: int = 5):
-    best, out = float("inf"), None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
 
 
 def main() -> int:
@@ -58,7 +53,7 @@ def main() -> int:
             print(f"(first fit, importing scipy: {time.perf_counter() - t0:.3f} s)")
             cold = False
         # the fit itself, on all 50 cycles x 2 samples, both branches, no selection
-        t_fit, _ = best_of(lambda: fit(model, loaded, ("E_t",), start))
+        t_fit, _ = best_of(lambda: fit(model, loaded, ("E_t",), start), 5)
         worst = max(worst, t_fit)
         floor = noise_floor_deg(p)
         for sel, rows in (("last", prepare(loaded)), ("all", rows_all)):

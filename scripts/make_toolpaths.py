@@ -44,7 +44,7 @@ def offsets_figure(path: Path) -> None:
     drill, kerf = 0.04, 0.05
     fig, axes = plt.subplots(1, 2, figsize=(9, 5.8))
     for ax, k, title in ((axes[0], 0.0, "kerf = 0 (the paper): cut 0 on the design line"),
-                         (axes[1], kerf, f"kerf compensation: cut 0 moved kerf/2 inward")):
+                         (axes[1], kerf, "kerf compensation: cut 0 moved kerf/2 inward")):
         ax.add_patch(Patch([(-0.3, -0.3), (0.8, -0.3), (0.8, 0.9), (-0.3, 0.9)], closed=True, color="#d9c38c",
                            label="tube wall (kept)"))
         ax.add_patch(Patch(design.points, closed=True, color="white", label="cut region (removed)"))

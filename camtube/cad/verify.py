@@ -120,7 +120,7 @@ def verify(pattern: Pattern, *, design_mesh=None, ascut=None, ascut_mesh=None, s
 
     seg = segments or auto_segments(len(pattern.cuts))
     t = pattern.tube
-    ro, ri = t.outer_radius_mm, t.inner_radius_mm
+    ro = t.outer_radius_mm
     v_ana = analytic_volume_mm3(pattern)
     checks: list[Check] = []
     summary: dict = {"analytic_volume_mm3": v_ana, "tube": asdict(t), "cuts": len(pattern.cuts),

@@ -13,7 +13,6 @@ them, and only then formats the text. Same job and dialect: byte-identical text.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Callable
 
@@ -115,7 +114,6 @@ def emit(job, mm: MachineMoves, memo: bool = True, progress: Callable[[int, int]
     ax, ay, az = d.axes
     f = f"{{:.{d.decimals}f}}"
     ff = f"{{:.{d.feed_decimals}f}}"
-    rapid = f"G0 {ax}{f} {ay}{f}".format
     focus = f"G0 {az}{f}".format
     cut = f"G1 {ax}{f} {ay}{f} F{ff}".format
     X, Y, Z, F = mm.ax.tolist(), mm.ay.tolist(), mm.az.tolist(), mm.feed.tolist()
