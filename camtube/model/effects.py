@@ -1,0 +1,425 @@
+"""Built-in effects: the physics the paper's base model leaves out.
+
+Importing this module registers every effect below (``camtube.model.api``
+imports it on first use of the registry). Each effect is a named term on one
+stage of the model chain (see :mod:`camtube.model.api`):
+
+=============  ==========  =====================================================
+name           stage       physics (parameters)
+=============  ==========  =====================================================
+slack          stroke      tendon slack: a deadband at low stroke (deadband_mm)
+play           stroke      lost motion in the drive, direction dependent (play_mm)
+creep          stroke      tendon creep / drift over time (creep_mm, tau_s)
+friction       elongation  tendon-sheath friction: mean tension differs from the
+                           load cell by a fraction, sign of motion (mu)
+toe            elongation  toe region of the tendon (quadratic, then linear) (toe_mm)
+viscoelastic   elongation  standard linear solid: delayed elongation (ratio, tau_s)
+series         elongation  extra series compliance: sheath/tube compression (compliance_mm_per_N)
+kerf           kinematics  notch arc widened by the kerf: phi, hence the arm, change (kerf_mm)
+flat_walls     kinematics  flat (planar) instead of radial notch walls: other arm (none)
+chords         kinematics  tendon as straight chords across the notches (none)
+hardstop       kinematics  notches close: the joint stops bending (stop_deg)
+angle_bias     angle       tracker offset (bias_deg)
+force_zero     force       load-cell zero offset (zero_N)
+=============  ==========  =====================================================
+
+History-dependent effects (``play``, ``viscoelastic``) run per sample in time
+order; the play operator is exact and vectorised over the monotone segments of
+the stroke (one NumPy call per stroke reversal); the linear filter of
+``viscoelastic`` uses :func:`scipy.signal.lfilter` when the sampling is uniform.
+"""
+from __future__ import annotations
+
+import math
+import weakref
+
+import numpy as np
+
+from camtube.design.geometry import backbone_angle_rad, centroid_mm
+from camtube.model.api import Context, Effect, Param, register
+from camtube.model.dataset import Dataset
+
+# ----------------------------------------------------------------------------- helpers
+
+_SEGMENTS: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
+
+
+def monotone_segments(data: Dataset) -> list[tuple[int, int, int, bool]]:
+    """``(start, stop, direction, first_of_sample)`` of every run of constant direction.
+
+    Cached per :class:`Dataset` object (the fit evaluates the model many times on the same rows).
+    """
+    hit = _SEGMENTS.get(data)
+    if hit is not None:
+        return hit
+    d = data.direction
+    out = []
+    for _, sl in data.sample_slices():
+        dd = d[sl]
+        cut = np.flatnonzero(np.diff(dd)) + 1
+        starts = np.concatenate(([0], cut))
+        stops = np.concatenate((cut, [dd.size]))
+        for k, (a, b) in enumerate(zip(starts, stops)):
+            out.append((sl.start + int(a), sl.start + int(b), int(dd[a]), k == 0))
+    _SEGMENTS[data] = out
+    return out
+
+
+def play_operator(data: Dataset, x: np.ndarray, width_mm: float) -> np.ndarray:
+    """Play (backlash) operator of width ``width_mm`` on ``x`` (n,), per sample, exact.
+
+    The output lags ``width_mm`` behind the input while it grows and stays put
+    after a reversal until the input has come back by ``width_mm``:
+    ``y_k = clip(y_{k-1}, x_k - w, x_k)``, starting at ``x_0 - w``. Within a
+    monotone run of ``x`` the recursion is ``max(y_prev, x - w)`` (growing) or
+    ``min(y_prev, x)`` (shrinking), so each run is one NumPy call.
+    """
+    w = float(width_mm)
+    y = np.empty_like(x)
+    prev = 0.0
+    for a, b, dirn, first in monotone_segments(data):
+        xs = x[a:b]
+        if first:
+            prev = float(xs[0]) - (w if dirn > 0 else 0.0)
+        if dirn > 0:
+            seg = np.maximum(xs - w, prev)
+        else:
+            seg = np.minimum(xs, prev)
+        y[a:b] = seg
+        prev = float(seg[-1])
+    return y
+
+
+def first_order_lag(data: Dataset, u: np.ndarray, tau_s: float) -> np.ndarray:
+    """``v`` with ``tau dv/dt = u - v`` per sample (exact for piecewise-constant ``u``), ``v_0 = u_0``.
+
+    Uniform sampling uses :func:`scipy.signal.lfilter`; otherwise a loop.
+    """
+    from scipy.signal import lfilter
+
+    tau = max(float(tau_s), 1e-9)
+    v = np.empty_like(u)
+    t = np.asarray(data.time_s, float)
+    for _, sl in data.sample_slices():
+        us, ts = u[sl], t[sl]
+        if us.size == 0:
+            continue
+        dt = np.diff(ts)
+        if dt.size == 0:
+            v[sl] = us
+            continue
+        h = float(np.median(dt))
+        if h > 0 and np.all(np.abs(dt - h) <= 1e-6 * h + 1e-12):
+            a = math.exp(-h / tau)
+            v[sl], _ = lfilter([1.0 - a], [1.0, -a], us, zi=[a * us[0]])
+        else:
+            a = np.exp(-np.maximum(dt, 0.0) / tau)
+            out = np.empty_like(us)
+            out[0] = us[0]
+            acc = float(us[0])
+            for k in range(1, us.size):
+                acc = a[k - 1] * acc + (1.0 - a[k - 1]) * float(us[k])
+                out[k] = acc
+            v[sl] = out
+    return v
+
+
+def _stroke_span(data: Dataset) -> float:
+    s = np.asarray(data.stroke_mm, float)
+    return float(np.ptp(s)) if s.size else 1.0
+
+
+def _duration(data: Dataset) -> float:
+    t = np.asarray(data.time_s, float)
+    spans = [float(np.ptp(t[sl])) for _, sl in data.sample_slices()]
+    return max(max(spans, default=1.0), 1e-3)
+
+
+def _period(data: Dataset) -> float:
+    """Mean cycle period (s) of the data, from the time span and the cycle count."""
+    t = np.asarray(data.time_s, float)
+    c = np.asarray(data.cycle)
+    per = []
+    for _, sl in data.sample_slices():
+        n = int(np.unique(c[sl]).size)
+        if n:
+            per.append(float(np.ptp(t[sl])) / n)
+    return max(float(np.median(per)) if per else 1.0, 1e-3)
+
+
+def _slack_guess(data: Dataset, ctx: Context) -> float:
+    """Stroke at which the angle leaves its low plateau (0 if none): a loose starting value."""
+    s = np.asarray(data.stroke_mm, float)
+    a = np.asarray(data.angle_deg, float)
+    if s.size < 10:
+        return 0.0
+    lo, hi = np.percentile(a, [2, 98])
+    moving = a > lo + 0.05 * (hi - lo)
+    if not moving.any():
+        return 0.0
+    s_move = float(np.percentile(s[moving], 1))
+    return max(0.5 * (s_move - float(np.min(s))), 0.0)
+
+
+def _arm_for(ro: float, ri: float, rt: float, ybar: float) -> float:
+    return ybar + ri - rt
+
+
+def _flat_wall_ybar(ro: float, ri: float, arc_mm: float) -> float:
+    """Centroid distance (mm) of the backbone left by a notch with one flat (planar) wall.
+
+    The cut plane lies at ``d = r_o cos(s / 2 r_o)`` from the axis so that it
+    removes the outer arc ``s``; the annulus part beyond the plane is removed.
+    Circular segment beyond a chord at ``d``: area ``R^2 acos(d/R) - d sqrt(R^2 - d^2)``,
+    first moment ``2/3 (R^2 - d^2)^(3/2)``.
+    """
+    d = ro * math.cos(arc_mm / (2.0 * ro))
+
+    def seg(r: float) -> tuple[float, float]:
+        if d >= r:
+            return 0.0, 0.0
+        if d <= -r:
+            return math.pi * r * r, 0.0
+        q = r * r - d * d
+        return r * r * math.acos(d / r) - d * math.sqrt(q), 2.0 / 3.0 * q**1.5
+
+    ao, mo = seg(ro)
+    ai, mi = seg(ri)
+    area = math.pi * (ro**2 - ri**2) - (ao - ai)
+    return (mo - mi) / area
+
+
+# ----------------------------------------------------------------------------- stroke stage
+
+def _slack(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
+    return np.maximum(stroke - p["deadband_mm"], 0.0)
+
+
+SLACK = register(Effect(
+    name="slack", stage="stroke",
+    params=(Param("deadband_mm", "mm", 0.0, 10.0, _slack_guess,
+                  "motor stroke taken up before the tendon is taut"),),
+    apply=_slack,
+    meaning="tendon slack: the first part of the stroke only takes up the slack, the joint does not move",
+    signature="at low stroke the joint stays straight while the base model already bends it "
+              "(negative residual at small stroke, then a constant offset)",
+))
+
+
+def _play(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
+    return play_operator(ctx.data, stroke, p["play_mm"])
+
+
+PLAY = register(Effect(
+    name="play", stage="stroke",
+    params=(Param("play_mm", "mm", 0.0, 10.0, lambda d, c: 0.02 * _stroke_span(d),
+                  "lost motion between the motor and the tendon (full width of the play)"),),
+    apply=_play,
+    meaning="lost motion (backlash, play) between the motor and the tendon: after each reversal the "
+            "motor moves through the play before the tendon follows",
+    signature="the residual flips sign with the direction of motion, with a constant size: "
+              "loading lags, unloading leads (a parallelogram loop)",
+))
+
+
+def _creep(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
+    t = np.asarray(ctx.data.time_s, float)
+    return stroke - p["creep_mm"] * -np.expm1(-t / max(p["tau_s"], 1e-9))
+
+
+CREEP = register(Effect(
+    name="creep", stage="stroke",
+    params=(Param("creep_mm", "mm", -5.0, 5.0, lambda d, c: 0.01 * _stroke_span(d),
+                  "tendon lengthening reached after a long time (stroke lost)"),
+            Param("tau_s", "s", 1e-2, 1e7, lambda d, c: _duration(d) / 4.0,
+                  "time constant of the creep (s since the start of the sample's record)")),
+    apply=_creep,
+    meaning="creep (drift over cycles): the tendon lengthens slowly under load, so later cycles "
+            "bend less for the same stroke; it settles with a time constant",
+    signature="the residual trends with cycle number and time: early cycles differ from late ones",
+))
+
+
+# ----------------------------------------------------------------------------- elongation stage
+
+def _friction(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
+    return elong * (1.0 - p["mu"] * ctx.direction)
+
+
+FRICTION = register(Effect(
+    name="friction", stage="elongation",
+    params=(Param("mu", "", -0.9, 0.9, 0.02,
+                  "fraction by which the tendon's mean tension falls below (loading) or rises above "
+                  "(unloading) the load cell"),),
+    apply=_friction,
+    meaning="tendon-sheath friction between the load cell and the joint: the tendon's mean tension is "
+            "lower than measured while pulling and higher while releasing (friction hysteresis)",
+    signature="the residual flips sign with the direction of motion and grows with force",
+))
+
+
+def _toe(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
+    et = max(p["toe_mm"], 0.0)
+    if et <= 0.0:
+        return elong
+    c = ctx.compliance_mm_per_N
+    f = np.maximum(ctx.force_N, 0.0)
+    f_toe = et / (2.0 * c)
+    toe = np.where(f < f_toe, np.sqrt(2.0 * et * c * f), c * f + 0.5 * et) - c * f
+    return elong + toe
+
+
+TOE = register(Effect(
+    name="toe", stage="elongation",
+    params=(Param("toe_mm", "mm", 0.0, 5.0, lambda d, c: 0.05 * _stroke_span(d),
+                  "elongation over which the tendon's fibres straighten (end of the toe region)"),),
+    apply=_toe,
+    meaning="toe region of the tendon: crimped fibres straighten first, so the tendon is soft at low "
+            "force (force grows with elongation squared) and reaches its linear stiffness after toe_mm",
+    signature="the residual is curved against force: it moves quickly at low force and is constant at "
+              "high force (the tendon stretches more than linear at the start)",
+))
+
+
+def _visco(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
+    lag = first_order_lag(ctx.data, np.asarray(ctx.force_N, float), p["tau_s"])
+    return elong + p["ratio"] * ctx.compliance_mm_per_N * lag
+
+
+VISCOELASTIC = register(Effect(
+    name="viscoelastic", stage="elongation",
+    params=(Param("ratio", "", 0.0, 20.0, 0.1,
+                  "delayed compliance as a fraction of the instantaneous one (standard linear solid)"),
+            Param("tau_s", "s", 1e-3, 1e6, lambda d, c: _period(d) / 4.0,
+                  "retardation time of the delayed compliance")),
+    apply=_visco,
+    meaning="viscoelastic tendon (standard linear solid): part of the elongation follows the force "
+            "with a delay, so the tendon is stiffer in fast loading and creeps at constant load",
+    signature="the residual follows the force history: a loop against force (hysteresis) that depends "
+              "on the loading rate",
+))
+
+
+def _series(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
+    return elong + p["compliance_mm_per_N"] * ctx.force_N
+
+
+SERIES = register(Effect(
+    name="series", stage="elongation",
+    params=(Param("compliance_mm_per_N", "mm/N", -2.0, 10.0, 0.02,
+                  "extra compliance in series with the tendon (sheath or tube compression)"),),
+    apply=_series,
+    meaning="an extra compliance in series with the tendon (the sheath or the tube compresses)",
+    signature="the residual is proportional to force, like a softer tendon",
+    family="compliance",
+))
+
+
+# ----------------------------------------------------------------------------- kinematics stage
+
+def _kerf(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
+    g = ctx.geometry
+    arc = min(max(g.arc_mm + p["kerf_mm"], 1e-6), 2.0 * math.pi * g.outer_radius_mm - 1e-6)
+    ybar = centroid_mm(g.outer_radius_mm, g.inner_radius_mm, backbone_angle_rad(g.outer_radius_mm, arc))
+    arm = _arm_for(g.outer_radius_mm, g.inner_radius_mm, g.tendon_radius_mm, ybar)
+    return theta * (g.moment_arm_mm / arm)
+
+
+KERF = register(Effect(
+    name="kerf", stage="kinematics",
+    params=(Param("kerf_mm", "mm", -0.5, 0.5, 0.02,
+                  "widening of the notch arc by the laser kerf (on the outer surface)"),),
+    apply=_kerf,
+    meaning="the laser kerf widens the notch arc, so the backbone angle phi, its centroid and the moment "
+            "arm change",
+    signature="the residual is proportional to the angle (a gain error of the joint)",
+    family="arm",
+))
+
+
+def _flat(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
+    g = ctx.geometry
+    arm = _arm_for(g.outer_radius_mm, g.inner_radius_mm, g.tendon_radius_mm,
+                   _flat_wall_ybar(g.outer_radius_mm, g.inner_radius_mm, g.arc_mm))
+    return theta * (g.moment_arm_mm / arm)
+
+
+FLAT_WALLS = register(Effect(
+    name="flat_walls", stage="kinematics", params=(), apply=_flat,
+    meaning="the notch walls are flat (one planar cut) rather than radial, so the backbone and the arm differ",
+    signature="the residual is proportional to the angle (a gain error of the joint)",
+    family="arm",
+))
+
+
+def _chords(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
+    # per notch: dL(t) = a t + (h/t - a)(t - 2 sin(t/2)), solve n dL(t) = l_kin by Newton
+    n = max(ctx.n_notches, 1)
+    a = ctx.arm_mm
+    h = ctx.geometry.notch_width_mm
+    target = np.asarray(ctx.l_kin_mm, float) / n
+    t = target / a
+    for _ in range(6):
+        ts = np.where(np.abs(t) < 1e-9, 1e-9, t)
+        s = np.sin(ts / 2.0)
+        f = h - 2.0 * (h / ts - a) * s - target
+        df = 2.0 * h / ts**2 * s - (h / ts - a) * np.cos(ts / 2.0)
+        t = t - f / df
+    return t * n
+
+
+CHORDS = register(Effect(
+    name="chords", stage="kinematics", params=(), apply=_chords,
+    meaning="the tendon crosses each notch as a straight chord, not an arc, so it shortens a little "
+            "less than arm x angle",
+    signature="a small residual growing with the angle squared",
+))
+
+
+def _hardstop(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
+    return np.minimum(theta, math.radians(p["stop_deg"]))
+
+
+HARDSTOP = register(Effect(
+    name="hardstop", stage="kinematics",
+    params=(Param("stop_deg", "deg", 1.0, 720.0,
+                  lambda d, c: math.degrees(c.n_notches * c.geometry.closure_angle_rad),
+                  "joint angle at which the notches close"),),
+    apply=_hardstop,
+    meaning="the notches close: beyond this angle the joint stops bending (hard stop)",
+    signature="at high stroke the measured angle levels off while the model keeps rising",
+))
+
+
+# ----------------------------------------------------------------------------- measurement stages
+
+def _bias(ctx: Context, angle: np.ndarray, p: dict) -> np.ndarray:
+    return angle + p["bias_deg"]
+
+
+ANGLE_BIAS = register(Effect(
+    name="angle_bias", stage="angle",
+    params=(Param("bias_deg", "deg", -90.0, 90.0, 0.0, "constant offset of the angle sensor"),),
+    apply=_bias,
+    meaning="the angle sensor (EM tracker) reads a constant offset",
+    signature="a constant residual everywhere, also where the joint is straight",
+    family="offset",
+))
+
+
+def _zero(ctx: Context, force: np.ndarray, p: dict) -> np.ndarray:
+    return force - p["zero_N"]
+
+
+FORCE_ZERO = register(Effect(
+    name="force_zero", stage="force",
+    params=(Param("zero_N", "N", -10.0, 10.0, 0.0, "load-cell reading at zero tension"),),
+    apply=_zero,
+    meaning="the load cell is not zeroed: it reads an offset at zero tension",
+    signature="a constant residual (the offset times the tendon compliance over the arm)",
+    family="offset",
+))
+
+#: Built-in effect names in registration order.
+BUILTINS = tuple(e.name for e in (SLACK, PLAY, CREEP, FRICTION, TOE, VISCOELASTIC, SERIES, KERF,
+                                  FLAT_WALLS, CHORDS, HARDSTOP, ANGLE_BIAS, FORCE_ZERO))
