@@ -207,7 +207,8 @@ SLACK = register(Effect(
 
 
 def _play(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
-    return play_operator(ctx.data, stroke, p["play_mm"])
+    # a negative output is a slack tendon (it cannot push): the joint stays straight
+    return np.maximum(play_operator(ctx.data, stroke, p["play_mm"]), 0.0)
 
 
 PLAY = register(Effect(
@@ -224,7 +225,8 @@ PLAY = register(Effect(
 
 def _creep(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
     t = np.asarray(ctx.data.time_s, float)
-    return stroke - p["creep_mm"] * -np.expm1(-t / max(p["tau_s"], 1e-9))
+    # a tendon longer than the stroke is slack: the joint stays straight
+    return np.maximum(stroke - p["creep_mm"] * -np.expm1(-t / max(p["tau_s"], 1e-9)), 0.0)
 
 
 CREEP = register(Effect(
@@ -283,7 +285,8 @@ TOE = register(Effect(
 
 def _visco(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
     lag = first_order_lag(ctx.data, np.asarray(ctx.force_N, float), p["tau_s"])
-    return elong + p["ratio"] * ctx.compliance_mm_per_N * lag
+    # while the delayed elongation exceeds the stroke the tendon is slack: the joint stays straight
+    return np.minimum(elong + p["ratio"] * ctx.compliance_mm_per_N * lag, ctx.stroke_mm)
 
 
 VISCOELASTIC = register(Effect(
