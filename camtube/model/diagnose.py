@@ -10,7 +10,7 @@ Method
 2. **Noise floor.** The sensor noise is white, the model error is smooth in
    time; so the noise shows in the high-order differences of the residual
    within each sample: ``sigma = 1.4826 MAD(diff^k r) / sqrt(C(2k, k))``
-   for ``k = 2, 3`` (the smaller is kept; robust to kinks at reversals). A
+   for ``k = 2, 3, 4`` (the smallest is kept; the median ignores kinks at reversals). A
    perfect model leaves an RMSE of ``sigma``.
 3. **Candidates.** Each registered effect not yet in the model is added in
    turn; the model's fitted parameters plus the effect's are fitted (on at
@@ -26,11 +26,13 @@ Method
 
    Candidates are ranked by held-out RMSE.
 4. **Equivalences.** A candidate whose parameter correlates with a fitted
-   parameter by ``|r| > 0.99`` cannot be told apart from that parameter (a
-   series compliance is a softer tendon); two candidates whose predictions
-   differ by less than half the noise floor (rms) and whose held-out errors are
-   within a few percent cannot be told apart from each other; a declared
-   :attr:`Effect.family` is reported the same way.
+   parameter by ``|r| > 0.99`` is reported as confounded with it (a series
+   compliance is a softer tendon: it then gains nothing and is not
+   significant). Two useful candidates whose held-out RMSEs are within 3% of
+   each other, or whose predictions differ by less than half the noise floor
+   (rms), cannot be told apart from each other; a declared
+   :attr:`Effect.family` is reported the same way. Among candidates that
+   cannot be told apart from the best one, the lowest BIC leads the ranking.
 5. **Greedy combination.** The best candidate is recommended and added if
    it is significant: ``delta BIC < -bic_threshold``, its held-out RMSE falls
    by at least ``min_gain`` (relative) and it explains at least
@@ -167,6 +169,7 @@ class Diagnosis:
     stop_reason: str
     fixed: dict = field(default_factory=dict)
     seconds: dict = field(default_factory=dict)
+    catalog: dict = field(default_factory=dict)
 
     @property
     def candidates(self) -> tuple:
@@ -415,13 +418,12 @@ def diagnose(
         vals.update(r.params)
         steps.append(Step(tuple(e.name for e in m.effects), r.rmse, dict(r.rmse_per_sample), dict(r.params),
                           dict(r.stderr), dict(r.units), r.predicted, r.residuals))
-    # the floor again from the final residual (less model error leaks into it)
-    floor = min(floor, noise_floor(data, steps[-1].residuals))
     clock["waterfall"] = time.perf_counter()
     secs = {"base": clock["base"] - clock["start"], "search": clock["search"] - clock["base"],
             "waterfall": clock["waterfall"] - clock["search"], "total": clock["waterfall"] - clock["start"]}
+    catalog = {e.name: e for e in list(model.effects) + list(pool) + chosen}
     return Diagnosis(data, model, floor, base_rmse, base_ho, tuple(rounds), tuple(recommended), tuple(steps),
-                     tuple(fit_params), stop, fixed, secs)
+                     tuple(fit_params), stop, fixed, secs, catalog)
 
 
 def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: Fitted, cur_ho: float,

@@ -1,0 +1,95 @@
+"""``camtube model diagnose``: which physics is missing from the model (thin CLI over :mod:`camtube.model.diagnose`).
+
+``register(model_sub)`` adds the sub-command to the ``model`` group that
+:mod:`camtube.model.cli` creates.
+"""
+from __future__ import annotations
+
+import argparse
+import shlex
+
+
+def register(model_sub) -> None:
+    d = model_sub.add_parser(
+        "diagnose", help="find the physical effects the model is missing, rank them, say how to add them",
+        description="Fit the current model to every selected row (both directions of motion, slack deadband "
+                    "kept), estimate the noise floor from the residual, try each candidate effect and greedy "
+                    "combinations (held-out RMSE on alternate cycles and BIC), and recommend the effects that "
+                    "bring the error to the noise floor, with their fitted parameters and the command that "
+                    "adds them. Angles deg, strokes mm, forces N.")
+    d.add_argument("data", metavar="DATA.csv",
+                   help="columns sample, cycle, time_s, stroke_mm, force_N, angle_deg")
+    d.add_argument("--pattern", required=True, metavar="PATTERN", help="pattern YAML of the joint (see patterns/)")
+    d.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a pattern scalar, e.g. --set tendon.length=80")
+    d.add_argument("-q", "--quiet", action="store_true", help="do not print design warnings")
+    d.add_argument("--cycles", default="all", metavar="SPEC",
+                   help="cycles to use: all (default), last20, 31-50, 2-, ... (comma lists allowed)")
+    d.add_argument("--effects", default="", metavar="A,B", help="effects already in the model (default: none)")
+    d.add_argument("--effect-file", action="append", default=[], metavar="F.py",
+                   help="a .py file defining Effect objects; its effects become candidates too (repeatable)")
+    d.add_argument("--candidates", default="", metavar="A,B",
+                   help="effects to try (default: every registered effect not in the model)")
+    d.add_argument("--fit", dest="fit_params", default="E_t", metavar="P1,P2",
+                   help="base parameters fitted besides the effects' own (default E_t)")
+    d.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
+                   help="hold a parameter at a value (E_t GPa, L0 mm); repeatable")
+    d.add_argument("--max-rows", type=int, default=4000, metavar="N",
+                   help="rows used by the candidate search, thinned evenly in time (default 4000; 0 = all)")
+    d.add_argument("--max-effects", type=int, default=4, metavar="N", help="most effects recommended (default 4)")
+    d.add_argument("--json", metavar="OUT.json", help="write the diagnosis as JSON")
+    d.add_argument("--report", metavar="DIR", help="write an HTML report with PNG plots into DIR")
+    d.set_defaults(func=cmd_diagnose)
+
+
+def fit_command_prefix(args: argparse.Namespace) -> str:
+    """The ``camtube model fit`` command selecting the same rows and files as this diagnosis."""
+    parts = ["camtube", "model", "fit", args.data, "--pattern", args.pattern]
+    for o in args.overrides:
+        parts += ["--set", o]
+    parts += ["--cycles", args.cycles, "--branch", "both", "--no-deadband"]
+    for f in args.effect_file:
+        parts += ["--effect-file", f]
+    for f in args.fix:
+        parts += ["--fix", f]
+    return shlex.join(parts)
+
+
+def cmd_diagnose(args: argparse.Namespace) -> int:
+    from camtube.cliutil import load_from_args
+    from camtube.errors import DataError
+    from camtube.io import write_atomic
+    from camtube.model.cli import _names, _parse_fix, build_model
+    from camtube.model.data import load_csv, select_cycles
+    from camtube.model.diagnose import diagnose
+    from camtube.model.fit import FitError
+    from camtube.model.predict import pattern_values
+    from camtube.model.report import diagnosis_json, diagnosis_text, write_report
+
+    pattern = load_from_args(args).pattern
+    model = build_model(pattern, args.effects, args.effect_file)
+    raw = load_csv(args.data)
+    rows = select_cycles(raw, args.cycles)
+    fixed = pattern_values(pattern)
+    fixed.update(_parse_fix(args.fix))
+    cands = _names(args.candidates) or None
+    if cands:
+        from camtube.model.api import get_effect
+
+        try:
+            cands = [get_effect(c) for c in cands]
+        except KeyError as exc:
+            raise FitError(exc.args[0]) from None
+    if args.max_rows < 0 or args.max_effects < 0:
+        raise DataError("--max-rows and --max-effects must be >= 0")
+    d = diagnose(model, rows, _names(args.fit_params), fixed, candidates=cands,
+                 max_rows=args.max_rows, max_effects=args.max_effects)
+    prefix = fit_command_prefix(args)
+    title = f"{pattern.name}: {args.data} ({len(rows)} rows, cycles {args.cycles}, both directions, deadband kept)"
+    print(diagnosis_text(d, prefix, title))
+    meta = {"pattern": pattern.name, "data": str(args.data), "cycles": args.cycles}
+    if args.json:
+        print(f"wrote {write_atomic(args.json, diagnosis_json(d, prefix, meta))}")
+    if args.report:
+        print(f"wrote {write_report(d, args.report, prefix, title)}")
+    return 0

@@ -1,0 +1,323 @@
+"""Reports of a :class:`~camtube.model.diagnose.Diagnosis`: text, JSON, and an offline HTML page with PNG plots.
+
+Pure writers return ``str``/``bytes``; :func:`write_report` puts the files on
+disk through :mod:`camtube.io` (each file atomically; ``index.html`` last, so a
+report directory with an index is complete).
+
+``diagnosis_dict(d, command="")`` is the JSON-ready summary (schema
+``camtube.diagnose/1``)::
+
+    {"schema", "noise_floor_deg",
+     "base": {"effects", "rmse_deg", "heldout_rmse_deg", "per_sample", "params"},
+     "candidates": [{"effect", "rmse_deg", "heldout_rmse_deg", "delta_bic", "params": {name: {value, stderr, unit}},
+                     "equivalent", "confounded", "significant", "why", "meaning", "signature"}],
+     "rounds": [[candidate, ...], ...],        # candidates of each greedy round (first = "candidates")
+     "recommended": [effect, ...],             # in order
+     "waterfall": [{"effects", "rmse_deg", "per_sample"}],
+     "final": {"effects", "rmse_deg", "params"}, "stop_reason", "command"}
+
+Non-finite numbers are written as ``null``.
+"""
+from __future__ import annotations
+
+import html
+import io
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from camtube.model.atlas import describe, residual_atlas
+from camtube.model.diagnose import Candidate, Diagnosis
+
+
+def _num(x) -> float | None:
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _pm(value: float, err: float, unit: str) -> str:
+    e = f" +- {err:.2g}" if math.isfinite(err) else " +- inf"
+    return f"{value:.4g}{e} {unit}".rstrip()
+
+
+def fit_names(d: Diagnosis, effects) -> list[str]:
+    """Full names of the parameters fitted with ``effects``: the base ones, then each effect's."""
+    names = list(d.fit_params)
+    for name in effects:
+        names += [f"{name}.{p.name}" for p in d.catalog[name].params]
+    return list(dict.fromkeys(names))
+
+
+def add_command(d: Diagnosis, prefix: str) -> str:
+    """The ``camtube model fit`` command that fits the model with the recommended effects."""
+    effects = list(d.final.effects)
+    if not effects or not prefix:
+        return ""
+    return f"{prefix} --effects {','.join(effects)} --fit {','.join(fit_names(d, effects))}"
+
+
+def _candidate_dict(d: Diagnosis, c: Candidate) -> dict:
+    e = d.catalog.get(c.effect)
+    return {
+        "effect": c.effect,
+        "rmse_deg": _num(c.rmse_deg),
+        "heldout_rmse_deg": _num(c.heldout_rmse_deg),
+        "delta_bic": _num(c.delta_bic),
+        "params": {k: {"value": _num(v), "stderr": _num(s), "unit": u} for k, (v, s, u) in c.params.items()},
+        "equivalent": list(c.equivalent),
+        "confounded": list(c.confounded),
+        "significant": bool(c.significant),
+        "why": c.why,
+        "meaning": e.meaning if e else "",
+        "signature": e.signature if e else "",
+    }
+
+
+def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) -> dict:
+    """JSON-ready summary of ``d`` (see the module docstring); ``command`` is the ``model fit`` prefix."""
+    base, final = d.waterfall[0], d.final
+    out: dict = {"schema": "camtube.diagnose/1"}
+    out.update(meta or {})
+    out["noise_floor_deg"] = _num(d.noise_floor_deg)
+    out["base"] = {"effects": list(base.effects), "rmse_deg": _num(base.rmse_deg),
+                   "heldout_rmse_deg": _num(d.base_heldout_rmse_deg),
+                   "per_sample": {k: _num(v) for k, v in base.rmse_per_sample.items()},
+                   "params": {k: {"value": _num(v), "stderr": _num(base.stderr[k]) if k in base.stderr else None,
+                                  "unit": base.units.get(k, "")} for k, v in base.params.items()}}
+    out["candidates"] = [_candidate_dict(d, c) for c in d.candidates]
+    out["rounds"] = [[_candidate_dict(d, c) for c in r] for r in d.rounds]
+    out["recommended"] = list(d.recommended)
+    out["waterfall"] = [{"effects": list(s.effects), "rmse_deg": _num(s.rmse_deg),
+                         "per_sample": {k: _num(v) for k, v in s.rmse_per_sample.items()}} for s in d.waterfall]
+    out["final"] = {"effects": list(final.effects), "rmse_deg": _num(final.rmse_deg),
+                    "params": {k: {"value": _num(v), "stderr": _num(final.stderr[k]) if k in final.stderr else None,
+                                   "unit": final.units.get(k, "")} for k, v in final.params.items()}}
+    out["stop_reason"] = d.stop_reason
+    out["command"] = add_command(d, command)
+    return out
+
+
+def diagnosis_json(d: Diagnosis, command: str = "", meta: dict | None = None) -> str:
+    """:func:`diagnosis_dict` as indented JSON with a final newline (deterministic)."""
+    return json.dumps(diagnosis_dict(d, command, meta), indent=2, allow_nan=False) + "\n"
+
+
+def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
+    """The diagnosis in words: floor, where the model fails, the ranking, what to add and how."""
+    floor = d.noise_floor_deg
+    base = d.waterfall[0]
+    lines = [title] if title else []
+    cur = ", ".join(base.effects) or "none"
+    lines.append(f"noise floor (white noise in the residual): {floor:.3f} deg")
+    lines.append(f"current model (effects: {cur}): RMSE {base.rmse_deg:.3f} deg = "
+                 f"{base.rmse_deg / floor:.2f} x the noise floor; held-out {d.base_heldout_rmse_deg:.3f} deg")
+    where = describe(residual_atlas(d.data, base.residuals), floor)
+    if where:
+        lines.append("where it fails:")
+        lines += [f"  - {w}" for w in where]
+    if d.candidates:
+        lines.append("")
+        lines.append("candidates (each effect added to the current model, ranked by held-out RMSE):")
+        w = max(len(c.effect) for c in d.candidates)
+        lines.append(f"  {'#':>2}  {'effect':<{w}}  {'held-out':>8}  {'RMSE':>7}  {'dBIC':>9}  verdict")
+        for k, c in enumerate(d.candidates, 1):
+            verdict = "significant" if c.significant else c.why
+            if c.equivalent:
+                verdict += f"; cannot be told apart from {', '.join(c.equivalent)}"
+            lines.append(f"  {k:>2}  {c.effect:<{w}}  {c.heldout_rmse_deg:8.3f}  {c.rmse_deg:7.3f}  "
+                         f"{c.delta_bic:9.1f}  {verdict}")
+    lines.append("")
+    if d.recommended:
+        lines.append("recommended, in order:")
+        prev = base
+        for k, name in enumerate(d.recommended, 1):
+            e = d.catalog[name]
+            step = d.waterfall[k]
+            lines.append(f"  {k}. {name}: {e.signature}: {e.meaning}.")
+            for p in e.params:
+                full = f"{name}.{p.name}"
+                lines.append(f"       {full} = {_pm(step.params[full], step.stderr.get(full, math.inf), p.unit)}"
+                             f"  ({p.doc})")
+            rnd = d.rounds[k - 1] if k - 1 < len(d.rounds) else ()
+            c = next((c for c in rnd if c.effect == name), None)
+            if c is not None and c.equivalent:
+                lines.append(f"       the data cannot tell it apart from: {', '.join(c.equivalent)}")
+            if c is not None and c.confounded:
+                lines.append(f"       strongly correlated with: {', '.join(c.confounded)}")
+            lines.append(f"       RMSE {prev.rmse_deg:.3f} -> {step.rmse_deg:.3f} deg "
+                         f"({step.rmse_deg / floor:.2f} x the noise floor)")
+            prev = step
+        cmd = add_command(d, command)
+        if cmd:
+            lines.append("add them:")
+            lines.append(f"  {cmd}")
+    else:
+        lines.append("recommended: nothing")
+    lines.append(f"stop: {d.stop_reason}")
+    return "\n".join(lines)
+
+
+# ----------------------------------------------------------------------------- figures
+
+def _png(fig) -> bytes:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", metadata={"Software": None})
+    return buf.getvalue()
+
+
+def _figure(w: float, h: float):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=(w, h), dpi=100)
+
+
+def model_png(d: Diagnosis, max_samples: int = 4) -> bytes:
+    """Angle vs stroke: measured, current model and the model with the recommended effects, per sample."""
+    sl = d.data.sample_slices()[:max_samples]
+    fig = _figure(4.2 * len(sl), 4.0)
+    axes = np.atleast_1d(fig.subplots(1, len(sl), squeeze=False)[0])
+    base, final = d.waterfall[0], d.final
+    for ax, (smp, s) in zip(axes, sl):
+        st = d.data.stroke_mm[s]
+        ax.plot(st, d.data.angle_deg[s], ".", ms=1.5, color="0.6", label="measured", rasterized=True)
+        ax.plot(st, base.predicted[s], "-", lw=0.7, color="tab:red", label="current model")
+        if final is not base:
+            ax.plot(st, final.predicted[s], "-", lw=0.7, color="black",
+                    label="+ " + ", ".join(d.recommended))
+        ax.set_title(f"sample {smp}: RMSE {base.rmse_per_sample[smp]:.2f} -> {final.rmse_per_sample[smp]:.2f} deg",
+                     fontsize=9)
+        ax.set_xlabel("stroke (mm)")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("joint angle (deg)")
+    axes[0].legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    return _png(fig)
+
+
+def atlas_png(d: Diagnosis) -> bytes:
+    """The residual atlas of the current model (grey points, red trend) and of the final model (black trend)."""
+    base = residual_atlas(d.data, d.waterfall[0].residuals)
+    final = residual_atlas(d.data, d.final.residuals) if d.recommended else None
+    fig = _figure(13.0, 7.0)
+    axes = fig.subplots(2, 3).ravel()
+    from camtube.model.atlas import variable
+
+    rng = np.random.default_rng(0)
+    n = len(d.data)
+    pick = np.sort(rng.choice(n, size=min(n, 4000), replace=False)) if n else np.zeros(0, int)
+    for ax, p in zip(axes, base.panels):
+        x = variable(d.data, p.key)[pick]
+        jitter = rng.uniform(-0.3, 0.3, x.size) if p.key == "direction" else 0.0
+        ax.plot(x + jitter, d.waterfall[0].residuals[pick], ".", ms=1, color="0.7", rasterized=True)
+        ax.axhline(0.0, color="0.4", lw=0.7)
+        ax.fill_between(p.centre, np.nan_to_num(p.q25), np.nan_to_num(p.q75), color="tab:red", alpha=0.15, lw=0)
+        ax.plot(p.centre, p.median, "o-", ms=3, color="tab:red", label="current model (median)")
+        for sgn, style in ((1, "--"), (-1, ":")):
+            if sgn in p.by_direction:
+                c, m = p.by_direction[sgn]
+                ax.plot(c, m, style, color="tab:red", lw=1,
+                        label="loading" if sgn > 0 else "unloading")
+        if final is not None:
+            q = final.panel(p.key)
+            ax.plot(q.centre, q.median, "s-", ms=3, color="black", label="with " + ", ".join(d.recommended))
+        ax.set_xlabel(f"{p.label} ({p.unit})" if p.unit else p.label)
+        ax.set_title(f"explains {100 * p.explained:.0f}% of the residual", fontsize=9)
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("residual (deg)")
+    axes[3].set_ylabel("residual (deg)")
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    return _png(fig)
+
+
+def ranking_png(d: Diagnosis) -> bytes:
+    """Held-out RMSE of each first-round candidate, with the current model and the noise floor."""
+    cands = list(d.candidates)
+    fig = _figure(7.0, 0.35 * max(len(cands), 3) + 1.2)
+    ax = fig.subplots()
+    y = np.arange(len(cands))[::-1]
+    ax.barh(y, [c.heldout_rmse_deg for c in cands],
+            color=["tab:green" if c.significant else "0.6" for c in cands])
+    ax.set_yticks(y, [c.effect for c in cands])
+    ax.axvline(d.base_heldout_rmse_deg, color="tab:red", lw=1, label="current model")
+    ax.axvline(d.noise_floor_deg, color="black", ls="--", lw=1, label="noise floor")
+    ax.set_xlabel("held-out RMSE (deg); green: significant")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    return _png(fig)
+
+
+def waterfall_png(d: Diagnosis) -> bytes:
+    """RMSE overall and per sample as the recommended effects are added."""
+    steps = d.waterfall
+    samples = list(steps[0].rmse_per_sample)
+    groups = ["all"] + samples
+    fig = _figure(1.6 + 1.1 * len(steps) * len(groups) / 2, 3.6)
+    ax = fig.subplots()
+    width = 0.8 / len(steps)
+    x = np.arange(len(groups))
+    for k, s in enumerate(steps):
+        vals = [s.rmse_deg] + [s.rmse_per_sample[g] for g in samples]
+        label = "current model" if k == 0 else "+ " + d.recommended[k - 1]
+        ax.bar(x + (k - (len(steps) - 1) / 2) * width, vals, width, label=label)
+    ax.axhline(d.noise_floor_deg, color="black", ls="--", lw=1, label="noise floor")
+    ax.set_xticks(x, ["all"] + [f"sample {g}" for g in samples])
+    ax.set_ylabel("RMSE (deg)")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    return _png(fig)
+
+
+def report_files(d: Diagnosis, command: str = "", title: str = "camtube diagnosis") -> dict[str, bytes]:
+    """``{file name: bytes}`` of the report: four PNGs and ``index.html`` (self-contained, offline)."""
+    files = {"model.png": model_png(d), "atlas.png": atlas_png(d), "ranking.png": ranking_png(d),
+             "waterfall.png": waterfall_png(d)}
+    esc = html.escape
+    rows = []
+    for k, c in enumerate(d.candidates, 1):
+        params = "; ".join(f"{n} = {_pm(v, s, u)}" for n, (v, s, u) in c.params.items())
+        note = "significant" if c.significant else c.why
+        if c.equivalent:
+            note += f"; cannot be told apart from {', '.join(c.equivalent)}"
+        rows.append(f"<tr><td>{k}</td><td>{esc(c.effect)}</td><td>{c.heldout_rmse_deg:.3f}</td>"
+                    f"<td>{c.rmse_deg:.3f}</td><td>{c.delta_bic:.1f}</td><td>{esc(params)}</td>"
+                    f"<td>{esc(note)}</td></tr>")
+    page = f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{esc(title)}</title>
+<style>body{{font-family:sans-serif;max-width:1300px;margin:1em auto}}pre{{background:#f4f4f4;padding:.6em;
+white-space:pre-wrap}}table{{border-collapse:collapse;font-size:90%}}td,th{{border:1px solid #ccc;padding:2px 6px}}
+img{{max-width:100%}}</style></head><body>
+<h1>{esc(title)}</h1>
+<pre>{esc(diagnosis_text(d, command))}</pre>
+<h2>Model vs measurement</h2><img src="model.png" alt="angle vs stroke">
+<h2>Residual atlas</h2>
+<p>Residual (measured - model) against each variable; lines are binned medians, the band the quartiles of the
+current model; dashed/dotted: loading/unloading.</p><img src="atlas.png" alt="residual atlas">
+<h2>Candidate ranking</h2><img src="ranking.png" alt="ranking">
+<table><tr><th>#</th><th>effect</th><th>held-out RMSE deg</th><th>RMSE deg</th><th>delta BIC</th>
+<th>parameters</th><th>verdict</th></tr>
+{chr(10).join(rows)}
+</table>
+<h2>Waterfall</h2><p>RMSE as the recommended effects are added, refitted on all rows.</p>
+<img src="waterfall.png" alt="waterfall">
+</body></html>
+"""
+    files["index.html"] = page.encode("utf-8")
+    return files
+
+
+def write_report(d: Diagnosis, directory: str | Path, command: str = "", title: str = "camtube diagnosis") -> Path:
+    """Write :func:`report_files` into ``directory`` (PNGs first, ``index.html`` last); returns the index path."""
+    from camtube.io import write_atomic
+
+    files = report_files(d, command, title)
+    directory = Path(directory)
+    for name, payload in files.items():
+        if name != "index.html":
+            write_atomic(directory / name, payload)
+    return write_atomic(directory / "index.html", files["index.html"])
