@@ -1,0 +1,149 @@
+"""Built-in effects: registered, documented, and each one checked against an independent calculation."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from camtube.design.geometry import joint_geometry
+from camtube.design.loader import load_pattern
+from camtube.model.api import STAGES, get_effect, registry
+from camtube.model.dataset import Dataset
+from camtube.model.effects import BUILTINS, _flat_wall_ybar, first_order_lag, play_operator
+from camtube.model.predict import model_for_pattern, pattern_values
+from tests.conftest import PATTERNS
+
+
+def _data(stroke, time=None, force=None, samples=None):
+    n = len(stroke)
+    return Dataset(np.array(samples if samples is not None else ["a"] * n, dtype=object), np.ones(n, int),
+                   np.arange(n, dtype=float) if time is None else np.asarray(time, float),
+                   np.asarray(stroke, float), np.zeros(n) if force is None else np.asarray(force, float),
+                   np.zeros(n))
+
+
+@pytest.fixture(scope="module")
+def tube1():
+    return load_pattern(PATTERNS / "tube1.yaml")
+
+
+def test_every_builtin_is_registered_and_documented():
+    reg = registry()
+    need = {"slack", "play", "friction", "toe", "creep", "viscoelastic", "series", "kerf", "flat_walls",
+            "chords", "hardstop", "angle_bias", "force_zero"}
+    assert need <= set(reg) and need <= set(BUILTINS)
+    for name in BUILTINS:
+        e = reg[name]
+        assert e.stage in STAGES and e.meaning and e.signature
+        for p in e.params:
+            assert p.unit is not None and p.lo < p.hi and p.doc
+    assert {get_effect(n).stage for n in BUILTINS} == set(STAGES)  # all five stages used
+
+
+def test_play_operator_matches_a_plain_loop():
+    rng = np.random.default_rng(1)
+    # random walk with pauses, two samples
+    x = np.concatenate([np.cumsum(rng.choice([-1, 0, 1], 400) * rng.uniform(0, 0.05, 400)) for _ in range(2)])
+    data = _data(x, samples=["a"] * 400 + ["b"] * 400)
+    for w in (0.0, 0.03, 0.2):
+        y = play_operator(data, x, w)
+        ref = np.empty_like(x)
+        d = data.direction
+        for _, sl in data.sample_slices():
+            prev = x[sl][0] - (w if d[sl][0] > 0 else 0.0)
+            for k in range(sl.start, sl.stop):
+                prev = min(max(prev, x[k] - w), x[k])
+                ref[k] = prev
+        np.testing.assert_allclose(y, ref, atol=1e-12)
+
+
+def test_first_order_lag_matches_the_ode_solution():
+    t = np.linspace(0, 10, 2001)
+    u = np.where(t > 1.0, 1.0, 0.0)
+    v = first_order_lag(_data(np.zeros_like(t), time=t), u, 2.0)
+    k = t > 1.0
+    exact = 1.0 - np.exp(-(t[k] - t[k][0]) / 2.0)
+    np.testing.assert_allclose(v[k], exact, atol=3e-3)
+    # non-uniform sampling takes the loop and agrees
+    tn = np.sort(np.concatenate([t, [0.0013, 3.3337]]))
+    vn = first_order_lag(_data(np.zeros_like(tn), time=tn), np.where(tn > 1.0, 1.0, 0.0), 2.0)
+    assert abs(np.interp(5.0, tn, vn) - np.interp(5.0, t, v)) < 3e-3
+
+
+def test_stroke_effects(tube1):
+    s = np.concatenate([np.linspace(0, 2, 50), np.linspace(2, 0, 50)[1:]])
+    data = _data(s)
+    vals = pattern_values(tube1)
+    arm = model_for_pattern(tube1).geometry.moment_arm_mm
+    base = model_for_pattern(tube1).predict(data, vals)
+    sl = model_for_pattern(tube1, ["slack"]).predict(data, vals | {"slack.deadband_mm": 0.3})
+    np.testing.assert_allclose(sl, np.degrees(np.maximum(s - 0.3, 0) / arm), atol=1e-12)
+    pl = model_for_pattern(tube1, ["play"]).predict(data, vals | {"play.play_mm": 0.2})
+    up, down = slice(5, 49), slice(60, 95)
+    np.testing.assert_allclose(base[up] - pl[up], math.degrees(0.2 / arm), atol=1e-9)  # loading lags by w
+    np.testing.assert_allclose(base[down], pl[down], atol=1e-9)  # unloading: caught up
+    assert np.all(pl[49:54] == pl[49]) and pl[54] < pl[49]  # after the reversal it stays put for w
+    cr = model_for_pattern(tube1, ["creep"]).predict(data, vals | {"creep.creep_mm": 0.1, "creep.tau_s": 1e-6})
+    np.testing.assert_allclose(cr[1:], np.degrees(np.maximum(s[1:] - 0.1, 0) / arm), atol=1e-9)
+
+
+def test_series_compliance_is_a_softer_tendon(tube1):
+    rng = np.random.default_rng(0)
+    data = _data(rng.uniform(0, 2, 50), force=rng.uniform(0, 3, 50))
+    vals = pattern_values(tube1)
+    c = vals["L0"] / (vals["E_t"] * 1e3 * tube1.tendon.area_mm2)
+    ser = model_for_pattern(tube1, ["series"]).predict(data, vals | {"series.compliance_mm_per_N": 0.2})
+    e_soft = vals["L0"] / ((c + 0.2) * 1e3 * tube1.tendon.area_mm2)
+    np.testing.assert_allclose(ser, model_for_pattern(tube1).predict(data, vals | {"E_t": e_soft}), atol=1e-9)
+
+
+def test_toe_law_is_quadratic_then_linear(tube1):
+    f = np.linspace(0, 4, 81)
+    data = _data(np.full_like(f, 2.0), force=f)
+    vals = pattern_values(tube1)
+    c = vals["L0"] / (vals["E_t"] * 1e3 * tube1.tendon.area_mm2)
+    arm = model_for_pattern(tube1).geometry.moment_arm_mm
+    th = np.radians(model_for_pattern(tube1, ["toe"]).predict(data, vals | {"toe.toe_mm": 0.3}))
+    elong = 2.0 - th * arm
+    # force from elongation: e^2/(2 e_t C) in the toe, (e - e_t/2)/C beyond
+    back = np.where(elong < 0.3, elong**2 / (2 * 0.3 * c), (elong - 0.15) / c)
+    np.testing.assert_allclose(back, f, atol=1e-9)
+
+
+def test_flat_wall_centroid_by_numerical_integration():
+    ro, ri, s = 0.75, 0.45, 2.83
+    d = ro * math.cos(s / (2 * ro))
+    r = np.linspace(ri, ro, 801)[:, None]
+    a = np.linspace(-math.pi, math.pi, 3201)[None, :]
+    y = r * np.cos(a)
+    keep = y < d
+    wgt = r * keep
+    ybar_num = -float((y * wgt).sum() / wgt.sum())
+    assert abs(_flat_wall_ybar(ro, ri, s) - ybar_num) < 2e-3
+    # a flat wall removes more of the inner wall than a radial one: a different arm
+    assert abs(_flat_wall_ybar(ro, ri, s) - joint_geometry(ro, ri, s, 0.5).ybar_mm) > 0.01
+
+
+def test_chords_shorten_less_than_the_arc(tube1):
+    model = model_for_pattern(tube1, ["chords"])
+    g = model.geometry
+    th_n = np.radians(np.array([1.0, 5.0, 10.0]))  # per notch
+    n = model.n_notches
+    dl = g.moment_arm_mm * th_n + (g.notch_width_mm / th_n - g.moment_arm_mm) * (th_n - 2 * np.sin(th_n / 2))
+    data = _data(n * dl)
+    got = np.radians(model.predict(data, pattern_values(tube1)))
+    np.testing.assert_allclose(got, n * th_n, rtol=1e-9)
+
+
+def test_offsets_and_hardstop(tube1):
+    data = _data(np.linspace(0, 2, 20), force=np.linspace(0, 3, 20))
+    vals = pattern_values(tube1)
+    base = model_for_pattern(tube1).predict(data, vals)
+    b = model_for_pattern(tube1, ["angle_bias"]).predict(data, vals | {"angle_bias.bias_deg": 1.5})
+    np.testing.assert_allclose(b - base, 1.5)
+    z = model_for_pattern(tube1, ["force_zero"]).predict(data, vals | {"force_zero.zero_N": 0.2})
+    assert np.ptp(z - base) < 1e-9 and (z - base)[0] > 0  # a constant: same family as angle_bias
+    assert get_effect("angle_bias").family == get_effect("force_zero").family
+    h = model_for_pattern(tube1, ["hardstop"]).predict(data, vals | {"hardstop.stop_deg": 5.0})
+    assert h.max() == pytest.approx(5.0) and np.all(h <= base + 1e-12)
