@@ -117,6 +117,7 @@ class Candidate:
     significant: bool = False
     why: str = ""
     predicted: np.ndarray | None = None
+    values: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True, eq=False)
@@ -396,8 +397,7 @@ def diagnose(
         chosen.append(eff)
         current = model.with_effects(list(model.effects) + chosen)
         cur_names = cur_names + tuple(f"{eff.name}.{p.name}" for p in eff.params)
-        start = dict(cur.params)
-        start.update({k: v[0] for k, v in best.params.items()})
+        start = dict(best.values)
         cur = _least_squares(current, search, cur_names, start)
         cur_ho = best.heldout_rmse_deg
         pool = [e for e in pool if e.name != best.effect]
@@ -461,7 +461,7 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: Fitted, 
             why.append("its parameters end on their bounds")
         tried.append(Candidate(eff.name, tuple(e.name for e in m.effects), f.rmse_deg, ho, dbic, params,
                                confounded=tuple(conf), significant=not why, why="; ".join(why),
-                               predicted=f.predicted))
+                               predicted=f.predicted, values=dict(f.params)))
     tried.sort(key=lambda c: (c.heldout_rmse_deg, c.effect))
     # equivalences: near-equal held-out error and predictions within half the noise floor
     fam = {e.name: e.family for e in pool}
@@ -479,7 +479,7 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: Fitted, 
             if same_fam or close:
                 eq.append(o.effect)
         out.append(Candidate(c.effect, c.effects, c.rmse_deg, c.heldout_rmse_deg, c.delta_bic, c.params,
-                             tuple(eq), c.confounded, c.significant, c.why, c.predicted))
+                             tuple(eq), c.confounded, c.significant, c.why, c.predicted, c.values))
     # among candidates that cannot be told apart from the best, the lowest BIC (the simplest) leads
     if out and out[0].equivalent:
         group = [c for c in out if c is out[0] or c.effect in out[0].equivalent]

@@ -268,7 +268,9 @@ def _toe(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
     f = np.maximum(ctx.force_N, 0.0)
     f_toe = et / (2.0 * c)
     toe = np.where(f < f_toe, np.sqrt(2.0 * et * c * f), c * f + 0.5 * et) - c * f
-    return elong + toe
+    # the toe law is steep at zero force (force noise is amplified there); where the elongation
+    # exceeds the stroke the tendon is slack and the joint straight
+    return np.minimum(elong + toe, np.maximum(ctx.stroke_mm, elong))
 
 
 TOE = register(Effect(

@@ -1,0 +1,145 @@
+"""The diagnosis finds hidden physics in data from the independent truth simulator (and nothing in a control)."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from camtube.cli import main
+from camtube.design.loader import load_pattern
+from camtube.model.atlas import residual_atlas
+from camtube.model.data import format_csv
+from camtube.model.diagnose import diagnose, noise_floor
+from camtube.model.predict import model_for_pattern, pattern_values
+from camtube.model.truth import Hidden, simulate
+from tests.conftest import PATTERNS
+
+TRAP = 0.05  # N mm of joint friction in every case: measured-force hysteresis the model absorbs
+
+# (case id, tube, hidden physics, acceptable first effects, {param: true value, relative tolerance})
+CASES = [
+    ("slack-tube1", "tube1", Hidden(slack_mm=0.1, joint_friction_nmm=TRAP), {"slack"},
+     {"slack.deadband_mm": (0.1, 0.1)}),
+    ("slack-tube3", "tube3", Hidden(slack_mm=0.3), {"slack"}, {"slack.deadband_mm": (0.3, 0.1)}),
+    ("play-tube2", "tube2", Hidden(play_mm=0.06, joint_friction_nmm=TRAP), {"play"}, {"play.play_mm": (0.06, 0.1)}),
+    ("play-tube1", "tube1", Hidden(play_mm=0.15), {"play"}, {"play.play_mm": (0.15, 0.1)}),
+    ("toe-tube1", "tube1", Hidden(toe_mm=0.2, joint_friction_nmm=TRAP), {"toe"}, {"toe.toe_mm": (0.2, 0.1)}),
+    ("toe-tube2", "tube2", Hidden(toe_mm=0.4), {"toe"}, {"toe.toe_mm": (0.4, 0.1)}),
+    ("visco-tube2", "tube2", Hidden(visco_ratio=0.3, visco_tau_s=1.0, joint_friction_nmm=TRAP), {"viscoelastic"},
+     {"viscoelastic.ratio": (0.3, 0.15), "viscoelastic.tau_s": (1.0, 0.2)}),
+    ("visco-tube3", "tube3", Hidden(visco_ratio=0.6, visco_tau_s=3.0), {"viscoelastic"},
+     {"viscoelastic.ratio": (0.6, 0.15), "viscoelastic.tau_s": (3.0, 0.2)}),
+    ("creep-tube1", "tube1", Hidden(creep_mm_per_N=0.05, creep_tau_s=20.0, joint_friction_nmm=TRAP), {"creep"}, {}),
+    ("creep-tube2", "tube2", Hidden(creep_mm_per_N=0.03, creep_tau_s=40.0), {"creep"}, {}),
+    ("slack+play-tube2", "tube2", Hidden(slack_mm=0.08, play_mm=0.06, joint_friction_nmm=TRAP), {"slack", "play"},
+     {"slack.deadband_mm": (0.08, 0.1), "play.play_mm": (0.06, 0.1)}),
+    ("play+creep-tube3", "tube3", Hidden(play_mm=0.2, creep_mm_per_N=0.02, creep_tau_s=30.0), {"play", "creep"},
+     {"play.play_mm": (0.2, 0.1)}),
+]
+
+
+def _run(tube: str, hidden: Hidden, seed: int = 7):
+    p = load_pattern(PATTERNS / f"{tube}.yaml")
+    sim = simulate(p, hidden, n_samples=2, n_cycles=10, rate_hz=10.0, seed=seed)
+    d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
+    return p, sim, d
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+def test_finds_the_hidden_effect(case):
+    _, tube, hidden, want, truth = case
+    p, sim, d = _run(tube, hidden)
+    first = d.candidates[0]
+    # ranked first, or an effect it declares indistinguishable from the first
+    assert want & ({first.effect} | set(first.equivalent)), [(c.effect, c.heldout_rmse_deg) for c in d.candidates]
+    hidden_found = want & ({r for r in d.recommended}
+                           | {e for rnd in d.rounds for c in rnd if c.effect in d.recommended
+                              for e in c.equivalent})
+    assert hidden_found == want, (d.recommended, d.stop_reason)
+    assert len(d.recommended) <= len(want) + 1
+    # the error falls to the noise floor: estimated and true
+    assert d.final.rmse_deg <= 1.3 * d.noise_floor_deg
+    assert d.final.rmse_deg <= 1.3 * sim.sensor_floor_deg
+    assert abs(d.noise_floor_deg / sim.sensor_floor_deg - 1) < 0.15
+    # fed the true tension, the model with the recommended effects reproduces the true angle (where the
+    # tendon is taut: a slack tendon leaves the joint wherever the friction trap holds it)
+    clean = sim.data.with_angle(sim.angle_true_deg)
+    clean = type(clean)(clean.sample, clean.cycle, clean.time_s, clean.stroke_mm, sim.tension_true_N,
+                        clean.angle_deg)
+    pred = model_for_pattern(p, list(d.final.effects)).predict(clean, d.final.params)
+    taut = sim.tension_true_N > 0.01
+    err = float(np.sqrt(np.mean((pred - sim.angle_true_deg)[taut] ** 2)))
+    assert err < 0.5 * sim.sensor_floor_deg, err
+    for name, (value, tol) in truth.items():
+        assert abs(d.final.params[name] / value - 1) < tol, (name, d.final.params[name], value)
+    assert abs(d.final.params["E_t"] / 28.0 - 1) < 0.05
+
+
+@pytest.mark.parametrize("tube", ["tube1", "tube2", "tube3"])
+def test_control_recommends_nothing(tube):
+    _, sim, d = _run(tube, Hidden(joint_friction_nmm=TRAP), seed=11)
+    assert d.recommended == ()
+    assert d.final.rmse_deg <= 1.15 * d.noise_floor_deg
+
+
+def test_control_with_the_search_forced_finds_nothing_significant():
+    """Even when the search runs (stop ratio 0), no effect passes the significance tests on pure noise."""
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    sim = simulate(p, Hidden(), n_cycles=10, seed=3)
+    d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p), stop_ratio=0.0)
+    assert d.recommended == () and d.rounds and not any(c.significant for c in d.candidates)
+
+
+def test_series_compliance_is_declared_confounded_with_e_t():
+    _, _, d = _run("tube1", Hidden(slack_mm=0.1))
+    ser = next(c for c in d.candidates if c.effect == "series")
+    assert not ser.significant and any(s.startswith("E_t") for s in ser.confounded)
+
+
+def test_noise_floor_is_robust_to_model_error():
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    sim = simulate(p, Hidden(play_mm=0.1, visco_ratio=0.3), n_cycles=10, seed=2)
+    base = model_for_pattern(p)
+    resid = sim.data.angle_deg - base.predict(sim.data, pattern_values(p))
+    assert abs(noise_floor(sim.data, resid) / sim.sensor_floor_deg - 1) < 0.15
+
+
+def test_atlas_shows_direction_for_play():
+    p = load_pattern(PATTERNS / "tube1.yaml")
+    sim = simulate(p, Hidden(play_mm=0.15), n_cycles=4, seed=1)
+    r = sim.data.angle_deg - model_for_pattern(p).predict(sim.data, pattern_values(p))
+    at = residual_atlas(sim.data, r)
+    dirn = at.panel("direction")
+    assert dirn.median[1] < dirn.median[0]  # loading (+1) lags: negative residual
+    assert at.panel("direction").explained > 0.3 and at.panel("cycle").explained < 0.05
+
+
+def test_cli_json_report_and_fit_command(tmp_path, capsys):
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    sim = simulate(p, Hidden(slack_mm=0.08, play_mm=0.06), n_cycles=6, seed=5)
+    csv = tmp_path / "d.csv"
+    csv.write_text(format_csv(sim.data))
+    out, rep = tmp_path / "d.json", tmp_path / "rep"
+    pat = str(PATTERNS / "tube2.yaml")
+    assert main(["model", "diagnose", str(csv), "--pattern", pat, "-q", "--json", str(out),
+                 "--report", str(rep)]) == 0
+    text = capsys.readouterr().out
+    js = json.loads(out.read_text())
+    assert js["recommended"] == ["slack", "play"]
+    assert {"rmse_deg"} <= set(js["base"]) and js["noise_floor_deg"] > 0
+    for c in js["candidates"]:
+        assert {"effect", "rmse_deg", "heldout_rmse_deg", "delta_bic", "params"} <= set(c)
+    assert "lost motion" in text and "--effects slack,play" in js["command"]
+    for f in ("index.html", "model.png", "atlas.png", "ranking.png", "waterfall.png"):
+        assert (rep / f).stat().st_size > 1000
+    assert "http" not in (rep / "index.html").read_text()  # offline: no external resources
+    # the printed command fits the model with the effects
+    cmd = js["command"].split()
+    assert cmd[:3] == ["camtube", "model", "fit"]
+    fit_json = tmp_path / "fit.json"
+    assert main(cmd[1:] + ["-q", "--json", str(fit_json)]) == 0
+    fitted = json.loads(fit_json.read_text())
+    assert fitted["rmse_deg"] == pytest.approx(js["waterfall"][-1]["rmse_deg"], rel=1e-3)
+    assert math.isclose(fitted["params"]["play.play_mm"]["value"], 0.06, rel_tol=0.1)
