@@ -100,12 +100,12 @@ def test_series_compliance_is_a_softer_tendon(tube1):
 
 def test_toe_law_is_quadratic_then_linear(tube1):
     f = np.linspace(0, 4, 81)
-    data = _data(np.full_like(f, 2.0), force=f)
+    data = _data(np.full_like(f, 5.0), force=f)
     vals = pattern_values(tube1)
     c = vals["L0"] / (vals["E_t"] * 1e3 * tube1.tendon.area_mm2)
     arm = model_for_pattern(tube1).geometry.moment_arm_mm
     th = np.radians(model_for_pattern(tube1, ["toe"]).predict(data, vals | {"toe.toe_mm": 0.3}))
-    elong = 2.0 - th * arm
+    elong = 5.0 - th * arm
     # force from elongation: e^2/(2 e_t C) in the toe, (e - e_t/2)/C beyond
     back = np.where(elong < 0.3, elong**2 / (2 * 0.3 * c), (elong - 0.15) / c)
     np.testing.assert_allclose(back, f, atol=1e-9)
