@@ -431,7 +431,6 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: Fitted, 
            min_excess: float) -> tuple[Candidate, ...]:
     """Every effect of ``pool`` on top of ``current``, ranked by held-out RMSE."""
     tried: list[Candidate] = []
-    n = cur.n
     for eff in pool:
         m = current.with_effects(list(current.effects) + [eff])
         new = tuple(f"{eff.name}.{p.name}" for p in eff.params)
