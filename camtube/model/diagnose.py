@@ -56,6 +56,7 @@ import numpy as np
 
 from camtube.model.api import Effect, JointModel, get_effect, registry
 from camtube.model.dataset import Dataset
+from camtube.model.fit import fit
 
 #: Parameter correlation above which two parameters cannot be told apart.
 CORR_LIMIT = 0.99
@@ -226,62 +227,10 @@ def holdout_mask(data: Dataset) -> np.ndarray:
 
 def _least_squares(model: JointModel, data: Dataset, names: Sequence[str], values: Mapping[str, float],
                    rows: np.ndarray | None = None, max_nfev: int = 120) -> Fitted:
-    """Bounded least squares of ``names`` on ``rows`` (the model runs on all rows)."""
-    from scipy.optimize import least_squares
-
-    from camtube.model.fit import _blas_single_thread
-
-    specs = model.param_specs
-    names = tuple(names)
-    work = dict(values)
-    meas = np.asarray(data.angle_deg, float)
-    sel = slice(None) if rows is None else rows
-
-    def resid(x: np.ndarray) -> np.ndarray:
-        work.update(zip(names, map(float, x)))
-        r = (meas - model.predict(data, work))[sel]
-        return np.nan_to_num(r, nan=1e3, posinf=1e3, neginf=-1e3)
-
-    lo = np.array([specs[n].lo for n in names], float)
-    hi = np.array([specs[n].hi for n in names], float)
-    span = hi - lo
-    x0 = np.clip(np.array([work[n] for n in names], float), lo + 1e-9 * span, hi - 1e-9 * span)
-    jac = np.zeros((0, len(names)))
-    with _blas_single_thread():
-        if names:
-            scale = np.maximum(np.abs(x0), 1e-3 * np.minimum(span, 1e3))
-            sol = least_squares(resid, x0, bounds=(lo, hi), x_scale=scale, method="trf",
-                                xtol=1e-8, ftol=1e-8, gtol=1e-8, max_nfev=max_nfev)
-            x, jac = sol.x, np.atleast_2d(sol.jac)
-        else:
-            x = x0
-        r = resid(x)
-    pred = model.predict(data, work)
-    n = int(r.size)
-    sse = float(r @ r)
-    p = len(names)
-    cov = np.full((p, p), np.inf)
-    if p and n > p:
-        jtj = jac.T @ jac
-        s2 = sse / (n - p)
-        try:
-            cov = np.linalg.pinv(jtj) * s2
-            if np.linalg.matrix_rank(jtj) < p:
-                cov[:] = np.inf
-        except np.linalg.LinAlgError:
-            pass
-    var = np.diag(cov) if p else np.zeros(0)
-    sd = np.sqrt(np.where(np.isfinite(var) & (var >= 0), var, np.inf))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        corr = cov / np.outer(sd, sd) if p else np.zeros((0, 0))
-    corr = np.where(np.isfinite(corr), corr, np.nan)
-    if p:
-        np.fill_diagonal(corr, 1.0)
-    tol = 1e-6 * span
-    at_bound = tuple(nm for nm, v, a, b, t in zip(names, x, lo, hi, tol) if v - a <= t or b - v <= t)
-    mse = sse / max(n, 1)
-    return Fitted(model, names, dict(work), dict(zip(names, map(float, sd))), corr, sse, n,
-                  math.sqrt(mse), n * math.log(max(mse, 1e-300)) + p * math.log(max(n, 2)), at_bound, pred)
+    """Bounded least squares of ``names`` on ``rows`` (the model runs on all rows): :func:`fit`, searched loosely."""
+    r = fit(model, data, tuple(names), values, max_nfev=max_nfev, rows=rows, tol=1e-8)
+    return Fitted(model, r.fitted, dict(r.params), dict(r.stderr), r.correlation, r.sse, r.n_points,
+                  r.rmse, r.bic, r.at_bound, r.predicted)
 
 
 def _heldout(model: JointModel, data: Dataset, names: Sequence[str], start: Mapping[str, float],
@@ -344,7 +293,7 @@ def diagnose(
     """
     import time
 
-    from camtube.model.fit import fit
+
 
     clock = {"start": time.perf_counter()}
     fixed = dict(fixed or {})

@@ -33,7 +33,8 @@ residual variance: ``cov = s^2 (J^T J)^-1``, ``s^2 = SSE / (n - p)``),
 parameters), ``n_points``, ``n_params``, ``covariance`` and ``correlation``
 ``(p, p)`` in ``fitted`` order, ``at_bound`` (fitted names that ended on a
 bound: their stderr is not meaningful), ``success``, ``message``, ``nfev``,
-``model``, ``data``, and ``predict(data) -> (m,)`` deg for any rows.
+``model``, ``data``, ``rows`` (the row mask of a held-out fit, else ``None``),
+and ``predict(data) -> (m,)`` deg for any rows.
 """
 from __future__ import annotations
 
@@ -79,11 +80,13 @@ class FitResult:
     message: str = ""
     nfev: int = 0
     initial: dict = field(default_factory=dict)
+    rows: np.ndarray | None = None
 
     @property
     def sse(self) -> float:
-        """Sum of squared residuals (deg^2)."""
-        return float(np.dot(self.residuals, self.residuals))
+        """Sum of squared residuals of the fitted rows (deg^2)."""
+        r = self.residuals if self.rows is None else self.residuals[self.rows]
+        return float(np.dot(r, r))
 
     @property
     def dof(self) -> int:
@@ -143,6 +146,8 @@ def fit(
     initial: Mapping[str, float] | None = None,
     bounds: Mapping[str, tuple[float, float]] | None = None,
     max_nfev: int | None = None,
+    rows: np.ndarray | None = None,
+    tol: float = 1e-10,
 ) -> FitResult:
     """Fit ``fit_params`` of ``model`` to ``data`` by bounded least squares.
 
@@ -162,6 +167,14 @@ def fit(
         ``{name: (lo, hi)}`` overriding the Param specs.
     max_nfev : int, optional
         Cap on model evaluations (default: scipy's).
+    rows : (n,) bool array, optional
+        Only these rows' residuals enter the fit (held-out fits). The model
+        still runs on every row, because history effects (play, creep,
+        viscoelasticity) need the whole record. ``residuals`` and
+        ``predicted`` stay ``(n,)``; every statistic (RMSE, SSE, AIC/BIC,
+        standard errors, ``n_points``) counts the selected rows only.
+    tol : float
+        ``xtol``, ``ftol`` and ``gtol`` of the solver (looser is faster).
 
     Returns
     -------
@@ -174,7 +187,8 @@ def fit(
     for nm in list(names) + list(fixed or {}) + list(initial or {}) + list(bounds or {}):
         if nm not in specs:
             raise _unknown(nm, list(specs))
-    n = len(data)
+    sel = np.ones(len(data), bool) if rows is None else np.asarray(rows, bool)
+    n = int(sel.sum())
     p = len(names)
     if n == 0:
         raise FitError("no data rows to fit (check the cycle, branch and deadband selection)")
@@ -200,20 +214,24 @@ def fit(
     def residual(x: np.ndarray) -> np.ndarray:
         for nm, v in zip(names, x):
             work[nm] = float(v)
-        return measured - model.predict(data, work)
+        return (measured - model.predict(data, work))[sel]
 
     r0 = residual(x0)
     if not np.all(np.isfinite(r0)):
-        k = int(np.flatnonzero(~np.isfinite(r0))[0])
+        k = int(np.flatnonzero(sel)[np.flatnonzero(~np.isfinite(r0))[0]])
         raise FitError(f"the model gives a non-finite angle at row {k} with the starting values "
                        f"{ {nm: start[nm] for nm in names} }")
+
+    def guarded(x: np.ndarray) -> np.ndarray:
+        # a trial step may leave an effect's valid region: a large finite residual steers it back
+        return np.nan_to_num(residual(x), nan=1e3, posinf=1e3, neginf=-1e3)
 
     with _blas_single_thread():
         if p:
             scale = np.maximum(np.abs(x0), 1e-3 * np.where(np.isfinite(span), span, 1.0))
             scale = np.where(scale > 0, scale, 1.0)
-            sol = least_squares(residual, x0, bounds=(lo, hi), x_scale=scale, method="trf",
-                                max_nfev=max_nfev, xtol=1e-10, ftol=1e-10, gtol=1e-10)
+            sol = least_squares(guarded, x0, bounds=(lo, hi), x_scale=scale, method="trf",
+                                max_nfev=max_nfev, xtol=tol, ftol=tol, gtol=tol)
             x = sol.x
             jac = np.atleast_2d(sol.jac)
             success, message, nfev = bool(sol.success), str(sol.message), int(sol.nfev)
@@ -226,7 +244,7 @@ def fit(
         final.update(zip(names, map(float, x)))
         pred = model.predict(data, final)
         res = measured - pred
-        sse = float(np.dot(res, res))
+        sse = float(np.dot(res[sel], res[sel]))
 
         cov = np.full((p, p), np.nan)
         if p:
@@ -266,7 +284,8 @@ def fit(
         covariance=cov,
         correlation=corr,
         rmse=float(math.sqrt(mse)),
-        rmse_per_sample=rmse_by_sample(data, res),
+        rmse_per_sample=rmse_by_sample(data, res) if rows is None else
+        rmse_by_sample(data.take(sel), res[sel]),
         aic=logl + 2 * p,
         bic=logl + p * math.log(n),
         n_points=n,
@@ -276,4 +295,5 @@ def fit(
         message=message,
         nfev=nfev,
         initial={nm: start[nm] for nm in names},
+        rows=None if rows is None else sel,
     )

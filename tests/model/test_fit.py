@@ -141,3 +141,20 @@ def test_generic_over_a_bare_joint_model():
     data = synthesize(p, n_cycles=2, slack_mm=0.0, modulus_gpa=35.0, seed=9)
     r = fit(model, data)  # L0 defaults to 70 mm like tube1
     assert r.params["E_t"] == pytest.approx(35.0, rel=0.01)
+
+
+def test_row_mask_fits_only_the_selected_rows(tube2):
+    """A held-out fit (``rows``) of a history-free model equals a fit of those rows alone."""
+    pattern = tube2
+    rows = prepare(synthesize(pattern, n_samples=1, n_cycles=6, seed=3), "all", "loading", True)
+    model = model_for_pattern(pattern)
+    mask = rows.cycle % 2 == 1
+    held = fit(model, rows, ("E_t",), pattern_values(pattern), rows=mask)
+    alone = fit(model, rows.take(mask), ("E_t",), pattern_values(pattern))
+    assert held.params["E_t"] == pytest.approx(alone.params["E_t"], rel=1e-6)
+    assert held.n_points == alone.n_points == int(mask.sum())
+    assert held.rmse == pytest.approx(alone.rmse, rel=1e-6)
+    assert held.sse == pytest.approx(alone.sse, rel=1e-6)
+    assert held.residuals.shape == (len(rows),)  # predictions for the held-out rows too
+    other = held.residuals[~mask]
+    assert math.sqrt(np.mean(other**2)) < 2 * held.rmse
