@@ -34,8 +34,9 @@ def register(sub) -> None:
                    help="keep the slack deadband (default: remove it per cycle, as in the paper)")
     f.add_argument("--deadband-threshold", type=float, default=None, metavar="DEG",
                    help="smallest angle rise (deg) that counts as motion (default max(0.5, 4 x noise))")
-    f.add_argument("--fit", dest="fit_params", default="E_t", metavar="P1,P2",
-                   help="parameters to fit, full names (default E_t; e.g. E_t,arm_scale; 'none')")
+    f.add_argument("--fit", dest="fit_params", default=None, metavar="P1,P2",
+                   help="parameters to fit, full names (default: E_t and every parameter of the --effects; "
+                        "e.g. E_t,arm_scale; 'none')")
     f.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
                    help="hold a parameter at a value (units as listed: E_t GPa, L0 mm); repeatable")
     f.add_argument("--effects", default="", metavar="A,B", help="effects to add to the base model, by name")
@@ -81,8 +82,16 @@ def _add_pattern_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("-q", "--quiet", action="store_true", help="do not print design warnings")
 
 
-def _names(text: str) -> list[str]:
+def split_names(text: str) -> list[str]:
+    """``'a, b,none'`` -> ``['a', 'b']`` (comma list; 'none' means nothing)."""
     return [t.strip() for t in text.split(",") if t.strip() and t.strip().lower() != "none"]
+
+
+def fit_param_names(model, text: str | None) -> list[str]:
+    """Parameters to fit: the ``--fit`` list, or by default E_t and every parameter of the model's effects."""
+    if text is not None:
+        return split_names(text)
+    return ["E_t"] + [f"{e.name}.{p.name}" for e in model.effects for p in e.params]
 
 
 def build_model(pattern, effects: str = "", effect_files=()):
@@ -97,13 +106,13 @@ def build_model(pattern, effects: str = "", effect_files=()):
         except (OSError, ImportError, SyntaxError, ValueError) as exc:
             raise FitError(f"{path}: cannot load the effect file: {exc}") from None
     try:
-        effs = [get_effect(n) for n in _names(effects)]
+        effs = [get_effect(n) for n in split_names(effects)]
     except KeyError as exc:
         raise FitError(exc.args[0]) from None
     return model_for_pattern(pattern, effs)
 
 
-def _parse_fix(items: list[str]) -> dict[str, float]:
+def parse_fix(items: list[str]) -> dict[str, float]:
     from camtube.model.fit import FitError
 
     out = {}
@@ -131,8 +140,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
     raw = load_csv(args.data)
     rows = prepare(raw, args.cycles, args.branch, args.deadband, args.deadband_threshold)
     fixed = pattern_values(pattern)
-    fixed.update(_parse_fix(args.fix))
-    result = fit(model, rows, _names(args.fit_params), fixed)
+    fixed.update(parse_fix(args.fix))
+    result = fit(model, rows, fit_param_names(model, args.fit_params), fixed)
 
     sel = (f"cycles {args.cycles}, {args.branch} branch, "
            + ("slack deadband removed" if args.deadband else "deadband kept"))

@@ -59,7 +59,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     from camtube.cliutil import load_from_args
     from camtube.errors import DataError
     from camtube.io import write_atomic
-    from camtube.model.cli import _names, _parse_fix, build_model
+    from camtube.model.cli import build_model, parse_fix, split_names
     from camtube.model.data import load_csv, select_cycles
     from camtube.model.diagnose import diagnose
     from camtube.model.fit import FitError
@@ -71,8 +71,8 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     raw = load_csv(args.data)
     rows = select_cycles(raw, args.cycles)
     fixed = pattern_values(pattern)
-    fixed.update(_parse_fix(args.fix))
-    cands = _names(args.candidates) or None
+    fixed.update(parse_fix(args.fix))
+    cands = split_names(args.candidates) or None
     if cands:
         from camtube.model.api import get_effect
 
@@ -82,7 +82,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
             raise FitError(exc.args[0]) from None
     if args.max_rows < 0 or args.max_effects < 0:
         raise DataError("--max-rows and --max-effects must be >= 0")
-    d = diagnose(model, rows, _names(args.fit_params), fixed, candidates=cands,
+    d = diagnose(model, rows, split_names(args.fit_params), fixed, candidates=cands,
                  max_rows=args.max_rows, max_effects=args.max_effects)
     prefix = fit_command_prefix(args)
     title = f"{pattern.name}: {args.data} ({len(rows)} rows, cycles {args.cycles}, both directions, deadband kept)"

@@ -55,7 +55,10 @@ def add_command(d: Diagnosis, prefix: str) -> str:
     effects = list(d.final.effects)
     if not effects or not prefix:
         return ""
-    return f"{prefix} --effects {','.join(effects)} --fit {','.join(fit_names(d, effects))}"
+    cmd = f"{prefix} --effects {','.join(effects)}"
+    if tuple(d.fit_params) != ("E_t",):  # model fit's default: E_t plus every effect parameter
+        cmd += f" --fit {','.join(fit_names(d, effects))}"
+    return cmd
 
 
 def _candidate_dict(d: Diagnosis, c: Candidate) -> dict:
