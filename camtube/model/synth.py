@@ -32,16 +32,19 @@ from camtube.model.predict import POLYIMIDE_MODULUS_GPA, joint_stiffness_nmm_per
 
 
 def triangle_stroke(max_stroke_mm: float, speed_mm_s: float, rate_hz: float,
-                    n_cycles: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                    n_cycles: int, dwell_s: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Time (s), stroke (mm) and cycle (1-based) of ``n_cycles`` triangles 0 -> max -> 0.
 
-    Returns arrays of shape ``(n_cycles * m,)``, ``m = round(2 max / speed * rate)``
-    samples per cycle; each cycle starts at stroke 0.
+    Each cycle ramps up and down at ``speed_mm_s`` and then rests ``dwell_s`` at 0.
+    Returns arrays of shape ``(n_cycles * m,)``, ``m = round(period * rate)``
+    samples per cycle (at least 6); each cycle starts at stroke 0.
     """
-    period = 2.0 * max_stroke_mm / speed_mm_s
-    m = max(int(round(period * rate_hz)), 4)
+    ramp = max_stroke_mm / speed_mm_s
+    period = 2.0 * ramp + dwell_s
+    m = max(int(round(period * rate_hz)), 6)
     t1 = np.arange(m) / m * period
-    s1 = max_stroke_mm - np.abs(max_stroke_mm - speed_mm_s * t1)
+    s1 = np.clip(max_stroke_mm - np.abs(max_stroke_mm - speed_mm_s * t1), 0.0, None)
+    s1[t1 > 2.0 * ramp] = 0.0
     time = (np.arange(n_cycles)[:, None] * period + t1[None, :]).ravel()
     stroke = np.tile(s1, n_cycles)
     cycle = np.repeat(np.arange(1, n_cycles + 1), m)

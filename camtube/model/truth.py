@@ -37,6 +37,7 @@ import numpy as np
 from camtube.design.geometry import pattern_geometry
 from camtube.design.pattern import Pattern
 from camtube.model.dataset import Dataset
+from camtube.model.synth import triangle_stroke
 
 
 @dataclass(frozen=True)
@@ -177,22 +178,6 @@ def _run(x: np.ndarray, t: np.ndarray, arm: float, k: float, c: float, h: Hidden
     return theta_out, t_out
 
 
-def triangle(max_stroke_mm: float, speed_mm_s: float, rate_hz: float, n_cycles: int,
-             dwell_s: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Time (s), motor stroke (mm), cycle of ``n_cycles`` triangles 0 -> max -> 0 with a dwell at 0.
-
-    Shapes ``(n_cycles * m,)``.
-    """
-    ramp = max_stroke_mm / speed_mm_s
-    period = 2.0 * ramp + dwell_s
-    m = max(int(round(period * rate_hz)), 6)
-    t1 = np.arange(m) / m * period
-    s1 = np.clip(max_stroke_mm - np.abs(max_stroke_mm - speed_mm_s * t1), 0.0, None)
-    s1[t1 > 2.0 * ramp] = 0.0
-    time = (np.arange(n_cycles)[:, None] * period + t1[None, :]).ravel()
-    return time, np.tile(s1, n_cycles), np.repeat(np.arange(1, n_cycles + 1), m)
-
-
 def simulate(
     pattern: Pattern,
     hidden: Hidden = Hidden(),
@@ -245,7 +230,7 @@ def simulate(
     c = pattern.tendon.length_mm / (e_t * 1e3 * pattern.tendon.area_mm2)
     k0 = joint_stiffness_nmm_per_rad(pattern) if stiffness_nmm_per_rad is None else stiffness_nmm_per_rad
     smax = pattern.rules.max_stroke_mm if max_stroke_mm is None else max_stroke_mm
-    time, stroke, cycle = triangle(smax, speed_mm_s, rate_hz, n_cycles, dwell_s)
+    time, stroke, cycle = triangle_stroke(smax, speed_mm_s, rate_hz, n_cycles, dwell_s)
     m = stroke.size
     parts: dict[str, list] = {k: [] for k in ("sample", "angle", "force", "true", "tension")}
     ks = []

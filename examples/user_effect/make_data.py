@@ -24,7 +24,7 @@ from camtube.io import write_atomic
 from camtube.model.data import format_csv
 from camtube.model.dataset import Dataset
 from camtube.model.predict import joint_stiffness_nmm_per_rad
-from camtube.model.truth import triangle
+from camtube.model.synth import triangle_stroke
 
 ROOT = Path(__file__).resolve().parents[2]
 SLIP_MM, F_SLIP_N, F_SCALE_N = 0.12, 1.0, 0.8
@@ -42,7 +42,7 @@ def simulate(seed: int = 0) -> Dataset:
         times, strokes, cycles = [], [], []
         t0 = 0.0
         for cyc, smax in enumerate(np.linspace(1.2, 2.5, 8), 1):
-            t, s, _ = triangle(smax, 0.5, 10.0, 1)
+            t, s, _ = triangle_stroke(smax, 0.5, 10.0, 1)
             times.append(t + t0)
             strokes.append(s)
             cycles.append(np.full(s.size, cyc))
