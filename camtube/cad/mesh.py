@@ -59,6 +59,42 @@ def _rings(region) -> list[np.ndarray]:
     return rings
 
 
+def _cutter_rings(region, circumference_mm: float) -> list[list[np.ndarray]]:
+    """The rings of each cutter of one removed region: one cutter per polygon of the region.
+
+    A cutter is wrapped onto the cylinder, so it must span less than a turn in ``y``.
+    Separate polygons of a region (the notches of a bidirectional pattern, say) become
+    separate cutters wherever they lie; a single polygon that spans a turn or more (a
+    ring cut, or a removed region that joins cuts of several directions) is cut into
+    bands of half a turn, whose cutters overlap only on shared edges and together
+    remove the same material.
+    """
+    from shapely.geometry import Polygon, box
+
+    if isinstance(region, Contour):
+        polys = [Polygon(region.points)]
+    else:
+        polys = [p for p in getattr(region, "geoms", [region]) if not p.is_empty]
+    out: list[list[np.ndarray]] = []
+    for p in polys:
+        if p.geom_type != "Polygon":  # a nested collection
+            out.extend(_cutter_rings(p, circumference_mm))
+            continue
+        x0, y0, x1, y1 = p.bounds
+        if y1 - y0 < circumference_mm:
+            out.append(_rings(p))
+            continue
+        band = 0.5 * circumference_mm
+        k = 0
+        while y0 + k * band < y1:
+            piece = p.intersection(box(x0 - 1.0, y0 + k * band, x1 + 1.0, y0 + (k + 1) * band))
+            for q in getattr(piece, "geoms", [piece]):
+                if q.geom_type == "Polygon" and q.area > 0:
+                    out.append(_rings(q))
+            k += 1
+    return out
+
+
 def tube_manifold(outer_radius_mm: float, inner_radius_mm: float, length_mm: float,
                   regions: Iterable, segments: int = DEFAULT_SEGMENTS):
     """The tube minus radial-walled cuts, as a ``manifold3d.Manifold``.
@@ -69,7 +105,8 @@ def tube_manifold(outer_radius_mm: float, inner_radius_mm: float, length_mm: flo
         r_o > r_i > 0 and L; the tube spans ``0 <= x <= L`` along X.
     regions : iterable of Contour or shapely Polygon/MultiPolygon
         Removed regions of the unrolled sheet (unwrapped ``y`` allowed: the
-        wrap is periodic). A region must span less than ``2 pi r_o`` in ``y``.
+        wrap is periodic). Any region is accepted: each of its polygons becomes a cutter,
+        one that spans a turn or more is cut into bands first (:func:`_cutter_rings`).
     segments : int
         Sides of the polygonal circles (volume error ~ (2 pi / segments)^2 / 6).
     """
@@ -95,15 +132,10 @@ def tube_manifold(outer_radius_mm: float, inner_radius_mm: float, length_mm: flo
 
     cutters = []
     for reg in regions:
-        rings = _rings(reg)
-        if not rings:
-            continue
-        ys = np.concatenate([r[:, 1] for r in rings])
-        if ys.max() - ys.min() >= circ:
-            raise ValueError(f"a removed region spans {ys.max() - ys.min():.4f} mm >= the circumference {circ:.4f} mm")
-        cs = m3.CrossSection([np.ascontiguousarray(r) for r in rings], m3.FillRule.EvenOdd)
-        prism = m3.Manifold.extrude(cs, r_out - r_in).translate((0.0, 0.0, -r_out)).refine_to_length(step)
-        cutters.append(prism.warp_batch(warp))
+        for rings in _cutter_rings(reg, circ):
+            cs = m3.CrossSection([np.ascontiguousarray(r) for r in rings], m3.FillRule.EvenOdd)
+            prism = m3.Manifold.extrude(cs, r_out - r_in).translate((0.0, 0.0, -r_out)).refine_to_length(step)
+            cutters.append(prism.warp_batch(warp))
     if not cutters:
         return tube
     return tube - m3.Manifold.batch_boolean(cutters, m3.OpType.Add)

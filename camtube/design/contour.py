@@ -27,7 +27,7 @@ from camtube.tol import TOL
 
 @dataclass(frozen=True)
 class Contour:
-    """A closed polygon (last point joins the first; not repeated).
+    """A closed polygon (last point joins the first; not repeated), or an open path (a slit).
 
     Attributes
     ----------
@@ -37,11 +37,15 @@ class Contour:
         ``notch``, ``hole`` or ``cut`` (from a foreign DXF).
     cut_index : int
         Index of the cut in ``Pattern.cuts`` it comes from (-1 if unknown).
+    closed : bool
+        True (the default) for a closed polygon; False for an open path the beam
+        follows from the first point to the last (a slit: its kerf is the cut).
     """
 
     points: tuple[tuple[float, float], ...]
     kind: str = "cut"
     cut_index: int = -1
+    closed: bool = True
 
     @property
     def xy(self) -> np.ndarray:
@@ -63,8 +67,10 @@ class Contour:
 
     @property
     def length_mm(self) -> float:
-        """Perimeter of the closed polygon."""
+        """Perimeter of the closed polygon, or the length of the open path."""
         a = self.xy
+        if not self.closed:
+            return float(np.linalg.norm(np.diff(a, axis=0), axis=1).sum())
         return float(np.linalg.norm(np.roll(a, -1, axis=0) - a, axis=1).sum())
 
 

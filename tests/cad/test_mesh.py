@@ -78,3 +78,32 @@ def test_seam_crossing_and_free_polygon():
     a, _ = _material_angles(m, 3.05)
     assert np.any(np.isclose(a, 2.0 / ro, atol=1e-9)) and np.any(np.isclose(a, 2.1 / ro, atol=2e-3))
     assert not np.any((a > 2.01 / ro) & (a < 2.09 / ro))
+
+
+def test_removed_region_spanning_more_than_a_turn_is_cut():
+    """A region whose polygons together (or one polygon alone) span more than a turn is still cut.
+
+    Truth: the same polygons passed one by one, and the removed volume of an annular sector
+    (wrapped area x (r_o^2 - r_i^2) / (2 r_o)).
+    """
+    from shapely.geometry import MultiPolygon, box
+
+    ro, ri, L = 0.75, 0.45, 6.0
+    circ = 2 * math.pi * ro
+    # two notches 180 deg apart: together they span 5.2 mm of unwrapped y (> circumference 4.71)
+    a = box(1.0, -1.4, 1.5, 1.4)
+    b = box(2.0, circ / 2 - 1.4 + 0.9, 2.5, circ / 2 + 1.4 + 0.9)
+    whole = tube_mesh(ro, ri, L, [MultiPolygon([a, b])], 128)
+    single = tube_mesh(ro, ri, L, [a, b], 128)
+    assert whole.is_watertight and abs(whole.volume - single.volume) < 1e-9
+    # one L-shaped polygon spanning 1.2 turns: removed volume = area x (r_o^2 - r_i^2) / (2 r_o)
+    poly = box(3.0, 0.0, 3.4, 1.2 * circ).union(box(3.0, 0.0, 4.0, 0.5))
+    m = tube_mesh(ro, ri, L, [poly], 256)
+    full = tube_mesh(ro, ri, L, [], 256)
+    # the part beyond one turn overlaps the start: the material removed is the wrapped area
+    from camtube.cad.ascut import wrap_sheet
+
+    area = wrap_sheet(poly, circ).area
+    want = area * (ro * ro - ri * ri) / (2 * ro)
+    assert m.is_watertight
+    assert abs((full.volume - m.volume) / want - 1) < 0.01
