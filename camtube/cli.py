@@ -14,7 +14,9 @@ from camtube import __version__
 from camtube.errors import CamtubeError
 
 #: Stage CLI modules, each with ``register(subparsers)``; missing ones are skipped.
-COMMAND_MODULES = ("camtube.design.cli", "camtube.plan.cli", "camtube.cad.cli", "camtube.model.cli")
+COMMAND_MODULES = (
+    "camtube.design.cli", "camtube.plan.cli", "camtube.cad.cli", "camtube.model.cli", "camtube.motion.cli",
+)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -306,6 +306,7 @@ def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = Non
         repeat_rule=tuple(sorted((RepeatRule(x["max_depth"], x["repeats"]) for x in proc["repeat_rule"]),
                                  key=lambda q: q.max_depth_mm)),
         kerf_mm=proc["kerf"], rapid_speed_mm_s=proc["rapid_speed_mm_s"], focus_speed_mm_s=proc["focus_speed_mm_s"],
+        max_time_h=proc["max_time_h"],
     )
     pattern = Pattern(
         name=raw.get("name") or name or "pattern",

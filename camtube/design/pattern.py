@@ -131,6 +131,8 @@ class Process:
         Speed of laser-off traverses (time estimate).
     focus_speed_mm_s : float
         Speed of Z focus moves (time estimate).
+    max_time_h : float
+        A job whose estimated laser time exceeds this many hours is warned about.
     """
 
     power_w: float = 2.0
@@ -149,6 +151,7 @@ class Process:
     kerf_mm: float = 0.0
     rapid_speed_mm_s: float = 50.0
     focus_speed_mm_s: float = 5.0
+    max_time_h: float = 8.0
 
 
 @dataclass(frozen=True)

@@ -117,6 +117,7 @@ SCHEMA: dict[str, dict[str, Field]] | dict = {
         "kerf": Field("float", "mm", "kerf width for compensation (0 = off)", 0.0, 0.0),
         "rapid_speed_mm_s": Field("float", "mm/s", "laser-off traverse speed (time estimate)", 50.0, **POS),
         "focus_speed_mm_s": Field("float", "mm/s", "Z focus move speed (time estimate)", 5.0, **POS),
+        "max_time_h": Field("float", "h", "warn when the estimated laser time of a job exceeds this", 8.0, **POS),
     },
     "rules": {
         "min_backbone_arc": Field("float", "mm", "smallest backbone arc 2 pi r_o - s allowed", 0.3, 0.0),
