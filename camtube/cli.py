@@ -39,16 +39,57 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one command; return the exit status.
+
+    0 success; 1 the command ran but its result failed a check (e.g. a CAD
+    verification); 2 a user mistake or unsafe job, printed as one clear
+    message (no traceback); 130 interrupted (Ctrl-C).
+    """
     parser = build_parser()
-    args = parser.parse_args(argv)
-    if not getattr(args, "func", None):
-        parser.print_help()
-        return 1
+    try:
+        args = parser.parse_args(argv)
+        if not getattr(args, "func", None):
+            parser.print_help()
+            return 1
+        return _run(args)
+    except KeyboardInterrupt:
+        print("camtube: interrupted; no output of this command was published", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        # the reader of our output went away (e.g. `camtube design ... | head -1`): stop quietly
+        _silence_stdout()
+        return 0
+
+
+def _run(args: argparse.Namespace) -> int:
     try:
         return int(args.func(args) or 0)
     except CamtubeError as exc:
-        print(f"camtube {args.command}: error:\n{exc}", file=sys.stderr)
+        print(f"camtube {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except MemoryError:
+        print(f"camtube {args.command}: error: out of memory; fix: make the job smaller (fewer notches or "
+              "repeats) or use a machine with more memory", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        if isinstance(exc, BrokenPipeError):
+            raise
+        where = exc.filename if exc.filename is not None else "input/output"
+        print(f"camtube {args.command}: error: {where}: {exc.strerror or exc}; fix: check the path "
+              "(it must exist, be readable, and be a file where a file is expected)", file=sys.stderr)
+        return 2
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's final flush cannot raise again."""
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):
+        pass
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,15 +1,68 @@
 """File handling: the only place that writes files, always atomically.
 
-Writers elsewhere return ``str``/``bytes``; this layer puts them on disk via a
-temporary file in the same directory and :func:`os.replace`, so a crash or a
-rejected input never leaves a half-written output behind.
+Writers elsewhere return ``str``/``bytes`` (or an iterable of text chunks, for
+outputs too large to hold); this layer puts them on disk.
+
+- :func:`write_atomic`: one file, via a temporary file in the same directory
+  and :func:`os.replace`, so a crash or a rejected input never leaves a
+  half-written file behind.
+- :func:`write_set`: the whole set of files one command writes, so that they
+  appear all at once or not at all (a new G-code is never found beside an old
+  job file). The set is written into a sibling staging directory; a new output
+  directory is then renamed into place, an existing one is swapped with it in
+  one ``renameat2(RENAME_EXCHANGE)`` call (Linux), keeping the entries of the
+  old directory that the new set does not replace.
+
+Every failure to write is raised as :class:`OutputError`, which names the path,
+the reason and the fix.
 """
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
+import errno
 import os
+import shutil
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Iterable, Mapping, Union
+
+from camtube.errors import CamtubeError
+
+#: What a writer may hand to the file layer: all of it, or an iterable of chunks.
+Payload = Union[str, bytes, Iterable[Union[str, bytes]]]
+
+_FIXES = {
+    errno.EROFS: "choose an output location on a writable file system",
+    errno.EACCES: "choose an output location you may write to, or change its permissions",
+    errno.EPERM: "choose an output location you may write to, or change its permissions",
+    errno.EISDIR: "name a file, not a directory",
+    errno.ENOTDIR: "a part of the path is a file, not a directory: choose another path",
+    errno.EEXIST: "name a directory that does not exist yet or is a directory, not a file",
+    errno.ENOSPC: "free some disk space or write elsewhere",
+    errno.ENAMETOOLONG: "use a shorter path",
+}
+
+
+class OutputError(CamtubeError, OSError):
+    """An output could not be written; the message names the path and the fix.
+
+    Also an ``OSError``, so code that caught the file system's error keeps working.
+    """
+
+    def __init__(self, path: str | os.PathLike, reason: str, fix: str):
+        self.path, self.reason, self.fix = str(path), reason, fix
+        super().__init__(f"{path}: cannot write: {reason}; fix: {fix}")
+
+    def __str__(self) -> str:
+        return f"{self.path}: cannot write: {self.reason}; fix: {self.fix}"
+
+
+def output_error(path: str | os.PathLike, exc: OSError) -> OutputError:
+    """An :class:`OutputError` for an ``OSError`` raised while writing ``path``."""
+    reason = exc.strerror or str(exc)
+    return OutputError(path, reason, _FIXES.get(exc.errno or 0, "check the output path"))
 
 
 def _umask() -> int:
@@ -24,33 +77,63 @@ def _publish(tmp: str, path: Path) -> None:
     os.replace(tmp, path)
 
 
+def _check_file_target(path: Path) -> None:
+    if path.is_dir():
+        raise OutputError(path, "it is a directory", "name a file (e.g. add the file name to the path)")
+
+
 @contextmanager
 def _staged(path: Path, prefix: str, suffix: str):
     """Yield ``(fd, tmp)`` of a temporary file beside ``path``; publish it on success, remove it on failure."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=path.parent)
+    _check_file_target(path)
+    tmp = None
     try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=path.parent)
         yield fd, tmp
         _publish(tmp, path)
+    except OSError as exc:
+        _discard(tmp)
+        raise output_error(path, exc) from None
     except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
+        _discard(tmp)
         raise
 
 
-def write_atomic(path: str | os.PathLike, data: str | bytes) -> Path:
+def _discard(tmp: str | None) -> None:
+    if tmp is None:
+        return
+    try:
+        os.unlink(tmp)
+    except FileNotFoundError:
+        pass
+
+
+def _write_payload(fh, data: Payload) -> None:
+    if isinstance(data, str):
+        fh.write(data.encode("utf-8"))
+    elif isinstance(data, (bytes, bytearray, memoryview)):
+        fh.write(bytes(data))
+    else:
+        for chunk in data:
+            fh.write(chunk.encode("utf-8") if isinstance(chunk, str) else bytes(chunk))
+
+
+def write_atomic(path: str | os.PathLike, data: Payload) -> Path:
     """Write ``data`` to ``path`` atomically and return the path.
 
-    ``str`` is encoded as UTF-8 with ``\\n`` line endings, unchanged.
-    Parent directories are created.
+    ``str`` is encoded as UTF-8 with ``\\n`` line endings, unchanged; an
+    iterable of chunks is written chunk by chunk. Parent directories are created.
+
+    Raises
+    ------
+    OutputError
+        The file cannot be written (read-only location, a directory of that name, ...).
     """
     path = Path(path)
-    payload = data.encode("utf-8") if isinstance(data, str) else bytes(data)
     with _staged(path, f".{path.name}.", ".tmp") as (fd, _tmp):
         with os.fdopen(fd, "wb") as fh:
-            fh.write(payload)
+            _write_payload(fh, data)
             fh.flush()
             os.fsync(fh.fileno())
     return path
@@ -70,3 +153,118 @@ def write_atomic_with(path: str | os.PathLike, writer) -> Path:
         if os.path.getsize(tmp) == 0:
             raise OSError(f"writer produced no output for {path}")
     return path
+
+
+# ------------------------------------------------------------------ sets of files
+_RENAME_EXCHANGE = 2
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two directories atomically (Linux ``renameat2``); False where unsupported."""
+    libc_name = ctypes.util.find_library("c")
+    if not libc_name:
+        return False
+    libc = ctypes.CDLL(libc_name, use_errno=True)
+    fn = getattr(libc, "renameat2", None)
+    if fn is None:
+        return False
+    AT_FDCWD = -100
+    rc = fn(AT_FDCWD, os.fsencode(a), AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE)
+    if rc == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.ENOSYS, errno.EINVAL, errno.EOPNOTSUPP):
+        return False
+    raise OSError(err, os.strerror(err), str(a))
+
+
+def _link_tree(src: Path, dst: Path) -> None:
+    """Hard-link (or copy, across devices) ``src`` into ``dst``."""
+    if src.is_dir() and not src.is_symlink():
+        shutil.copytree(src, dst, symlinks=True, copy_function=_link_or_copy)
+    elif src.is_symlink():
+        os.symlink(os.readlink(src), dst)
+    else:
+        _link_or_copy(src, dst)
+
+
+def _link_or_copy(src, dst) -> None:
+    try:
+        os.link(src, dst)
+    except OSError:
+        shutil.copy2(src, dst)
+
+
+def _contains_cwd(path: Path) -> bool:
+    try:
+        cwd = Path.cwd().resolve()
+    except OSError:
+        return False
+    p = path.resolve()
+    return cwd == p or p in cwd.parents
+
+
+def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload]) -> list[Path]:
+    """Write a set of files into ``outdir`` so that they appear together or not at all.
+
+    Parameters
+    ----------
+    outdir : path
+        Output directory; created if missing. Entries already in it that the
+        set does not replace are kept.
+    files : mapping of file name -> str | bytes | iterable of chunks
+        File names relative to ``outdir`` (no sub-directories). Iterables are
+        consumed once, chunk by chunk, so a large output is never held whole.
+
+    Returns
+    -------
+    list of Path
+        The paths of the set's files in ``outdir``, in the order given.
+
+    Raises
+    ------
+    OutputError
+        ``outdir`` cannot be created or written (it names a file, the location is
+        read-only, ...); nothing of the new set is visible then.
+    """
+    out = Path(outdir)
+    if out.exists() and not out.is_dir():
+        raise OutputError(out, "a file of that name exists", "name a directory (new or existing), not a file")
+    for name in files:
+        if Path(name).name != name or name in ("", ".", ".."):
+            raise ValueError(f"write_set: {name!r} is not a plain file name")
+    parent = out.absolute().parent
+    stage = None
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".staging", dir=parent))
+        for name, data in files.items():
+            with open(stage / name, "wb") as fh:
+                _write_payload(fh, data)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.chmod(stage / name, 0o666 & ~_umask())
+        if not out.exists():
+            os.chmod(stage, 0o777 & ~_umask())
+            os.rename(stage, out)
+            stage = None
+        elif _contains_cwd(out):
+            # the working directory cannot be swapped away under the user: move the files in one by one
+            for name in files:
+                os.replace(stage / name, out / name)
+        else:
+            for entry in out.iterdir():
+                if entry.name not in files:
+                    _link_tree(entry, stage / entry.name)
+            os.chmod(stage, out.stat().st_mode & 0o7777)
+            if not _exchange(stage, out):
+                old = stage.with_name(stage.name + ".old")
+                os.rename(out, old)
+                os.rename(stage, out)
+                stage = old
+        return [out / name for name in files]
+    except OSError as exc:
+        raise output_error(out, exc) from None
+    finally:
+        if stage is not None and stage.exists():
+            shutil.rmtree(stage, ignore_errors=True)

@@ -27,3 +27,11 @@ def preset_path():
         return PATTERNS / f"{name}.yaml"
 
     return get
+
+
+# Property tests never read or write a local example database: every run (a fresh clone, CI, a
+# developer's machine) draws its examples from the seed alone (`pytest --hypothesis-seed N`).
+from hypothesis import settings as _hyp_settings  # noqa: E402
+
+_hyp_settings.register_profile("camtube", database=None)
+_hyp_settings.load_profile("camtube")

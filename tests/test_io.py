@@ -44,3 +44,36 @@ def test_write_atomic_with_publishes(tmp_path):
             fh.write("ISO-10303-21;")
 
     assert write_atomic_with(tmp_path / "t.step", ok).read_text() == "ISO-10303-21;"
+
+
+def test_write_set_appears_whole_or_not_at_all(tmp_path):
+    from camtube.io import write_set
+
+    out = tmp_path / "job"
+    paths = write_set(out, {"j.ngc": "G0 X0\n", "j.job.json": b"{}", "j.dxf": iter(["0\n", "EOF\n"])})
+    assert [p.name for p in paths] == ["j.ngc", "j.job.json", "j.dxf"]
+    assert (out / "j.dxf").read_text() == "0\nEOF\n"
+    (out / "notes.txt").write_text("the user's own file")
+
+    def exploding():
+        yield "G0 X1\n"
+        raise RuntimeError("killed between files")
+
+    with pytest.raises(RuntimeError):
+        write_set(out, {"j.ngc": "G0 X9\n", "j.job.json": exploding()})
+    # the old set is untouched: no new G-code beside an old job file
+    assert (out / "j.ngc").read_text() == "G0 X0\n" and (out / "j.job.json").read_bytes() == b"{}"
+    assert sorted(os.listdir(tmp_path)) == ["job"]  # no staging directory left
+    write_set(out, {"j.ngc": "G0 X2\n", "j.job.json": "{\"v\": 2}"})
+    assert (out / "j.ngc").read_text() == "G0 X2\n" and (out / "j.job.json").read_text() == '{"v": 2}'
+    assert (out / "notes.txt").read_text() == "the user's own file" and (out / "j.dxf").exists()
+    assert sorted(os.listdir(tmp_path)) == ["job"]
+
+
+def test_write_set_refuses_a_file_as_directory(tmp_path):
+    from camtube.io import OutputError, write_set
+
+    (tmp_path / "f").write_text("x")
+    with pytest.raises(OutputError, match="a file of that name exists"):
+        write_set(tmp_path / "f", {"a": "b"})
+    assert (tmp_path / "f").read_text() == "x"

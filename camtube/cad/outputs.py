@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from camtube.design.pattern import Pattern
-from camtube.io import write_atomic
+from camtube.io import write_set
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,20 +41,16 @@ class Models:
     segments: int
 
 
-def cad_models(pattern: Pattern, job=None, *, step: bool = True, segments: int | None = None,
+def cad_models(pattern: Pattern, job, *, step: bool = True, segments: int | None = None,
                kerf_mm: float | None = None) -> Models:
-    """Compute the design mesh, the kerf simulation and its mesh, and (if ``step``) the B-rep and its STEP.
+    """Compute the design mesh, the kerf simulation of ``job`` and its mesh, and (if ``step``) the B-rep and its STEP.
 
-    ``job`` defaults to ``camtube.plan.plan_job(pattern)``.
+    ``job`` is the planned job of ``pattern`` (the CAD stage simulates a job; it does not plan one).
     """
     from camtube.cad.ascut import simulate
     from camtube.cad.mesh import auto_segments, design_mesh, tube_mesh
 
     seg = segments or auto_segments(len(pattern.cuts))
-    if job is None:
-        from camtube.plan import plan_job
-
-        job = plan_job(pattern)
     t = pattern.tube
     dm = design_mesh(pattern, seg)
     a = simulate(job, kerf_mm=kerf_mm)
@@ -68,67 +64,99 @@ def cad_models(pattern: Pattern, job=None, *, step: bool = True, segments: int |
     return Models(dm, a, am, solid, data, seg)
 
 
-def build_outputs(pattern: Pattern, job, outdir: str | os.PathLike, *, step: bool = True, pictures: bool = True,
-                  segments: int | None = None, kerf_mm: float | None = None, log=None) -> list[Path]:
-    """Write the CAD models, pictures and verification report; return the paths in order.
+@dataclass(frozen=True, eq=False)
+class CadOutputs:
+    """The CAD files of a pattern (name -> bytes, in writing order) and its verification report.
+
+    Attributes
+    ----------
+    files : dict[str, bytes]
+    report : camtube.cad.verify.Report
+    """
+
+    files: dict
+    report: object
+
+    @property
+    def passed(self) -> bool:
+        return bool(self.report.passed)
+
+    def verdict_lines(self) -> list[str]:
+        """``verification: PASS (n/m checks passed)`` and one ``FAIL name: detail`` line per failed check."""
+        r = self.report
+        out = [f"verification: {'PASS' if r.passed else 'FAIL'} "
+               f"({len(r.checks) - len(r.failures)}/{len(r.checks)} checks passed)"]
+        out += [f"  FAIL {c.name}: {c.detail}" for c in r.failures]
+        return out
+
+
+def cad_outputs(pattern: Pattern, job, *, step: bool = True, pictures: bool = True,
+                segments: int | None = None, kerf_mm: float | None = None) -> CadOutputs:
+    """Compute every CAD output of ``pattern`` and its ``job`` in memory (no file is written).
 
     Parameters
     ----------
     pattern : Pattern
-    job : camtube.plan.Job or None
-        The job to simulate (``None``: plan it with the defaults).
-    outdir : path
+    job : camtube.plan.Job
+        The planned job to simulate.
     step : bool
-        Also build the exact B-rep and write the STEP (build123d; slower).
+        Also build the exact B-rep and its STEP (build123d; slower); its volume is
+        read back from the STEP text with OCCT for the report.
     pictures : bool
-        Write the PNG pictures.
+        Also render the PNG pictures.
     segments : int, optional
         Sides of the meshes' polygonal circles.
     kerf_mm : float, optional
         Beam kerf for the simulation (default: the process's, or 0.02 mm).
-    log : callable, optional
-        Called with one line of text per step (e.g. ``print``).
     """
     from camtube.cad.mesh import stl_bytes
     from camtube.cad.verify import report_json, report_text, verify
 
-    say = log or (lambda _msg: None)
-    out = Path(outdir)
     name = pattern.name
     m = cad_models(pattern, job, step=step, segments=segments, kerf_mm=kerf_mm)
-    paths: list[Path] = []
+    files: dict[str, bytes] = {}
     step_volume = None
     if m.step is not None:
-        from camtube.cad.solid import import_step_volume
-
-        p = write_atomic(out / f"{name}.design.step", m.step)
-        paths.append(p)
-        step_volume = import_step_volume(p)
-    paths.append(write_atomic(out / f"{name}.design.stl", stl_bytes(m.design_mesh)))
-    paths.append(write_atomic(out / f"{name}.ascut.stl", stl_bytes(m.ascut_mesh)))
+        files[f"{name}.design.step"] = m.step
+        step_volume = _step_volume(m.step)
+    files[f"{name}.design.stl"] = stl_bytes(m.design_mesh)
+    files[f"{name}.ascut.stl"] = stl_bytes(m.ascut_mesh)
     report = verify(pattern, design_mesh=m.design_mesh, ascut=m.ascut, ascut_mesh=m.ascut_mesh,
                     solid_volume_mm3=float(m.solid.volume) if m.solid is not None else None,
                     step_volume_mm3=step_volume, segments=m.segments)
-    paths.append(write_atomic(out / f"{name}.verify.txt", report_text(report)))
-    paths.append(write_atomic(out / f"{name}.verify.json", report_json(report)))
-    say(f"verification: {'PASS' if report.passed else 'FAIL'} "
-        f"({len(report.checks) - len(report.failures)}/{len(report.checks)} checks passed)")
-    for c in report.failures:
-        say(f"  FAIL {c.name}: {c.detail}")
+    files[f"{name}.verify.txt"] = report_text(report).encode("utf-8")
+    files[f"{name}.verify.json"] = report_json(report).encode("utf-8")
     if pictures:
         from camtube.cad.render import tube_png, unrolled_png
 
         notches = pattern.notches
         facing = (notches[0].angle_deg if notches else 180.0) + 60.0  # notches seen obliquely
-        paths.append(write_atomic(out / f"{name}.tube.png", tube_png(m.design_mesh, facing_angle_deg=facing,
-                                                                     title=f"{name} (design)")))
-        paths.append(write_atomic(out / f"{name}.unrolled.png", unrolled_png(
-            job.design if job is not None else _contours(pattern),
-            pattern.tube.length_mm, pattern.tube.outer_radius_mm, m.ascut, title=name)))
+        files[f"{name}.tube.png"] = tube_png(m.design_mesh, facing_angle_deg=facing, title=f"{name} (design)")
+        files[f"{name}.unrolled.png"] = unrolled_png(job.design, pattern.tube.length_mm,
+                                                     pattern.tube.outer_radius_mm, m.ascut, title=name)
+    return CadOutputs(files, report)
+
+
+def _step_volume(step: bytes) -> float:
+    """Volume (mm^3) of a STEP text, read back by OCCT from a private temporary file."""
+    import tempfile
+
+    from camtube.cad.solid import import_step_volume
+
+    with tempfile.TemporaryDirectory(prefix="camtube-step-") as tmp:
+        path = Path(tmp) / "readback.step"
+        path.write_bytes(step)
+        return import_step_volume(path)
+
+
+def build_outputs(pattern: Pattern, job, outdir: str | os.PathLike, *, step: bool = True, pictures: bool = True,
+                  segments: int | None = None, kerf_mm: float | None = None, log=None) -> list[Path]:
+    """Compute the CAD outputs (:func:`cad_outputs`) and write them into ``outdir`` as one set.
+
+    ``log`` (e.g. ``print``) receives the verification verdict lines. Returns the written paths.
+    """
+    out = cad_outputs(pattern, job, step=step, pictures=pictures, segments=segments, kerf_mm=kerf_mm)
+    paths = write_set(outdir, out.files)
+    for line in out.verdict_lines():
+        (log or (lambda _msg: None))(line)
     return paths
-
-
-def _contours(pattern: Pattern):
-    from camtube.design.contour import cut_contours
-
-    return cut_contours(pattern)

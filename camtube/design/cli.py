@@ -3,8 +3,10 @@ from __future__ import annotations
 
 import argparse
 import math
+from pathlib import Path
 
 from camtube.cliutil import add_pattern_argument, load_from_args
+from camtube.errors import CamtubeError
 
 
 def register(sub) -> None:
@@ -33,17 +35,23 @@ def register(sub) -> None:
 
 
 def design_report(pattern) -> str:
-    """Text table of a pattern's derived geometry."""
+    """Text table of a pattern's derived geometry, then notes on the bend at ``rules.max_stroke``."""
     from camtube.design.geometry import beam_depth_mm, pattern_geometry
+    from camtube.design.rules import stroke_notes
 
-    geo = pattern_geometry(pattern)
-    g = geo.first
     t = pattern.tube
     rows = [
         ("pattern", pattern.name, ""),
         ("notches / holes", f"{len(pattern.notches)} / {len(pattern.holes)}", ""),
         ("tube r_o / r_i / wall", f"{t.outer_radius_mm:.3f} / {t.inner_radius_mm:.3f} / {t.wall_mm:.3f}", "mm"),
         ("tube length", f"{t.length_mm:.3f}", "mm"),
+    ]
+    if not pattern.notches:
+        rows.append(("note", "no notches: the tube does not bend (phi, ybar and the moment arm are undefined)", ""))
+        return _table(rows)
+    geo = pattern_geometry(pattern)
+    g = geo.first
+    rows += [
         ("notched length (sum of h)", f"{geo.notched_length_mm:.3f}", "mm"),
         ("backbone angle phi", f"{g.phi_rad:.3f}", f"rad ({math.degrees(g.phi_rad):.1f} deg)"),
         ("centroid ybar", f"{g.ybar_mm:.3f}", "mm"),
@@ -51,12 +59,28 @@ def design_report(pattern) -> str:
         ("backbone area", f"{g.area_mm2:.4f}", "mm^2"),
         ("backbone second moment", f"{g.second_moment_mm4:.5f}", "mm^4"),
         ("closure angle per notch", f"{math.degrees(g.closure_angle_rad):.2f}", "deg"),
-        ("closure angle, all notches", f"{math.degrees(geo.total_closure_angle_rad):.1f}", "deg"),
+    ]
+    for angle_deg, closure_rad, count in _closure_by_direction(pattern, geo):
+        rows.append((f"closure angle, {count} notches at {angle_deg:g} deg", f"{math.degrees(closure_rad):.1f}", "deg"))
+    rows += [
         ("backbone strain at closure", f"{g.closure_strain:.3f}", ""),
         ("beam depth r_o (1 - cos(s / 2 r_o))", f"{beam_depth_mm(t.outer_radius_mm, g.arc_mm):.3f}", "mm"),
     ]
     if not geo.uniform:
         rows.append(("note", "notches differ: values are for the first notch", ""))
+    notes = stroke_notes(pattern)
+    return _table(rows) + ("".join(f"\nnote: {n}" for n in notes))
+
+
+def _closure_by_direction(pattern, geo) -> list[tuple[float, float, int]]:
+    """(direction deg, closure angle of its notches rad, notch count) per bending direction."""
+    out: dict[float, list] = {}
+    for n, g in zip(pattern.notches, geo.notches):
+        out.setdefault(round(n.angle_deg % 360.0, 9), []).append(g.closure_angle_rad)
+    return [(a, sum(v), len(v)) for a, v in sorted(out.items())]
+
+
+def _table(rows) -> str:
     w = max(len(r[0]) for r in rows)
     return "\n".join(f"{a:<{w}}  {b} {c}".rstrip() for a, b, c in rows)
 
@@ -72,6 +96,8 @@ def cmd_design(args: argparse.Namespace) -> int:
 
 def _design_extras(pattern) -> str:
     """Sections other stages add to ``camtube design`` (the predicted stroke-angle curve)."""
+    if not pattern.notches:
+        return ""
     try:
         from camtube.model.predict import design_summary
     except ModuleNotFoundError:
@@ -83,6 +109,8 @@ def cmd_dxf(args: argparse.Namespace) -> int:
     from camtube.export.dxf import design_dxf
     from camtube.io import write_atomic
 
+    if Path(args.output).suffix.lower() != ".dxf":
+        raise CamtubeError(f"{args.output}: dxf writes a DXF drawing; fix: name the output OUT.dxf")
     loaded = load_from_args(args)
     text = design_dxf(loaded.pattern)
     path = write_atomic(args.output, text)
@@ -96,6 +124,9 @@ def cmd_preview(args: argparse.Namespace) -> int:
     from camtube.export.svg import unrolled_svg
     from camtube.io import write_atomic
 
+    if Path(args.output).suffix.lower() != ".svg":
+        raise CamtubeError(f"{args.output}: preview writes SVG, not {Path(args.output).suffix or 'a file without a suffix'}; "
+                           "fix: name the output OUT.svg (convert it to PNG with any SVG tool if needed)")
     loaded = load_from_args(args)
     path = write_atomic(args.output, unrolled_svg(loaded.pattern))
     print(f"wrote {path}")

@@ -176,3 +176,93 @@ def beam_depth_mm(outer_radius_mm: float, arc_mm: float) -> float:
     escape through the narrowing kerf.
     """
     return outer_radius_mm * (1.0 - math.cos(arc_mm / (2.0 * outer_radius_mm)))
+
+
+#: Young's modulus (GPa) of tube materials, for the bending stiffness of the backbone.
+#: Polyimide: 2.5 GPa, a typical figure for polyimide tubing (the source paper does not give one).
+MATERIAL_MODULUS_GPA = {"polyimide": 2.5}
+
+
+@dataclass(frozen=True)
+class DirectionBend:
+    """How the notches of one bending direction behave at a given tendon stroke (base model, stroke only).
+
+    The tendon of a direction bends its notches in series: moment M = F arm, notch i bends
+    theta_i = M h_i / (E I_i); the stroke is arm * theta + F L0 / (E_t pi r_t^2).
+
+    Attributes
+    ----------
+    angle_deg : float
+        Direction (rotary angle of the notch centres).
+    notches : int
+        Notches in this direction.
+    stroke_mm : float
+        The tendon stroke analysed (``rules.max_stroke``).
+    bend_rad : float
+        Joint bend of this direction at ``stroke_mm``.
+    strain : float
+        Largest backbone strain of its notches at that bend.
+    elastic_bend_rad, elastic_stroke_mm : float
+        Largest bend (and the stroke that gives it) with every notch within ``strain_limit``.
+    closure_rad : float
+        Bend at which every notch of the direction is closed (sum of h / (r_o + ybar)).
+    closing_stroke_mm : float
+        Stroke at which the first notch closes (inf if never within the analysis).
+    strain_limit : float
+        The material's elastic strain limit used (``rules.max_strain``).
+    """
+
+    angle_deg: float
+    notches: int
+    stroke_mm: float
+    bend_rad: float
+    strain: float
+    elastic_bend_rad: float
+    elastic_stroke_mm: float
+    closure_rad: float
+    closing_stroke_mm: float
+    strain_limit: float
+
+    @property
+    def closes(self) -> bool:
+        """True when a notch closes before ``stroke_mm`` is reached."""
+        return self.closing_stroke_mm < self.stroke_mm
+
+
+def bends_at_stroke(pattern: Pattern, stroke_mm: float | None = None,
+                    modulus_gpa: float | None = None) -> tuple[DirectionBend, ...]:
+    """Per bending direction: the bend, strain and notch closure at ``stroke_mm`` (default ``rules.max_stroke``).
+
+    Returns ``()`` when the pattern has no notches or the tube material has no known modulus
+    (:data:`MATERIAL_MODULUS_GPA`) and none is given.
+    """
+    t = pattern.tube
+    e_gpa = modulus_gpa if modulus_gpa is not None else MATERIAL_MODULUS_GPA.get(t.material)
+    if e_gpa is None or not pattern.notches:
+        return ()
+    e = e_gpa * 1e3  # N/mm^2
+    stroke = pattern.rules.max_stroke_mm if stroke_mm is None else stroke_mm
+    td = pattern.tendon
+    compliance = td.length_mm / (td.modulus_gpa * 1e3 * math.pi * td.radius_mm ** 2)  # mm/N
+    groups: dict[float, list] = {}
+    for n in pattern.notches:
+        groups.setdefault(round(n.angle_deg % 360.0, 9), []).append(n)
+    out = []
+    for ang, notches in sorted(groups.items()):
+        geos = [joint_geometry(t.outer_radius_mm, t.inner_radius_mm, n.arc_mm, n.width_mm, td.radius_mm)
+                for n in notches]
+        arm = geos[0].moment_arm_mm
+        flex = [g.notch_width_mm / (e * g.second_moment_mm4) for g in geos]  # rad per N mm
+        k = 1.0 / sum(flex)
+        per_rad = arm + k * compliance / arm  # stroke per rad of bend
+        bend = stroke / per_rad
+        moment = k * bend
+        strain = max(g.extreme_fibre_mm * moment * f / g.notch_width_mm for g, f in zip(geos, flex))
+        scale = pattern.rules.max_strain / strain if strain > 0 else math.inf
+        close_moment = min(g.closure_angle_rad / f for g, f in zip(geos, flex))
+        out.append(DirectionBend(
+            angle_deg=ang, notches=len(notches), stroke_mm=stroke, bend_rad=bend, strain=strain,
+            elastic_bend_rad=bend * scale, elastic_stroke_mm=stroke * scale,
+            closure_rad=sum(g.closure_angle_rad for g in geos),
+            closing_stroke_mm=close_moment / k * per_rad, strain_limit=pattern.rules.max_strain))
+    return tuple(out)

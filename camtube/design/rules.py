@@ -1,14 +1,19 @@
 """Design-rule checks on a built :class:`~camtube.design.pattern.Pattern`.
 
 Errors make a pattern unusable (nothing is written); warnings are what a
-designer needs to know (notch closure, backbone strain at closure).
+designer must act on: at ``rules.max_stroke`` a notch closes (the tendon then
+pulls against a hard stop), or the backbone strain passes twice the material's
+elastic limit (a large permanent set, risk of cracking). A strain between the
+limit and twice it is what the source paper's joints see (their first cycle
+differs, later cycles repeat): ``camtube design`` says so in a note
+(:func:`stroke_notes`), and no warning is printed.
 """
 from __future__ import annotations
 
 import math
 from typing import Sequence
 
-from camtube.design.geometry import joint_geometry
+from camtube.design.geometry import DirectionBend, bends_at_stroke, joint_geometry
 from camtube.design.pattern import Cut, Pattern
 from camtube.errors import Issue
 
@@ -145,20 +150,48 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
         if len(errors) > 50:
             break
 
-    notches = pattern.notches
-    if notches and not errors:
-        geoms = [joint_geometry(ro, ri, n.arc_mm, n.width_mm, pattern.tendon.radius_mm) for n in notches]
-        g = geoms[0]
-        total = sum(x.closure_angle_rad for x in geoms)
-        warn("notch.width", f"notch closure angle h/(r_o+ybar) = {math.degrees(g.closure_angle_rad):.2f} deg "
-             f"per notch, {math.degrees(total):.1f} deg for all {len(notches)} notches "
-             "(the joint cannot bend further: notches close)", None)
-        worst = max(geoms, key=lambda x: x.closure_strain)
-        if worst.closure_strain > rules.max_strain:
-            safe_deg = math.degrees(rules.max_strain * worst.notch_width_mm / worst.extreme_fibre_mm)
-            warn("rules.max_strain", f"backbone strain at notch closure is {worst.closure_strain:.3f}, above the "
-                 f"{t.material} limit {rules.max_strain:g}: the backbone yields before the notch closes",
-                 round(worst.closure_strain, 6), f"<= {rules.max_strain:g}",
-                 f"keep the bend below {safe_deg:.2f} deg per notch "
-                 f"({safe_deg * len(notches):.1f} deg in total), or narrow the notch width h")
+    if pattern.notches and not errors:
+        for d in bends_at_stroke(pattern):
+            for w in stroke_warnings(d, t.material):
+                warn(w.key, w.message, w.value, w.allowed, w.fix)
     return errors, warnings
+
+
+#: A strain above this multiple of ``rules.max_strain`` at ``rules.max_stroke`` is a warning.
+STRAIN_WARNING_FACTOR = 2.0
+
+
+def stroke_warnings(d: DirectionBend, material: str) -> list[Issue]:
+    """Warnings for one bending direction at ``rules.max_stroke`` (empty when the design is fine for it)."""
+    out = []
+    where = f"notches at {d.angle_deg:g} deg"
+    if d.closes:
+        out.append(Issue("rules.max_stroke", f"{where}: a notch closes at a tendon stroke of "
+                         f"{d.closing_stroke_mm:.2f} mm, before rules.max_stroke = {d.stroke_mm:g} mm; beyond it the "
+                         "tendon pulls against closed notches (a hard stop) and the joint angle stops following the "
+                         "model", round(d.stroke_mm, 6), f"<= {d.closing_stroke_mm:.3f} mm",
+                         "lower rules.max_stroke, or widen the notches (notch.width) or add notches"))
+    if d.strain > STRAIN_WARNING_FACTOR * d.strain_limit:
+        out.append(Issue("rules.max_strain", f"{where}: at rules.max_stroke = {d.stroke_mm:g} mm the joint bends "
+                         f"{math.degrees(d.bend_rad):.1f} deg with a backbone strain of {d.strain:.3f}, more than "
+                         f"{STRAIN_WARNING_FACTOR:g}x the {material} elastic limit {d.strain_limit:g} (largest elastic "
+                         f"bend {math.degrees(d.elastic_bend_rad):.1f} deg at {d.elastic_stroke_mm:.2f} mm): expect a "
+                         "large permanent set in the first cycles and a risk of cracking the backbone",
+                         round(d.strain, 6), f"<= {STRAIN_WARNING_FACTOR * d.strain_limit:g}",
+                         f"lower rules.max_stroke towards {d.elastic_stroke_mm:.2f} mm, or use more or wider notches"))
+    return out
+
+
+def stroke_notes(pattern: Pattern) -> list[str]:
+    """Plain-language notes on the bend at ``rules.max_stroke``, per direction (for ``camtube design``)."""
+    notes = []
+    for d in bends_at_stroke(pattern):
+        head = (f"notches at {d.angle_deg:g} deg ({d.notches}): at rules.max_stroke {d.stroke_mm:g} mm the joint "
+                f"bends {math.degrees(d.bend_rad):.1f} deg (base model, stroke only), backbone strain {d.strain:.3f}; "
+                f"largest elastic bend {math.degrees(d.elastic_bend_rad):.1f} deg at {d.elastic_stroke_mm:.2f} mm; "
+                f"all notches closed at {math.degrees(d.closure_rad):.1f} deg")
+        if d.strain > d.strain_limit:
+            head += (f". Above the elastic limit {d.strain_limit:g}: expect a permanent set in the first cycles "
+                     "(the source paper's first cycle differs; later cycles repeat)")
+        notes.append(head)
+    return notes

@@ -1,10 +1,12 @@
-"""CLI of the plan stage: ``camtube toolpath`` and ``camtube build``."""
+"""CLI of the plan stage: ``camtube toolpath`` and ``camtube build`` (the orchestration is :mod:`camtube.pipeline`)."""
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from camtube.cliutil import add_pattern_argument, load_from_args
+from camtube.errors import CamtubeError
 
 PROGRESS_MIN_PASSES = 20000
 
@@ -15,46 +17,56 @@ def register(sub) -> None:
 
     def common(p):
         add_pattern_argument(p)
-        p.add_argument("-o", "--output", required=True, metavar="DIR", help="output directory (created)")
+        p.add_argument("-o", "--output", required=True, metavar="DIR",
+                       help="output directory (created; files of this command are replaced all at once, "
+                            "other files in it are kept)")
         p.add_argument("--ordering", choices=ORDERINGS, default=DEFAULT_ORDERING,
                        help=f"pass ordering (default {DEFAULT_ORDERING}: one round per repeat/focus/drill "
                             "visits every cut; sequential: all passes of a cut, then the next)")
         p.add_argument("--dialect", choices=("all",) + tuple(DIALECTS), default="all",
                        help="G-code dialect(s) to write (default all: linuxcnc .ngc rotary X/A/Z, "
                             "grbl .nc flat X/Y/Z)")
-        p.add_argument("--outer-radius", type=float, metavar="MM",
-                       help="tube outer radius r_o in mm (needed when PATTERN is a .dxf)")
-        p.add_argument("--length", type=float, metavar="MM",
-                       help="tube length in mm for a .dxf without a CONSTRUCTION outline")
 
     p = sub.add_parser("toolpath", help="plan the laser passes; write toolpath DXF, G-code and job file",
                        description="Plan the multi-pass laser job (drill offsets 0.005 mm, focus + defocus, "
-                                   "repeats by beam depth) of a pattern YAML or a DXF of closed contours and "
-                                   "write NAME.toolpath.dxf, NAME.ngc, NAME.nc and NAME.job.json. Lengths mm, "
+                                   "repeats by beam depth) of a pattern YAML or a DXF drawing and write "
+                                   "NAME.toolpath.dxf, NAME.ngc, NAME.nc and NAME.job.json. Lengths mm, "
                                    "speeds mm/s, times s.")
     common(p)
     p.set_defaults(func=cmd_toolpath)
-    p = sub.add_parser("build", help="write everything: design DXF, toolpaths, G-code, job file (+ CAD, report)",
-                       description="Like toolpath, plus the design DXF and, when the CAD stage is installed, "
-                                   "the CAD model and report.")
+    p = sub.add_parser("build", help="write everything: design DXF, toolpaths, G-code, job file, CAD model, report",
+                       description="Like toolpath, plus the design DXF, the CAD model (STEP, STL), the as-cut "
+                                   "simulation, pictures and the verification report. Exits 1 when a "
+                                   "verification check fails.")
     common(p)
+    add_cad_options(p)
     p.set_defaults(func=cmd_build)
 
 
-def _load(args):
-    """(pattern or None, job)."""
-    from camtube.plan.planner import plan_job
+def add_cad_options(p: argparse.ArgumentParser) -> None:
+    """The CAD stage's options (shared by ``camtube cad`` and ``camtube build``)."""
+    g = p.add_argument_group("CAD model and verification")
+    g.add_argument("--no-step", action="store_true", help="skip the build123d B-rep and STEP (fast preview)")
+    g.add_argument("--no-pictures", action="store_true", help="skip the PNG pictures")
+    g.add_argument("--kerf", type=float, default=None, metavar="MM",
+                   help="beam kerf for the simulation, mm (default: process.kerf, or 0.02 if that is 0)")
+    g.add_argument("--segments", type=int, default=None, metavar="N",
+                   help="sides of the meshes' polygonal circles (default 256; 128 above 64 cuts)")
+    g.add_argument("--allow-fail", action="store_true",
+                   help="exit 0 even when a verification check fails (default: exit 1)")
 
-    if str(args.pattern).lower().endswith(".dxf"):
-        if args.overrides:
-            from camtube.errors import Issue, PatternError
 
-            raise PatternError([Issue("--set", "applies to pattern YAML files, not to a DXF", args.overrides[0],
-                                      "", "drop --set; a DXF input is planned with the paper's process")])
-        return None, plan_job(args.pattern, ordering=args.ordering, outer_radius_mm=args.outer_radius,
-                              length_mm=args.length)
-    loaded = load_from_args(args)
-    return loaded.pattern, plan_job(loaded.pattern, ordering=args.ordering)
+def cad_options(args: argparse.Namespace):
+    """:class:`camtube.pipeline.CadOptions` from the parsed CAD options (values checked)."""
+    from camtube.pipeline import CadOptions
+
+    if args.kerf is not None and not (0 < args.kerf < 1.0):
+        raise CamtubeError(f"--kerf {args.kerf}: the simulated kerf must be > 0 and < 1 mm; fix: give the beam's "
+                           "kerf width in mm, e.g. --kerf 0.02")
+    if args.segments is not None and not (8 <= args.segments <= 4096):
+        raise CamtubeError(f"--segments {args.segments}: allowed 8..4096; fix: e.g. --segments 256")
+    return CadOptions(step=not args.no_step, pictures=not args.no_pictures, segments=args.segments,
+                      kerf_mm=args.kerf)
 
 
 def summary_table(job, est) -> str:
@@ -74,8 +86,8 @@ def summary_table(job, est) -> str:
     return "\n".join(f"{a:<{w}}  {b} {c}".rstrip() for a, b, c in rows)
 
 
-def _progress():
-    if not sys.stderr.isatty():
+def _progress(args):
+    if getattr(args, "quiet", False) or os.environ.get("CI") or not sys.stderr.isatty():
         return None
 
     def show(done: int, total: int) -> None:
@@ -88,34 +100,41 @@ def _progress():
     return show
 
 
-def _run(args, with_design: bool) -> int:
-    from camtube.export.dialects import DIALECTS
-    from camtube.plan.moves import estimate
-    from camtube.plan.outputs import write_toolpaths
+def check_output_dir(path: str) -> None:
+    """Refuse an output directory that names an existing file."""
+    if os.path.exists(path) and not os.path.isdir(path):
+        raise CamtubeError(f"{path}: is a file, but -o names the output directory; fix: give a directory "
+                           "(new or existing)")
 
-    pattern, job = _load(args)
-    dialects = tuple(DIALECTS.values()) if args.dialect == "all" else (DIALECTS[args.dialect],)
-    progress = _progress() if len(job.passes) >= PROGRESS_MIN_PASSES else None
-    paths = write_toolpaths(job, args.output, dialects, pattern if with_design else None, progress)
-    if with_design and pattern is not None:
-        paths += _cad_outputs(pattern, job, args.output)
-    print(summary_table(job, estimate(job)))
-    for p in paths:
+
+def _run(args, what: str) -> int:
+    from camtube.export.dialects import DIALECTS
+    from camtube.pipeline import Request, run
+
+    check_output_dir(args.output)
+    loaded = load_from_args(args)
+    dialects = None if getattr(args, "dialect", "all") == "all" else (DIALECTS[args.dialect],)
+    cad = cad_options(args) if what != "toolpath" else None
+    request = Request(what=what, dialects=dialects, ordering=getattr(args, "ordering", None),
+                      **({"cad": cad} if cad is not None else {}))
+    result = run(loaded, args.output, request, _progress(args))
+    if result.estimate is not None:
+        print(summary_table(result.job, result.estimate))
+    for p in result.paths:
         print(f"wrote {p}")
+    if result.cad is not None:
+        for line in result.cad.verdict_lines():
+            print(line)
+        if not result.verified:
+            print(f"camtube {args.command}: the job failed its own verification (see the report above): "
+                  "do not cut it; exit status 1", file=sys.stderr)
+            return 0 if args.allow_fail else 1
     return 0
 
 
-def _cad_outputs(pattern, job, outdir) -> list:
-    try:
-        from camtube.cad import build_outputs
-    except ImportError:
-        return []
-    return list(build_outputs(pattern, job, outdir, log=print) or [])  # prints the verification verdict
-
-
 def cmd_toolpath(args: argparse.Namespace) -> int:
-    return _run(args, with_design=False)
+    return _run(args, "toolpath")
 
 
 def cmd_build(args: argparse.Namespace) -> int:
-    return _run(args, with_design=True)
+    return _run(args, "build")

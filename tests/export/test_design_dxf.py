@@ -97,13 +97,15 @@ def _normalised_boxes(contours, circ):
 # ---------------------------------------------------------------- property-based tests
 @st.composite
 def raw_patterns(draw):
+    """Patterns that pass every design rule by construction (default rules: backbone arc >= 0.3 mm,
+    web >= 0.1 mm), so a failure means the round trip is wrong, not that the input was invalid."""
     ro = draw(st.floats(0.3, 3.0))
     ri = ro * draw(st.floats(0.3, 0.9))
     circ = 2 * math.pi * ro
     n = draw(st.integers(1, 25))
     h = draw(st.floats(0.05, 1.5))
     c = draw(st.floats(0.1, 1.5))
-    s = circ * draw(st.floats(0.05, 0.9))
+    s = draw(st.floats(0.05 * circ, circ - 0.35))  # backbone arc 2 pi r_o - s >= 0.35 > rules.min_backbone_arc
     layout = draw(st.sampled_from(["uan", "bidirectional", "directions"]))
     angle = draw(st.floats(0, 359.99))
     first = draw(st.floats(0.0, 2.0))

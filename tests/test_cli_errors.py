@@ -1,0 +1,137 @@
+"""Everyday mistakes: one clear line naming the path or value and the fix, exit 2, no traceback, nothing left.
+
+Each case runs the real command in a subprocess (as a user would), so the exit status, stderr
+and the files on disk are exactly what a user sees.
+"""
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import PATTERNS, ROOT
+
+TUBE1 = str(PATTERNS / "tube1.yaml")
+
+
+def camtube(*argv: str, cwd: Path | None = None, timeout: float = 120) -> subprocess.CompletedProcess:
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    return subprocess.run([sys.executable, "-m", "camtube", *argv], capture_output=True, text=True,
+                          timeout=timeout, cwd=cwd, env=env)
+
+
+def assert_refused(r: subprocess.CompletedProcess, *words: str) -> None:
+    assert r.returncode == 2, (r.returncode, r.stderr)
+    assert "Traceback" not in r.stderr, r.stderr
+    lines = [x for x in r.stderr.splitlines() if x.strip()]
+    assert len(lines) == 1, r.stderr
+    assert "fix:" in lines[0], r.stderr
+    for w in words:
+        assert w in lines[0], (w, r.stderr)
+
+
+def listing(d: Path) -> list[str]:
+    return sorted(str(p.relative_to(d)) for p in d.rglob("*"))
+
+
+@pytest.fixture
+def readonly_dir(tmp_path):
+    """A directory nobody may write into: a read-only tmpfs as root, permissions otherwise."""
+    d = tmp_path / "ro"
+    d.mkdir()
+    if os.geteuid() == 0:
+        r = subprocess.run(["mount", "-t", "tmpfs", "-o", "ro,size=1m", "tmpfs", str(d)], capture_output=True)
+        if r.returncode != 0:
+            pytest.skip("running as root without permission to mount a read-only file system")
+        yield d, "Read-only file system"
+        subprocess.run(["umount", str(d)], check=False)
+    else:
+        d.chmod(0o500)
+        yield d, "Permission denied"
+        d.chmod(0o700)
+
+
+@pytest.mark.parametrize("cmd", [["toolpath", TUBE1, "-o", "{ro}/out"], ["dxf", TUBE1, "-o", "{ro}/t.dxf"],
+                                 ["preview", TUBE1, "-o", "{ro}/t.svg"]])
+def test_read_only_output(readonly_dir, cmd):
+    d, reason = readonly_dir
+    r = camtube(*[a.replace("{ro}", str(d)) for a in cmd], "-q")
+    assert_refused(r, str(d), reason)
+    assert listing(d) == []
+
+
+def test_output_file_named_like_a_directory(tmp_path):
+    (tmp_path / "x.dxf").mkdir()
+    assert_refused(camtube("dxf", TUBE1, "-o", str(tmp_path / "x.dxf"), "-q"), "x.dxf", "is a directory")
+    assert listing(tmp_path) == ["x.dxf"]
+
+
+def test_toolpath_output_directory_that_is_a_file(tmp_path):
+    f = tmp_path / "out"
+    f.write_text("mine")
+    assert_refused(camtube("toolpath", TUBE1, "-o", str(f), "-q"), str(f), "is a file")
+    assert f.read_text() == "mine" and listing(tmp_path) == ["out"]
+
+
+def test_pattern_path_that_is_a_directory_or_missing(tmp_path):
+    assert_refused(camtube("design", str(tmp_path)), str(tmp_path), "is a directory")
+    assert_refused(camtube("toolpath", str(tmp_path / "nope.yaml"), "-o", str(tmp_path / "o")), "no such file")
+    assert listing(tmp_path) == []
+
+
+def test_preview_refuses_a_suffix_it_does_not_write(tmp_path):
+    assert_refused(camtube("preview", TUBE1, "-o", str(tmp_path / "x.png"), "-q"), "x.png", "SVG")
+    assert listing(tmp_path) == []
+
+
+def test_no_notches_is_described_not_crashed(tmp_path):
+    r = camtube("design", TUBE1, "--set", "notch.count=0")
+    assert r.returncode == 0 and "Traceback" not in r.stderr
+    assert "no notches" in r.stdout and "notches / holes        0 / 1" in r.stdout
+
+
+def test_broken_pipe_is_quiet():
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    p = subprocess.run(f"{sys.executable} -m camtube design {TUBE1} | head -1", shell=True, capture_output=True,
+                       text=True, env=env, timeout=60)
+    assert p.stdout.startswith("pattern") and p.stdout.count("\n") == 1
+    assert "Traceback" not in p.stderr and "BrokenPipe" not in p.stderr, p.stderr
+
+
+def test_ctrl_c_exits_130_and_publishes_nothing(tmp_path):
+    """SIGINT in the middle of a long build: exit 130, one line, no traceback, no output directory."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    out = tmp_path / "big"
+    p = subprocess.Popen([sys.executable, "-m", "camtube", "build", TUBE1, "--set", "notch.count=300",
+                          "--set", "tube.length=310", "-o", str(out), "-q"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, env=env)
+    time.sleep(4.0)
+    assert p.poll() is None, "the build ended before it could be interrupted"
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 130, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert listing(tmp_path) == []
+
+
+def test_failed_verification_is_not_success(tmp_path):
+    """A beam 5x wider than the kerf the job compensates for cuts outside the design: FAIL -> exit 1."""
+    bad = ("--kerf", "0.1", "--set", "process.kerf=0.02")
+    r = camtube("cad", TUBE1, "-q", "-o", str(tmp_path / "c"), "--no-step", "--no-pictures", *bad)
+    assert r.returncode == 1, r.stdout + r.stderr
+    assert "verification: FAIL" in r.stdout and "do not cut it" in r.stderr
+    assert (tmp_path / "c" / "tube1.verify.txt").exists()  # the report that says why is written
+    r = camtube("cad", TUBE1, "-q", "-o", str(tmp_path / "d"), "--no-step", "--no-pictures", *bad, "--allow-fail")
+    assert r.returncode == 0
+
+
+@pytest.mark.parametrize("opt,value", [("--kerf", "-1"), ("--segments", "2"), ("--outer-radius", "-1"),
+                                       ("--layer", "NOTCHES")])
+def test_bad_option_values(tmp_path, opt, value):
+    assert_refused(camtube("cad", TUBE1, "-q", "-o", str(tmp_path / "c"), opt, value), opt)
+    assert listing(tmp_path) == []
