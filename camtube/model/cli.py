@@ -12,6 +12,34 @@ import importlib
 import sys
 
 
+#: Names of the built-in effects, for ``--help`` without importing the effect code
+#: (``tests/model/test_cli_fit.py`` checks it against the registry).
+EFFECT_NAMES = ("slack", "play", "creep", "friction", "toe", "viscoelastic", "series", "kerf", "flat_walls",
+                "chords", "hardstop", "angle_bias", "force_zero")
+
+
+def check_suffix(path: str | None, suffixes: tuple[str, ...], option: str) -> None:
+    """Refuse an output file whose suffix does not match the format written to it.
+
+    Raises
+    ------
+    DataError
+        Naming the option, the path and the suffix to use.
+    """
+    from pathlib import Path
+
+    from camtube.errors import DataError
+
+    if path is None:
+        return
+    p = Path(path)
+    if p.suffix.lower() not in suffixes:
+        raise DataError(f"{option} {path}: writes {suffixes[0][1:].upper()}, so the file must end in "
+                        f"{' or '.join(suffixes)} (got {p.suffix or 'no suffix'!r})")
+    if p.is_dir():
+        raise DataError(f"{option} {path}: is a directory; fix: name a file")
+
+
 def register(sub) -> None:
     p = sub.add_parser("model", help="fit the joint model to measurements, make synthetic data",
                        description="Joint mechanics: tendon stroke (mm) and force (N) -> joint angle (deg).")
@@ -39,7 +67,9 @@ def register(sub) -> None:
                         "e.g. E_t,arm_scale; 'none')")
     f.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
                    help="hold a parameter at a value (units as listed: E_t GPa, L0 mm); repeatable")
-    f.add_argument("--effects", default="", metavar="A,B", help="effects to add to the base model, by name")
+    f.add_argument("--effects", default="", metavar="A,B",
+                   help="effects to add to the base model, by name: " + ", ".join(EFFECT_NAMES)
+                        + " (or one of an --effect-file)")
     f.add_argument("--effect-file", action="append", default=[], metavar="F.py",
                    help="a .py file defining or registering Effect objects (loaded before --effects)")
     f.add_argument("--json", metavar="OUT.json", help="write the summary as JSON")
@@ -131,14 +161,19 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from camtube.cliutil import load_from_args
     from camtube.io import write_atomic
     from camtube.model.data import find_slack, load_csv, prepare, remove_deadband, select_cycles
-    from camtube.model.fit import fit
+    from camtube.model.fit import FitError, fit
     from camtube.model.predict import pattern_values
     from camtube.model.report_fit import fit_json, fit_text
 
+    from camtube.model.data import check_fittable
+
+    check_suffix(args.json, (".json",), "--json")
+    check_suffix(args.plot, (".png",), "--plot")
     pattern = load_from_args(args).pattern
     model = build_model(pattern, args.effects, args.effect_file)
     raw = load_csv(args.data)
     rows = prepare(raw, args.cycles, args.branch, args.deadband, args.deadband_threshold)
+    check_fittable(rows, f"{args.data} (cycles {args.cycles}, {args.branch} branch)")
     fixed = pattern_values(pattern)
     fixed.update(parse_fix(args.fix))
     result = fit(model, rows, fit_param_names(model, args.fit_params), fixed)
@@ -166,6 +201,11 @@ def cmd_fit(args: argparse.Namespace) -> int:
             full = remove_deadband(raw, args.deadband_threshold)
         png = fit_png(result, full, title=f"{pattern.name}: model vs measurement ({sel})")
         print(f"wrote {write_atomic(args.plot, png)}")
+    bad = result.unidentified
+    if bad:
+        raise FitError("these rows cannot identify " + "; ".join(f"{k}: {v}" for k, v in bad.items())
+                       + "; the values above are not estimates. Fix: hold them (--fix NAME=VALUE), drop the "
+                       "effect, or select rows where they matter (e.g. --cycles all --branch both)")
     return 0
 
 
@@ -173,10 +213,8 @@ def cmd_synth(args: argparse.Namespace) -> int:
     from camtube.cliutil import load_from_args
     from camtube.model.synth import noise_floor_deg, synthesize, write
 
+    check_suffix(args.output, (".csv",), "-o/--output")
     pattern = load_from_args(args).pattern
-    if args.samples < 1 or args.cycles < 1:
-        print("camtube model synth: --samples and --cycles must be >= 1", file=sys.stderr)
-        return 2
     data = synthesize(pattern, args.samples, args.cycles, args.noise_angle, args.noise_force, args.seed,
                       modulus_gpa=args.modulus, speed_mm_s=args.speed, rate_hz=args.rate,
                       slack_mm=args.slack)

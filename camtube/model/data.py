@@ -194,9 +194,31 @@ def load_csv(path: str | Path) -> Dataset:
         text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         raise DataError(f"{path}: no such measurement file") from None
+    except IsADirectoryError:
+        raise DataError(f"{path}: is a directory, not a measurement file; fix: name the CSV file") from None
+    except PermissionError:
+        raise DataError(f"{path}: cannot read the measurement file (permission denied)") from None
+    except OSError as exc:
+        raise DataError(f"{path}: cannot read the measurement file ({exc.strerror or exc})") from None
     except UnicodeDecodeError as exc:
         raise DataError(f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start})") from None
     return parse_csv(text, str(path))
+
+
+def check_fittable(data: Dataset, what: str = "the selected rows") -> None:
+    """Refuse rows the joint model cannot be fitted to: a stroke or an angle that never changes.
+
+    Raises
+    ------
+    DataError
+        Naming the column, its value range and the fix.
+    """
+    for col, unit in (("stroke_mm", "mm"), ("angle_deg", "deg")):
+        v = np.asarray(getattr(data, col), float)
+        if v.size and float(np.ptp(v)) <= 1e-12 * max(1.0, float(np.max(np.abs(v)))):
+            raise DataError(f"{what}: column {col!r} never changes (every value is {float(v[0]):g} {unit}): "
+                            "the model's parameters cannot be identified; fix: give rows where the joint "
+                            "is actuated (check the file and the --cycles selection)")
 
 
 def format_csv(data: Dataset) -> str:

@@ -55,6 +55,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from camtube.model.api import Effect, JointModel, get_effect, registry
+from camtube.model.data import check_fittable
 from camtube.model.dataset import Dataset
 from camtube.model.fit import fit
 
@@ -304,6 +305,7 @@ def diagnose(
     have = {e.name for e in model.effects}
     pool = [e for e in pool if e.name not in have]
 
+    check_fittable(data)
     full_names = _names_for(model, fit_params)
     base_full = fit(model, data, full_names, fixed)
     floor = noise_floor(data, base_full.residuals)

@@ -7,9 +7,12 @@ from __future__ import annotations
 
 import argparse
 import shlex
+from pathlib import Path
 
 
 def register(model_sub) -> None:
+    from camtube.model.cli import EFFECT_NAMES
+
     d = model_sub.add_parser(
         "diagnose", help="find the physical effects the model is missing, rank them, say how to add them",
         description="Fit the current model to every selected row (both directions of motion, slack deadband "
@@ -25,11 +28,13 @@ def register(model_sub) -> None:
     d.add_argument("-q", "--quiet", action="store_true", help="do not print design warnings")
     d.add_argument("--cycles", default="all", metavar="SPEC",
                    help="cycles to use: all (default), last20, 31-50, 2-, ... (comma lists allowed)")
-    d.add_argument("--effects", default="", metavar="A,B", help="effects already in the model (default: none)")
+    d.add_argument("--effects", default="", metavar="A,B",
+                   help="effects already in the model (default: none); built-in: " + ", ".join(EFFECT_NAMES))
     d.add_argument("--effect-file", action="append", default=[], metavar="F.py",
                    help="a .py file defining Effect objects; its effects become candidates too (repeatable)")
     d.add_argument("--candidates", default="", metavar="A,B",
-                   help="effects to try (default: every registered effect not in the model)")
+                   help="effects to try (default: every registered effect not in the model, i.e. the built-in "
+                        + ", ".join(EFFECT_NAMES) + " and those of --effect-file)")
     d.add_argument("--fit", dest="fit_params", default="E_t", metavar="P1,P2",
                    help="base parameters fitted besides the effects' own (default E_t)")
     d.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
@@ -66,6 +71,11 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     from camtube.model.predict import pattern_values
     from camtube.model.report import diagnosis_json, diagnosis_text, write_report
 
+    from camtube.model.cli import check_suffix
+
+    check_suffix(args.json, (".json",), "--json")
+    if args.report is not None and Path(args.report).exists() and not Path(args.report).is_dir():
+        raise DataError(f"--report {args.report}: is a file; the report is a directory (index.html and PNGs)")
     pattern = load_from_args(args).pattern
     model = build_model(pattern, args.effects, args.effect_file)
     raw = load_csv(args.data)

@@ -104,6 +104,26 @@ class FitResult:
     def value(self, name: str) -> float:
         return float(self.params[name])
 
+    @property
+    def unidentified(self) -> dict[str, str]:
+        """Fitted parameters the rows cannot pin down: ``{name: reason}`` (empty when all are identified).
+
+        A parameter is unidentified when it ended on a bound (its value is the
+        bound, not an estimate) or when its standard error is infinite or
+        undefined (the data do not depend on it).
+        """
+        out = {}
+        specs = self.model.param_specs
+        for nm in self.fitted:
+            se = self.stderr.get(nm, math.inf)
+            if nm in self.at_bound:
+                spec = specs.get(nm)
+                unit = f" {spec.unit}" if spec is not None and spec.unit else ""
+                out[nm] = f"ended on its bound ({self.params[nm]:.4g}{unit})"
+            elif not math.isfinite(se):
+                out[nm] = "its standard error is infinite (the rows do not depend on it)"
+        return out
+
     def correlation_of(self, a: str, b: str) -> float:
         """Correlation coefficient of two fitted parameters."""
         i, j = self.fitted.index(a), self.fitted.index(b)

@@ -27,6 +27,7 @@ import numpy as np
 
 from camtube.design.geometry import pattern_geometry
 from camtube.design.pattern import Pattern
+from camtube.errors import DataError
 from camtube.model.dataset import Dataset
 from camtube.model.predict import POLYIMIDE_MODULUS_GPA, joint_stiffness_nmm_per_rad, stroke_only_angle_rad
 
@@ -49,6 +50,59 @@ def triangle_stroke(max_stroke_mm: float, speed_mm_s: float, rate_hz: float,
     stroke = np.tile(s1, n_cycles)
     cycle = np.repeat(np.arange(1, n_cycles + 1), m)
     return time, stroke, cycle
+
+
+#: Most rows one synthetic file may have (about 100 MB of CSV); more is a typing error, not a data set.
+MAX_ROWS = 2_000_000
+
+
+def rows_per_cycle(max_stroke_mm: float, speed_mm_s: float, rate_hz: float, dwell_s: float = 0.0) -> int:
+    """Rows of one triangle cycle (see :func:`triangle_stroke`), computed without allocating them."""
+    return max(int(round((2.0 * max_stroke_mm / speed_mm_s + dwell_s) * rate_hz)), 6)
+
+
+def check_arguments(n_samples: int, n_cycles: int, noise_angle_deg: float, noise_force_N: float, *,
+                    modulus_gpa: float | None, max_stroke_mm: float, speed_mm_s: float, rate_hz: float,
+                    slack_mm: float, stiffness_spread: float = 0.1, dwell_s: float = 0.0) -> None:
+    """Refuse generator settings that make no physical sense or an absurd file.
+
+    Raises
+    ------
+    DataError
+        Naming the setting (with its command-line option), the value and the allowed range.
+    """
+    def bad(name: str, value, allowed: str) -> DataError:
+        return DataError(f"{name} = {value!r}: allowed {allowed}")
+
+    checks = (
+        (n_samples >= 1, "samples (--samples)", n_samples, ">= 1"),
+        (n_cycles >= 1, "cycles (--cycles)", n_cycles, ">= 1"),
+        (math.isfinite(noise_angle_deg) and noise_angle_deg >= 0, "angle noise (--noise-angle)",
+         noise_angle_deg, ">= 0 deg (a standard deviation)"),
+        (math.isfinite(noise_force_N) and noise_force_N >= 0, "force noise (--noise-force)", noise_force_N,
+         ">= 0 N (a standard deviation)"),
+        (math.isfinite(speed_mm_s) and speed_mm_s > 0, "stroke speed (--speed)", speed_mm_s, "> 0 mm/s"),
+        (math.isfinite(rate_hz) and rate_hz > 0, "sampling rate (--rate)", rate_hz, "> 0 Hz"),
+        (math.isfinite(max_stroke_mm) and max_stroke_mm > 0, "peak stroke (rules.max_stroke)", max_stroke_mm,
+         "> 0 mm"),
+        (math.isfinite(slack_mm) and 0 <= slack_mm < max_stroke_mm, "slack (--slack)", slack_mm,
+         f"0 <= slack < the peak stroke {max_stroke_mm:g} mm"),
+        (modulus_gpa is None or (math.isfinite(modulus_gpa) and modulus_gpa > 0), "tendon modulus (--modulus)",
+         modulus_gpa, "> 0 GPa"),
+        (0 <= stiffness_spread < 1, "stiffness spread", stiffness_spread, "0 <= spread < 1"),
+    )
+    for ok, name, value, allowed in checks:
+        if not ok:
+            raise bad(name, value, allowed)
+    m = rows_per_cycle(max_stroke_mm, speed_mm_s, rate_hz, dwell_s)
+    rows = m * n_cycles * n_samples
+    if m < 12:
+        raise DataError(f"sampling rate (--rate) = {rate_hz!r}: only {m} rows per cycle "
+                        f"({2 * max_stroke_mm / speed_mm_s:g} s); allowed: at least 12 rows per cycle, "
+                        f"i.e. --rate >= {12 * speed_mm_s / (2 * max_stroke_mm):.3g} Hz at --speed {speed_mm_s:g}")
+    if rows > MAX_ROWS:
+        raise DataError(f"{n_samples} sample(s) x {n_cycles} cycles x {m} rows per cycle = {rows:,} rows: "
+                        f"allowed at most {MAX_ROWS:,}; fix: lower --rate, --cycles or --samples, or raise --speed")
 
 
 def noise_floor_deg(pattern: Pattern, noise_angle_deg: float = 0.25, noise_force_N: float = 0.005,
@@ -106,15 +160,16 @@ def synthesize(
     Dataset
         ``n_samples * n_cycles * m`` rows; ``extra`` is empty.
     """
-    if n_samples < 1 or n_cycles < 1:
-        raise ValueError("n_samples and n_cycles must be >= 1")
+    smax = pattern.rules.max_stroke_mm if max_stroke_mm is None else max_stroke_mm
+    check_arguments(n_samples, n_cycles, noise_angle_deg, noise_force_N, modulus_gpa=modulus_gpa,
+                    max_stroke_mm=smax, speed_mm_s=speed_mm_s, rate_hz=rate_hz, slack_mm=slack_mm,
+                    stiffness_spread=stiffness_spread)
     rng = np.random.default_rng(seed)
     g = pattern_geometry(pattern).first
     e_t = pattern.tendon.modulus_gpa if modulus_gpa is None else modulus_gpa
     c = pattern.tendon.length_mm / (e_t * 1e3 * pattern.tendon.area_mm2)
     k0 = (joint_stiffness_nmm_per_rad(pattern, POLYIMIDE_MODULUS_GPA)
           if stiffness_nmm_per_rad is None else stiffness_nmm_per_rad)
-    smax = pattern.rules.max_stroke_mm if max_stroke_mm is None else max_stroke_mm
     time, stroke, cycle = triangle_stroke(smax, speed_mm_s, rate_hz, n_cycles)
     arm = g.moment_arm_mm
     cols: dict[str, list[np.ndarray]] = {k: [] for k in ("sample", "cycle", "time", "stroke", "force", "angle")}
