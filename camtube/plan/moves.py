@@ -240,3 +240,15 @@ def estimate(job, moves: Moves | Iterable[Moves] | None = None) -> Estimate:
     if moves is None:
         return job.cached("_estimate", lambda: _estimate_of(job, iter_moves(job)))
     return _estimate_of(job, [moves] if isinstance(moves, Moves) else moves)
+
+
+def time_warning(job, est: Estimate) -> str | None:
+    """A warning when the estimated laser time exceeds ``job.process.max_time_h``, else None."""
+    from camtube.fmt import format_duration_s
+
+    limit_h = getattr(job.process, "max_time_h", None)
+    if limit_h is None or not est.total_s > limit_h * 3600.0:
+        return None
+    return (f"the estimated laser time {format_duration_s(est.total_s)} exceeds process.max_time_h = {limit_h:g} h "
+            f"({format_duration_s(limit_h * 3600.0)}) for {est.passes} passes of {est.cuts} cuts; split the job "
+            f"(fewer notches per file) or raise process.max_time_h")

@@ -157,12 +157,13 @@ def _nearest_vertex(points, p: tuple[float, float]) -> int:
     return d.index(min(d))
 
 
-def _chain_starts(design: Sequence[Contour], order: Sequence[int], start: tuple[float, float]
-                  ) -> tuple[dict[int, int], tuple[float, float]]:
+def _chain_starts(design: Sequence[Contour], order: Sequence[int], start: tuple[float, float],
+                  slit_returns: bool = False) -> tuple[dict[int, int], tuple[float, float]]:
     """Start vertex of each contour in ``order`` (nearest to where the previous one left the beam).
 
     A closed contour starts at its vertex nearest the previous end and ends there; an
-    open one (a slit) starts at its nearer end (index 0 or n - 1) and ends at the other.
+    open one (a slit) starts at its nearer end (index 0 or n - 1) and ends at the other
+    (or at the same end if ``slit_returns``: an even number of alternating passes).
     Returns the starts and the point where the last contour leaves the beam.
     """
     out: dict[int, int] = {}
@@ -176,7 +177,7 @@ def _chain_starts(design: Sequence[Contour], order: Sequence[int], start: tuple[
         else:
             last = len(pts) - 1
             k = 0 if _nearest_vertex((pts[0], pts[last]), p) == 0 else last
-            p = pts[last - k]
+            p = pts[k] if slit_returns else pts[last - k]
         out[i] = k
     return out, p
 
@@ -188,18 +189,20 @@ def _rotate(contour: Contour, k: int) -> Contour:
     return Contour(pts[k:] + pts[:k], contour.kind, contour.cut_index, contour.closed)
 
 
-def pass_path(design: Contour, offset_mm: float, start: int, drill_index: int = 0, index: int = -1) -> Contour:
+def pass_path(design: Contour, offset_mm: float, start: int, drill_index: int = 0, index: int = -1,
+              alternate: bool = False) -> Contour:
     """The path of one pass over ``design``: the planner's (and the job-file reader's) one rule.
 
     Closed contour: moved ``offset_mm`` inward (:func:`offset_contour`) and started at the
     vertex matching ``design.points[start]`` (the same vertex for a rectangle, else the
     nearest one). Open contour (a slit): the path itself, no offset, cut from the end
-    ``start`` (0 or n - 1) to the other on even drill passes and back on odd ones, so
-    consecutive passes need no long rapid.
+    ``start`` (0 or n - 1) to the other; with ``alternate`` (sequential ordering, where a
+    slit's passes follow each other) odd drill passes run back, so consecutive passes
+    need no long rapid.
     """
     if not design.closed:
         pts = design.points
-        if (start != 0) != (drill_index % 2 == 1):
+        if (start != 0) != (alternate and drill_index % 2 == 1):
             pts = pts[::-1]
         return Contour(tuple(pts), design.kind, design.cut_index, False)
     c = offset_contour(design, offset_mm, index)
@@ -308,7 +311,9 @@ def _plan(source, process, ordering, outer_radius_mm, length_mm, name, progress)
     n_total = len(design) * repeats * 2 * proc.drill_passes
     with progress.task("planning", total=n_total) as task:
         fwd = tour(design)
-        s0, end = _chain_starts(design, fwd, (0.0, 0.0))
+        # sequential: a slit's passes alternate direction; an even number of them ends where it began
+        returns = ordering == "sequential" and proc.drill_passes % 2 == 0
+        s0, end = _chain_starts(design, fwd, (0.0, 0.0), returns)
         starts = [s0]
         if ordering == "interleaved":
             # backward rounds start where forward rounds end and vice versa
@@ -381,7 +386,7 @@ def assemble(design: Sequence[Contour], order: Sequence[int], starts: np.ndarray
     other: dict[int, np.ndarray] = {}
     for r in np.flatnonzero(~is_rect[i_u]).tolist():
         t, i, d = int(t_u[r]), int(i_u[r]), int(d_u[r])
-        path = pass_path(design[i], float(offsets[d]), int(starts[t, i]), d, i)
+        path = pass_path(design[i], float(offsets[d]), int(starts[t, i]), d, i, ordering == "sequential")
         other[r] = np.asarray(path.points, dtype=float).reshape(-1, 2)
         sizes[r] = len(path.points)
     geom_offset = np.zeros(len(used) + 1, dtype=np.int64)
