@@ -183,10 +183,14 @@ class PassView(SequenceABC):
     when first needed). Nothing is kept per pass, so a job of 10^6 passes stays arrays.
     """
 
-    def __init__(self, packed: Packed, design: Sequence[Contour]) -> None:
+    def __init__(self, packed: Packed, design: Sequence[Contour], tour: np.ndarray | None = None,
+                 starts: np.ndarray | None = None) -> None:
         self.packed = packed
         self._design = design
         self._contours: dict[int, Contour] = {}
+        #: The planner's recipe (visiting order of the cuts, (n_dir, n_cut) start vertices): with
+        #: the process it regenerates every pass (:func:`camtube.plan.planner.assemble`).
+        self.tour, self.starts = tour, starts
 
     def __len__(self) -> int:
         return self.packed.n_pass

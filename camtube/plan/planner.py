@@ -323,8 +323,8 @@ def _plan(source, process, ordering, outer_radius_mm, length_mm, name, progress)
         start_arr = np.array([[st[i] for i in range(len(design))] for st in starts], dtype=np.int64)
         packed = assemble(design, fwd, start_arr, repeats, ordering, proc)
         task.advance(n_total - n_total // 4)
-    return Job(src.name, src.outer_radius_mm, src.length_mm, design, PassView(packed, design), proc, repeats,
-               ordering)
+    view = PassView(packed, design, np.asarray(fwd, dtype=np.int64), start_arr)
+    return Job(src.name, src.outer_radius_mm, src.length_mm, design, view, proc, repeats, ordering)
 
 
 def pass_sequence(order: Sequence[int], n_cut: int, repeats: int, n_drill: int, ordering: str):
