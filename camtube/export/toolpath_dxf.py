@@ -9,10 +9,10 @@ seam-crossing paths are unwrapped (``y`` may leave ``[0, 2 pi r_o]``, as the rot
 stage cuts them). The design regions and the tube surface are on construction
 layers (not plotted).
 
-Streaming: ezdxf builds the document without the passes (header, tables, the
-construction entities, with handles reserved for the passes), and
-:func:`iter_toolpath_dxf` writes each pass's LWPOLYLINE as DXF text into its
-ENTITIES section, chunk by chunk, exactly as ezdxf would (a test compares the
+Streaming: ezdxf builds the document without entities (header, tables, objects,
+with handles reserved for the entities), and :func:`iter_toolpath_dxf` writes
+each LWPOLYLINE (design regions, outline, passes) as DXF text into its ENTITIES
+section, chunk by chunk, exactly as ezdxf would (a test compares the
 bytes with :func:`toolpath_document` and reads the result with ezdxf's
 ``readfile`` + ``audit``).
 """
@@ -24,7 +24,7 @@ from typing import Iterator
 import numpy as np
 
 from camtube.design.contour import rectangle
-from camtube.export.dxf import add_contour, new_document, to_string
+from camtube.export.dxf import new_document, to_string
 from camtube.plan.moves import CHUNK_PASSES
 from camtube.plan.safety import check_job
 from camtube.progress import NO_PROGRESS, Progress
@@ -40,21 +40,23 @@ def layer_name(focus_level: int, drill_index: int) -> str:
 
 
 def _classes(job) -> list[tuple[int, int, float, float]]:
-    """(focus level, drill index, focus offset, inward offset) of each layer, sorted."""
+    """(focus level, drill index, focus offset, inward offset) of each layer, sorted.
+
+    A slit's passes (offset 0) share the layer of their class; its offset is the largest.
+    """
     pk = job.packed
     if pk.n_pass == 0:
         return []
-    key = np.stack([pk.pass_focus.astype(float), pk.pass_drill.astype(float), pk.pass_z, pk.pass_offset], 1)
-    rows = np.unique(key, axis=0)
-    out: dict[tuple[int, int], tuple[float, float]] = {}
-    for f, d, z, o in rows.tolist():  # a slit's passes (offset 0) share the layer of their class
-        k = (int(f), int(d))
-        out[k] = (z, max(o, out[k][1])) if k in out else (z, o)
-    return [(f, d, z, o) for (f, d), (z, o) in sorted(out.items())]
+    key = pk.pass_focus.astype(np.int64) * (int(pk.pass_drill.max()) + 1) + pk.pass_drill
+    uniq, first, inv = np.unique(key, return_index=True, return_inverse=True)
+    off = np.full(len(uniq), -np.inf)
+    np.maximum.at(off, inv, pk.pass_offset)
+    return [(int(pk.pass_focus[i]), int(pk.pass_drill[i]), float(pk.pass_z[i]), float(o))
+            for i, o in zip(first.tolist(), off.tolist())]
 
 
 def _skeleton(job, n_reserved: int):
-    """The document without the passes; ``n_reserved`` handles kept free for them. Returns (doc, first handle)."""
+    """The document without entities, ``n_reserved`` handles kept free for them. Returns (doc, first handle)."""
     doc = new_document()
     pr = job.process
     for k, (f, d, z, off) in enumerate(_classes(job)):
@@ -66,11 +68,6 @@ def _skeleton(job, n_reserved: int):
         layer = doc.layers.add(name, color=color)
         layer.description = desc
         layer.dxf.plot = 0
-    msp = doc.modelspace()
-    circ = 2.0 * math.pi * job.outer_radius_mm
-    for c in job.design:
-        _add(msp, c, "CONSTRUCTION-DESIGN")
-    add_contour(msp, rectangle(0.0, 0.0, job.length_mm, circ), "CONSTRUCTION-OUTLINE")  # last: read_contours' size
     handles = doc.entitydb.handles
     first = int(str(handles), 16)
     handles.reset("%X" % (first + n_reserved))
@@ -82,11 +79,18 @@ def _add(msp, contour, layer: str) -> None:
                        dxfattribs={"layer": layer})
 
 
+def _outline(job):
+    return rectangle(0.0, 0.0, job.length_mm, 2.0 * math.pi * job.outer_radius_mm)
+
+
 def toolpath_document(job):
     """ezdxf document of the job's passes (safety-checked first; small jobs: one entity object per pass)."""
     check_job(job)
     doc, first = _skeleton(job, 0)
     msp = doc.modelspace()
+    for c in job.design:
+        _add(msp, c, "CONSTRUCTION-DESIGN")
+    _add(msp, _outline(job), "CONSTRUCTION-OUTLINE")  # last construction entity: read_contours' size
     for p in job.passes:
         _add(msp, p.contour, layer_name(p.focus_level, p.drill_index))
     return doc
@@ -98,9 +102,8 @@ def iter_toolpath_dxf(job, progress: Progress = NO_PROGRESS) -> Iterator[str]:
     The whole neutral move list is safety-checked (chunk by chunk) before the first chunk.
     """
     check_job(job)
-    pk = job.packed
-    n = pk.n_pass
-    doc, first = _skeleton(job, n)
+    n_design = len(job.design)
+    doc, first = _skeleton(job, n_design + 1 + job.packed.n_pass)
     text = to_string(doc)
     owner = doc.modelspace().block_record_handle
     start = text.index("\n  2\nENTITIES\n")
@@ -108,37 +111,59 @@ def iter_toolpath_dxf(job, progress: Progress = NO_PROGRESS) -> Iterator[str]:
     head, tail = text[:cut], text[cut:]
     del text
     yield head
-    yield from _entities(job, first, owner, progress)
+    for lo in range(0, n_design, CHUNK_PASSES):
+        hi = min(n_design, lo + CHUNK_PASSES)
+        yield "".join([_polyline(first + i, owner, "CONSTRUCTION-DESIGN", job.design[i].points, job.design[i].closed)
+                       for i in range(lo, hi)])
+    yield _polyline(first + n_design, owner, "CONSTRUCTION-OUTLINE", _outline(job).points, True)
+    yield from _entities(job, first + n_design + 1, owner, progress)
     yield tail
 
 
+def _polyline(handle: int, owner: str, layer: str, points, closed: bool) -> str:
+    """One LWPOLYLINE as ezdxf writes it (R2013): handle, owner, layer, count, closed flag, vertices."""
+    return (f"  0\nLWPOLYLINE\n  5\n{handle:X}\n330\n{owner}\n100\nAcDbEntity\n  8\n{layer}\n100\nAcDbPolyline\n"
+            f" 90\n{len(points)}\n 70\n{1 if closed else 0}\n"
+            + "".join([" 10\n%r\n 20\n%r\n" % (float(x), float(y)) for x, y in points]))
+
+
 def _entities(job, first: int, owner: str, progress: Progress) -> Iterator[str]:
+    """LWPOLYLINE text of every pass, chunk by chunk.
+
+    An entity's text is its handle, a part that depends on its layer and vertex count,
+    and its vertices; the vertex text is formatted once per path and reused (up to
+    :data:`MEMO_MAX` paths), so a pass costs one string join.
+    """
     pk = job.packed
     n = pk.n_pass
-    head = ("  0\nLWPOLYLINE\n  5\n%X\n330\n" + owner + "\n100\nAcDbEntity\n  8\n%s\n100\nAcDbPolyline\n"
-            " 90\n%d\n 70\n%d\n")
+    lead = "  0\nLWPOLYLINE\n  5\n"
+    rest = "\n330\n" + owner + "\n100\nAcDbEntity\n  8\n%s\n100\nAcDbPolyline\n 90\n%d\n 70\n%d\n"
     memo: dict[int, str] = {}
+    heads: dict[tuple[int, int, int, bool], str] = {}
     off, closed, verts = pk.geom_offset, pk.geom_closed, pk.vertices
-    layers: dict[tuple[int, int], str] = {}
+    size = pk.geom_size
+
     with progress.task("toolpath DXF", total=n) as task:
         for lo in range(0, n, CHUNK_PASSES):
             hi = min(n, lo + CHUNK_PASSES)
-            parts = []
-            for k, (g, f, d) in enumerate(zip(pk.pass_geom[lo:hi].tolist(), pk.pass_focus[lo:hi].tolist(),
-                                               pk.pass_drill[lo:hi].tolist())):
-                body = memo.get(g)
-                if body is None:
+            geoms = pk.pass_geom[lo:hi]
+            keys = list(zip(pk.pass_focus[lo:hi].tolist(), pk.pass_drill[lo:hi].tolist(), size[geoms].tolist(),
+                            closed[geoms].tolist()))
+            for k in set(keys) - heads.keys():
+                heads[k] = rest % (layer_name(k[0], k[1]), k[2], 1 if k[3] else 0)
+            gl = geoms.tolist()
+            local = {}
+            for g in set(gl):
+                t = memo.get(g)
+                if t is None:
                     a, b = int(off[g]), int(off[g + 1])
-                    body = "".join(" 10\n%r\n 20\n%r\n" % (x, y) for x, y in verts[a:b].tolist())
+                    t = "".join([" 10\n%r\n 20\n%r\n" % (x, y) for x, y in verts[a:b].tolist()])
                     if len(memo) < MEMO_MAX:
-                        memo[g] = body
-                layer = layers.get((f, d))
-                if layer is None:
-                    layer = layers[(f, d)] = layer_name(f, d)
-                parts.append(head % (first + lo + k, layer, int(off[g + 1] - off[g]), 1 if closed[g] else 0))
-                parts.append(body)
+                        memo[g] = t
+                local[g] = t
+            yield "".join([lead + ("%X" % h) + heads[k] + local[g]
+                           for h, k, g in zip(range(first + lo, first + hi), keys, gl)])
             task.advance(hi - lo)
-            yield "".join(parts)
 
 
 def toolpath_dxf(job) -> str:
