@@ -1,14 +1,26 @@
-"""Benchmark of the plan stage: plan + safety check + LinuxCNC G-code for 1,000 and 10,000 notches.
+"""Benchmark of the plan stage: what `camtube toolpath` costs, in time and peak memory, at 10^4-10^5 notches.
 
-    python scripts/bench_plan.py
+    python scripts/bench_plan.py              # 1k/3k/10k in process, then the CLI at 10k and 100k notches
+    python scripts/bench_plan.py --quick      # the CLI at 10k notches only
 
-Prints the time of each step (best of 3), the total for 10k notches (target < 3 s)
-and the 10k/1k ratio (linear growth: ~10), then the presets' estimated-time /
-lower-bound ratios for both orderings (target <= 1.10 with the default).
+1. In process (best of N): plan, then the LinuxCNC G-code through ``iter_gcode``
+   (build, check, format chunk by chunk) into /dev/null; ms/notch and the 10k/1k ratio.
+2. What users run: ``python -m camtube toolpath tube1.yaml --set notch.count=N -o DIR -q``
+   in a subprocess (every output written), against "its G-code alone": a subprocess that
+   loads and plans the same pattern and writes only ``NAME.ngc`` with the same functions
+   the CLI calls. Peak memory is the child's peak resident set size
+   (``resource.getrusage(RUSAGE_CHILDREN).ru_maxrss`` of a runner process that waits for
+   exactly one child), which counts NumPy's buffers too. Targets: at 10k notches the CLI
+   within 2x its G-code alone and under 400 MB; at 100k under 1 GB.
+3. The presets' estimated-time / lower-bound ratios for both orderings.
 """
 from __future__ import annotations
 
+import argparse
+import json
+import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -17,52 +29,112 @@ sys.path.insert(0, str(ROOT / "scripts"))
 
 from benchutil import best_of  # noqa: E402
 
+PATTERN = ROOT / "patterns" / "tube1.yaml"
 
-def pattern_with(count: int):
-    from camtube.design.loader import load_pattern
+# runs one command as its only child; prints its wall time (s) and peak RSS (kB) as JSON
+RUNNER = """
+import json, resource, subprocess, sys, time
+t0 = time.perf_counter()
+r = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL)
+dt = time.perf_counter() - t0
+print(json.dumps({"s": dt, "kb": resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, "rc": r.returncode}))
+"""
 
+# the G-code alone, through the functions the CLI calls
+GCODE_ONLY = """
+import sys
+from camtube.design.loader import load_pattern
+from camtube.export.dialects import LINUXCNC
+from camtube.export.gcode import iter_gcode
+from camtube.plan import plan_job
+from camtube.plan.outputs import write_streams
+job = plan_job(load_pattern(sys.argv[1], sys.argv[3:]))
+write_streams({job.name + ".ngc": iter_gcode(job, LINUXCNC)}, sys.argv[2])
+"""
+
+
+def overrides(count: int) -> list[str]:
     # tube 1 geometry, `count` notches at 1 mm pitch on a long enough tube
-    return load_pattern(ROOT / "patterns" / "tube1.yaml",
-                        [f"notch.count={count}", f"tube.length={count * 1.0 + 3.0}"])
+    return [f"notch.count={count}", f"tube.length={count * 1.0 + 100.0}"]
 
 
-def run(count: int, repeat: int = 3) -> dict:
+def measure(cmd: list[str]) -> dict:
+    """Wall time (s) and peak RSS (MB) of ``cmd`` run as the only child of a fresh runner."""
+    env_cmd = [sys.executable, "-c", RUNNER] + cmd
+    out = subprocess.run(env_cmd, check=True, capture_output=True, text=True, cwd=ROOT,
+                         env=_env()).stdout.strip().splitlines()[-1]
+    r = json.loads(out)
+    if r["rc"] != 0:
+        raise SystemExit(f"command failed ({r['rc']}): {' '.join(cmd)}")
+    return {"s": r["s"], "MB": r["kb"] / 1024.0}
+
+
+def _env() -> dict:
+    import os
+
+    env = dict(os.environ)
+    env["PYTHONPATH"] = str(ROOT) + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+    return env
+
+
+def cli_vs_gcode(count: int) -> dict:
+    with tempfile.TemporaryDirectory(prefix="camtube-bench-") as tmp:
+        g = measure([sys.executable, "-c", GCODE_ONLY, str(PATTERN), f"{tmp}/g"] + overrides(count))
+        sets = [a for o in overrides(count) for a in ("--set", o)]
+        c = measure([sys.executable, "-m", "camtube", "toolpath", str(PATTERN), *sets, "-o", f"{tmp}/c", "-q"])
+        sizes = {p.name: p.stat().st_size for p in Path(tmp, "c").iterdir()}
+    return {"count": count, "gcode": g, "cli": c, "sizes": sizes}
+
+
+def in_process(count: int, repeat: int) -> dict:
+    from camtube.design.loader import load_pattern
     from camtube.export.dialects import LINUXCNC
-    from camtube.export.gcode import emit, machine_moves
-    from camtube.plan.packed import no_gc
+    from camtube.export.gcode import iter_gcode
     from camtube.plan import plan_job
-    from camtube.plan.safety import check_moves
 
-    pattern = pattern_with(count)
+    pattern = load_pattern(PATTERN, overrides(count))
     t_plan, job = best_of(lambda: plan_job(pattern), repeat)
-    t_moves, mm = best_of(lambda: machine_moves(job, LINUXCNC), repeat)
-    t_check, _ = best_of(lambda: check_moves(job, mm.unrolled()), repeat)
 
     def post():
-        with no_gc():  # as gcode() does
-            return emit(job, mm)
+        n = 0
+        for chunk in iter_gcode(plan_job(pattern), LINUXCNC):  # a fresh job: nothing cached
+            n += len(chunk)
+        return n
 
-    t_emit, text = best_of(post, repeat)
-    return {"count": count, "passes": len(job.passes), "moves": len(mm.neutral), "plan": t_plan,
-            "moves_s": t_moves, "check": t_check, "emit": t_emit, "MB": len(text) / 1e6,
-            "total": t_plan + t_moves + t_check + t_emit}
+    t_all, size = best_of(post, repeat)
+    return {"count": count, "passes": len(job.passes), "plan": t_plan, "gcode": t_all - t_plan, "MB": size / 1e6,
+            "total": t_all}
 
 
-def main() -> int:
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="the CLI at 10k notches only (skip 100k, ~2 min)")
+    args = ap.parse_args(argv)
     from camtube.design.loader import load_pattern
-    from camtube.plan import ORDERINGS, DEFAULT_ORDERING, estimate, plan_job
+    from camtube.plan import DEFAULT_ORDERING, ORDERINGS, estimate, plan_job
 
-    print("== plan stage: plan + move list + safety check + LinuxCNC G-code ==")
-    # small sizes are noisy on a shared machine: more repeats there (best of N)
-    rows = [run(1000, 9), run(3000, 5), run(10000, 3)]
+    print("== in process: plan + LinuxCNC G-code (iter_gcode: build, check, format per chunk), best of N ==")
+    rows = [in_process(1000, 7), in_process(3000, 3), in_process(10000, 3)]
     for r in rows:
-        print(f"{r['count']:>6} notches: {r['passes']:>7} passes, {r['moves']:>8} moves, plan {r['plan']:.3f} s, "
-              f"moves {r['moves_s']:.3f} s, check {r['check']:.3f} s, G-code {r['emit']:.3f} s "
+        print(f"{r['count']:>6} notches: {r['passes']:>7} passes, plan {r['plan']:.3f} s, G-code {r['gcode']:.3f} s "
               f"({r['MB']:.1f} MB); total {r['total']:.3f} s = {1e3 * r['total'] / r['count']:.3f} ms/notch")
-    rows = [rows[0], rows[-1]]
-    ratio = rows[1]["total"] / rows[0]["total"]
-    print(f"10k notches total {rows[1]['total']:.2f} s (target < 3 s): {'ok' if rows[1]['total'] < 3 else 'SLOW'}")
-    print(f"10k / 1k time ratio {ratio:.2f} (linear = 10)")
+    print(f"10k / 1k time ratio {rows[-1]['total'] / rows[0]['total']:.2f} (linear = 10)")
+
+    print("== what users run: `camtube toolpath` (all outputs written) vs its G-code alone, subprocesses ==")
+    targets = {10000: 400.0, 100000: 1024.0}
+    for count in (10000,) if args.quick else (10000, 100000):
+        r = cli_vs_gcode(count)
+        g, c = r["gcode"], r["cli"]
+        ratio = c["s"] / g["s"]
+        mb = targets[count]
+        total_mb = sum(r["sizes"].values()) / 1e6
+        print(f"{count:>6} notches: G-code alone {g['s']:.1f} s, peak {g['MB']:.0f} MB | camtube toolpath "
+              f"{c['s']:.1f} s, peak {c['MB']:.0f} MB, {total_mb:.0f} MB written "
+              f"(job file {r['sizes'].get('tube1.job.json', 0) / 1e6:.1f} MB)")
+        time_ok = "" if count != 10000 else f"  time ratio {ratio:.2f} (target < 2): {'ok' if ratio < 2 else 'SLOW'};"
+        print(f"{'':>15}{time_ok}  peak {c['MB']:.0f} / {mb:.0f} MB = {c['MB'] / mb:.2f} of the target: "
+              f"{'ok' if c['MB'] < mb else 'OVER'}")
+
     print("== estimated time / lower bound (target <= 1.10 with the default ordering) ==")
     for name in ("tube1", "tube2", "tube3", "tube1-bidirectional"):
         p = load_pattern(ROOT / "patterns" / f"{name}.yaml")

@@ -1,14 +1,20 @@
-"""Job file: valid JSON, schema camtube.job/1, every pass, deterministic bytes, fixed float format."""
+"""Job file camtube.job/2: valid JSON, one entry per cut, exact numbers, deterministic bytes, and a reader
+whose expansion equals the planner's passes."""
 from __future__ import annotations
 
 import json
-import math
 import re
 
+import numpy as np
 import pytest
 
+from camtube.design.contour import Contour, rectangle
 from camtube.design.loader import load_pattern
-from camtube.export.jobfile import SCHEMA, job_json
+from camtube.design.pattern import Process
+from camtube.errors import DataError
+from camtube.export.dialects import LINUXCNC
+from camtube.export.gcode import gcode
+from camtube.export.jobfile import SCHEMA, iter_job_json, job_json, read_job
 from camtube.plan import estimate, plan_job
 from tests.conftest import PATTERNS
 
@@ -20,29 +26,77 @@ def job():
 
 def test_schema_and_content(job):
     d = json.loads(job_json(job))
-    assert d["schema"] == SCHEMA == "camtube.job/1"
+    assert d["schema"] == SCHEMA == "camtube.job/2"
     assert list(d)[:3] == ["schema", "generator", "name"]
-    assert len(d["passes"]) == len(job.passes) == 576
-    assert len(d["design"]) == len(job.design)
+    assert "passes" not in d  # not every point of every pass: one entry per cut
+    assert len(d["cuts"]) == len(job.design) == 18
+    assert sorted(d["tour"]) == list(range(18))
     e = estimate(job)
     s = d["summary"]
     assert s["passes"] == 576 and s["cuts"] == 18
-    assert s["ratio"] == pytest.approx(e.ratio, abs=1e-6)
-    assert s["total_time_s"] == pytest.approx(s["cut_time_s"] + s["rapid_time_s"] + s["focus_time_s"], abs=3e-6)
-    for k, (pd, ps) in enumerate(zip(d["passes"], job.passes)):
-        assert pd["index"] == k and pd["cut_index"] == ps.cut_index and pd["drill_index"] == ps.drill_index
-        assert [v for q in pd["points"] for v in q] == pytest.approx(
-            [v for q in ps.contour.points for v in q], abs=1e-6)
-        # geometry and settings suffice to recompute the length
-        pts = pd["points"] + pd["points"][:1]
-        length = sum(math.dist(a, b) for a, b in zip(pts, pts[1:]))
-        assert length == pytest.approx(pd["length_mm"], abs=1e-5)
+    assert s["ratio"] == e.ratio and s["cut_length_mm"] == e.cut_length_mm  # exact round trip
+    assert s["total_time_s"] == pytest.approx(s["cut_time_s"] + s["rapid_time_s"] + s["focus_time_s"]
+                                              + s["lead_time_s"], rel=1e-12)
+    for i, (c, design) in enumerate(zip(d["cuts"], job.design)):
+        assert c["index"] == i and c["kind"] == design.kind and c["closed"] is True
+        assert [tuple(p) for p in c["points"]] == list(design.points)
+        assert len(c["start"]) == 2  # interleaved: one start vertex per tour direction
+    # classes: 2 focus levels x 4 drill cuts with the paper's offsets
+    assert [(k["focus_level"], k["drill_index"]) for k in d["classes"]] == [(f, i) for f in (0, 1) for i in range(4)]
+    assert [k["offset_mm"] for k in d["classes"][:4]] == pytest.approx([0.0, 0.005, 0.01, 0.015])
 
 
-def test_deterministic_and_fixed_float_format(job):
+@pytest.mark.parametrize("ordering", ["interleaved", "sequential"])
+@pytest.mark.parametrize("name", ["tube1-bidirectional", "tube3"])
+def test_reader_expands_to_the_planners_passes(tmp_path, name, ordering):
+    job = plan_job(load_pattern(PATTERNS / f"{name}.yaml"), ordering=ordering)
+    path = tmp_path / "j.job.json"
+    path.write_text(job_json(job))
+    back = read_job(path)
+    assert back.name == job.name and back.repeats == job.repeats and back.ordering == ordering
+    assert back.process == job.process and back.design == job.design
+    assert len(back.passes) == len(job.passes)
+    assert list(back.passes) == list(job.passes)  # geometry, provenance and settings, exactly
+    assert gcode(back, LINUXCNC) == gcode(job, LINUXCNC)
+
+
+def test_reader_expands_slits_and_general_polygons(tmp_path):
+    hexagon = Contour(tuple((2 + 0.4 * np.cos(a), 3 + 0.8 * np.sin(a))
+                            for a in np.linspace(0, 2 * np.pi, 6, endpoint=False)), "cut")
+    slit = Contour(((4.0, 1.0), (4.5, 1.2), (5.0, 1.2)), "cut", closed=False)
+    for ordering in ("interleaved", "sequential"):
+        job = plan_job([hexagon, slit, rectangle(6, 1, 6.5, 2.5)], Process(kerf_mm=0.01), ordering=ordering,
+                       outer_radius_mm=1.0, length_mm=8.0)
+        back = read_job(json.loads(job_json(job)))
+        assert list(back.passes) == list(job.passes)
+        assert json.loads(job_json(job))["cuts"][1]["closed"] is False
+
+
+def test_reader_refuses_other_schemas_and_contradictions(tmp_path, job):
+    d = json.loads(job_json(job))
+    with pytest.raises(DataError, match="schema 'camtube.job/1'"):
+        read_job(dict(d, schema="camtube.job/1"))
+    bad = json.loads(job_json(job))
+    bad["classes"][2]["offset_mm"] = 0.5
+    with pytest.raises(DataError, match="classes differ"):
+        read_job(bad)
+    bad = json.loads(job_json(job))
+    bad["tour"] = bad["tour"][:-1]
+    with pytest.raises(DataError, match="permutation"):
+        read_job(bad)
+    p = tmp_path / "x.json"
+    p.write_text("{not json")
+    with pytest.raises(DataError, match="not JSON"):
+        read_job(p)
+
+
+def test_deterministic_streamed_and_compact(job):
     a = job_json(job)
     b = job_json(plan_job(load_pattern(PATTERNS / "tube1-bidirectional.yaml")))
     assert a.encode() == b.encode()
-    numbers = re.findall(r"(?<![\w.])-?\d+\.\d+(?:[eE][-+]?\d+)?", re.sub(r'"[^"]*"', '""', a))
-    assert numbers and all(re.fullmatch(r"-?\d+\.\d{6}", n) for n in numbers)
-    assert "-0.000000" not in a
+    assert "".join(iter_job_json(job)) == a
+    assert "-0.0," not in a and "-0.0]" not in a
+    # one cut per line
+    assert len(re.findall(r'^  \{"index": ', a, flags=re.M)) == len(job.design)
+    # far smaller than one entry per pass with its points (schema 1 wrote ~150 bytes of points per pass)
+    assert len(a) < 60 * len(job.passes)

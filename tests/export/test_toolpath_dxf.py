@@ -45,3 +45,39 @@ def test_deterministic_and_readable_by_the_contour_reader(job):
     read = read_contours(ezdxf.read(io.StringIO(text)), merge_seam=False)
     assert len(read.contours) == len(job.passes)
     assert read.length_mm == pytest.approx(job.length_mm)
+
+
+def test_streamed_text_is_ezdxfs_own_and_audits_clean(job, tmp_path):
+    from camtube.export.dxf import to_string
+    from camtube.export.toolpath_dxf import iter_toolpath_dxf, toolpath_document
+
+    chunks = list(iter_toolpath_dxf(job))
+    assert len(chunks) >= 3
+    text = "".join(chunks)
+    assert text == to_string(toolpath_document(job))  # byte for byte what ezdxf writes for the same entities
+    path = tmp_path / "t.dxf"
+    path.write_text(text)
+    doc = ezdxf.readfile(path)
+    auditor = doc.audit()
+    assert not auditor.has_errors and not auditor.has_fixes, [str(e) for e in auditor.errors + auditor.fixes]
+    handles = [e.dxf.handle for e in doc.modelspace()]
+    assert len(handles) == len(set(handles)) == len(job.passes) + len(job.design) + 1
+    assert int(doc.header["$HANDSEED"], 16) > max(int(h, 16) for h in handles)
+
+
+def test_slits_are_open_polylines(tmp_path):
+    from camtube.design.contour import Contour, rectangle
+    from camtube.design.pattern import Process
+
+    slit = Contour(((2.0, 1.0), (3.0, 1.5), (4.0, 1.5)), "cut", closed=False)
+    job = plan_job([slit, rectangle(5, 1, 5.5, 2)], Process(), outer_radius_mm=1.0, length_mm=7.0)
+    path = tmp_path / "s.dxf"
+    path.write_text(toolpath_dxf(job))
+    doc = ezdxf.readfile(path)
+    assert not doc.audit().has_errors
+    polys = [e for e in doc.modelspace().query("LWPOLYLINE") if not e.dxf.layer.startswith("CONSTRUCTION")]
+    assert len(polys) == len(job.passes)
+    for e, p in zip(polys, job.passes):
+        assert e.closed == p.contour.closed
+        assert [tuple(q) for q in e.get_points("xy")] == pytest.approx(list(p.contour.points))
+    assert sum(not e.closed for e in polys) == len(job.passes) // 2
