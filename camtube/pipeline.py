@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Callable, Sequence
 
 from camtube.design.loader import Loaded
+from camtube.progress import NO_PROGRESS, Progress
 
 #: What each command writes.
 TOOLPATH, BUILD, CAD = "toolpath", "build", "cad"
@@ -83,37 +84,42 @@ class Result:
         return self.cad is None or self.cad.passed
 
 
-def plan(loaded: Loaded, ordering: str | None = None):
+def plan(loaded: Loaded, ordering: str | None = None, progress: Progress = NO_PROGRESS):
     """The planned job of a loaded pattern."""
     from camtube.plan import plan_job
 
     kwargs = {} if ordering is None else {"ordering": ordering}
-    return plan_job(loaded.pattern, **kwargs)
+    return plan_job(loaded.pattern, progress=progress, **kwargs)
 
 
-def outputs(loaded: Loaded, request: Request, progress: Callable[[int, int], None] | None = None):
-    """Compute every file of ``request`` in memory: ``(files: dict[name, payload], job, estimate, cad)``.
+def outputs(loaded: Loaded, request: Request, progress: Progress = NO_PROGRESS):
+    """Every file of ``request``: ``(files: dict[name, payload], job, estimate, cad)``.
+
+    Toolpath files are lazy streams of text chunks (safety-checked chunk by chunk as
+    they are written, so a job of 10^6 passes never sits in memory); the design DXF
+    and the CAD files are computed here.
 
     Raises
     ------
     SafetyError
-        The job fails the laser safety check (before anything is returned).
+        The job fails the laser safety check (when its stream is written; nothing is
+        published then).
     """
     pattern = loaded.pattern
-    job = plan(loaded, request.ordering)
+    job = plan(loaded, request.ordering, progress)
     files: dict = {}
     est = cad = None
     if request.what in (TOOLPATH, BUILD):
         from camtube.export.dialects import DIALECTS
         from camtube.plan.moves import estimate
-        from camtube.plan.outputs import toolpath_texts
+        from camtube.plan.outputs import toolpath_streams
 
         if request.what == BUILD:
             from camtube.export.dxf import design_dxf
 
             files[f"{job.name}.design.dxf"] = design_dxf(pattern)
         dialects = tuple(request.dialects) if request.dialects else tuple(DIALECTS.values())
-        files.update(toolpath_texts(job, dialects, progress))
+        files.update(toolpath_streams(job, dialects, progress))
         est = estimate(job)
     if request.what in (BUILD, CAD):
         from camtube.cad.outputs import cad_outputs
@@ -124,11 +130,21 @@ def outputs(loaded: Loaded, request: Request, progress: Callable[[int, int], Non
     return files, job, est, cad
 
 
-def run(loaded: Loaded, outdir: str | os.PathLike, request: Request,
-        progress: Callable[[int, int], None] | None = None) -> Result:
-    """Build the outputs of ``request`` for ``loaded`` and write them into ``outdir`` as one set."""
+def run(loaded: Loaded, outdir: str | os.PathLike, request: Request, progress: Progress = NO_PROGRESS,
+        warn: Callable[[str], None] | None = None) -> Result:
+    """Build the outputs of ``request`` for ``loaded`` and write them into ``outdir`` as one set.
+
+    ``warn`` (e.g. a print to stderr) hears the laser-time warning of the job, if any,
+    before the (possibly long) writing starts.
+    """
     from camtube.io import write_set
 
     files, job, est, cad = outputs(loaded, request, progress)
+    if warn is not None and est is not None:
+        from camtube.plan.moves import time_warning
+
+        w = time_warning(job, est)
+        if w:
+            warn(w)
     paths = write_set(Path(outdir), files)
     return Result(paths, job, est, cad)

@@ -8,9 +8,6 @@ import sys
 from camtube.cliutil import add_pattern_argument, load_from_args
 from camtube.errors import CamtubeError
 
-PROGRESS_MIN_PASSES = 20000
-
-
 def register(sub) -> None:
     from camtube.export.dialects import DIALECTS
     from camtube.plan.planner import DEFAULT_ORDERING, ORDERINGS
@@ -69,37 +66,6 @@ def cad_options(args: argparse.Namespace):
                       kerf_mm=args.kerf)
 
 
-def summary_table(job, est) -> str:
-    """Text table: cuts, passes, cut length, estimated time, lower bound, ratio."""
-    rows = [
-        ("job", job.name, ""),
-        ("ordering / repeats", f"{job.ordering} / {job.repeats}", ""),
-        ("cuts", f"{est.cuts}", ""),
-        ("passes", f"{est.passes}", ""),
-        ("cut length", f"{est.cut_length_mm:.3f}", "mm"),
-        ("estimated time", f"{est.total_s:.1f}", f"s (cut {est.cut_s:.1f}, rapid {est.rapid_s:.1f}, "
-                                                  f"focus {est.focus_s:.1f})"),
-        ("lower bound (length / speed)", f"{est.lower_bound_s:.1f}", "s"),
-        ("ratio", f"{est.ratio:.4f}", ""),
-    ]
-    w = max(len(r[0]) for r in rows)
-    return "\n".join(f"{a:<{w}}  {b} {c}".rstrip() for a, b, c in rows)
-
-
-def _progress(args):
-    if getattr(args, "quiet", False) or os.environ.get("CI") or not sys.stderr.isatty():
-        return None
-
-    def show(done: int, total: int) -> None:
-        n = 30 * done // total
-        sys.stderr.write(f"\rposting [{'#' * n}{'.' * (30 - n)}] {done}/{total} passes")
-        if done == total:
-            sys.stderr.write("\n")
-        sys.stderr.flush()
-
-    return show
-
-
 def check_output_dir(path: str) -> None:
     """Refuse an output directory that names an existing file."""
     if os.path.exists(path) and not os.path.isdir(path):
@@ -110,6 +76,8 @@ def check_output_dir(path: str) -> None:
 def _run(args, what: str) -> int:
     from camtube.export.dialects import DIALECTS
     from camtube.pipeline import Request, run
+    from camtube.plan.report import summary_table
+    from camtube.progress import make_progress
 
     check_output_dir(args.output)
     loaded = load_from_args(args)
@@ -117,7 +85,9 @@ def _run(args, what: str) -> int:
     cad = cad_options(args) if what != "toolpath" else None
     request = Request(what=what, dialects=dialects, ordering=getattr(args, "ordering", None),
                       **({"cad": cad} if cad is not None else {}))
-    result = run(loaded, args.output, request, _progress(args))
+    with make_progress(quiet=args.quiet) as progress:
+        result = run(loaded, args.output, request, progress,
+                     warn=None if args.quiet else (lambda w: print(f"warning: {w}", file=sys.stderr)))
     if result.estimate is not None:
         print(summary_table(result.job, result.estimate))
     for p in result.paths:
