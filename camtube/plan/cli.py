@@ -46,13 +46,15 @@ def _load(args):
     from camtube.plan.planner import plan_job
 
     if str(args.pattern).lower().endswith(".dxf"):
-        if args.overrides:
-            from camtube.errors import Issue, PatternError
+        from camtube.design.source import DrawingOptions, load_source
 
-            raise PatternError([Issue("--set", "applies to pattern YAML files, not to a DXF", args.overrides[0],
-                                      "", "drop --set; a DXF input is planned with the paper's process")])
-        return None, plan_job(args.pattern, ordering=args.ordering, outer_radius_mm=args.outer_radius,
-                              length_mm=args.length)
+        loaded = load_source(args.pattern, args.overrides,
+                             DrawingOptions(outer_radius_mm=args.outer_radius, length_mm=args.length))
+        if not getattr(args, "quiet", False):
+            print(loaded.summary, file=sys.stderr)
+            for w in loaded.warnings:
+                print(f"warning: {w}", file=sys.stderr)
+        return loaded.pattern, plan_job(loaded.pattern, ordering=args.ordering)
     loaded = load_from_args(args)
     return loaded.pattern, plan_job(loaded.pattern, ordering=args.ordering)
 
