@@ -442,19 +442,21 @@ def _close_and_chain(rd: _Reading) -> None:
         chains = sorted(em.find_all_simple_chains(deposit), key=lambda ch: min(e.payload for e in ch))
         consumed: set[int] = set()
         for chain in chains:
-            if len(chain) < 2 or not em.is_loop(chain, gap_tol=TOL.gap):
+            if len(chain) < 2:
                 continue
+            is_loop = em.is_loop(chain, gap_tol=TOL.gap)
             pts: list[tuple[float, float]] = []
             for e in chain:
                 seg = pieces[e.payload].points
                 seg = list(reversed(seg)) if e.is_reverse else list(seg)
                 pts.extend(seg if not pts else seg[1:])
-            if _isclose(pts[0], pts[-1], TOL.gap):
+            if is_loop and _isclose(pts[0], pts[-1], TOL.gap):
                 pts = pts[:-1]
             ents = [pieces[e.payload].entities[0] for e in chain]
-            loop = _Piece(_dedupe(pts), True, ents, layer, pieces[0].role)
-            rd.joined.append(loop)
-            rd.pieces.append(loop)
+            joined = _Piece(_dedupe(pts), is_loop, ents, layer, pieces[0].role)
+            if is_loop:
+                rd.joined.append(joined)
+            rd.pieces.append(joined)  # an open chain is one open path (refused or set aside as one)
             consumed.update(e.payload for e in chain)
         rd.pieces = [p for p in rd.pieces if not any(p is pieces[k] for k in consumed)]
 
@@ -483,6 +485,8 @@ def _rectangle(piece: _Piece) -> tuple[float, float, float, float] | None:
 def _find_outline(rd: _Reading, ro: float | None, length: float | None):
     """The tube outline piece (or None), and r_o and L (checked against it, or taken from it)."""
     cut_pieces = [p for p in rd.pieces if p.role != "ignore"]
+    if not cut_pieces:
+        return None, ro or 1.0, length or 1.0  # nothing to cut: refused as such by the caller
     best = None
     for p in rd.pieces:
         box = _rectangle(p)
@@ -492,8 +496,9 @@ def _find_outline(rd: _Reading, ro: float | None, length: float | None):
         others = [q for q in cut_pieces if q is not p]
         if not others:
             continue
-        inside = all(b[0] >= x0 - TOL.gap and b[2] <= x1 + TOL.gap and b[1] >= y0 - TOL.gap and b[3] <= y1 + TOL.gap
-                     for b in (q.bounds for q in others))
+        # every cut lies inside in x; in y a cut may cross the seam line drawn whole (its centre on the sheet)
+        inside = all(b[0] >= x0 - TOL.gap and b[2] <= x1 + TOL.gap and y0 - TOL.gap <= 0.5 * (b[1] + b[3]) <= y1
+                     + TOL.gap for b in (q.bounds for q in others))
         area = (x1 - x0) * (y1 - y0)
         if inside and (best is None or area < best[1] - TOL.gap):
             best = (p, area, box)
