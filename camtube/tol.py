@@ -23,11 +23,25 @@ class Tolerances:
     safety : float
         Allowance for a laser-on move to lie outside the cut region it belongs
         to (numerical slack for the safety check, not a process allowance).
+    chord : float
+        Drawing import: largest distance between a drawn curve (arc, circle,
+        ellipse, spline, polyline bulge) and the chords that replace it
+        (0.1 um; the cut equals the drawing within this).
+    gap : float
+        Drawing import: two path ends closer than this are joined (1 um); a
+        loop open by more is refused, naming the gap. Also the tolerance for
+        a piece to lie on the seam or the outline's edge.
+    outline : float
+        Drawing import: the tube outline's height may differ from 2 pi r_o by
+        this much (1 um) before the radius is called a mismatch.
     """
 
     merge: float = 1e-7
     zero: float = 1e-9
     safety: float = 1e-6
+    chord: float = 1e-4
+    gap: float = 1e-3
+    outline: float = 1e-3
 
 
 TOL = Tolerances()

@@ -157,9 +157,38 @@ def tube_mesh(outer_radius_mm: float, inner_radius_mm: float, length_mm: float,
     return to_trimesh(tube_manifold(outer_radius_mm, inner_radius_mm, length_mm, regions, segments))
 
 
-def design_regions(pattern: Pattern) -> Sequence[Contour]:
-    """The removed regions of the design: one unwrapped rectangle per cut."""
-    return cut_contours(pattern)
+#: Kerf assumed for a slit's removed region when ``process.kerf`` is 0 (mm), as in the kerf simulation.
+DEFAULT_SLIT_KERF_MM = 0.02
+
+
+def slit_kerf_mm(pattern: Pattern) -> float:
+    """Width (mm) of the material a slit removes: ``process.kerf``, or :data:`DEFAULT_SLIT_KERF_MM`."""
+    return pattern.process.kerf_mm or DEFAULT_SLIT_KERF_MM
+
+
+def design_regions(pattern: Pattern) -> Sequence:
+    """The removed regions of the design, one per cut, unwrapped.
+
+    A rectangle or drawn outline is its :class:`Contour`; a slit (an open path
+    the beam follows) removes the path buffered by half of :func:`slit_kerf_mm`
+    (round ends, as a round beam leaves), a shapely Polygon.
+    """
+    out: list = []
+    for con in cut_contours(pattern):
+        if con.closed:
+            out.append(con)
+        else:
+            from shapely.geometry import LineString
+
+            out.append(LineString(con.points).buffer(0.5 * slit_kerf_mm(pattern), quad_segs=4))
+    return out
+
+
+def region_area_mm2(region) -> float:
+    """Sheet area (mm^2) of a removed region (a Contour or a shapely polygon)."""
+    if isinstance(region, Contour):
+        return abs(region.area_mm2)
+    return float(region.area)
 
 
 def design_mesh(pattern: Pattern, segments: int | None = None):

@@ -7,7 +7,13 @@ whole wall: a rectangle ``width x (r_o - r_i + 2 margin)`` in the ``(x, r)``
 half-plane revolved about X. Its side walls are radial planes, as cut by a
 rotary-stage beam aimed at the axis. All cutters are subtracted in one
 boolean; identical cut shapes share one revolved solid, moved into place.
-Frame and angle origin: :mod:`camtube.cad.frame`.
+
+A drawn cut (any polygon in the unwrapped sheet; a slit as its kerf region)
+becomes an exact radial-walled prism: its outline's edges, straight lines in
+the cylinder's ``(angle, x)`` parameter plane, are laid on the cylinders
+``r_i - margin`` and ``r_o + margin`` (helices, circles or lines), the two
+faces bounded by them are the caps, and each pair of edges is joined by a
+ruled face whose rulings are radial. Frame and angle origin: :mod:`camtube.cad.frame`.
 """
 from __future__ import annotations
 
@@ -27,8 +33,80 @@ def _sector_tool(bd, width_mm: float, sweep_deg: float, r0: float, r1: float):
     return bd.Solid.revolve(face, sweep_deg, bd.Axis.X)
 
 
+def drawn_tool(points, outer_radius_mm: float, r0: float, r1: float):
+    """Exact radial-walled prism of a polygon of the unwrapped sheet, between radii ``r0 < r1``.
+
+    Parameters
+    ----------
+    points : (n, 2) float
+        Polygon vertices ``(x_mm, y_mm)`` (unwrapped; ``y = r_o * angle``), not repeated at the end.
+    outer_radius_mm : float
+        r_o (maps ``y`` to the angle).
+    r0, r1 : float
+        Radii of the inner and outer caps (mm).
+
+    Returns
+    -------
+    build123d.Solid
+    """
+    import build123d as bd
+    from OCP.BRepBuilderAPI import (BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeSolid,
+                                    BRepBuilderAPI_MakeWire, BRepBuilderAPI_Sewing)
+    from OCP.BRepFill import BRepFill
+    from OCP.BRepLib import BRepLib
+    from OCP.Geom import Geom_CylindricalSurface
+    from OCP.Geom2d import Geom2d_Line
+    from OCP.gp import gp_Ax3, gp_Dir, gp_Dir2d, gp_Pnt, gp_Pnt2d
+    from OCP.ShapeFix import ShapeFix_Solid
+    from OCP.TopAbs import TopAbs_SHELL
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    # cylinder parameters (u, v) = (angle from +Y towards +Z, x): the frame of camtube.cad.frame
+    axis = gp_Ax3(gp_Pnt(0.0, 0.0, 0.0), gp_Dir(1.0, 0.0, 0.0), gp_Dir(0.0, 1.0, 0.0))
+    uv: list[tuple[float, float]] = []
+    for x, y in points:
+        p = (float(y) / outer_radius_mm, float(x))
+        if not uv or math.hypot(p[0] - uv[-1][0], p[1] - uv[-1][1]) > 1e-12:
+            uv.append(p)
+    if math.hypot(uv[0][0] - uv[-1][0], uv[0][1] - uv[-1][1]) <= 1e-12:
+        uv.pop()
+    n = len(uv)
+    edges: dict[float, list] = {}
+    faces = []
+    for r in (r0, r1):
+        surface = Geom_CylindricalSurface(axis, r)
+        ring = []
+        for k in range(n):
+            (u1, v1), (u2, v2) = uv[k], uv[(k + 1) % n]
+            line = Geom2d_Line(gp_Pnt2d(u1, v1), gp_Dir2d(u2 - u1, v2 - v1))
+            edge = BRepBuilderAPI_MakeEdge(line, surface, 0.0, math.hypot(u2 - u1, v2 - v1)).Edge()
+            BRepLib.BuildCurves3d_s(edge)
+            ring.append(edge)
+        wire = BRepBuilderAPI_MakeWire()
+        for edge in ring:
+            wire.Add(edge)
+        faces.append(BRepBuilderAPI_MakeFace(surface, wire.Wire(), True).Face())
+        edges[r] = ring
+    faces += [BRepFill.Face_s(a, b) for a, b in zip(edges[r0], edges[r1])]  # ruled: radial rulings
+    sewing = BRepBuilderAPI_Sewing(1e-7)
+    for f in faces:
+        sewing.Add(f)
+    sewing.Perform()
+    shells = TopExp_Explorer(sewing.SewedShape(), TopAbs_SHELL)
+    if not shells.More():
+        raise RuntimeError("the drawn cut's faces do not close into a solid")
+    fix = ShapeFix_Solid(BRepBuilderAPI_MakeSolid(TopoDS.Shell(shells.Current())).Solid())
+    fix.Perform()
+    return bd.Solid(fix.Solid())
+
+
 def cut_tools(pattern: Pattern):
-    """One radial-walled annular-sector solid per cut of ``pattern`` (list of build123d Solids)."""
+    """One radial-walled solid per cut of ``pattern`` (list of build123d Solids).
+
+    Rectangles are revolved annular sectors; drawn outlines (and slits, as the
+    kerf region of :func:`camtube.cad.mesh.design_regions`) are :func:`drawn_tool` prisms.
+    """
     import build123d as bd
 
     t = pattern.tube
@@ -36,7 +114,17 @@ def cut_tools(pattern: Pattern):
     margin = 0.25 * (ro - ri)
     cache: dict[tuple[float, float], object] = {}
     tools = []
-    for c in pattern.cuts:
+    regions = None
+    for i, c in enumerate(pattern.cuts):
+        if c.is_drawn:
+            if regions is None:
+                from camtube.cad.mesh import design_regions
+
+                regions = design_regions(pattern)
+            reg = regions[i]
+            pts = reg.points if hasattr(reg, "points") else list(reg.exterior.coords)[:-1]
+            tools.append(drawn_tool(pts, ro, ri - margin, ro + margin))
+            continue
         sweep = math.degrees(c.arc_mm / ro)
         key = (c.width_mm, sweep)
         if key not in cache:

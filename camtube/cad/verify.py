@@ -3,10 +3,12 @@
 Checks (each pass/fail with measured value, expected value and tolerance):
 
 - ``design.stl.watertight``; ``design.stl.volume`` within 0.5 % of the
-  analytic volume ``pi (r_o^2 - r_i^2) L - sum_cuts (arc / r_o) / 2 (r_o^2 - r_i^2) width``;
+  analytic volume ``pi (r_o^2 - r_i^2) L - sum_cuts (arc / r_o) / 2 (r_o^2 - r_i^2) width``
+  (a drawn cut: its sheet area mapped radially, ``area / r_o (r_o^2 - r_i^2) / 2``);
 - ``design.step.volume`` (B-rep) within 0.2 % of the analytic volume, and
   ``design.step.reimport``: the STEP file read back has the same volume within 0.2 %;
-- per notch, from sections of the design mesh: ``notch[i].phi`` (backbone
+- per rectangular notch (drawn outlines are covered by the volume checks and
+  named in the report's note), from sections of the design mesh: ``notch[i].phi`` (backbone
   angle at ``x = x_c``) within 1 % of ``(2 pi r_o - s) / r_o``; ``notch[i].width``
   (empty ``x`` interval on the half-plane at the notch angle) within 1 % of h;
 - per cut, from the kerf simulation (:mod:`camtube.cad.ascut`):
@@ -83,10 +85,23 @@ class Report:
 
 
 def analytic_volume_mm3(pattern: Pattern) -> float:
-    """Volume (mm^3) of the tube minus radial-walled annular-sector cuts."""
+    """Volume (mm^3) of the tube minus radial-walled cuts.
+
+    A rectangle removes the annular sector ``(arc / r_o) / 2 (r_o^2 - r_i^2) width``;
+    a drawn outline (or a slit's kerf region) its sheet area mapped radially
+    (:func:`sheet_area_volume_mm3`), which is exact for radial walls.
+    """
+    from camtube.cad.mesh import design_regions, region_area_mm2
+
     t = pattern.tube
     ring = t.outer_radius_mm**2 - t.inner_radius_mm**2
-    cut = sum((c.arc_mm / t.outer_radius_mm) / 2.0 * ring * c.width_mm for c in pattern.cuts)
+    regions = design_regions(pattern) if any(c.is_drawn for c in pattern.cuts) else None
+    cut = 0.0
+    for i, c in enumerate(pattern.cuts):
+        if c.is_drawn:
+            cut += sheet_area_volume_mm3(region_area_mm2(regions[i]), t.outer_radius_mm, t.inner_radius_mm)
+        else:
+            cut += (c.arc_mm / t.outer_radius_mm) / 2.0 * ring * c.width_mm
     return math.pi * ring * t.length_mm - cut
 
 
@@ -125,7 +140,13 @@ def verify(pattern: Pattern, *, design_mesh=None, ascut=None, ascut_mesh=None, s
     checks: list[Check] = []
     summary: dict = {"analytic_volume_mm3": v_ana, "tube": asdict(t), "cuts": len(pattern.cuts),
                      "notches": len(pattern.notches)}
-    notch_idx = [i for i, c in enumerate(pattern.cuts) if c.kind == "notch"]
+    # sections at x_c measure a rectangle's phi and width; a drawn outline is checked by volume instead
+    notch_idx = [i for i, c in enumerate(pattern.cuts) if c.kind == "notch" and not c.is_drawn]
+    drawn = [i for i, c in enumerate(pattern.cuts) if c.is_drawn]
+    if drawn:
+        summary["not_rectangles"] = (f"{len(drawn)} drawn cut(s) ({', '.join(f'cut[{i}]' for i in drawn[:8])}"
+                                     f"{', ...' if len(drawn) > 8 else ''}) are not rectangles: their phi and width "
+                                     "are not measured from sections; the volume checks cover them")
 
     if design_mesh is not None:
         v = float(design_mesh.volume)
@@ -286,6 +307,8 @@ def report_text(report: Report) -> str:
     for label, key, unit in facts:
         if key in s:
             lines.append(f"  {label:<20} {_fmt(s[key])} {unit}")
+    if "not_rectangles" in s:
+        lines.append(f"  note: {s['not_rectangles']}")
     if "kerf_from_process" in s and not s["kerf_from_process"]:
         lines.append("  (process.kerf is 0: the simulation assumes this beam kerf; the job overcuts by half of it)")
     lines.append("")

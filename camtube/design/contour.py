@@ -80,7 +80,13 @@ def rectangle(x0: float, y0: float, x1: float, y1: float, kind: str = "cut", cut
 
 
 def cut_contour(cut: Cut, outer_radius_mm: float, cut_index: int = -1) -> Contour:
-    """Unwrapped contour of one cut (``y`` may leave ``[0, 2 pi r_o)``)."""
+    """Unwrapped contour of one cut (``y`` may leave ``[0, 2 pi r_o)``).
+
+    A drawn cut gives its outline (an open path, ``closed=False``, for a slit);
+    any other cut its rectangle.
+    """
+    if cut.outline is not None:
+        return Contour(cut.outline, cut.kind, cut_index, cut.kind != "slit")
     y0, y1 = cut.y_range_mm(outer_radius_mm)
     return rectangle(cut.x_start_mm, y0, cut.x_end_mm, y1, cut.kind, cut_index)
 
@@ -91,17 +97,26 @@ def cut_contours(pattern: Pattern) -> tuple[Contour, ...]:
     return tuple(cut_contour(c, ro, i) for i, c in enumerate(pattern.cuts))
 
 
+def _is_rectangle(contour: Contour) -> bool:
+    if len(contour.points) != 4 or not contour.closed:
+        return False
+    x0, y0, x1, y1 = contour.bounds
+    return all((abs(x - x0) <= TOL.zero or abs(x - x1) <= TOL.zero) and (abs(y - y0) <= TOL.zero or abs(y - y1) <= TOL.zero)
+               for x, y in contour.points)
+
+
 def split_at_seam(contour: Contour, circumference_mm: float) -> tuple[Contour, ...]:
-    """Pieces of an axis-aligned rectangular contour inside ``0 <= y <= C``.
+    """Pieces of a contour inside ``0 <= y <= C``.
 
     A rectangle that crosses ``y = 0`` (or ``y = C``) becomes two closed
     rectangles, one ending on ``y = C`` and one starting on ``y = 0``. A
     rectangle inside the sheet is returned unchanged (shifted by a multiple of
-    C if needed).
+    C if needed). Any other polygon (or open path) is cut by the seam lines
+    with shapely, each piece shifted onto the sheet.
     """
+    if not _is_rectangle(contour):
+        return _split_general(contour, circumference_mm)
     x0, y0, x1, y1 = contour.bounds
-    if len(contour.points) != 4:
-        raise ValueError("split_at_seam handles rectangles only")
     c = circumference_mm
     shift = math.floor(y0 / c) * c
     y0, y1 = y0 - shift, y1 - shift
@@ -113,6 +128,27 @@ def split_at_seam(contour: Contour, circumference_mm: float) -> tuple[Contour, .
         rectangle(x0, y0, x1, c, contour.kind, contour.cut_index),
         rectangle(x0, 0.0, x1, y1 - c, contour.kind, contour.cut_index),
     )
+
+
+def _split_general(contour: Contour, c: float) -> tuple[Contour, ...]:
+    import shapely
+    from shapely.geometry import LineString, Polygon, box
+    from shapely.geometry.polygon import orient
+
+    x0, y0, x1, y1 = contour.bounds
+    geom = Polygon(contour.points) if contour.closed else LineString(contour.points)
+    out: list[Contour] = []
+    for k in range(math.floor(y0 / c), math.floor(y1 / c) + 1):
+        piece = shapely.intersection(geom, box(x0 - 1.0, k * c, x1 + 1.0, (k + 1) * c))
+        piece = shapely.affinity.translate(piece, 0.0, -k * c)
+        for g in getattr(piece, "geoms", [piece]):
+            if contour.closed and g.geom_type == "Polygon" and g.area > TOL.zero:
+                ring = list(orient(g, 1.0).exterior.coords)[:-1]
+                out.append(Contour(tuple((float(x), float(y)) for x, y in ring), contour.kind, contour.cut_index))
+            elif not contour.closed and g.geom_type == "LineString" and g.length > TOL.zero:
+                out.append(Contour(tuple((float(x), float(y)) for x, y in g.coords), contour.kind,
+                                   contour.cut_index, False))
+    return tuple(out)
 
 
 def sheet_contours(pattern: Pattern) -> tuple[Contour, ...]:
@@ -127,6 +163,88 @@ def sheet_contours(pattern: Pattern) -> tuple[Contour, ...]:
 def outline(pattern: Pattern) -> Contour:
     """The unrolled tube surface [0, L] x [0, 2 pi r_o] (construction, never cut)."""
     return rectangle(0.0, 0.0, pattern.tube.length_mm, pattern.tube.circumference_mm, "outline")
+
+
+def merge_seam_polygons(contours, circumference_mm: float, tol_mm: float) -> list[tuple[Contour, tuple[int, ...]]]:
+    """Join seam-split pieces of any shape back into unwrapped contours.
+
+    A closed piece touching ``y = C`` and one of the same kind touching
+    ``y = 0`` are one cut when, moved up by C, the second shares an edge of
+    positive length with the first (both within ``tol_mm`` of the seam). Open
+    paths (slits) are joined when one ends on ``y = C`` where the other starts
+    (or ends) on ``y = 0``. Chains of pieces (a cut spanning more than a turn)
+    are not joined.
+
+    Returns
+    -------
+    list of (Contour, tuple[int, ...])
+        Each joined or untouched contour and the indices of the input pieces it is made of.
+    """
+    import shapely
+    from shapely.geometry import LineString, Polygon
+    from shapely.geometry.polygon import orient
+
+    c = circumference_mm
+    items = list(contours)
+    used = [False] * len(items)
+    out: list[tuple[Contour, tuple[int, ...]]] = []
+
+    def on_line(con: Contour, y: float) -> list[tuple[float, float]]:
+        pts = con.points
+        n = len(pts)
+        segs = []
+        for k in range(n if con.closed else n - 1):
+            (xa, ya), (xb, yb) = pts[k], pts[(k + 1) % n]
+            if abs(ya - y) <= tol_mm and abs(yb - y) <= tol_mm and abs(xa - xb) > tol_mm:
+                segs.append((min(xa, xb), max(xa, xb)))
+        return segs
+
+    for i, a in enumerate(items):
+        if used[i]:
+            continue
+        ax0, ay0, ax1, ay1 = a.bounds
+        joined = None
+        if abs(ay1 - c) <= tol_mm and ay0 > tol_mm:
+            top = on_line(a, c) if a.closed else []
+            for j, b in enumerate(items):
+                if used[j] or j == i or b.kind != a.kind or b.closed != a.closed:
+                    continue
+                bx0, by0, bx1, by1 = b.bounds
+                if abs(by0) > tol_mm or by1 >= c - tol_mm:
+                    continue
+                if a.closed:
+                    bottom = on_line(b, 0.0)
+                    if not any(min(p1, q1) - max(p0, q0) > tol_mm for p0, p1 in top for q0, q1 in bottom):
+                        continue
+                    up = Polygon([(x, y + c) for x, y in b.points])
+                    snapped = shapely.snap(up, Polygon(a.points), tol_mm)
+                    u = shapely.union(Polygon(a.points), snapped).buffer(0)
+                    if u.geom_type != "Polygon" or u.interiors:
+                        continue
+                    u = shapely.simplify(u, tol_mm * 1e-3)
+                    ring = list(orient(u, 1.0).exterior.coords)[:-1]
+                    joined = Contour(tuple((float(x), float(y)) for x, y in ring), a.kind, a.cut_index)
+                else:
+                    pa, pb = a.points, [(x, y + c) for x, y in b.points]
+                    ends_a = [pa[-1], pa[0]]
+                    for ea in ends_a:
+                        for eb in (pb[0], pb[-1]):
+                            if abs(ea[0] - eb[0]) <= tol_mm and abs(ea[1] - eb[1]) <= tol_mm and abs(ea[1] - c) <= tol_mm:
+                                la = list(pa) if ea == pa[-1] else list(reversed(pa))
+                                lb = list(pb) if eb == pb[0] else list(reversed(pb))
+                                joined = Contour(tuple(la + lb[1:]), a.kind, a.cut_index, False)
+                                break
+                        if joined:
+                            break
+                    if joined is None:
+                        continue
+                used[i] = used[j] = True
+                out.append((joined, (i, j)))
+                break
+        if not used[i]:
+            used[i] = True
+            out.append((a, (i,)))
+    return out
 
 
 def merge_seam_pieces(contours, circumference_mm: float) -> list[Contour]:

@@ -34,12 +34,17 @@ class Loaded:
     warnings : list[Issue]
         Design warnings (closure angle, strain).
     origins : tuple[str, ...]
-        YAML key each cut came from, parallel to ``pattern.cuts``.
+        YAML key each cut came from, parallel to ``pattern.cuts`` (for a
+        drawing: the entity, e.g. ``LWPOLYLINE #2A on layer NOTCHES``).
+    summary : str
+        One line saying what was read (a drawing: what was imported from how
+        many entities); empty for a YAML pattern.
     """
 
     pattern: Pattern
     warnings: tuple[Issue, ...]
     origins: tuple[str, ...]
+    summary: str = ""
 
 
 def _line_map(text: str) -> dict[str, int]:
@@ -258,6 +263,37 @@ def read_yaml(path: str | os.PathLike) -> tuple[dict, dict[str, int], str]:
     return raw, _line_map(text), file
 
 
+def _process(proc: dict) -> Process:
+    return Process(
+        power_w=proc["power_w"], frequency_khz=proc["frequency_khz"], scan_speed_mm_s=proc["scan_speed_mm_s"],
+        wavelength_nm=proc["wavelength_nm"], drill_offset_mm=proc["drill_offset"],
+        drill_passes=proc["drill_passes"], defocus_mm=proc["defocus"],
+        repeats=None if proc["repeats"] == "auto" else proc["repeats"],  # the schema default is the word
+        repeat_rule=tuple(sorted((RepeatRule(x["max_depth"], x["repeats"]) for x in proc["repeat_rule"]),
+                                 key=lambda q: q.max_depth_mm)),
+        kerf_mm=proc["kerf"], rapid_speed_mm_s=proc["rapid_speed_mm_s"], focus_speed_mm_s=proc["focus_speed_mm_s"],
+        max_time_h=proc["max_time_h"],
+    )
+
+
+def build_settings(raw: dict, file: str | None = None) -> tuple[Tube, Process, Tendon, Rules]:
+    """The tube, process, tendon and rules sections of raw pattern data, validated.
+
+    Used for inputs whose cuts come from elsewhere (a drawing). Raises
+    :class:`~camtube.errors.PatternError` listing every problem.
+    """
+    r = _Reader(file, {})
+    tube = _section(r, raw, "tube")
+    tendon = _section(r, raw, "tendon")
+    proc = _section(r, raw, "process")
+    rl = _section(r, raw, "rules")
+    if r.issues:
+        raise PatternError(r.issues)
+    return (Tube(tube["outer_radius"], tube["inner_radius"], tube["length"], tube["material"]), _process(proc),
+            Tendon(tendon["radius"], tendon["length"], tendon["modulus_gpa"], tendon["material"]),
+            Rules(rl["min_backbone_arc"], rl["min_web"], rl["max_strain"], rl["max_stroke"]))
+
+
 def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = None, name: str | None = None) -> Loaded:
     """Validate raw YAML data and build a checked :class:`Pattern`.
 
@@ -299,15 +335,7 @@ def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = Non
     cuts = sort_cuts(cuts)
     origins = [origins[k] for k in order]
 
-    process = Process(
-        power_w=proc["power_w"], frequency_khz=proc["frequency_khz"], scan_speed_mm_s=proc["scan_speed_mm_s"],
-        wavelength_nm=proc["wavelength_nm"], drill_offset_mm=proc["drill_offset"],
-        drill_passes=proc["drill_passes"], defocus_mm=proc["defocus"], repeats=proc["repeats"],
-        repeat_rule=tuple(sorted((RepeatRule(x["max_depth"], x["repeats"]) for x in proc["repeat_rule"]),
-                                 key=lambda q: q.max_depth_mm)),
-        kerf_mm=proc["kerf"], rapid_speed_mm_s=proc["rapid_speed_mm_s"], focus_speed_mm_s=proc["focus_speed_mm_s"],
-        max_time_h=proc["max_time_h"],
-    )
+    process = _process(proc)
     pattern = Pattern(
         name=raw.get("name") or name or "pattern",
         tube=Tube(tube["outer_radius"], tube["inner_radius"], tube["length"], tube["material"]),

@@ -10,6 +10,11 @@ A cut is described by its centre ``(x_mm, angle_deg)`` and its extent on the
 outer surface (axial ``width_mm``, circumferential ``arc_mm``). Notches and
 square tendon holes share this description; they differ in kind and in which
 rules apply to them.
+
+A cut read from a drawing may carry its drawn ``outline`` (any polygon, or an
+open path for a *slit*, in the unwrapped frame); its centre and extents are then
+the outline's bounding values, so every rule and measure written for rectangles
+still sees the right size and place.
 """
 from __future__ import annotations
 
@@ -17,7 +22,7 @@ import math
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
-CutKind = Literal["notch", "hole"]
+CutKind = Literal["notch", "hole", "slit"]
 
 
 @dataclass(frozen=True)
@@ -51,11 +56,12 @@ class Tube:
 
 @dataclass(frozen=True)
 class Cut:
-    """A rectangular cut in the unrolled frame (notch or square hole).
+    """A cut in the unrolled frame: a rectangle (notch or square hole), or a drawn outline.
 
     Attributes
     ----------
-    kind : {"notch", "hole"}
+    kind : {"notch", "hole", "slit"}
+        ``slit``: an open path the beam follows (only from a drawing; needs ``outline``).
     x_mm : float
         Axial position of the cut's centre from the tip.
     width_mm : float
@@ -64,6 +70,11 @@ class Cut:
         Circumferential extent on the outer surface (notch arc s; hole side).
     angle_deg : float
         Rotary angle of the cut's centre, in [0, 360).
+    outline : tuple[tuple[float, float], ...] | None
+        Drawn shape, ``(n, 2)`` vertices ``(x_mm, y_mm)`` in the unwrapped frame:
+        a closed polygon (counter-clockwise, last point not repeated) for a notch
+        or hole, the open path from first to last point for a slit. Its bounding
+        box is ``[x_start, x_end] x y_range_mm(r_o)``. ``None``: the rectangle.
     """
 
     kind: CutKind
@@ -71,6 +82,12 @@ class Cut:
     width_mm: float
     arc_mm: float
     angle_deg: float
+    outline: tuple[tuple[float, float], ...] | None = None
+
+    @property
+    def is_drawn(self) -> bool:
+        """True when the cut has a drawn outline (not the plain rectangle)."""
+        return self.outline is not None
 
     @property
     def x_start_mm(self) -> float:
@@ -89,6 +106,31 @@ class Cut:
         """Unwrapped ``(y0, y1)``; may extend below 0 or above 2 pi r_o (seam)."""
         yc = self.y_center_mm(outer_radius_mm)
         return yc - self.arc_mm / 2.0, yc + self.arc_mm / 2.0
+
+
+def drawn(kind: CutKind, points, outer_radius_mm: float) -> Cut:
+    """A cut with a drawn outline; centre and extents are the outline's bounding values.
+
+    Parameters
+    ----------
+    kind : {"notch", "hole", "slit"}
+    points : (n, 2) float
+        Unwrapped ``(x_mm, y_mm)`` vertices (see :class:`Cut`). They are shifted
+        by a whole turn, if needed, so the centre lies in ``[0, 2 pi r_o)``.
+    outer_radius_mm : float
+        r_o (maps ``y`` to the angle).
+    """
+    pts = [(float(x), float(y)) for x, y in points]
+    xs = [p[0] for p in pts]
+    ys = [p[1] for p in pts]
+    circ = 2.0 * math.pi * outer_radius_mm
+    yc = 0.5 * (min(ys) + max(ys))
+    shift = math.floor(yc / circ) * circ
+    if shift:
+        pts = [(x, y - shift) for x, y in pts]
+        yc -= shift
+    angle = math.degrees(yc / outer_radius_mm) % 360.0
+    return Cut(kind, 0.5 * (min(xs) + max(xs)), max(xs) - min(xs), max(ys) - min(ys), angle, tuple(pts))
 
 
 def notch(x_mm: float, width_mm: float, arc_mm: float, angle_deg: float) -> Cut:
@@ -212,6 +254,10 @@ class Pattern:
     @property
     def holes(self) -> tuple[Cut, ...]:
         return tuple(c for c in self.cuts if c.kind == "hole")
+
+    @property
+    def slits(self) -> tuple[Cut, ...]:
+        return tuple(c for c in self.cuts if c.kind == "slit")
 
     def with_cuts(self, cuts) -> "Pattern":
         return replace(self, cuts=tuple(sorted(cuts, key=_cut_key)))

@@ -11,6 +11,7 @@ differs, later cycles repeat): ``camtube design`` says so in a note
 from __future__ import annotations
 
 import math
+import re
 from typing import Sequence
 
 from camtube.design.geometry import DirectionBend, bends_at_stroke, joint_geometry
@@ -27,12 +28,42 @@ def _circular_gap(a0: float, a1: float, b0: float, b1: float, c: float) -> float
     return best
 
 
+_YAML_ORIGIN = re.compile(r"^(notch|cuts\[\d+\]|holes\[\d+\])$")
+
+
+def _is_key(origin: str) -> bool:
+    """True for a YAML origin (``notch``, ``cuts[2]``, ``holes[0]``, a bare kind); False for a drawn entity."""
+    return bool(_YAML_ORIGIN.match(origin)) or origin in ("hole", "slit")
+
+
+def _shape(cut: Cut, outer_radius_mm: float):
+    """The cut's region on the unwrapped sheet as a shapely geometry (polygon, or line for a slit)."""
+    from shapely.geometry import LineString, Polygon, box
+
+    if cut.outline is None:
+        y0, y1 = cut.y_range_mm(outer_radius_mm)
+        return box(cut.x_start_mm, y0, cut.x_end_mm, y1)
+    return LineString(cut.outline) if cut.kind == "slit" else Polygon(cut.outline)
+
+
+def _shifted_pairs(a: Cut, b: Cut, outer_radius_mm: float):
+    import shapely
+
+    c = 2.0 * math.pi * outer_radius_mm
+    ga, gb = _shape(a, outer_radius_mm), _shape(b, outer_radius_mm)
+    for k in (-1.0, 0.0, 1.0):
+        yield ga, shapely.affinity.translate(gb, 0.0, k * c)
+
+
 def cut_distance_mm(a: Cut, b: Cut, outer_radius_mm: float) -> float:
     """Shortest distance between two cuts on the unrolled surface (0 if they touch or overlap).
 
     Negative-overlap is not measured: overlapping cuts report 0 and
-    :func:`cuts_overlap` tells them apart from touching ones.
+    :func:`cuts_overlap` tells them apart from touching ones. Drawn cuts are
+    measured on their outlines (shapely), the sheet wrapping at the seam.
     """
+    if a.outline is not None or b.outline is not None:
+        return min(float(ga.distance(gb)) for ga, gb in _shifted_pairs(a, b, outer_radius_mm))
     c = 2.0 * math.pi * outer_radius_mm
     dx = max(0.0, b.x_start_mm - a.x_end_mm, a.x_start_mm - b.x_end_mm)
     ay, by = a.y_range_mm(outer_radius_mm), b.y_range_mm(outer_radius_mm)
@@ -41,7 +72,15 @@ def cut_distance_mm(a: Cut, b: Cut, outer_radius_mm: float) -> float:
 
 
 def cuts_overlap(a: Cut, b: Cut, outer_radius_mm: float, tol: float = 1e-9) -> bool:
-    """True if the two cut regions share area (not only an edge)."""
+    """True if the two cut regions share area (not only an edge); a slit overlaps what it crosses."""
+    if a.outline is not None or b.outline is not None:
+        for ga, gb in _shifted_pairs(a, b, outer_radius_mm):
+            if "slit" in (a.kind, b.kind):
+                if ga.intersects(gb) and ga.distance(gb) <= tol:
+                    return True
+            elif ga.intersection(gb).area > tol * max(1.0, ga.length):
+                return True
+        return False
     c = 2.0 * math.pi * outer_radius_mm
     ox = min(a.x_end_mm, b.x_end_mm) - max(a.x_start_mm, b.x_start_mm)
     if ox <= tol:
@@ -55,7 +94,12 @@ def cuts_overlap(a: Cut, b: Cut, outer_radius_mm: float, tol: float = 1e-9) -> b
 
 
 def _pair_key(origin_a: str, origin_b: str, a: Cut, b: Cut) -> str:
-    """The YAML key to blame for a clash: the hole, else a hand-placed cut, else the notch spacing."""
+    """The YAML key to blame for a clash: the hole, else a hand-placed cut, else the notch spacing.
+
+    Drawn cuts: both entities.
+    """
+    if not _is_key(origin_a):
+        return f"{origin_b} and {origin_a}"
     for o, c in ((origin_b, b), (origin_a, a)):
         if c.kind == "hole":
             return o
@@ -67,6 +111,46 @@ def _pair_key(origin_a: str, origin_b: str, a: Cut, b: Cut) -> str:
 
 def _describe(cut: Cut) -> str:
     return f"{cut.kind} at x={cut.x_mm:.4g} mm, angle {cut.angle_deg:.4g} deg"
+
+
+def _same(a: Cut, b: Cut, outer_radius_mm: float, tol: float = 1e-6) -> bool:
+    """True if two cuts are the same cut (a copy drawn or listed twice)."""
+    if a.kind != b.kind or abs(a.x_mm - b.x_mm) > tol or abs(a.width_mm - b.width_mm) > tol \
+            or abs(a.arc_mm - b.arc_mm) > tol:
+        return False
+    c = 2.0 * math.pi * outer_radius_mm
+    dy = (a.y_center_mm(outer_radius_mm) - b.y_center_mm(outer_radius_mm)) % c
+    if min(dy, c - dy) > tol:
+        return False
+    if a.outline is None and b.outline is None:
+        return True
+    ga, gb = _shape(a, outer_radius_mm), _shape(b, outer_radius_mm)
+    return float(ga.hausdorff_distance(gb)) <= max(tol, 2e-4)
+
+
+def section_arc_mm(cut: Cut) -> float:
+    """Largest circumferential extent (mm) of the cut in any section ``x = const``.
+
+    For a rectangle this is ``arc_mm``; for a drawn outline the span of its
+    intersection with the lines ``x = const`` through its vertices (where the
+    span is largest for a polygon), so a slanted or rounded notch is judged
+    by its widest section, not its bounding box.
+    """
+    if cut.outline is None or cut.kind == "slit":
+        return cut.arc_mm
+    from shapely.geometry import LineString, Polygon
+
+    poly = Polygon(cut.outline)
+    y0, y1 = min(p[1] for p in cut.outline) - 1.0, max(p[1] for p in cut.outline) + 1.0
+    xs = sorted({p[0] for p in cut.outline})
+    probes = [x + d for x in xs for d in (-1e-9, 1e-9)] + [0.5 * (a + b) for a, b in zip(xs, xs[1:])]
+    best = 0.0
+    for x in probes:
+        sec = poly.intersection(LineString([(x, y0), (x, y1)]))
+        if not sec.is_empty:
+            b = sec.bounds
+            best = max(best, b[3] - b[1])
+    return best
 
 
 def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | None = None,
@@ -103,22 +187,31 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
 
     seen_keys: set[str] = set()
     for cut, origin in zip(pattern.cuts, origins):
-        key_arc = "notch.arc" if origin == "notch" else (f"{origin}.arc" if cut.kind == "notch" else f"{origin}.size")
-        key_x = "notch.first_offset" if origin == "notch" else f"{origin}.x"
+        if _is_key(origin):
+            key_arc = "notch.arc" if origin == "notch" else (f"{origin}.arc" if cut.kind == "notch" else f"{origin}.size")
+            key_x = "notch.first_offset" if origin == "notch" else f"{origin}.x"
+            fix_arc = "reduce the arc s"
+        else:  # a drawn entity: the message names it
+            key_arc = key_x = origin
+            fix_arc = "draw the notch shorter around the tube"
         if cut.kind == "notch" and (origin != "notch" or "arc" not in seen_keys):
-            if cut.arc_mm >= circ:
+            arc = section_arc_mm(cut)
+            if arc >= circ:
                 err(key_arc, "notch arc must be shorter than the outer circumference",
-                    cut.arc_mm, f"< 2 pi r_o = {circ:.4f} mm", "reduce the arc s")
-            elif circ - cut.arc_mm < rules.min_backbone_arc_mm:
-                err(key_arc, f"backbone arc 2 pi r_o - s = {circ - cut.arc_mm:.4f} mm is thinner than "
-                    f"rules.min_backbone_arc", cut.arc_mm,
-                    f"<= {circ - rules.min_backbone_arc_mm:.4f} mm", "reduce the arc s or lower rules.min_backbone_arc")
+                    round(arc, 9), f"< 2 pi r_o = {circ:.4f} mm", fix_arc)
+            elif circ - arc < rules.min_backbone_arc_mm:
+                err(key_arc, f"backbone arc 2 pi r_o - s = {circ - arc:.4f} mm is thinner than "
+                    f"rules.min_backbone_arc = {rules.min_backbone_arc_mm:g} mm", round(arc, 9),
+                    f"<= {circ - rules.min_backbone_arc_mm:.4f} mm", fix_arc + " or lower rules.min_backbone_arc")
             if origin == "notch":
                 seen_keys.add("arc")
-        if cut.kind == "hole" and cut.arc_mm >= circ / 2.0:
+        if cut.kind == "slit":
+            pass
+        elif cut.kind == "hole" and cut.arc_mm >= circ / 2.0:
             err(key_arc, "hole is wider than half the circumference", cut.arc_mm, f"< {circ / 2:.4f} mm",
                 "use a smaller hole")
-        if cut.x_start_mm < -1e-12 or cut.x_end_mm > t.length_mm + 1e-12:
+        slack = 1e-12 if cut.outline is None else 1e-9
+        if cut.x_start_mm < -slack or cut.x_end_mm > t.length_mm + slack:
             err(key_x, f"{_describe(cut)} spans x = [{cut.x_start_mm:.4g}, {cut.x_end_mm:.4g}] mm, outside the tube",
                 round(cut.x_mm, 9), f"the cut inside 0 <= x <= tube.length = {t.length_mm:g} mm",
                 "move the cut or lengthen tube.length")
@@ -135,7 +228,10 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
                 break
             hole_pair = "hole" in (a.kind, b.kind)
             key = _pair_key(origins[i], origins[j], a, b)
-            if cuts_overlap(a, b, ro):
+            if _same(a, b, ro):
+                err(key, f"{_describe(b)} is a duplicate of {_describe(a)} (drawn or listed twice)", None,
+                    "each cut once", "delete one of the two")
+            elif cuts_overlap(a, b, ro):
                 what = "collides with" if hole_pair else "overlaps"
                 err(key, f"{_describe(b)} {what} {_describe(a)}", None, "cuts must not overlap",
                     "move the hole along x or around the tube" if hole_pair else "increase notch.spacing or move the cut")

@@ -1,21 +1,22 @@
-"""Design DXF: the unrolled drawing a CAD user would make, and reading DXF contours back.
+"""Design DXF: the unrolled drawing a CAD user would make (reading drawings is :mod:`camtube.design.drawing`).
 
 Frame: x along the tube from the tip, y arc length on the outer surface,
 ``0 <= y <= 2 pi r_o`` (mm, ``$INSUNITS = 4``). Every cut is a closed
-LWPOLYLINE on its kind's layer; a cut crossing the seam ``y = 0`` is split into
-closed pieces there. The unrolled outer surface is drawn on a construction
-layer that is switched off for plotting and never cut.
+LWPOLYLINE on its kind's layer (a drawn cut keeps its outline's vertices), a
+slit an open LWPOLYLINE on ``SLITS``; a cut crossing the seam ``y = 0`` is split
+into pieces there. The unrolled outer surface is drawn on a construction layer
+that is switched off for plotting and never cut. Read back with
+:func:`camtube.design.drawing.load_drawing`, the drawing gives the same cuts.
 """
 from __future__ import annotations
 
 import io
-from dataclasses import dataclass
 
 import ezdxf
 from ezdxf.document import Drawing
 
 from camtube import __version__
-from camtube.design.contour import Contour, merge_seam_pieces, outline, sheet_contours
+from camtube.design.contour import Contour, outline, sheet_contours
 from camtube.design.pattern import Pattern
 
 DXF_VERSION = "R2013"
@@ -23,11 +24,12 @@ LAYERS = {
     # name: (ACI colour, meaning)
     "NOTCHES": (1, "notch cut contours"),
     "HOLES": (5, "tendon hole cut contours"),
+    "SLITS": (6, "slits: open paths the beam follows"),
     "CUTS": (3, "cut contours of other kinds"),
     "CONSTRUCTION-OUTLINE": (8, "unrolled outer surface, 0<=x<=L, 0<=y<=2 pi r_o; never cut"),
 }
-KIND_LAYER = {"notch": "NOTCHES", "hole": "HOLES"}
-CUT_LAYERS = ("NOTCHES", "HOLES", "CUTS")
+KIND_LAYER = {"notch": "NOTCHES", "hole": "HOLES", "slit": "SLITS"}
+CUT_LAYERS = ("NOTCHES", "HOLES", "SLITS", "CUTS")
 
 
 def new_document() -> Drawing:
@@ -40,7 +42,8 @@ def new_document() -> Drawing:
 
 
 def add_contour(msp, contour: Contour, layer: str) -> None:
-    msp.add_lwpolyline([(float(x), float(y)) for x, y in contour.points], close=True,
+    """A closed LWPOLYLINE of the contour (an open one for an open path) on ``layer``."""
+    msp.add_lwpolyline([(float(x), float(y)) for x, y in contour.points], close=contour.closed,
                        dxfattribs={"layer": layer})
 
 
@@ -100,78 +103,3 @@ def _fix_class_order(doc: Drawing) -> None:
 def design_dxf(pattern: Pattern) -> str:
     """DXF text of the unrolled design of ``pattern``."""
     return to_string(design_document(pattern))
-
-
-@dataclass(frozen=True)
-class DxfContours:
-    """Closed contours read from a DXF.
-
-    Attributes
-    ----------
-    contours : tuple[Contour, ...]
-        Cut contours (seam pieces joined when ``circumference_mm`` is known).
-    circumference_mm : float | None
-        Height of the construction outline, if the drawing has one.
-    length_mm : float | None
-        Width of the construction outline.
-    """
-
-    contours: tuple[Contour, ...]
-    circumference_mm: float | None
-    length_mm: float | None
-
-
-def _layer_kind(layer: str) -> str:
-    up = layer.upper()
-    if up.startswith("NOTCH"):
-        return "notch"
-    if up.startswith("HOLE"):
-        return "hole"
-    return "cut"
-
-
-def read_contours(source, circumference_mm: float | None = None, merge_seam: bool = True) -> DxfContours:
-    """Closed contours of a DXF (a camtube drawing or one drawn by hand).
-
-    Closed LWPOLYLINEs and POLYLINEs on any layer not starting with
-    ``CONSTRUCTION`` are cuts; their layer name gives the kind (``NOTCH*``,
-    ``HOLE*``, else ``cut``). The construction outline gives the sheet size.
-
-    Parameters
-    ----------
-    source : str | os.PathLike | ezdxf Drawing
-        A file path or a loaded document.
-    circumference_mm : float, optional
-        Sheet height used to join seam pieces; defaults to the outline's height.
-    """
-    doc = source if isinstance(source, Drawing) else ezdxf.readfile(str(source))
-    msp = doc.modelspace()
-    cuts: list[Contour] = []
-    circ, length = None, None
-    for e in msp.query("LWPOLYLINE POLYLINE"):
-        layer = e.dxf.layer
-        if e.dxftype() == "LWPOLYLINE":
-            closed = e.closed
-            pts = [(float(p[0]), float(p[1])) for p in e.get_points("xy")]
-        else:
-            closed = e.is_closed
-            pts = [(float(v.dxf.location.x), float(v.dxf.location.y)) for v in e.vertices]
-        if len(pts) > 1 and pts[0] == pts[-1]:
-            pts = pts[:-1]
-            closed = True
-        if layer.upper().startswith("CONSTRUCTION"):
-            xs = [p[0] for p in pts]
-            ys = [p[1] for p in pts]
-            length, circ = max(xs) - min(xs), max(ys) - min(ys)
-            continue
-        if not closed or len(pts) < 3:
-            continue
-        c = Contour(tuple(pts), _layer_kind(layer), -1)
-        if c.area_mm2 < 0:  # normalise to counter-clockwise
-            c = Contour(tuple(reversed(pts)), c.kind, -1)
-        cuts.append(c)
-    circ_used = circumference_mm if circumference_mm is not None else circ
-    if merge_seam and circ_used:
-        cuts = merge_seam_pieces(cuts, circ_used)
-    cuts.sort(key=lambda c: (c.bounds[0], c.bounds[1], c.kind))
-    return DxfContours(tuple(cuts), circ, length)

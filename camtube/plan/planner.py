@@ -225,30 +225,20 @@ def _source(source, process, outer_radius_mm, length_mm, name) -> _Source:
         t = source.tube
         return _Source(name or source.name, cut_contours(source), t.outer_radius_mm,
                        length_mm if length_mm is not None else t.length_mm, process or source.process)
-    from camtube.export.dxf import DxfContours, read_contours
-
+    if isinstance(source, (str, bytes, os.PathLike)):
+        raise PatternError([Issue(str(source), "plan_job takes a Pattern or contours, not a file", None, "",
+                                  "load a drawing with camtube.design.source.load_source first")])
     if outer_radius_mm is None or outer_radius_mm <= 0:
-        raise PatternError([Issue("outer_radius_mm", "a DXF input needs the tube's outer radius", outer_radius_mm,
-                                  "> 0 mm", "pass outer_radius_mm (CLI: --outer-radius)")])
-    circ = 2.0 * math.pi * outer_radius_mm
-    outline_len = None
-    if isinstance(source, DxfContours):
-        contours, outline_len = source.contours, source.length_mm
-        label = name or "dxf"
-    elif isinstance(source, (str, os.PathLike)):
-        read = read_contours(source, circumference_mm=circ)
-        contours, outline_len = read.contours, read.length_mm
-        label = name or os.path.splitext(os.path.basename(os.fspath(source)))[0]
-    else:
-        contours = tuple(source)
-        label = name or "contours"
+        raise PatternError([Issue("outer_radius_mm", "contours need the tube's outer radius", outer_radius_mm,
+                                  "> 0 mm", "pass outer_radius_mm")])
+    contours = tuple(source)
+    label = name or "contours"
     if not contours:
         raise PatternError([Issue(str(label), "no closed contours to cut", None, "",
                                   "draw the cuts as closed polylines on a layer not named CONSTRUCTION*")])
-    length = length_mm if length_mm is not None else outline_len
+    length = length_mm
     if length is None:
-        raise PatternError([Issue("length_mm", "the tube length is unknown (no CONSTRUCTION outline in the DXF)",
-                                  None, "> 0 mm", "pass length_mm (CLI: --length)")])
+        raise PatternError([Issue("length_mm", "contours need the tube length", None, "> 0 mm", "pass length_mm")])
     contours = tuple(replace(c, cut_index=i) for i, c in enumerate(contours))
     return _Source(label, contours, float(outer_radius_mm), float(length), process or Process())
 
@@ -267,9 +257,9 @@ def plan_job(
 
     Parameters
     ----------
-    source : Pattern | str | os.PathLike | DxfContours | sequence of Contour
+    source : Pattern | sequence of Contour
         A pattern (cut from ``cut_contours(pattern)``, unwrapped across the
-        seam), or a DXF file / its contours (a drawing made by hand).
+        seam; a drawing is read into one by :mod:`camtube.design.drawing`), or contours.
     process : Process, optional
         Defaults to the pattern's process (or the paper's for a DXF).
     ordering : {"interleaved", "sequential"}

@@ -8,7 +8,6 @@ import ezdxf
 import pytest
 
 from camtube.design.loader import load_pattern
-from camtube.export.dxf import read_contours
 from camtube.export.toolpath_dxf import toolpath_dxf
 from camtube.plan import plan_job
 from tests.conftest import PATTERNS
@@ -39,12 +38,15 @@ def test_layers_and_passes(job):
     assert doc.layers.get("CONSTRUCTION-DESIGN").dxf.plot == 0
 
 
-def test_deterministic_and_readable_by_the_contour_reader(job):
+def test_deterministic_and_readable_by_ezdxf(job):
     text = toolpath_dxf(job)
     assert text == toolpath_dxf(plan_job(load_pattern(PATTERNS / "tube3.yaml")))
-    read = read_contours(ezdxf.read(io.StringIO(text)), merge_seam=False)
-    assert len(read.contours) == len(job.passes)
-    assert read.length_mm == pytest.approx(job.length_mm)
+    msp = ezdxf.read(io.StringIO(text)).modelspace()
+    passes = [e for e in msp.query("LWPOLYLINE") if not e.dxf.layer.startswith("CONSTRUCTION") and e.closed]
+    assert len(passes) == len(job.passes)
+    outline = [e for e in msp.query("LWPOLYLINE") if e.dxf.layer == "CONSTRUCTION-OUTLINE"]
+    xs = [p[0] for p in outline[-1].get_points("xy")]
+    assert max(xs) - min(xs) == pytest.approx(job.length_mm)
 
 
 def test_streamed_text_is_ezdxfs_own_and_audits_clean(job, tmp_path):

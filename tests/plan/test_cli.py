@@ -46,5 +46,6 @@ def test_errors_exit_2(tmp_path, capsys):
     assert not any(tmp_path.iterdir())
     dxf = tmp_path / "x.dxf"
     main(["dxf", str(PATTERNS / "tube1.yaml"), "-o", str(dxf), "-q"])
-    assert main(["toolpath", str(dxf), "-o", str(tmp_path / "o")]) == 2
+    assert main(["toolpath", str(dxf), "--outer-radius", "0.5", "-o", str(tmp_path / "o")]) == 2  # drawn for 0.75
     assert "outer radius" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()

@@ -13,6 +13,7 @@ from camtube.design.contour import Contour, cut_contours, rectangle
 from camtube.design.geometry import beam_depth_mm
 from camtube.design.loader import load_pattern
 from camtube.design.pattern import Process, RepeatRule
+from camtube.design.source import DrawingOptions, load_source
 from camtube.errors import PatternError
 from camtube.export.dxf import add_contour, design_dxf, new_document
 from camtube.plan import estimate, job_moves, plan_job, repeats_for
@@ -170,13 +171,16 @@ def test_dxf_input_plans_like_the_pattern(presets, tmp_path):
     p = presets["tube2"]
     path = tmp_path / "t2.dxf"
     path.write_text(design_dxf(p))
-    job = plan_job(path, p.process, outer_radius_mm=p.tube.outer_radius_mm)
+    drawn = load_source(path, [], DrawingOptions(outer_radius_mm=p.tube.outer_radius_mm)).pattern
+    job = plan_job(drawn, p.process)
     ref = plan_job(p)
     assert job.repeats == 6 and len(job.passes) == len(ref.passes)
     assert job.length_mm == pytest.approx(p.tube.length_mm)
     assert estimate(job).cut_length_mm == pytest.approx(estimate(ref).cut_length_mm)
     with pytest.raises(PatternError, match="outer radius"):
-        plan_job(path, p.process)
+        load_source(path, [], DrawingOptions(outer_radius_mm=0.5))  # the outline says 0.85
+    with pytest.raises(PatternError, match="not a file"):
+        plan_job(path, p.process)  # the planner takes patterns; drawings are design input
 
 
 def test_dxf_of_general_contours(tmp_path):
@@ -185,7 +189,7 @@ def test_dxf_of_general_contours(tmp_path):
     hexagon = Contour(tuple((2 + 0.4 * math.cos(a), 3 + 0.8 * math.sin(a))
                             for a in np.linspace(0, 2 * math.pi, 6, endpoint=False)), "cut")
     path = _dxf_of([hexagon, rectangle(4, 1, 4.5, 2.5)], 8.0, circ, tmp_path)
-    job = plan_job(path, Process(), outer_radius_mm=ro)
+    job = plan_job(load_source(path, [], DrawingOptions(outer_radius_mm=ro)).pattern, Process())
     arc = 1.6 * math.sin(math.pi / 3)  # the hexagon's y extent is the largest arc
     assert beam_depth_mm(ro, arc) < 1.0 and job.repeats == 4
     assert len(job.passes) == 2 * 4 * 2 * 4

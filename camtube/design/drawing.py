@@ -1,0 +1,641 @@
+"""Design input from a drawing (DXF): the cuts a CAD user drew, or a refusal naming the entity.
+
+How a drawing is read (``docs/dxf.md`` has the long version):
+
+1. Entities of the model space are walked; block references (INSERT, MINSERT
+   arrays, nested, scaled, rotated, mirrored) are expanded with ezdxf's own
+   ``virtual_entities`` (entities on layer ``0`` inside a block take the
+   INSERT's layer, as in AutoCAD).
+2. Each entity's layer maps to a role (:data:`DEFAULT_ROLES`, overridden by
+   ``DrawingOptions.layers``): ``notch``, ``hole``, ``slit`` or ``ignore``.
+3. Every curve (LINE, ARC, CIRCLE, ELLIPSE, SPLINE, LWPOLYLINE / POLYLINE with
+   bulges) becomes an ``ezdxf.path`` and is flattened to chords within
+   :data:`camtube.tol.TOL.chord`; units follow ``$INSUNITS`` (or
+   ``DrawingOptions.units`` for a unitless drawing).
+4. Loose open pieces on one layer are chained into loops with
+   ``ezdxf.edgeminer`` (ends within :data:`camtube.tol.TOL.gap`).
+5. The tube outline -- the smallest axis-aligned rectangle, on any layer, that
+   encloses every cut -- sets the origin and checks (or gives) ``r_o`` and ``L``.
+6. Pieces split at the seam are rejoined; each closed loop on a notch / hole
+   layer is a cut (a drawn rectangle stays a plain rectangle), each open path on
+   a slit layer a slit; the design rules run with messages naming the entity.
+
+Every entity ends up imported, set aside by an explicit rule (annotation, ignored
+or hidden layer, the outline), or refused with a :class:`~camtube.errors.PatternError`.
+"""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable
+
+from camtube.design.loader import Loaded, apply_overrides, build_settings, parse_override, read_yaml
+from camtube.design.pattern import Cut, Pattern, drawn, sort_cuts
+from camtube.errors import Issue, PatternError
+from camtube.tol import TOL
+
+ROLES = ("notch", "hole", "slit", "ignore")
+
+#: Layer-name prefix (upper case) -> role; the first match wins. Any other layer is ``notch``.
+DEFAULT_ROLES: tuple[tuple[str, str], ...] = (
+    ("NOTCH", "notch"),
+    ("HOLE", "hole"),
+    ("SLIT", "slit"),
+    ("CONSTRUCTION", "ignore"),
+    ("DEFPOINTS", "ignore"),
+)
+DEFAULT_OTHER_ROLE = "notch"
+
+#: ``$INSUNITS`` code -> (name, mm per drawing unit). 0 (unitless) needs ``DrawingOptions.units``.
+INSUNITS: dict[int, tuple[str, float]] = {
+    1: ("inch", 25.4), 2: ("foot", 304.8), 4: ("mm", 1.0), 5: ("cm", 10.0), 6: ("m", 1000.0),
+    8: ("microinch", 25.4e-6), 9: ("mil", 0.0254), 13: ("um", 1e-3), 14: ("dm", 100.0),
+}
+#: Names accepted for ``DrawingOptions.units`` -> mm per unit.
+UNIT_NAMES: dict[str, float] = {
+    "mm": 1.0, "cm": 10.0, "dm": 100.0, "m": 1000.0, "um": 1e-3, "micron": 1e-3, "inch": 25.4, "in": 25.4,
+    "foot": 304.8, "ft": 304.8, "mil": 0.0254,
+}
+
+#: Entities that are never cut: set aside wherever they are (counted in the summary).
+ANNOTATIONS = frozenset({
+    "TEXT", "MTEXT", "ATTRIB", "ATTDEF", "DIMENSION", "ARC_DIMENSION", "LARGE_RADIAL_DIMENSION", "LEADER",
+    "MULTILEADER", "MLEADER", "TOLERANCE", "HATCH", "MPOLYGON", "SOLID", "TRACE", "POINT", "IMAGE", "WIPEOUT",
+    "VIEWPORT", "XLINE", "RAY", "ACAD_TABLE", "UNDERLAY", "PDFUNDERLAY", "DWFUNDERLAY", "DGNUNDERLAY",
+})
+CURVES = frozenset({"LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE", "LWPOLYLINE", "POLYLINE", "HELIX"})
+
+#: Wall assumed when the drawing's process settings do not give ``tube.inner_radius`` (mm).
+DEFAULT_WALL_MM = 0.3
+
+
+# ---------------------------------------------------------------- what was drawn
+@dataclass
+class _Entity:
+    """One drawn entity (a block's entity once per INSERT copy) and what became of it."""
+
+    dxftype: str
+    handle: str
+    layer: str
+    via: str = ""          # "in block B of INSERT #H" for block content
+    status: str = ""       # imported | outline | aside:<reason> | refused
+
+    def describe(self) -> str:
+        where = f" {self.via}" if self.via else ""
+        return f"{self.dxftype} #{self.handle}{where} on layer {self.layer}"
+
+
+@dataclass
+class _Piece:
+    """A flattened path in mm (drawing coordinates scaled to mm, origin not yet moved)."""
+
+    points: list[tuple[float, float]]
+    closed: bool
+    entities: list[_Entity]
+    layer: str
+    role: str
+
+    def describe(self) -> str:
+        if len(self.entities) == 1:
+            return self.entities[0].describe()
+        kinds: dict[str, int] = {}
+        for e in self.entities:
+            kinds[e.dxftype] = kinds.get(e.dxftype, 0) + 1
+        what = " + ".join(f"{n} {t}s" if n > 1 else f"1 {t}" for t, n in sorted(kinds.items()))
+        handles = ", ".join(f"#{e.handle}" for e in self.entities[:6]) + (", ..." if len(self.entities) > 6 else "")
+        return f"{what} ({handles}) on layer {self.layer}"
+
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        xs = [p[0] for p in self.points]
+        ys = [p[1] for p in self.points]
+        return min(xs), min(ys), max(xs), max(ys)
+
+
+@dataclass
+class _Reading:
+    file: str
+    factor: float                     # mm per drawing unit
+    unit: str
+    roles: dict[str, str]             # upper-case layer -> role (explicit overrides)
+    hidden: set[str]                  # upper-case names of layers switched off or frozen
+    entities: list[_Entity] = field(default_factory=list)
+    pieces: list[_Piece] = field(default_factory=list)
+    issues: list[Issue] = field(default_factory=list)
+    inserts: int = 0
+    joined: list[_Piece] = field(default_factory=list)
+
+    def role(self, layer: str) -> str:
+        up = layer.upper()
+        if up in self.roles:
+            return self.roles[up]
+        if up in self.hidden:
+            return "ignore"
+        for prefix, role in DEFAULT_ROLES:
+            if up.startswith(prefix):
+                return role
+        return DEFAULT_OTHER_ROLE
+
+    def refuse(self, what: str, message: str, fix: str, allowed: str = "", entities: Iterable[_Entity] = ()) -> None:
+        for e in entities:
+            e.status = "refused"
+        self.issues.append(Issue(what, message, None, allowed, fix, self.file))
+
+    def at(self, x_mm: float, y_mm: float) -> str:
+        """A point as the user finds it in the drawing (drawing units)."""
+        return f"({x_mm / self.factor:.6g}, {y_mm / self.factor:.6g}) {self.unit}"
+
+
+# ---------------------------------------------------------------- entry point
+def load_drawing(path: str | os.PathLike, overrides: Iterable[str], options) -> Loaded:
+    """Read a DXF drawing into a validated pattern (see the module docstring).
+
+    Parameters
+    ----------
+    path : path
+        The ``*.dxf`` file.
+    overrides : iterable of str
+        ``KEY=VALUE`` (``--set``) for the ``name``, ``tube``, ``process``,
+        ``tendon`` and ``rules`` sections; ``process=FILE.yaml`` takes the process
+        from a process file (relative to the working directory or the drawing).
+    options : camtube.design.source.DrawingOptions
+        Outer radius, length, units and layer roles given by the user.
+
+    Returns
+    -------
+    Loaded
+        The pattern (cuts in ``x, angle`` order), design warnings, the entity
+        each cut came from (``origins``) and a one-line ``summary``.
+
+    Raises
+    ------
+    PatternError
+        The drawing cannot be read as the user meant it, or breaks a design
+        rule; every issue names the entity (type, handle, layer) and the fix.
+    """
+    file = str(path)
+    overrides = list(overrides)
+    raw = _settings_raw(overrides, file, Path(path).parent)
+    ro_opt = _agree("outer radius", options.outer_radius_mm, raw.get("tube", {}).get("outer_radius"), file)
+    len_opt = _agree("length", options.length_mm, raw.get("tube", {}).get("length"), file)
+
+    doc = _read_document(path, file)
+    factor, unit = _units(doc, options.units, file)
+    layer_names = {layer.dxf.name.upper(): layer.dxf.name for layer in doc.layers}
+    roles = _layer_roles(options.layers, layer_names, file)
+    hidden = {layer.dxf.name.upper() for layer in doc.layers if layer.is_off() or layer.is_frozen()}
+    rd = _Reading(file, factor, unit, roles, hidden)
+
+    for entity in doc.modelspace():
+        _walk(rd, entity, "", "")
+    _close_and_chain(rd)
+    outline, ro, length = _find_outline(rd, ro_opt, len_opt)
+    if rd.issues:
+        raise PatternError(rd.issues)
+
+    cuts, origins, seam_joined = _cuts(rd, outline, ro, length)
+    for e in rd.entities:
+        if not e.status:
+            e.status = "aside:unused"  # pragma: no cover - every path above sets a status
+    if rd.issues:
+        raise PatternError(rd.issues)
+    if not cuts:
+        raise PatternError([Issue(file, "the drawing has no cuts", None,
+                                  "closed outlines on notch/hole layers, open paths on slit layers",
+                                  "draw the cuts, or map their layer with --layer NAME=notch|hole|slit", file)])
+
+    tube_raw = raw.setdefault("tube", {})
+    tube_raw["outer_radius"], tube_raw["length"] = ro, length
+    warnings: list[Issue] = []
+    if tube_raw.get("inner_radius") is None:
+        ri = ro - min(DEFAULT_WALL_MM, 0.5 * ro)
+        tube_raw["inner_radius"] = ri
+        warnings.append(Issue("tube.inner_radius", f"not given: the wall is assumed {ro - ri:g} mm (r_i = {ri:g} mm) "
+                              "for the CAD model and the closure warnings; the cut does not depend on it", None, "",
+                              "pass --set tube.inner_radius=R", file))
+    tube, process, tendon, rules = build_settings(raw, file)
+    order = sorted(range(len(cuts)), key=lambda k: (cuts[k].x_mm, cuts[k].angle_deg, cuts[k].kind))
+    pattern = Pattern(name=str(raw.get("name") or Path(path).stem), tube=tube, cuts=sort_cuts(cuts),
+                      process=process, tendon=tendon, rules=rules, source=file)
+    origins = [origins[k] for k in order]
+
+    from camtube.design import rules as design_rules
+
+    errors, rule_warnings = design_rules.check(pattern, origins, file)
+    widths = [c.width_mm for c in pattern.cuts if c.kind != "slit"]
+    if process.kerf_mm and widths and process.kerf_mm >= min(widths) / 2:
+        errors.append(Issue("process.kerf", "kerf is as wide as half the narrowest cut", process.kerf_mm,
+                            f"< {min(widths) / 2:g} mm", "check the kerf width", file))
+    if errors:
+        raise PatternError(errors)
+    summary = _summary(rd, pattern, outline, seam_joined, ro_opt is None, len_opt is None)
+    return Loaded(pattern, tuple(warnings + list(rule_warnings)), tuple(origins), summary)
+
+
+# ---------------------------------------------------------------- settings
+def _settings_raw(overrides: list[str], file: str, folder: Path) -> dict:
+    """The tube/process/tendon/rules raw data given by ``--set`` (a ``process=FILE`` first)."""
+    bad = []
+    plain = []
+    process_file = None
+    for item in overrides:
+        key, value = parse_override(item)
+        top = key.split(".")[0]
+        if top in ("notch", "cuts", "holes"):
+            bad.append(Issue(key, "a drawing's cuts come from the drawing", None, "name, tube.*, process.*, "
+                             "tendon.*, rules.*", "edit the drawing instead", file))
+        elif key == "process" and isinstance(value, str):
+            process_file = value
+        else:
+            plain.append(item)
+    if bad:
+        raise PatternError(bad)
+    raw: dict = {}
+    if process_file is not None:
+        candidates = [Path(process_file), folder / process_file]
+        found = next((p for p in candidates if p.is_file()), candidates[0])
+        praw, _, _ = read_yaml(found)
+        raw["process"] = dict(praw.get("process", praw))
+    return apply_overrides(raw, plain, file)
+
+
+def _agree(what: str, option, value, file: str):
+    if option is not None and value is not None and abs(float(option) - float(value)) > TOL.zero:
+        raise PatternError([Issue(f"tube.{what.replace(' ', '_')}", f"the {what} is given twice, differently",
+                                  f"{option:g} and {value:g}", "one value", "give it once", file)])
+    v = option if option is not None else value
+    if v is not None and not (isinstance(v, (int, float)) and float(v) > 0 and math.isfinite(float(v))):
+        raise PatternError([Issue(f"tube.{what.replace(' ', '_')}", f"the {what} must be a positive number", v,
+                                  "> 0 mm", "pass a positive number of mm", file)])
+    return float(v) if v is not None else None
+
+
+def _read_document(path, file: str):
+    import ezdxf
+
+    try:
+        return ezdxf.readfile(str(path))
+    except OSError as exc:
+        raise PatternError([Issue("file", f"cannot read the drawing: {exc.strerror or exc}", file,
+                                  "a readable DXF file", "check the path", file)]) from None
+    except ezdxf.DXFError as exc:
+        raise PatternError([Issue("file", f"not a valid DXF file: {exc}", None, "a DXF file (R12 or later)",
+                                  "save the drawing as DXF again from your CAD program", file)]) from None
+
+
+def _units(doc, given: str | None, file: str) -> tuple[float, str]:
+    code = int(doc.header.get("$INSUNITS", 0) or 0)
+    if given is not None:
+        name = given.strip().lower()
+        if name not in UNIT_NAMES:
+            raise PatternError([Issue("--units", "unknown unit", given, ", ".join(UNIT_NAMES),
+                                      "use one of the names listed", file)])
+        if code in INSUNITS and abs(INSUNITS[code][1] - UNIT_NAMES[name]) > 1e-12:
+            raise PatternError([Issue("--units", f"the drawing says its units are {INSUNITS[code][0]} ($INSUNITS = "
+                                      f"{code}), not {name}", given, INSUNITS[code][0],
+                                      "drop --units, or fix $INSUNITS in the drawing (UNITS command)", file)])
+        return UNIT_NAMES[name], name
+    if code in INSUNITS:
+        return INSUNITS[code][1], INSUNITS[code][0]
+    if code == 0:
+        raise PatternError([Issue("$INSUNITS", "the drawing is unitless ($INSUNITS = 0): its size is unknown", 0,
+                                  "mm, inch, ... ", "pass --units mm (or inch, um, ...), or set the drawing's units",
+                                  file)])
+    raise PatternError([Issue("$INSUNITS", "unsupported drawing unit", code, ", ".join(n for n, _ in INSUNITS.values()),
+                              "save the drawing in mm or inch, or pass --units", file)])
+
+
+def _layer_roles(pairs, layer_names: dict[str, str], file: str) -> dict[str, str]:
+    out: dict[str, str] = {}
+    issues = []
+    for name, role in pairs:
+        if role not in ROLES:
+            issues.append(Issue(f"--layer {name}={role}", "unknown layer role", role, " | ".join(ROLES),
+                                "use notch, hole, slit or ignore", file))
+            continue
+        if name.upper() not in layer_names:
+            import difflib
+
+            near = difflib.get_close_matches(name, list(layer_names.values()), n=1, cutoff=0.5)
+            issues.append(Issue(f"--layer {name}={role}", "the drawing has no such layer", name,
+                                ", ".join(sorted(layer_names.values())),
+                                f"did you mean '{near[0]}'?" if near else "check the layer name", file))
+            continue
+        out[name.upper()] = role
+    if issues:
+        raise PatternError(issues)
+    return out
+
+
+# ---------------------------------------------------------------- walking the entities
+def _walk(rd: _Reading, entity, via: str, insert_layer: str) -> None:
+    t = entity.dxftype()
+    layer = entity.dxf.get("layer", "0")
+    if via and layer == "0":
+        layer = insert_layer
+    if t == "INSERT":
+        rd.inserts += 1
+        here = f"INSERT #{entity.dxf.handle}" if entity.dxf.handle else "INSERT"
+        name = entity.dxf.name
+        copies = list(entity.multi_insert()) if entity.mcount > 1 else [entity]
+        for k, ins in enumerate(copies):
+            tag = f"in block {name} of {here}" + (f" (copy {k + 1} of {len(copies)})" if len(copies) > 1 else "")
+            if via:
+                tag += f", {via}"
+            skipped: list = []
+            for sub in ins.virtual_entities(skipped_entity_callback=lambda e, why: skipped.append((e, why))):
+                _walk(rd, sub, tag, layer)
+            for sub, why in skipped:
+                ent = _Entity(sub.dxftype(), "-", layer if sub.dxf.get("layer", "0") == "0" else sub.dxf.layer, tag)
+                rd.entities.append(ent)
+                if rd.role(ent.layer) == "ignore":
+                    ent.status = "aside:ignored layer"
+                else:
+                    rd.refuse(ent.describe(), f"cannot place this block entity: {why}",
+                              "explode the block in CAD (EXPLODE), or scale it uniformly", entities=[ent])
+        for att in getattr(entity, "attribs", []):
+            ent = _Entity("ATTRIB", att.dxf.handle or "-", layer, via)
+            ent.status = "aside:annotation"
+            rd.entities.append(ent)
+        return
+    ent = _Entity(t, entity.dxf.handle or "-", layer, via)
+    rd.entities.append(ent)
+    role = rd.role(layer)
+    if t in ANNOTATIONS:
+        ent.status = "aside:annotation"
+        return
+    if t not in CURVES:
+        if role == "ignore":
+            ent.status = "aside:ignored layer"
+        else:
+            rd.refuse(ent.describe(), f"a {t} cannot be read as a cut", "explode it into lines, arcs or polylines, "
+                      "or move it to a CONSTRUCTION layer", "LINE, ARC, CIRCLE, ELLIPSE, SPLINE, (LW)POLYLINE",
+                      [ent])
+        return
+    _flatten(rd, entity, ent, layer, role)
+
+
+def _flatten(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
+    from ezdxf import path as ezpath
+
+    try:
+        p = ezpath.make_path(entity, segments=16, level=8)
+    except (TypeError, ValueError) as exc:
+        if role == "ignore":
+            ent.status = "aside:ignored layer"
+        else:
+            rd.refuse(ent.describe(), f"cannot be read as a curve ({exc})", "redraw it as a polyline", entities=[ent])
+        return
+    distance = TOL.chord / rd.factor
+    found = False
+    for sub in (p.sub_paths() if p.has_sub_paths else [p]):
+        vs = list(sub.flattening(distance, segments=4))
+        if len(vs) < 2:
+            continue
+        zs = [v.z for v in vs]
+        if max(zs) - min(zs) > TOL.gap / rd.factor:
+            rd.refuse(ent.describe(), "is not drawn in the XY plane (its z varies by "
+                      f"{(max(zs) - min(zs)) * rd.factor:.4g} mm)", "flatten the drawing (FLATTEN) to the XY plane",
+                      entities=[ent])
+            return
+        pts = _dedupe([(v.x * rd.factor, v.y * rd.factor) for v in vs])
+        if len(pts) < 2:
+            continue
+        closed = bool(sub.is_closed) or _isclose(pts[0], pts[-1], TOL.gap)
+        if closed and _isclose(pts[0], pts[-1], TOL.gap):
+            pts = pts[:-1]
+        if closed and len(pts) < 3:
+            continue
+        rd.pieces.append(_Piece(pts, closed, [ent], layer, role))
+        found = True
+    if not found:
+        ent.status = "aside:zero length"
+
+
+def _isclose(a, b, tol: float) -> bool:
+    return math.hypot(a[0] - b[0], a[1] - b[1]) <= tol
+
+
+def _dedupe(pts: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    out = [pts[0]]
+    for p in pts[1:]:
+        if not _isclose(p, out[-1], TOL.merge):
+            out.append(p)
+    return out
+
+
+def _close_and_chain(rd: _Reading) -> None:
+    """Chain the open pieces of each layer (not slit layers) into loops with ezdxf.edgeminer."""
+    from ezdxf import edgeminer as em
+    from ezdxf.math import Vec3
+
+    by_layer: dict[str, list[_Piece]] = {}
+    for p in rd.pieces:
+        if not p.closed and p.role != "slit":
+            by_layer.setdefault(p.layer, []).append(p)
+    for layer, pieces in sorted(by_layer.items()):
+        edges = [em.make_edge(Vec3(p.points[0]), Vec3(p.points[-1]), length=1.0, payload=k)
+                 for k, p in enumerate(pieces)]
+        deposit = em.Deposit(edges, gap_tol=TOL.gap)
+        chains = sorted(em.find_all_simple_chains(deposit), key=lambda ch: min(e.payload for e in ch))
+        consumed: set[int] = set()
+        for chain in chains:
+            if len(chain) < 2:
+                continue
+            is_loop = em.is_loop(chain, gap_tol=TOL.gap)
+            pts: list[tuple[float, float]] = []
+            for e in chain:
+                seg = pieces[e.payload].points
+                seg = list(reversed(seg)) if e.is_reverse else list(seg)
+                pts.extend(seg if not pts else seg[1:])
+            if is_loop and _isclose(pts[0], pts[-1], TOL.gap):
+                pts = pts[:-1]
+            ents = [pieces[e.payload].entities[0] for e in chain]
+            joined = _Piece(_dedupe(pts), is_loop, ents, layer, pieces[0].role)
+            if is_loop:
+                rd.joined.append(joined)
+            rd.pieces.append(joined)  # an open chain is one open path (refused or set aside as one)
+            consumed.update(e.payload for e in chain)
+        rd.pieces = [p for p in rd.pieces if not any(p is pieces[k] for k in consumed)]
+
+
+# ---------------------------------------------------------------- the tube outline
+def _rectangle(piece: _Piece) -> tuple[float, float, float, float] | None:
+    """Bounds of a closed piece if it is an axis-aligned rectangle (within TOL.gap), else None."""
+    if not piece.closed:
+        return None
+    x0, y0, x1, y1 = piece.bounds
+    if x1 - x0 <= TOL.gap or y1 - y0 <= TOL.gap:
+        return None
+    for x, y in piece.points:
+        on_x = abs(x - x0) <= TOL.gap or abs(x - x1) <= TOL.gap
+        on_y = abs(y - y0) <= TOL.gap or abs(y - y1) <= TOL.gap
+        if not (on_x or on_y):
+            return None
+    from shapely.geometry import Polygon
+
+    area = Polygon(piece.points).area
+    if abs(area - (x1 - x0) * (y1 - y0)) > TOL.gap * (x1 - x0 + y1 - y0):
+        return None
+    return x0, y0, x1, y1
+
+
+def _find_outline(rd: _Reading, ro: float | None, length: float | None):
+    """The tube outline piece (or None), and r_o and L (checked against it, or taken from it)."""
+    cut_pieces = [p for p in rd.pieces if p.role != "ignore"]
+    if not cut_pieces:
+        return None, ro or 1.0, length or 1.0  # nothing to cut: refused as such by the caller
+    best = None
+    for p in rd.pieces:
+        box = _rectangle(p)
+        if box is None:
+            continue
+        x0, y0, x1, y1 = box
+        others = [q for q in cut_pieces if q is not p]
+        if not others:
+            continue
+        # every cut lies inside in x; in y a cut may cross the seam line drawn whole (its centre on the sheet)
+        inside = all(b[0] >= x0 - TOL.gap and b[2] <= x1 + TOL.gap and y0 - TOL.gap <= 0.5 * (b[1] + b[3]) <= y1
+                     + TOL.gap for b in (q.bounds for q in others))
+        area = (x1 - x0) * (y1 - y0)
+        if inside and (best is None or area < best[1] - TOL.gap):
+            best = (p, area, box)
+    if best is None:
+        missing = [w for w, v in (("--outer-radius", ro), ("--length", length)) if v is None]
+        if missing:
+            rd.refuse(rd.file, "no tube outline found (an axis-aligned rectangle L x 2 pi r_o around every cut)",
+                      "draw the unrolled tube outline (any layer), or pass " + " and ".join(missing))
+        return None, ro, length
+    piece, _, (x0, y0, x1, y1) = best
+    h, w = y1 - y0, x1 - x0
+    desc = piece.describe()
+    if ro is not None and abs(h - 2.0 * math.pi * ro) > TOL.outline:
+        rd.refuse(desc, f"the tube outline is {h / rd.factor:.6g} {rd.unit} = {h:.4f} mm high, i.e. 2 pi x "
+                  f"{h / (2 * math.pi):.4f} mm, but the outer radius {ro:g} mm needs 2 pi r_o = "
+                  f"{2 * math.pi * ro:.4f} mm", f"pass --outer-radius {h / (2 * math.pi):.4f} (or omit it), or redraw "
+                  "the outline", f"height 2 pi r_o within {TOL.outline:g} mm", piece.entities)
+    if length is not None and abs(w - length) > TOL.outline:
+        rd.refuse(desc, f"the tube outline is {w:.4f} mm long, but the tube length given is {length:g} mm",
+                  f"pass --length {w:.4f} (or omit it), or redraw the outline", f"length within {TOL.outline:g} mm",
+                  piece.entities)
+    for e in piece.entities:
+        e.status = "outline"
+    rd.pieces = [p for p in rd.pieces if p is not piece]
+    return piece, h / (2.0 * math.pi) if ro is None else ro, w if length is None else length
+
+
+# ---------------------------------------------------------------- cuts
+def _cuts(rd: _Reading, outline: _Piece | None, ro: float, length: float):
+    """Cuts (and their entity descriptions) from the remaining pieces, in the tube frame."""
+    from shapely.geometry import Polygon
+    from shapely.validation import explain_validity
+
+    from camtube.design.contour import Contour, merge_seam_polygons
+
+    ox, oy = (outline.bounds[0], outline.bounds[1]) if outline is not None else (0.0, 0.0)
+    circ = 2.0 * math.pi * ro
+    contours: list[Contour] = []
+    owners: list[_Piece] = []
+    for p in rd.pieces:
+        if p.role == "ignore":
+            why = "hidden layer" if p.layer.upper() in rd.hidden and p.layer.upper() not in rd.roles else "ignored layer"
+            for e in p.entities:
+                e.status = e.status or f"aside:{why}"
+            continue
+        pts = [(x - ox, y - oy) for x, y in p.points]
+        desc = p.describe()
+        if p.role == "slit":
+            if p.closed:
+                rd.refuse(desc, "a closed outline on a slit layer (a slit is an open path the beam follows)",
+                          f"draw the slit as an open path, or map the layer to notch (--layer {p.layer}=notch) "
+                          "to cut out the area", entities=p.entities)
+                continue
+            contours.append(Contour(tuple(pts), "slit", len(contours), False))
+            owners.append(p)
+            continue
+        if not p.closed:
+            (xa, ya), (xb, yb) = p.points[0], p.points[-1]
+            rd.refuse(desc, f"an open path on a {p.role} layer: its ends {rd.at(xa, ya)} and {rd.at(xb, yb)} are "
+                      f"{math.hypot(xa - xb, ya - yb):.4g} mm apart (joined only within {TOL.gap:g} mm)",
+                      f"close the outline in CAD (snap the ends, JOIN), or map the layer to slit "
+                      f"(--layer {p.layer}=slit) if it is a kerf path", "closed outlines", p.entities)
+            continue
+        poly = Polygon(pts)
+        if not poly.is_valid:
+            rd.refuse(desc, f"the outline crosses itself ({explain_validity(poly)}, drawing origin moved to the "
+                      "outline corner)", "redraw it as a simple closed outline", entities=p.entities)
+            continue
+        if poly.area <= TOL.gap * TOL.gap:
+            rd.refuse(desc, "the closed outline encloses no area", "delete it or redraw it", entities=p.entities)
+            continue
+        if poly.exterior.is_ccw is False:
+            pts = pts[::-1]
+        contours.append(Contour(tuple(pts), p.role, len(contours)))
+        owners.append(p)
+    merged = merge_seam_polygons(contours, circ, TOL.gap)
+    cuts: list[Cut] = []
+    origins: list[str] = []
+    seam_joined = 0
+    for con, idx in merged:
+        ents = [e for k in idx for e in owners[k].entities]
+        for e in ents:
+            e.status = "imported"
+        if len(idx) > 1:
+            seam_joined += 1
+            desc = " + ".join(owners[k].describe() for k in idx) + " (joined at the seam)"
+        else:
+            desc = owners[idx[0]].describe()
+        cuts.append(_to_cut(con, ro))
+        origins.append(desc)
+    return cuts, origins, seam_joined
+
+
+def _to_cut(con, ro: float) -> Cut:
+    """A plain rectangle cut if the contour is one (within TOL.gap), else a drawn cut."""
+    x0, y0, x1, y1 = con.bounds
+    if con.closed and _rectangle(_Piece(list(con.points), True, [], "", "")) is not None:
+        angle_deg = math.degrees(0.5 * (y0 + y1) / ro) % 360.0
+        return Cut(con.kind, 0.5 * (x0 + x1), x1 - x0, y1 - y0, angle_deg)
+    return drawn(con.kind, con.points, ro)
+
+
+# ---------------------------------------------------------------- the summary line
+def _plural(n: int, word: str) -> str:
+    return f"{n} {word}" + ("" if n == 1 else ("es" if word.endswith(("ch", "s")) else "s"))
+
+
+def _summary(rd: _Reading, pattern: Pattern, outline: _Piece | None, seam_joined: int,
+             radius_from_outline: bool, length_from_outline: bool) -> str:
+    counts = [(len(pattern.notches), "notch"), (len(pattern.holes), "hole"), (len(pattern.slits), "slit")]
+    parts = [_plural(n, w) for n, w in counts if n]
+    what = parts[0] if len(parts) == 1 else ", ".join(parts[:-1]) + " and " + parts[-1]
+    notes = []
+    if outline is not None:
+        t = pattern.tube
+        given = []
+        if radius_from_outline:
+            given.append(f"r_o = {t.outer_radius_mm:.4g} mm")
+        if length_from_outline:
+            given.append(f"L = {t.length_mm:.4g} mm")
+        notes.append(f"outline {outline.describe()}" + (f" gives {' and '.join(given)}" if given else " checked"))
+    else:
+        notes.append("no outline: origin at the drawing's origin")
+    notes.append(f"units {rd.unit}")
+    if rd.inserts:
+        notes.append(f"{_plural(rd.inserts, 'INSERT')} expanded")
+    joined = [p for p in rd.joined if any(e.status == "imported" for e in p.entities)]
+    if joined:
+        n_ent = sum(len(p.entities) for p in joined)
+        notes.append(f"{n_ent} loose entities joined into {_plural(len(joined), 'loop')}")
+    if seam_joined:
+        notes.append(f"{_plural(seam_joined, 'cut')} rejoined at the seam")
+    aside: dict[str, int] = {}
+    for e in rd.entities:
+        if e.status.startswith("aside:"):
+            aside[e.status[6:]] = aside.get(e.status[6:], 0) + 1
+    if aside:
+        notes.append("set aside: " + ", ".join(f"{n} ({why})" for why, n in sorted(aside.items())))
+    return f"imported {what} from {_plural(len(rd.entities), 'entity').replace('entitys', 'entities')} " \
+           f"({'; '.join(notes)})"
