@@ -47,3 +47,21 @@ def test_cad_request_writes_only_cad_files(tmp_path):
     assert sorted(x.name for x in tmp_path.iterdir()) == sorted(x.name for x in res.paths) == [
         "tube1.ascut.stl", "tube1.design.stl", "tube1.verify.json", "tube1.verify.txt"]
     assert res.estimate is None and res.verified
+
+
+def test_a_slit_drawing_builds_and_its_kerf_is_verified(tmp_path):
+    """Slits (open paths mapped with --layer KERF=slit) go through plan, G-code and the CAD simulation."""
+    from camtube.design.source import DrawingOptions, load_source
+    from tests.conftest import ROOT
+
+    loaded = load_source(ROOT / "examples" / "dxf" / "slits.dxf", (), DrawingOptions(layers=(("KERF", "slit"),)))
+    assert {c.kind for c in loaded.pattern.cuts} == {"slit"}
+    res = run(loaded, tmp_path, Request(what=BUILD, cad=CadOptions(step=False, pictures=False)))
+    assert res.verified, "\n".join(res.cad.verdict_lines())
+    # the as-cut region of each slit is the kerf band along it: area = length x kerf (+ round ends)
+    from camtube.cad.ascut import design_region
+
+    kerf = 0.02
+    for c in res.job.design:
+        assert not c.closed
+        assert design_region(c, kerf).area == pytest.approx(c.length_mm * kerf + math.pi * (kerf / 2) ** 2, rel=1e-3)

@@ -245,6 +245,16 @@ def _max_distance(piece, to_parts: list, to_tree, step_mm: float) -> tuple[float
     return float(d[k]), (float(pts[k, 0]), float(pts[k, 1]))
 
 
+def design_region(contour, kerf_mm: float):
+    """The sheet region a design contour asks to remove: its polygon, or for a slit (an open
+    path) the band the beam sweeps along it, ``kerf_mm`` wide with round ends."""
+    from shapely.geometry import LineString, Polygon
+
+    if getattr(contour, "closed", True):
+        return Polygon(contour.points)
+    return LineString(contour.points).buffer(kerf_mm / 2.0, quad_segs=QUAD_SEGS)
+
+
 # ---------------------------------------------------------------- simulation
 def _cut_segments(job, moves) -> dict[int, np.ndarray]:
     """Distinct laser-on segments (k, 4) [x0, y0, x1, y1] of each cut."""
@@ -294,7 +304,7 @@ def simulate(job, moves=None, kerf_mm: float | None = None) -> AsCut:
     n = len(job.design)
     step = max(kerf / 4.0, 1e-4)
 
-    design = tuple(Polygon(c.points) for c in job.design)
+    design = tuple(design_region(c, kerf) for c in job.design)
     segs = _cut_segments(job, mv)
     kerfs = []
     for i in range(n):

@@ -122,7 +122,7 @@ def unrolled_png(design_contours, length_mm: float, outer_radius_mm: float, ascu
     import shapely
     from shapely.geometry import Polygon
 
-    from camtube.cad.ascut import _polys, wrap_sheet
+    from camtube.cad.ascut import _polys, design_region, wrap_sheet
 
     circ = 2.0 * math.pi * outer_radius_mm
     aspect = length_mm / circ
@@ -140,7 +140,8 @@ def unrolled_png(design_contours, length_mm: float, outer_radius_mm: float, ascu
         for p in _polys(under):
             ax.add_patch(_patch(p, facecolor="#1f77b4", edgecolor="none"))
     for c in design_contours:
-        for p in _polys(wrap_sheet(Polygon(c.points), circ)):
+        region = Polygon(c.points) if getattr(c, "closed", True) else design_region(c, 0.02)
+        for p in _polys(wrap_sheet(region, circ)):
             ax.add_patch(_patch(p, facecolor="none", edgecolor="black" if c.kind == "notch" else "#1f4fb4",
                                 linewidth=0.7))
     ax.set_xlim(-0.02 * length_mm, 1.02 * length_mm)
