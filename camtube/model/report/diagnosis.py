@@ -28,8 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from camtube.model.atlas import describe, residual_atlas
-from camtube.model.diagnose import Candidate, Diagnosis
+from camtube.model.diagnose.atlas import describe, residual_atlas
+from camtube.model.diagnose.search import Candidate, Diagnosis
 
 
 def _num(x) -> float | None:
@@ -215,7 +215,7 @@ def atlas_png(d: Diagnosis) -> bytes:
     final = residual_atlas(d.data, d.final.residuals) if d.recommended else None
     fig = _figure(13.0, 7.0)
     axes = fig.subplots(2, 3).ravel()
-    from camtube.model.atlas import variable
+    from camtube.model.diagnose.atlas import variable
 
     rng = np.random.default_rng(0)
     n = len(d.data)
