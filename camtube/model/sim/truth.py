@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Sequence
 
 import numpy as np
 
@@ -57,9 +58,18 @@ class Hidden:
     creep_mm_per_N, creep_tau_s : float
         Ratcheting creep compliance ``C_c`` and time constant.
     joint_friction_nmm : float
-        Coulomb friction moment ``M_f`` of the joint (absorbed by the model: a trap).
+        Coulomb friction moment ``M_f`` of the joint (absorbed by the model: a trap); on by
+        default (0.05 N mm), as in a real joint; 0 turns it off.
     angle_bias_deg, force_zero_N : float
         Sensor offsets.
+    toe_form : str
+        ``quadratic`` (the library's law) or ``exponential``:
+        ``T(e) = (e - e_t (1 - exp(-e / e_t))) / C`` (soft at zero force, the same linear asymptote
+        shifted by ``e_t``), a form the library does not have.
+    cycle_creep_mm, cycle_creep_n : float
+        Creep counted in cycles: the tendon has lengthened by
+        ``cycle_creep_mm (1 - exp(-(k - 1) / cycle_creep_n))`` during cycle ``k`` (a step at each
+        cycle start, not a function of time).
     """
 
     slack_mm: float = 0.0
@@ -69,9 +79,16 @@ class Hidden:
     visco_tau_s: float = 1.0
     creep_mm_per_N: float = 0.0
     creep_tau_s: float = 60.0
-    joint_friction_nmm: float = 0.0
+    joint_friction_nmm: float = 0.05
     angle_bias_deg: float = 0.0
     force_zero_N: float = 0.0
+    toe_form: str = "quadratic"
+    cycle_creep_mm: float = 0.0
+    cycle_creep_n: float = 5.0
+
+    def __post_init__(self):
+        if self.toe_form not in ("quadratic", "exponential"):
+            raise ValueError(f"toe_form must be 'quadratic' or 'exponential', not {self.toe_form!r}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -97,18 +114,26 @@ class Simulation:
     params: dict = field(default_factory=dict)
 
 
-def _tension(e: float, c: float, et: float) -> float:
+def _tension(e: float, c: float, et: float, exponential: bool = False) -> float:
     """Tendon tension (N) at elastic elongation ``e`` (mm): toe region then linear."""
     if e <= 0.0:
         return 0.0
+    if exponential and et > 0.0:
+        return (e + et * math.expm1(-e / et)) / c
     if et > 0.0 and e < et:
         return e * e / (2.0 * et * c)
     return (e - 0.5 * et) / c
 
 
-def _run(x: np.ndarray, t: np.ndarray, arm: float, k: float, c: float, h: Hidden) -> tuple[np.ndarray, np.ndarray]:
+def _run(x: np.ndarray, t: np.ndarray, arm: float, k: float, c: float, h: Hidden,
+         cycle: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """One sample's angle (rad) and tension (N) for the motor stroke ``x`` (n,) at times ``t`` (n,)."""
     n = x.size
+    expo = h.toe_form == "exponential"
+    if cycle is not None and h.cycle_creep_mm != 0.0:
+        cyc_loss = h.cycle_creep_mm * -np.expm1(-(np.asarray(cycle, float) - 1.0) / h.cycle_creep_n)
+    else:
+        cyc_loss = np.zeros(n)
     theta_out = np.zeros(n)
     t_out = np.zeros(n)
     w, mf, et = h.play_mm, h.joint_friction_nmm, h.toe_mm
@@ -130,7 +155,7 @@ def _run(x: np.ndarray, t: np.ndarray, arm: float, k: float, c: float, h: Hidden
             u = xi - w
         elif xi < u:
             u = xi
-        p = u - h.slack_mm
+        p = u - h.slack_mm - float(cyc_loss[i])
         a_v = math.exp(-dt / h.visco_tau_s) if h.visco_ratio > 0.0 else 1.0
         rc = h.visco_ratio * c
 
@@ -144,7 +169,7 @@ def _run(x: np.ndarray, t: np.ndarray, arm: float, k: float, c: float, h: Hidden
                 return 0.0
             for _ in range(48):
                 mid = 0.5 * (lo + hi)
-                tn = _tension(mid, c, et)
+                tn = _tension(mid, c, et, expo)
                 if p - mid - delayed(tn) - e_c - arm * theta_of(tn) > 0.0:
                     lo = mid
                 else:
@@ -154,7 +179,7 @@ def _run(x: np.ndarray, t: np.ndarray, arm: float, k: float, c: float, h: Hidden
         if mf > 0.0:
             # stick: the joint keeps its angle while the tension stays inside the friction band
             e_s = solve(lambda tn: theta)
-            t_s = _tension(e_s, c, et)
+            t_s = _tension(e_s, c, et, expo)
             stuck = abs(arm * t_s - k * theta) <= mf
             if stuck:
                 e_el = e_s
@@ -163,7 +188,7 @@ def _run(x: np.ndarray, t: np.ndarray, arm: float, k: float, c: float, h: Hidden
                 e_el = solve(lambda tn: max((arm * tn - sgn * mf) / k, 0.0))
         else:
             e_el = solve(lambda tn: arm * tn / k)
-        tension = _tension(e_el, c, et)
+        tension = _tension(e_el, c, et, expo)
         if mf > 0.0:
             if e_el <= 0.0:
                 # slack tendon: the joint springs back until friction holds it
@@ -180,7 +205,7 @@ def _run(x: np.ndarray, t: np.ndarray, arm: float, k: float, c: float, h: Hidden
 
 def simulate(
     pattern: Pattern,
-    hidden: Hidden = Hidden(),
+    hidden: Hidden | Sequence[Hidden] = Hidden(),
     *,
     n_samples: int = 2,
     n_cycles: int = 10,
@@ -201,7 +226,8 @@ def simulate(
     ----------
     pattern : Pattern
         Geometry (first notch's arm), tendon (E_t, L0, r_t), ``rules.max_stroke``.
-    hidden : Hidden
+    hidden : Hidden or sequence of Hidden
+        One for every sample, or one per sample (samples that carry different effects).
     n_samples, n_cycles : int
     noise_angle_deg, noise_force_N : float
         Standard deviations of the sensor noise.
@@ -234,20 +260,25 @@ def simulate(
     m = stroke.size
     parts: dict[str, list] = {k: [] for k in ("sample", "angle", "force", "true", "tension")}
     ks = []
+    per = [hidden] * n_samples if isinstance(hidden, Hidden) else list(hidden)
+    if len(per) != n_samples:
+        raise ValueError(f"{len(per)} Hidden values for {n_samples} samples")
     for i in range(n_samples):
         k = k0 * (1.0 + stiffness_spread * rng.uniform(-1.0, 1.0))
         ks.append(k)
-        theta, tension = _run(stroke, time, arm, k, c, hidden)
+        hidden_i = per[i]
+        theta, tension = _run(stroke, time, arm, k, c, hidden_i, cycle)
         ang = np.degrees(theta)
         parts["sample"].append(np.full(m, str(i + 1), dtype=object))
         parts["true"].append(ang)
         parts["tension"].append(tension)
-        parts["angle"].append(ang + hidden.angle_bias_deg + rng.normal(0.0, noise_angle_deg, m))
-        parts["force"].append(tension + hidden.force_zero_N + rng.normal(0.0, noise_force_N, m))
+        parts["angle"].append(ang + hidden_i.angle_bias_deg + rng.normal(0.0, noise_angle_deg, m))
+        parts["force"].append(tension + hidden_i.force_zero_N + rng.normal(0.0, noise_force_N, m))
     cat = {k: np.concatenate(v) for k, v in parts.items()}
     data = Dataset(cat["sample"], np.tile(cycle, n_samples).astype(int), np.tile(time, n_samples),
                    np.tile(stroke, n_samples), cat["force"], cat["angle"])
     floor = math.hypot(noise_angle_deg, math.degrees(c / arm) * noise_force_N)
     params = {"E_t": e_t, "L0": pattern.tendon.length_mm, "arm_mm": arm, "K_nmm_per_rad": ks,
-              **{f: getattr(hidden, f) for f in hidden.__dataclass_fields__}}
+              **({f: getattr(hidden, f) for f in hidden.__dataclass_fields__} if isinstance(hidden, Hidden)
+                 else {"per_sample": [dict(vars(h)) for h in per]})}
     return Simulation(data, cat["true"], cat["tension"], floor, params)
