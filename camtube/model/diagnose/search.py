@@ -134,6 +134,7 @@ class Candidate:
     values: dict = field(default_factory=dict)
     gain_z: float = 0.0
     block_mse: np.ndarray | None = None
+    per_sample: tuple = ()
 
 
 @dataclass(frozen=True, eq=False)
@@ -291,6 +292,15 @@ def cycle_blocks(data: Dataset, per_sample: int = 8) -> tuple[np.ndarray, np.nda
     return block, fold
 
 
+def block_strata(data: Dataset, block: np.ndarray) -> np.ndarray:
+    """The sample index of each block id (``np.unique(block)`` order)."""
+    smp = np.zeros(len(data), int)
+    for k, (_, sl) in enumerate(data.sample_slices()):
+        smp[sl] = k
+    ids, first = np.unique(block, return_index=True)
+    return smp[first]
+
+
 def holdout_mask(data: Dataset) -> np.ndarray:
     """(n,) bool: rows of fold 0 (see :func:`cycle_blocks`): the training rows of the first fit."""
     return cycle_blocks(data)[1] == 0
@@ -363,11 +373,15 @@ def _resolution_problems(model: JointModel, names: Sequence[str], values: Mappin
     record = max((float(np.ptp(t[sl])) for _, sl in data.sample_slices()), default=0.0)
     span = float(np.ptp(np.asarray(data.stroke_mm, float))) if len(data) else 0.0
     out = []
+    free_base = {nm.split("@")[0] for nm in names if nm not in at_bound and math.isfinite(stderr.get(nm, math.inf))}
     for nm in names:
         spec = model.spec(nm)
         v = float(values[nm])
         se = float(stderr.get(nm, math.inf))
         unit = f" {spec.unit}" if spec.unit else ""
+        if ("@" in nm and nm.split("@")[0] in free_base and spec.lo == 0.0 and abs(v) <= 1e-6 * max(spec.hi, 1.0)
+                and nm in at_bound):
+            continue  # the effect is absent in this sample only (its value is zero): reported per sample
         if nm in at_bound:
             out.append(f"{nm} = {v:.4g}{unit} is on its bound")
         elif not math.isfinite(se):
@@ -471,8 +485,10 @@ def diagnose(
 
     search = thin(data, max_rows)
     block, fold = cycle_blocks(search)
+    strata = block_strata(search, block)
     current = model
     cur_names = full_names
+    cur_ps: list[str] = []
     cur = _search_fit(current, search, cur_names, base_full.params, fixed)
     cur_ho, cur_mse = _cv(current, search, cur_names, cur.params, fixed, fold, block)
     base_rmse, base_ho = cur.rmse, cur_ho
@@ -495,7 +511,8 @@ def diagnose(
             stop = "no candidate effects left"
             break
         ranked = _round(current, search, cur_names, cur, cur_ho, cur_mse, fold, block, pool, floor, fixed,
-                        bic_threshold, min_gain, min_excess, z, grid, modulus_range_gpa)
+                        bic_threshold, min_gain, min_excess, z, grid, modulus_range_gpa, cur_ps, strata,
+                        per_sample and len(search.samples) > 1)
         accepted = None
         for c in ranked:
             if not c.significant:
@@ -503,13 +520,16 @@ def diagnose(
             eff = next(e for e in pool if e.name == c.effect)
             m = current.with_effects(list(current.effects) + [eff])
             names = cur_names + eff.full_names()
-            init = {k: v for k, v in c.values.items() if k in names}
-            r = refit_all_rows(m, data, names, fixed, init, grid)
+            ps = cur_ps + list(c.per_sample)
+            init = {k: v for k, v in c.values.items() if k.split("@")[0] in names and (k in c.values)}
+            init = {k: v for k, v in init.items() if ("@" in k) or k not in ps}
+            r = refit_all_rows(m, data, names, fixed, init, grid, per_sample=ps)
             problems = []
             if not r.rmse < prev_all.rmse:
                 problems.append(f"its refit on all rows does not lower the RMSE ({prev_all.rmse:.3f} -> "
                                 f"{r.rmse:.3f} deg)")
-            problems += _resolution_problems(m, eff.full_names(), r.params, r.stderr, r.at_bound, data,
+            new_fitted = [n for n in r.fitted if n.split("@")[0] in eff.full_names()]
+            problems += _resolution_problems(m, new_fitted, r.params, r.stderr, r.at_bound, data,
                                              modulus_range_gpa)
             # the floor seen through this model's residual (a model error inflates the estimate a little)
             f_c = min(floor, noise_floor(data, r.residuals))
@@ -520,7 +540,7 @@ def diagnose(
             if problems:
                 rejected.append((c.effect, "; ".join(problems)))
                 continue
-            accepted = (c, eff, m, names, r, init)
+            accepted = (c, eff, m, names, r, {k: v for k, v in init.items() if k in r.fitted}, ps)
             break
         ranked = tuple(_mark_rejected(ranked, rejected))
         rounds.append(ranked)
@@ -529,14 +549,15 @@ def diagnose(
             stop = ("no candidate improves the model significantly and reliably"
                     + (f" (best: {top.effect}: {top.why})" if top is not None and top.why else ""))
             break
-        c, eff, m, names, r, init = accepted
+        c, eff, m, names, r, init, ps = accepted
         floor, floor_se = f_c, se_c
+        cur_ps = ps
         rejected = [(e, w) for e, w in rejected if e != eff.name]
         recommended.append(eff.name)
         chosen.append(eff)
         current, cur_names, prev_all = m, names, r
-        steps.append(_step(r, (), init))
-        cur = _search_fit(current, search, cur_names, c.values, fixed)
+        steps.append(_step(r, cur_ps, init))
+        cur = _search_fit(current, search, cur_names, c.values, fixed, per_sample=cur_ps)
         cur_ho, cur_mse = c.heldout_rmse_deg, c.block_mse
         pool = [e for e in pool if e.name != eff.name]
     clock["search"] = time.perf_counter()
@@ -546,9 +567,11 @@ def diagnose(
     notes: list[str] = []
     if per_sample and len(data.samples) > 1 and chosen:
         ps_names, notes, final = _per_sample(current, data, search, cur_names, cur, cur_ho, cur_mse, fold, block,
-                                             chosen, fixed, floor, floor_se, prev_all, bic_threshold, z, grid)
+                                             chosen, fixed, floor, floor_se, prev_all, bic_threshold, z, grid,
+                                             cur_ps, strata)
         if final is not None:
             steps.append(final)
+        ps_names = list(steps[-1].per_sample)
     base_ps = steps[0].rmse_per_sample
     fin_ps = steps[-1].rmse_per_sample
     for smp in base_ps:
@@ -575,33 +598,62 @@ def _mark_rejected(ranked, rejected):
         if c.effect in why and c.significant:
             yield Candidate(c.effect, c.effects, c.rmse_deg, c.heldout_rmse_deg, c.delta_bic, c.params,
                             c.equivalent, c.confounded, False, "all-rows check: " + why[c.effect], c.predicted,
-                            c.values, c.gain_z, c.block_mse)
+                            c.values, c.gain_z, c.block_mse, c.per_sample)
         else:
             yield c
 
 
-def _gain(cur_mse: np.ndarray, new_mse: np.ndarray) -> tuple[float, float]:
-    """Mean fall of the per-block held-out MSE and its standard error (paired over blocks)."""
+def _gain(cur_mse: np.ndarray, new_mse: np.ndarray, strata: np.ndarray | None = None) -> tuple[float, float]:
+    """Mean fall of the per-block held-out MSE and its standard error (paired over blocks).
+
+    With ``strata`` (the sample of each block) the standard error is the stratified one: samples may differ
+    (an effect present in one sample only), only the spread within a sample is noise.
+    """
     d = np.asarray(cur_mse) - np.asarray(new_mse)
     if d.size < 2:
         return float(d.mean()) if d.size else 0.0, math.inf
-    return float(d.mean()), float(d.std(ddof=1) / math.sqrt(d.size))
+    if strata is None or np.unique(strata).size < 2:
+        return float(d.mean()), float(d.std(ddof=1) / math.sqrt(d.size))
+    var = 0.0
+    for sv in np.unique(strata):
+        ds = d[strata == sv]
+        v = float(ds.var(ddof=1)) if ds.size > 1 else float(d.var(ddof=1))
+        var += ds.size * v
+    return float(d.mean()), math.sqrt(var) / d.size
 
 
 def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResult, cur_ho: float,
            cur_mse: np.ndarray, fold: np.ndarray, block: np.ndarray, pool: list[Effect], floor: float,
            fixed: Mapping[str, float], bic_threshold: float, min_gain: float, min_excess: float, z: float,
-           grid: int, modulus_range_gpa: tuple[float, float]) -> tuple[Candidate, ...]:
-    """Every effect of ``pool`` on top of ``current``, ranked by held-out RMSE."""
-    tried: list[Candidate] = []
+           grid: int, modulus_range_gpa: tuple[float, float], cur_ps: Sequence[str] = (),
+           strata: np.ndarray | None = None, try_per_sample: bool = False) -> tuple[Candidate, ...]:
+    """Every effect of ``pool`` on top of ``current``, ranked by held-out RMSE.
+
+    With ``try_per_sample``, the best three effects are also fitted with per-sample parameters; that
+    version replaces the shared one when its held-out error is significantly lower.
+    """
+    fits = []
     for eff in pool:
         m = current.with_effects(list(current.effects) + [eff])
         new = eff.full_names()
         start = m.initial_values(search, base=cur.params)
-        f = _search_fit(m, search, cur_names + new, start, fixed, grid=grid, grid_names=new)
-        ho, mse = _cv(m, search, cur_names + new, f.params, fixed, fold, block)
+        f = _search_fit(m, search, cur_names + new, start, fixed, grid=grid, grid_names=new, per_sample=cur_ps)
+        ho, mse = _cv(m, search, cur_names + new, f.params, fixed, fold, block, per_sample=cur_ps)
+        fits.append([eff, m, new, f, ho, mse, ()])
+    if try_per_sample:
+        for row in sorted([r for r in fits if r[2]], key=lambda r: r[4])[:3]:
+            eff, m, new, f, ho, mse, _ = row
+            ps = list(cur_ps) + list(new)
+            f2 = _search_fit(m, search, cur_names + new, f.params, fixed, per_sample=ps)
+            ho2, mse2 = _cv(m, search, cur_names + new, f2.params, fixed, fold, block, per_sample=ps)
+            dm, se = _gain(mse, mse2, strata)
+            if dm > z * se and f2.bic < f.bic - bic_threshold:
+                row[3:7] = [f2, ho2, mse2, tuple(new)]
+    tried: list[Candidate] = []
+    for eff, m, new, f, ho, mse, eff_ps in fits:
         dbic = f.bic - cur.bic
-        params = {nm: (f.params[nm], f.stderr.get(nm, math.inf), m.spec(nm).unit) for nm in new}
+        shown = [n for n in f.fitted if n.split("@")[0] in new] if eff_ps else list(new)
+        params = {nm: (f.params[nm], f.stderr.get(nm, math.inf), m.spec(nm).unit) for nm in shown}
         conf = []
         idx = {nm: i for i, nm in enumerate(f.fitted)}
         for a in new:
@@ -614,7 +666,7 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
         why = []
         gain = 1.0 - ho / cur_ho if cur_ho > 0 else 0.0
         excess = cur_ho**2 - floor**2
-        dm, se = _gain(cur_mse, mse)
+        dm, se = _gain(cur_mse, mse, strata)
         gz = dm / se if se > 0 and math.isfinite(se) else (math.inf if dm > 0 else 0.0)
         if not dbic < -bic_threshold:
             why.append(f"delta BIC {dbic:+.1f} is not below -{bic_threshold:g}")
@@ -625,10 +677,11 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
         if gain >= min_gain and not gz > z:
             why.append(f"the held-out gain is {gz:.1f} standard errors, not more than {z:g} (within the noise)")
         if new and not why:
-            why += _resolution_problems(m, new, f.params, f.stderr, f.at_bound, search, modulus_range_gpa)
+            why += _resolution_problems(m, shown, f.params, f.stderr, f.at_bound, search, modulus_range_gpa)
         tried.append(Candidate(eff.name, tuple(e.name for e in m.effects), f.rmse, ho, dbic, params,
                                confounded=tuple(conf), significant=not why, why="; ".join(why),
-                               predicted=f.predicted, values=dict(f.params), gain_z=gz, block_mse=mse))
+                               predicted=f.predicted, values=dict(f.params), gain_z=gz, block_mse=mse,
+                               per_sample=eff_ps))
     tried.sort(key=lambda c: (c.heldout_rmse_deg, c.effect))
     # equivalences: near-equal held-out error and predictions within half the noise floor
     fam = {e.name: e.family for e in pool}
@@ -647,7 +700,7 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
                 eq.append(o.effect)
         out.append(Candidate(c.effect, c.effects, c.rmse_deg, c.heldout_rmse_deg, c.delta_bic, c.params,
                              tuple(eq), c.confounded, c.significant, c.why, c.predicted, c.values, c.gain_z,
-                             c.block_mse))
+                             c.block_mse, c.per_sample))
     # among candidates that cannot be told apart from the best, the lowest BIC (the simplest) leads
     if out and out[0].equivalent:
         group = [c for c in out if c is out[0] or c.effect in out[0].equivalent]
@@ -660,30 +713,36 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
 
 
 def _per_sample(current, data, search, cur_names, cur, cur_ho, cur_mse, fold, block, chosen, fixed, floor, floor_se,
-                prev_all, bic_threshold, z, grid):
+                prev_all, bic_threshold, z, grid, cur_ps=(), strata=None):
     """Try each recommended effect's parameters per sample; returns (names, notes, final step or None)."""
-    ps: list[str] = []
+    ps: list[str] = list(cur_ps)
     notes: list[str] = []
     base_fit = cur
     base_mse = cur_mse
+    changed = False
     for eff in chosen:
-        if not eff.params:
+        if not eff.params or all(n in ps for n in eff.full_names()):
             continue
-        trial = ps + list(eff.full_names())
+        trial = ps + [n for n in eff.full_names() if n not in ps]
         f = _search_fit(current, search, cur_names, base_fit.params, fixed, per_sample=trial)
         ho, mse = _cv(current, search, cur_names, f.params, fixed, fold, block, per_sample=trial)
-        dm, se = _gain(base_mse, mse)
+        dm, se = _gain(base_mse, mse, strata)
         dbic = f.bic - base_fit.bic
         if dm > z * se and dbic < -bic_threshold:
             ps = trial
             base_fit, base_mse = f, mse
+            changed = True
     if not ps:
         return [], notes, None
-    init = {k: v for k, v in base_fit.params.items() if k in base_fit.fitted}
-    r = refit_all_rows(current, data, cur_names, fixed, init, grid, per_sample=ps)
-    if not r.rmse < prev_all.rmse or r.rmse < floor - 2.0 * floor_se:
-        notes.append("per-sample parameters were better on held-out cycles but not on all rows: kept shared")
-        return [], notes, None
+    final = None
+    r = prev_all
+    if changed:
+        init = {k: v for k, v in base_fit.params.items() if k in base_fit.fitted}
+        r = refit_all_rows(current, data, cur_names, fixed, init, grid, per_sample=ps)
+        if not r.rmse < prev_all.rmse or r.rmse < floor - 2.0 * floor_se:
+            notes.append("per-sample parameters were better on held-out cycles but not on all rows: kept as before")
+            return list(cur_ps), notes, None
+        final = _step(r, ps, init)
     samples = data.samples
     for nm in ps:
         vals = [(s, r.params[f"{nm}@{s}"], r.stderr.get(f"{nm}@{s}", math.inf)) for s in samples]
@@ -698,4 +757,4 @@ def _per_sample(current, data, search, cur_names, cur, cur_ho, cur_mse, fold, bl
             notes.append(f"samples differ in {nm}: " + "; ".join(diff))
         else:
             notes.append(f"{nm} per sample: " + ", ".join(f"{s} {v:.4g}" for s, v, _ in vals) + " (within errors)")
-    return ps, notes, _step(r, ps, init)
+    return ps, notes, final

@@ -159,6 +159,12 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
             lines.append(f"  {k}. {name}: {e.signature}: {e.meaning}.")
             for p in e.params:
                 full = f"{name}.{p.name}"
+                if full in step.per_sample:
+                    lines.append(f"       {full}, per sample ({p.doc}):")
+                    for smp in step.rmse_per_sample:
+                        key = f"{full}@{smp}"
+                        lines.append(f"         {key} = {_pm(step.params[key], step.stderr.get(key, math.inf), p.unit)}")
+                    continue
                 lines.append(f"       {full} = {_pm(step.params[full], step.stderr.get(full, math.inf), p.unit)}"
                              f"  ({p.doc})")
             rnd = d.rounds[k - 1] if k - 1 < len(d.rounds) else ()
@@ -170,7 +176,7 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
             lines.append(f"       RMSE {prev.rmse_deg:.3f} -> {step.rmse_deg:.3f} deg "
                          f"({_times(step.rmse_deg, floor)} the noise floor)")
             prev = step
-        if d.per_sample:
+        if d.per_sample and len(d.waterfall) > len(d.recommended) + 1:
             step = d.final
             lines.append(f"  per sample: {', '.join(d.per_sample)} (significantly better on held-out cycles)")
             for full in d.per_sample:
