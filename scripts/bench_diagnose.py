@@ -181,9 +181,9 @@ def speed() -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--batch", default="all", choices=("tune", "heldout", "speed", "all"))
+    ap.add_argument("--batch", default="tune", choices=("tune", "heldout", "speed", "all"))
     args = ap.parse_args()
-    if args.batch in ("speed", "all"):
+    if args.batch in ("speed", "all", "tune"):
         speed()
     for batch, sets, seed0 in (("tune", TUNE, 100), ("heldout", None, 5000)):
         if args.batch not in (batch, "all"):

@@ -20,7 +20,7 @@ Method
    always runs over the whole history.
 4. **Candidates.** Each effect not yet in the model is added in turn and
    fitted from several starts (the current fit plus the effect's defaults,
-   and the best points of a grid over each new parameter's declared range,
+   and the best point of a grid over each new parameter's declared range,
    log-spaced for scales). A candidate is **significant** when
    its held-out mean squared error falls by more than ``z`` times the
    standard error of that fall (paired over the blocks), ``delta BIC`` is
@@ -41,6 +41,7 @@ Method
    error falls significantly. The output says which samples differ (values
    more than three combined standard errors apart) and names any sample the
    final model leaves worse than the current one.
+   The next round retries only the candidates whose held-out RMSE fell by ``min_gain`` in this one.
 7. The search stops when the held-out RMSE is within ``stop_ratio`` of the
    noise floor (``stop_ratio=None`` turns the rule off: the significance
    tests alone must then stop it), when nothing qualifies, or after
@@ -327,13 +328,14 @@ def _fitted(r: FitResult) -> Fitted:
 
 def _search_fit(model: JointModel, data: Dataset, names: Sequence[str], values: Mapping[str, float],
                 fixed: Mapping[str, float], grid: int = 0, grid_names: Sequence[str] | None = None,
-                per_sample: Sequence[str] = (), rows: np.ndarray | None = None, max_nfev: int = 100) -> FitResult:
+                per_sample: Sequence[str] = (), rows: np.ndarray | None = None, max_nfev: int = 100,
+                keep: int = 1) -> FitResult:
     params = model.make_params(data, names, fixed, initial={k: v for k, v in values.items()
                                                           if k in model.param_specs or "@" in k},
                                per_sample=per_sample)
     params = params.with_values({k: v for k, v in values.items() if k in params})
     return fit(model, data, params=params, grid=grid, grid_names=grid_names, rows=rows, max_nfev=max_nfev,
-               tol=1e-8)
+               tol=1e-8, keep=keep)
 
 
 def _cv(model: JointModel, data: Dataset, names: Sequence[str], start: Mapping[str, float],
@@ -513,6 +515,7 @@ def diagnose(
         ranked = _round(current, search, cur_names, cur, cur_ho, cur_mse, fold, block, pool, floor, fixed,
                         bic_threshold, min_gain, min_excess, z, grid, modulus_range_gpa, cur_ps, strata,
                         per_sample and len(search.samples) > 1)
+        ranked_base_ho = cur_ho
         accepted = None
         for c in ranked:
             if not c.significant:
@@ -528,8 +531,8 @@ def diagnose(
             if not r.rmse < prev_all.rmse:
                 problems.append(f"its refit on all rows does not lower the RMSE ({prev_all.rmse:.3f} -> "
                                 f"{r.rmse:.3f} deg)")
-            new_fitted = [n for n in r.fitted if n.split("@")[0] in eff.full_names()]
-            problems += _resolution_problems(m, new_fitted, r.params, r.stderr, r.at_bound, data,
+            # every fitted parameter, not only the new ones: a new effect may push E_t to its bound
+            problems += _resolution_problems(m, list(r.fitted), r.params, r.stderr, r.at_bound, data,
                                              modulus_range_gpa)
             # the floor seen through this model's residual (a model error inflates the estimate a little)
             f_c = min(floor, noise_floor(data, r.residuals))
@@ -559,7 +562,10 @@ def diagnose(
         steps.append(_step(r, cur_ps, init))
         cur = _search_fit(current, search, cur_names, c.values, fixed, per_sample=cur_ps)
         cur_ho, cur_mse = c.heldout_rmse_deg, c.block_mse
-        pool = [e for e in pool if e.name != eff.name]
+        # the next round tries only the effects that helped in this one (held-out RMSE down by min_gain):
+        # one that explained nothing on the simpler model is not retried (speed; see the module docstring)
+        useful = {x.effect for x in ranked if x.heldout_rmse_deg <= (1.0 - min_gain) * ranked_base_ho}
+        pool = [e for e in pool if e.name != eff.name and e.name in useful]
     clock["search"] = time.perf_counter()
 
     # per-sample parameters of the recommended effects
@@ -629,7 +635,7 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
            strata: np.ndarray | None = None, try_per_sample: bool = False) -> tuple[Candidate, ...]:
     """Every effect of ``pool`` on top of ``current``, ranked by held-out RMSE.
 
-    With ``try_per_sample``, the best three effects are also fitted with per-sample parameters; that
+    With ``try_per_sample``, the best two effects are also fitted with per-sample parameters; that
     version replaces the shared one when its held-out error is significantly lower.
     """
     fits = []
@@ -641,7 +647,7 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
         ho, mse = _cv(m, search, cur_names + new, f.params, fixed, fold, block, per_sample=cur_ps)
         fits.append([eff, m, new, f, ho, mse, ()])
     if try_per_sample:
-        for row in sorted([r for r in fits if r[2]], key=lambda r: r[4])[:3]:
+        for row in sorted([r for r in fits if r[2]], key=lambda r: r[4])[:2]:
             eff, m, new, f, ho, mse, _ = row
             ps = list(cur_ps) + list(new)
             f2 = _search_fit(m, search, cur_names + new, f.params, fixed, per_sample=ps)
@@ -677,7 +683,8 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
         if gain >= min_gain and not gz > z:
             why.append(f"the held-out gain is {gz:.1f} standard errors, not more than {z:g} (within the noise)")
         if new and not why:
-            why += _resolution_problems(m, shown, f.params, f.stderr, f.at_bound, search, modulus_range_gpa)
+            why += _resolution_problems(m, list(f.fitted), f.params, f.stderr, f.at_bound, search,
+                                        modulus_range_gpa)
         tried.append(Candidate(eff.name, tuple(e.name for e in m.effects), f.rmse, ho, dbic, params,
                                confounded=tuple(conf), significant=not why, why="; ".join(why),
                                predicted=f.predicted, values=dict(f.params), gain_z=gz, block_mse=mse,
