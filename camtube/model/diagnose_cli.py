@@ -11,7 +11,7 @@ from pathlib import Path
 
 
 def register(model_sub) -> None:
-    from camtube.model.cli import EFFECT_NAMES
+    from camtube.model import EFFECT_NAMES
 
     d = model_sub.add_parser(
         "diagnose", help="find the physical effects the model is missing, rank them, say how to add them",
@@ -42,6 +42,12 @@ def register(model_sub) -> None:
     d.add_argument("--max-rows", type=int, default=4000, metavar="N",
                    help="rows used by the candidate search, thinned evenly in time (default 4000; 0 = all)")
     d.add_argument("--max-effects", type=int, default=4, metavar="N", help="most effects recommended (default 4)")
+    d.add_argument("--modulus-range", default="1,300", metavar="LO,HI",
+                   help="plausible tendon E_t in GPa; a fit outside is not trusted (default 1,300)")
+    d.add_argument("--no-stop-rule", dest="stop_rule", action="store_false",
+                   help="do not stop at 1.15 x the noise floor (the significance tests alone decide)")
+    d.add_argument("--no-per-sample", dest="per_sample", action="store_false",
+                   help="do not test per-sample parameters of the recommended effects")
     d.add_argument("--json", metavar="OUT.json", help="write the diagnosis as JSON")
     d.add_argument("--report", metavar="DIR", help="write an HTML report with PNG plots into DIR")
     d.set_defaults(func=cmd_diagnose)
@@ -64,36 +70,35 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     from camtube.cliutil import load_from_args
     from camtube.errors import DataError
     from camtube.io import write_atomic
-    from camtube.model.cli import build_model, parse_fix, split_names
+    from camtube.model.core.build import build_registry, check_suffix, parse_fix, split_names
+    from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import load_csv, select_cycles
     from camtube.model.diagnose import diagnose
-    from camtube.model.fit import FitError
-    from camtube.model.predict import pattern_values
-    from camtube.model.report import diagnosis_json, diagnosis_text, write_report
-
-    from camtube.model.cli import check_suffix
+    from camtube.model.report.diagnosis import diagnosis_json, diagnosis_text, write_report
 
     check_suffix(args.json, (".json",), "--json")
     if args.report is not None and Path(args.report).exists() and not Path(args.report).is_dir():
         raise DataError(f"--report {args.report}: is a file; the report is a directory (index.html and PNGs)")
+    if args.max_rows < 0 or args.max_effects < 0:
+        raise DataError("--max-rows and --max-effects must be >= 0")
     pattern = load_from_args(args).pattern
-    model = build_model(pattern, args.effects, args.effect_file)
+    reg, _ = build_registry(args.effect_file)
+    model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects)])
     raw = load_csv(args.data)
     rows = select_cycles(raw, args.cycles)
     fixed = pattern_values(pattern)
     fixed.update(parse_fix(args.fix))
-    cands = split_names(args.candidates) or None
-    if cands:
-        from camtube.model.api import get_effect
-
-        try:
-            cands = [get_effect(c) for c in cands]
-        except KeyError as exc:
-            raise FitError(exc.args[0]) from None
-    if args.max_rows < 0 or args.max_effects < 0:
-        raise DataError("--max-rows and --max-effects must be >= 0")
+    cands = [reg.get_effect(c) for c in split_names(args.candidates)] or None
+    try:
+        lo, hi = (float(v) for v in args.modulus_range.split(","))
+    except ValueError:
+        raise DataError(f"--modulus-range {args.modulus_range!r}: use LO,HI in GPa, e.g. 1,300") from None
+    if not 0 < lo < hi:
+        raise DataError(f"--modulus-range {args.modulus_range!r}: need 0 < LO < HI (GPa)")
     d = diagnose(model, rows, split_names(args.fit_params), fixed, candidates=cands,
-                 max_rows=args.max_rows, max_effects=args.max_effects)
+                 max_rows=args.max_rows, max_effects=args.max_effects, registry=reg,
+                 stop_ratio=1.15 if args.stop_rule else None, modulus_range_gpa=(lo, hi),
+                 per_sample=args.per_sample)
     prefix = fit_command_prefix(args)
     title = f"{pattern.name}: {args.data} ({len(rows)} rows, cycles {args.cycles}, both directions, deadband kept)"
     print(diagnosis_text(d, prefix, title))

@@ -137,7 +137,7 @@ def test_diagnose_on_noise_free_data_reports_without_dividing_by_zero(tmp_path, 
 
 @pytest.mark.parametrize("cmd", ["fit", "diagnose"])
 def test_help_lists_the_effect_names(cmd, capsys):
-    from camtube.model.cli import EFFECT_NAMES
+    from camtube.model import EFFECT_NAMES
     from camtube.model.effects import BUILTINS
 
     assert tuple(EFFECT_NAMES) == tuple(BUILTINS)

@@ -22,20 +22,20 @@ TRAP = 0.05  # N mm of joint friction in every case: measured-force hysteresis t
 CASES = [
     ("slack-tube1", "tube1", Hidden(slack_mm=0.1, joint_friction_nmm=TRAP), {"slack"},
      {"slack.deadband_mm": (0.1, 0.1)}),
-    ("slack-tube3", "tube3", Hidden(slack_mm=0.3), {"slack"}, {"slack.deadband_mm": (0.3, 0.1)}),
+    ("slack-tube3", "tube3", Hidden(slack_mm=0.3, joint_friction_nmm=0.0), {"slack"}, {"slack.deadband_mm": (0.3, 0.1)}),
     ("play-tube2", "tube2", Hidden(play_mm=0.06, joint_friction_nmm=TRAP), {"play"}, {"play.play_mm": (0.06, 0.1)}),
-    ("play-tube1", "tube1", Hidden(play_mm=0.15), {"play"}, {"play.play_mm": (0.15, 0.1)}),
+    ("play-tube1", "tube1", Hidden(play_mm=0.15, joint_friction_nmm=0.0), {"play"}, {"play.play_mm": (0.15, 0.1)}),
     ("toe-tube1", "tube1", Hidden(toe_mm=0.2, joint_friction_nmm=TRAP), {"toe"}, {"toe.toe_mm": (0.2, 0.1)}),
-    ("toe-tube2", "tube2", Hidden(toe_mm=0.4), {"toe"}, {"toe.toe_mm": (0.4, 0.1)}),
+    ("toe-tube2", "tube2", Hidden(toe_mm=0.4, joint_friction_nmm=0.0), {"toe"}, {"toe.toe_mm": (0.4, 0.1)}),
     ("visco-tube2", "tube2", Hidden(visco_ratio=0.3, visco_tau_s=1.0, joint_friction_nmm=TRAP), {"viscoelastic"},
      {"viscoelastic.ratio": (0.3, 0.15), "viscoelastic.tau_s": (1.0, 0.2)}),
-    ("visco-tube3", "tube3", Hidden(visco_ratio=0.6, visco_tau_s=3.0), {"viscoelastic"},
+    ("visco-tube3", "tube3", Hidden(visco_ratio=0.6, visco_tau_s=3.0, joint_friction_nmm=0.0), {"viscoelastic"},
      {"viscoelastic.ratio": (0.6, 0.15), "viscoelastic.tau_s": (3.0, 0.2)}),
     ("creep-tube1", "tube1", Hidden(creep_mm_per_N=0.05, creep_tau_s=20.0, joint_friction_nmm=TRAP), {"creep"}, {}),
-    ("creep-tube2", "tube2", Hidden(creep_mm_per_N=0.03, creep_tau_s=40.0), {"creep"}, {}),
+    ("creep-tube2", "tube2", Hidden(creep_mm_per_N=0.03, creep_tau_s=40.0, joint_friction_nmm=0.0), {"creep"}, {}),
     ("slack+play-tube2", "tube2", Hidden(slack_mm=0.08, play_mm=0.06, joint_friction_nmm=TRAP), {"slack", "play"},
      {"slack.deadband_mm": (0.08, 0.1), "play.play_mm": (0.06, 0.1)}),
-    ("play+creep-tube3", "tube3", Hidden(play_mm=0.2, creep_mm_per_N=0.02, creep_tau_s=30.0), {"play", "creep"},
+    ("play+creep-tube3", "tube3", Hidden(play_mm=0.2, creep_mm_per_N=0.02, creep_tau_s=30.0, joint_friction_nmm=0.0), {"play", "creep"},
      {"play.play_mm": (0.2, 0.1)}),
 ]
 
@@ -87,20 +87,20 @@ def test_control_recommends_nothing(tube):
 def test_control_with_the_search_forced_finds_nothing_significant():
     """Even when the search runs (stop ratio 0), no effect passes the significance tests on pure noise."""
     p = load_pattern(PATTERNS / "tube2.yaml")
-    sim = simulate(p, Hidden(), n_cycles=10, seed=3)
+    sim = simulate(p, Hidden(joint_friction_nmm=0.0), n_cycles=10, seed=3)
     d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p), stop_ratio=0.0)
     assert d.recommended == () and d.rounds and not any(c.significant for c in d.candidates)
 
 
 def test_series_compliance_is_declared_confounded_with_e_t():
-    _, _, d = _run("tube1", Hidden(slack_mm=0.1))
+    _, _, d = _run("tube1", Hidden(slack_mm=0.1, joint_friction_nmm=0.0))
     ser = next(c for c in d.candidates if c.effect == "series")
     assert not ser.significant and any(s.startswith("E_t") for s in ser.confounded)
 
 
 def test_noise_floor_is_robust_to_model_error():
     p = load_pattern(PATTERNS / "tube2.yaml")
-    sim = simulate(p, Hidden(play_mm=0.1, visco_ratio=0.3), n_cycles=10, seed=2)
+    sim = simulate(p, Hidden(play_mm=0.1, visco_ratio=0.3, joint_friction_nmm=0.0), n_cycles=10, seed=2)
     base = model_for_pattern(p)
     resid = sim.data.angle_deg - base.predict(sim.data, pattern_values(p))
     assert abs(noise_floor(sim.data, resid) / sim.sensor_floor_deg - 1) < 0.15
@@ -108,7 +108,7 @@ def test_noise_floor_is_robust_to_model_error():
 
 def test_atlas_shows_direction_for_play():
     p = load_pattern(PATTERNS / "tube1.yaml")
-    sim = simulate(p, Hidden(play_mm=0.15), n_cycles=4, seed=1)
+    sim = simulate(p, Hidden(play_mm=0.15, joint_friction_nmm=0.0), n_cycles=4, seed=1)
     r = sim.data.angle_deg - model_for_pattern(p).predict(sim.data, pattern_values(p))
     at = residual_atlas(sim.data, r)
     dirn = at.panel("direction")
@@ -118,7 +118,7 @@ def test_atlas_shows_direction_for_play():
 
 def test_cli_json_report_and_fit_command(tmp_path, capsys):
     p = load_pattern(PATTERNS / "tube2.yaml")
-    sim = simulate(p, Hidden(slack_mm=0.08, play_mm=0.06), n_cycles=6, seed=5)
+    sim = simulate(p, Hidden(slack_mm=0.08, play_mm=0.06, joint_friction_nmm=0.0), n_cycles=6, seed=5)
     csv = tmp_path / "d.csv"
     csv.write_text(format_csv(sim.data))
     out, rep = tmp_path / "d.json", tmp_path / "rep"
@@ -143,3 +143,69 @@ def test_cli_json_report_and_fit_command(tmp_path, capsys):
     fitted = json.loads(fit_json.read_text())
     assert fitted["rmse_deg"] == pytest.approx(js["waterfall"][-1]["rmse_deg"], rel=1e-3)
     assert math.isclose(fitted["params"]["play.play_mm"]["value"], 0.06, rel_tol=0.1)
+
+
+# ----------------------------------------------------------------------------- trust (issue 11)
+
+def test_cycle_blocks_test_every_cycle_and_cycle_one_in_both_folds():
+    from camtube.model.diagnose.search import cycle_blocks
+
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    sim = simulate(p, Hidden(joint_friction_nmm=0.0), n_samples=2, n_cycles=10, seed=1)
+    d = sim.data
+    block, fold = cycle_blocks(d)
+    first = np.asarray(d.cycle) == 1
+    s1 = d.sample == "1"
+    # every row is a test row of exactly one fold; cycle 1 of sample 1 is tested in one fold, of sample 2 in the other
+    assert set(np.unique(fold)) == {0, 1}
+    assert np.unique(fold[first & s1]).size == 1 and np.unique(fold[first & ~s1]).size == 1
+    assert fold[first & s1][0] != fold[first & ~s1][0]
+    # blocks hold whole cycles
+    for b in np.unique(block):
+        cyc = set(np.asarray(d.cycle)[block == b].tolist())
+        assert all(((np.asarray(d.cycle) == c) & (block != b) & (d.sample == d.sample[block == b][0])).sum() == 0
+                   for c in cyc)
+
+
+def test_a_control_gets_nothing_even_with_the_stop_rule_off():
+    p = load_pattern(PATTERNS / "tube1.yaml")
+    sim = simulate(p, Hidden(), n_samples=2, n_cycles=8, seed=21)  # friction distractor on (the default)
+    d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p), stop_ratio=None)
+    assert d.recommended == (), [(c.effect, c.why) for c in d.candidates[:3]]
+    # and the candidates that fail say why
+    assert all(c.why for c in d.candidates if not c.significant)
+
+
+def test_samples_that_differ_get_their_own_values_and_the_output_says_so():
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    sim = simulate(p, [Hidden(slack_mm=0.04), Hidden(slack_mm=0.10)], n_samples=2, n_cycles=6, seed=8)
+    d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
+    assert d.recommended[0] == "slack" and "slack.deadband_mm" in d.per_sample
+    assert d.final.params["slack.deadband_mm@1"] == pytest.approx(0.04, rel=0.1)
+    assert d.final.params["slack.deadband_mm@2"] == pytest.approx(0.10, rel=0.1)
+    assert any("samples differ in slack.deadband_mm" in n for n in d.sample_notes)
+    base, final = d.waterfall[0].rmse_per_sample, d.final.rmse_per_sample
+    assert all(final[s] < base[s] for s in base)
+    assert d.final.rmse_deg <= 1.15 * sim.sensor_floor_deg
+
+
+def test_every_recommended_step_lowers_the_rmse_and_its_parameters_are_identified():
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    sim = simulate(p, Hidden(play_mm=0.05, toe_mm=0.3, toe_form="exponential"), n_samples=2, n_cycles=6, seed=4)
+    d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
+    assert d.recommended and d.recommended[0] in ("toe", "play")
+    for a, b in zip(d.waterfall, d.waterfall[1:]):
+        assert b.rmse_deg < a.rmse_deg
+    for k, v in d.final.stderr.items():
+        assert math.isfinite(v) and v > 0, k
+    assert 1.0 <= d.final.params["E_t"] <= 300.0
+
+
+def test_fit_warns_when_a_history_effect_is_fitted_on_the_default_selection(tmp_path, capsys):
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    sim = simulate(p, Hidden(play_mm=0.06), n_samples=1, n_cycles=3, seed=2)
+    csv = tmp_path / "d.csv"
+    csv.write_text(format_csv(sim.data))
+    main(["model", "fit", str(csv), "--pattern", str(PATTERNS / "tube2.yaml"), "-q", "--effects", "play"])
+    out = capsys.readouterr().out
+    assert "warning: play" in out and "--branch both" in out
