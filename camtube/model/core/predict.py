@@ -175,7 +175,21 @@ def stiffness_from_data(data: Dataset, arm_mm: float) -> float:
 
 def design_summary(pattern: Pattern, steps: int = 5,
                    modulus_gpa: float = POLYIMIDE_MODULUS_GPA) -> str:
-    """Text table of the predicted stroke-angle curve up to ``rules.max_stroke`` (for ``camtube design``)."""
+    """Text table of the predicted stroke-angle curve up to ``rules.max_stroke`` (for ``camtube design``).
+
+    A pattern that bends several ways (bidirectional, multi-direction) has one tendon per
+    direction, each pulling only its own notches: one table per direction.
+    """
+    groups: dict[float, list] = {}
+    for n in pattern.notches:
+        groups.setdefault(round(n.angle_deg % 360.0, 9), []).append(n)
+    if len(groups) == 1:
+        return _direction_summary(pattern, steps, modulus_gpa, "")
+    return "".join(_direction_summary(pattern.with_cuts(cuts), steps, modulus_gpa, f", notches at {ang:g} deg")
+                   for ang, cuts in sorted(groups.items()))
+
+
+def _direction_summary(pattern: Pattern, steps: int, modulus_gpa: float, label: str) -> str:
     geo = pattern_geometry(pattern)
     g = geo.first
     model = model_for_pattern(pattern)
@@ -188,7 +202,7 @@ def design_summary(pattern: Pattern, steps: int = 5,
     closure_deg = math.degrees(geo.total_closure_angle_rad)
     lines = [
         "",
-        f"predicted stroke-angle (base model, stroke only: E_pi {modulus_gpa:g} GPa, "
+        f"predicted stroke-angle{label} (base model, stroke only: E_pi {modulus_gpa:g} GPa, "
         f"E_t {vals['E_t']:g} GPa, L0 {vals['L0']:g} mm)",
         f"  joint stiffness K = E_pi I / (n h): {k:.3f} N mm/rad; tendon compliance {c:.4f} mm/N; "
         f"{100 * (k * c / g.moment_arm_mm**2) / (1 + k * c / g.moment_arm_mm**2):.0f}% of the stroke "
