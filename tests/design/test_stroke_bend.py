@@ -48,3 +48,16 @@ def test_directions_are_analysed_separately():
     assert [d.angle_deg for d in ds] == [0.0, 180.0] and [d.notches for d in ds] == [8, 8]
     theta, strain, _ = _independent(0.75, 0.45, 2.83, 0.5, 8, 0.04, 2.5, 28.0, 70.0, 2.0)
     assert ds[0].bend_rad == pytest.approx(theta, rel=1e-9) and ds[1].strain == pytest.approx(strain, rel=1e-9)
+
+
+def test_design_summary_agrees_with_the_notes_per_direction():
+    """The model's stroke-angle table (one per direction) ends at the bend the design notes give."""
+    from camtube.model.core.predict import design_summary
+
+    p = load_pattern(PATTERNS / "tube1-bidirectional.yaml")
+    text = design_summary(p)
+    assert text.count("predicted stroke-angle, notches at") == 2
+    last_rows = [ln.split() for ln in text.splitlines() if ln.strip().startswith("2.000")]
+    assert len(last_rows) == 2
+    for row, d in zip(last_rows, bends_at_stroke(p)):
+        assert float(row[1]) == pytest.approx(math.degrees(d.bend_rad), abs=0.006)
