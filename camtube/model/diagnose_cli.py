@@ -48,6 +48,8 @@ def register(model_sub) -> None:
                    help="do not stop at 1.15 x the noise floor (the significance tests alone decide)")
     d.add_argument("--no-per-sample", dest="per_sample", action="store_false",
                    help="do not test per-sample parameters of the recommended effects")
+    d.add_argument("--init", action="append", default=[], metavar="NAME=VALUE",
+                   help="also start a candidate's parameter at VALUE (e.g. a period), repeatable")
     d.add_argument("--json", metavar="OUT.json", help="write the diagnosis as JSON")
     d.add_argument("--report", metavar="DIR", help="write an HTML report with PNG plots into DIR")
     d.set_defaults(func=cmd_diagnose)
@@ -70,7 +72,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     from camtube.cliutil import load_from_args
     from camtube.errors import DataError
     from camtube.io import write_atomic
-    from camtube.model.core.build import build_registry, check_suffix, parse_fix, split_names
+    from camtube.model.core.build import build_registry, check_suffix, parse_assignments, parse_fix, split_names
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import load_csv, select_cycles
     from camtube.model.diagnose import diagnose
@@ -98,7 +100,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     d = diagnose(model, rows, split_names(args.fit_params), fixed, candidates=cands,
                  max_rows=args.max_rows, max_effects=args.max_effects, registry=reg,
                  stop_ratio=1.15 if args.stop_rule else None, modulus_range_gpa=(lo, hi),
-                 per_sample=args.per_sample)
+                 per_sample=args.per_sample, init=parse_assignments(args.init, "--init"))
     prefix = fit_command_prefix(args)
     title = f"{pattern.name}: {args.data} ({len(rows)} rows, cycles {args.cycles}, both directions, deadband kept)"
     print(diagnosis_text(d, prefix, title))

@@ -329,13 +329,14 @@ def _fitted(r: FitResult) -> Fitted:
 def _search_fit(model: JointModel, data: Dataset, names: Sequence[str], values: Mapping[str, float],
                 fixed: Mapping[str, float], grid: int = 0, grid_names: Sequence[str] | None = None,
                 per_sample: Sequence[str] = (), rows: np.ndarray | None = None, max_nfev: int = 100,
-                keep: int = 1) -> FitResult:
+                keep: int = 1, starts: Sequence[Mapping[str, float]] = ()) -> FitResult:
     params = model.make_params(data, names, fixed, initial={k: v for k, v in values.items()
                                                           if k in model.param_specs or "@" in k},
                                per_sample=per_sample)
     params = params.with_values({k: v for k, v in values.items() if k in params})
+    starts = [{k: v for k, v in st.items() if k in params} for st in starts]
     return fit(model, data, params=params, grid=grid, grid_names=grid_names, rows=rows, max_nfev=max_nfev,
-               tol=1e-8, keep=keep)
+               tol=1e-8, keep=keep, starts=[st for st in starts if st])
 
 
 def _cv(model: JointModel, data: Dataset, names: Sequence[str], start: Mapping[str, float],
@@ -427,6 +428,7 @@ def diagnose(
     grid: int = GRID,
     modulus_range_gpa: tuple[float, float] = (1.0, 300.0),
     per_sample: bool = True,
+    init: Mapping[str, float] | None = None,
 ) -> Diagnosis:
     """Find the effects missing from ``model`` (see the module docstring).
 
@@ -462,6 +464,9 @@ def diagnose(
         Plausible tendon moduli; a fitted E_t outside is not trusted.
     per_sample : bool
         Test per-sample parameters for the recommended effects (several samples only).
+    init : dict, optional
+        Extra start values ``{full name: value}`` for candidates' parameters (``--init``): each candidate
+        is also fitted from them (useful for multimodal parameters such as a period).
 
     Returns
     -------
@@ -514,7 +519,7 @@ def diagnose(
             break
         ranked = _round(current, search, cur_names, cur, cur_ho, cur_mse, fold, block, pool, floor, fixed,
                         bic_threshold, min_gain, min_excess, z, grid, modulus_range_gpa, cur_ps, strata,
-                        per_sample and len(search.samples) > 1)
+                        per_sample and len(search.samples) > 1, init)
         ranked_base_ho = cur_ho
         accepted = None
         for c in ranked:
@@ -632,7 +637,8 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
            cur_mse: np.ndarray, fold: np.ndarray, block: np.ndarray, pool: list[Effect], floor: float,
            fixed: Mapping[str, float], bic_threshold: float, min_gain: float, min_excess: float, z: float,
            grid: int, modulus_range_gpa: tuple[float, float], cur_ps: Sequence[str] = (),
-           strata: np.ndarray | None = None, try_per_sample: bool = False) -> tuple[Candidate, ...]:
+           strata: np.ndarray | None = None, try_per_sample: bool = False,
+           init: Mapping[str, float] | None = None) -> tuple[Candidate, ...]:
     """Every effect of ``pool`` on top of ``current``, ranked by held-out RMSE.
 
     With ``try_per_sample``, the best two effects are also fitted with per-sample parameters; that
@@ -643,7 +649,8 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
         m = current.with_effects(list(current.effects) + [eff])
         new = eff.full_names()
         start = m.initial_values(search, base=cur.params)
-        f = _search_fit(m, search, cur_names + new, start, fixed, grid=grid, grid_names=new, per_sample=cur_ps)
+        f = _search_fit(m, search, cur_names + new, start, fixed, grid=grid, grid_names=new, per_sample=cur_ps,
+                        starts=[init] if init else ())
         ho, mse = _cv(m, search, cur_names + new, f.params, fixed, fold, block, per_sample=cur_ps)
         fits.append([eff, m, new, f, ho, mse, ()])
     if try_per_sample:
