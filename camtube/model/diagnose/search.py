@@ -237,9 +237,20 @@ def noise_floor_se(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarray) 
     return float(np.std(vals, ddof=1) / math.sqrt(len(vals)))
 
 
+#: The search keeps at least this many rows per cycle (it may then exceed ``max_rows``, up to 4x).
+MIN_ROWS_PER_CYCLE = 25
+
+
 def thin(data: Dataset, max_rows: int) -> Dataset:
-    """Every k-th row (time order kept) so that at most about ``max_rows`` remain."""
+    """Every k-th row (time order kept) so that at most about ``max_rows`` remain.
+
+    Long records keep at least :data:`MIN_ROWS_PER_CYCLE` rows per cycle (up to ``4 max_rows``) so
+    that history effects stay visible within each cycle.
+    """
     n = len(data)
+    if max_rows > 0:
+        cycles = sum(int(np.unique(np.asarray(data.cycle)[sl]).size) for _, sl in data.sample_slices())
+        max_rows = min(max(max_rows, MIN_ROWS_PER_CYCLE * cycles), 4 * max_rows)
     if max_rows <= 0 or n <= max_rows:
         return data
     k = int(math.ceil(n / max_rows))
