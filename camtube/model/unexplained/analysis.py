@@ -280,7 +280,7 @@ def _periodogram(x: np.ndarray, r: np.ndarray, sid: np.ndarray, pmin: float, pma
     if not (pmax > pmin > 0):
         return None
     span = max(float(np.ptp(x[sid == k])) for k in range(int(sid.max()) + 1))
-    df = 1.0 / (5.0 * span)
+    df = 1.0 / (3.0 * span)
     f = np.arange(1.0 / pmax, 1.0 / pmin + df, df)
     if f.size < 3:
         return None
@@ -309,6 +309,22 @@ def _periodogram(x: np.ndarray, r: np.ndarray, sid: np.ndarray, pmin: float, pma
     return 1.0 / float(fine[j]), float(pf[j]), fap, f.size
 
 
+def _bin_means(x: np.ndarray, r: np.ndarray, sid: np.ndarray, width: float):
+    """Means of ``x`` and ``r`` in bins of ``width`` per sample: (x, r, sample, mean rows per bin)."""
+    bx, br, bs = [], [], []
+    for k in range(int(sid.max()) + 1):
+        m = sid == k
+        xk = x[m]
+        lab = ((xk - xk.min()) // width).astype(int)
+        cnt = np.bincount(lab)
+        ok = cnt > 0
+        bx.append(np.bincount(lab, weights=xk)[ok] / cnt[ok])
+        br.append(np.bincount(lab, weights=r[m])[ok] / cnt[ok])
+        bs.append(np.full(int(ok.sum()), k))
+    xb = np.concatenate(bx)
+    return xb, np.concatenate(br), np.concatenate(bs), x.size / max(xb.size, 1)
+
+
 def _periodic(r: np.ndarray, v: dict, sid: np.ndarray, floor: float, excess: float,
               stroke_smooth: np.ndarray) -> list[dict]:
     out = []
@@ -319,7 +335,9 @@ def _periodic(r: np.ndarray, v: dict, sid: np.ndarray, floor: float, excess: flo
     span = float(np.ptp(x))
     if span > 0:
         rr = _detrend(x, r, sid, 4)
-        hit = _periodogram(x, rr, sid, max(6.0 * step, span / 400.0), span / 3.0, floor)
+        # bin means per sample in 2000 stroke bins (the stroke revisits the same positions every cycle)
+        xb, rb2, sb2, nb = _bin_means(x, rr, sid, span / 2000.0)
+        hit = _periodogram(xb, rb2, sb2, max(6.0 * step, span / 400.0), span / 3.0, floor / math.sqrt(nb))
         if hit is not None:
             period, _, fap, _ = hit
             amp, phase, drop = _sinusoid(x, rr, sid, 2 * math.pi / period)
@@ -329,22 +347,12 @@ def _periodic(r: np.ndarray, v: dict, sid: np.ndarray, floor: float, excess: flo
     # against time: what repeats with the stroke cycle removed; bin means of 0.25 s; >= 3 periods per record
     t = v["time"]
     rt = r - stroke_smooth
-    bt, bx, bs = [], [], []
-    for k in range(int(sid.max()) + 1):
-        m = sid == k
-        tk = t[m] - t[m].min()
-        lab = (tk // 0.25).astype(int)
-        cnt = np.bincount(lab)
-        ok = cnt > 0
-        bt.append((np.bincount(lab, weights=tk)[ok] / cnt[ok]))
-        bx.append((np.bincount(lab, weights=rt[m])[ok] / cnt[ok]))
-        bs.append(np.full(int(ok.sum()), k))
-    tb, rb, sb = np.concatenate(bt), np.concatenate(bx), np.concatenate(bs)
-    rows_per_bin = n / max(tb.size, 1)
+    t0 = np.array([t[sid == k].min() for k in range(int(sid.max()) + 1)])
+    tb, rb, sb, rows_per_bin = _bin_means(t - t0[sid], rt, sid, 0.25)
     tspan = float(tb.max()) if tb.size else 0.0
     if tspan > 0 and tb.size > 20:
         rb_d = _detrend(tb, rb, sb, 2)
-        hit = _periodogram(tb, rb_d, sb, 1.0, tspan / 3.0, floor / math.sqrt(rows_per_bin))
+        hit = _periodogram(tb, rb_d, sb, 2.0, tspan / 3.0, floor / math.sqrt(rows_per_bin))
         if hit is not None:
             period, _, fap, _ = hit
             amp, phase, _ = _sinusoid(tb, rb_d, sb, 2 * math.pi / period)
@@ -471,6 +479,20 @@ def analyse(residual_deg, variables: Mapping[str, np.ndarray], noise_floor_deg: 
         shape = "step"
     else:
         shape = ""
+    size = 0.0
+    rng_lead: list = []
+    if leading in labs:
+        lab = labs[leading]
+        cnt = np.bincount(lab)
+        means = np.bincount(lab, weights=r) / np.maximum(cnt, 1)
+        ok = cnt >= 10
+        if ok.any():
+            size = float(np.max(np.abs(means[ok] - r.mean())))
+    if leading in ("stroke", "angle", "force", "time", "cycle"):
+        rng_lead = [float(np.min(v[leading])), float(np.max(v[leading]))]
+    lead_score = next((s["explained"] for s in ranked if s["variable"] == leading), 0.0)
+    tied = [s["variable"] for s in ranked if s["variable"] != leading and s["variable"] in follows
+            and s["explained"] >= lead_score - 0.05 and lead_per is None]
     ex = {s: (float(np.sqrt(np.mean(r[v["sample"] == s] ** 2))) ** 2 - floor**2) for s in names}
     top = max(ex.values()) if ex else 0.0
     carry = [str(s) for s in names if per_sample[str(s)] > stop_ratio * floor and ex[s] >= 0.2 * top]
@@ -484,6 +506,9 @@ def analyse(residual_deg, variables: Mapping[str, np.ndarray], noise_floor_deg: 
         "periodic": [{k: p[k] for k in ("variable", "period", "unit", "amplitude_deg", "phase_rad", "explained")}
                      for p in periodic],
         "leading": leading,
+        "tied": tied,
+        "size_deg": size,
+        "range": rng_lead,
         "shape": shape,
         "samples": carry,
         "per_sample_rmse_deg": per_sample,
@@ -511,6 +536,9 @@ def sentence(u: dict) -> str:
         pct = 100 * u["explained"].get(lead, 0.0) * excess / mse
         shape = u.get("shape", "")
         what = f"follows {LABELS[lead]}" + (f" ({shape})" if shape else "")
+        if u.get("tied"):
+            what += (f", or as well {' and '.join(LABELS[t] for t in u['tied'])} (these data cannot tell "
+                     f"them apart)")
     if lead == "sample":
         text = f"{pct:.0f} % of the misfit {what}: the samples differ, and a shared parameter cannot follow them"
     else:
