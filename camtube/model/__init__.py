@@ -1,6 +1,25 @@
 """Model stage: joint mechanics (tendon stroke -> joint angle), fitting, effects, diagnosis.
 
-Owns: the measurement :class:`~camtube.model.dataset.Dataset`, the base
-model plus composable :class:`~camtube.model.api.Effect` terms, bounded
-least-squares fits, and the diagnosis of missing physics.
+Owns: the measurements, the base model plus composable effects, bounded
+least-squares fits, and the diagnosis of missing physics. Sub-packages, in the
+order data flows through them:
+
+``data``       the :class:`Dataset` value, CSV files, row selection (cycles, branch, deadband)
+``core``       parameters (:class:`Parameters`), the :class:`JointModel` with its effects, the explicit
+               effect registry, the fit, the stroke-only prediction, model set-up from user input
+``effects``    the built-in effects (slack, play, creep, ...) and their history operators
+``diagnose``   which effect is missing: the candidate search and the residual atlas
+``report``     text, JSON, HTML and figures of fits and diagnoses
+``sim``        synthetic data (``model synth``) and the independent truth simulator
+
+``cli`` and ``diagnose_cli`` are the thin command-line layer. ``api`` is the stable import path for
+users' effect files (``from camtube.model.api import Effect, Param``); ``dataset``, ``fit``,
+``predict``, ``synth``, ``truth``, ``atlas``, ``plot`` and ``report_fit`` are compatibility paths of
+the earlier flat layout.
 """
+from __future__ import annotations
+
+#: Names of the built-in effects, for ``--help`` without importing the effect code
+#: (a test checks it against :data:`camtube.model.effects.BUILTINS`).
+EFFECT_NAMES = ("slack", "play", "creep", "friction", "toe", "viscoelastic", "series", "kerf", "flat_walls",
+                "chords", "hardstop", "angle_bias", "force_zero")

@@ -9,7 +9,15 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import sys
+
+from camtube.model import EFFECT_NAMES
+
+
+def check_suffix(path, suffixes, option):
+    """See :func:`camtube.model.core.build.check_suffix`."""
+    from camtube.model.core.build import check_suffix as check
+
+    check(path, suffixes, option)
 
 
 def register(sub) -> None:
@@ -39,9 +47,19 @@ def register(sub) -> None:
                         "e.g. E_t,arm_scale; 'none')")
     f.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
                    help="hold a parameter at a value (units as listed: E_t GPa, L0 mm); repeatable")
-    f.add_argument("--effects", default="", metavar="A,B", help="effects to add to the base model, by name")
+    f.add_argument("--effects", default="", metavar="A,B",
+                   help="effects to add to the base model, by name: " + ", ".join(EFFECT_NAMES)
+                        + " (or one of an --effect-file)")
     f.add_argument("--effect-file", action="append", default=[], metavar="F.py",
                    help="a .py file defining or registering Effect objects (loaded before --effects)")
+    f.add_argument("--per-sample", default="", metavar="P1,P2",
+                   help="parameters (full names, or effect names for all their parameters) fitted with one "
+                        "value per sample, e.g. slack,play; JSON names <name>@<sample>")
+    f.add_argument("--init", action="append", default=[], metavar="NAME=VALUE",
+                   help="start a fitted parameter at VALUE (also NAME@SAMPLE=VALUE); repeatable")
+    f.add_argument("--starts", type=int, default=0, metavar="N",
+                   help="multi-start: also start from the best points of an N-per-parameter grid over each "
+                        "effect parameter's declared range (log-spaced for scales); default 0 (one start)")
     f.add_argument("--json", metavar="OUT.json", help="write the summary as JSON")
     f.add_argument("--plot", metavar="OUT.png", help="write angle and residual vs stroke (PNG)")
     f.set_defaults(func=cmd_fit)
@@ -82,72 +100,42 @@ def _add_pattern_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("-q", "--quiet", action="store_true", help="do not print design warnings")
 
 
-def split_names(text: str) -> list[str]:
-    """``'a, b,none'`` -> ``['a', 'b']`` (comma list; 'none' means nothing)."""
-    return [t.strip() for t in text.split(",") if t.strip() and t.strip().lower() != "none"]
-
-
-def fit_param_names(model, text: str | None) -> list[str]:
-    """Parameters to fit: the ``--fit`` list, or by default E_t and every parameter of the model's effects."""
-    if text is not None:
-        return split_names(text)
-    return ["E_t"] + [f"{e.name}.{p.name}" for e in model.effects for p in e.params]
-
-
-def build_model(pattern, effects: str = "", effect_files=()):
-    """JointModel of ``pattern`` with effect files loaded and ``effects`` (comma list) added."""
-    from camtube.model.api import get_effect, load_effect_file
-    from camtube.model.fit import FitError
-    from camtube.model.predict import model_for_pattern
-
-    for path in effect_files:
-        try:
-            load_effect_file(path)
-        except (OSError, ImportError, SyntaxError, ValueError) as exc:
-            raise FitError(f"{path}: cannot load the effect file: {exc}") from None
-    try:
-        effs = [get_effect(n) for n in split_names(effects)]
-    except KeyError as exc:
-        raise FitError(exc.args[0]) from None
-    return model_for_pattern(pattern, effs)
-
-
-def parse_fix(items: list[str]) -> dict[str, float]:
-    from camtube.model.fit import FitError
-
-    out = {}
-    for it in items:
-        name, sep, val = it.partition("=")
-        try:
-            out[name.strip()] = float(val)
-        except ValueError:
-            sep = ""
-        if not sep:
-            raise FitError(f"--fix {it!r}: use NAME=VALUE with a number, e.g. --fix L0=70")
-    return out
-
-
 def cmd_fit(args: argparse.Namespace) -> int:
     from camtube.cliutil import load_from_args
     from camtube.io import write_atomic
-    from camtube.model.data import find_slack, load_csv, prepare, remove_deadband, select_cycles
-    from camtube.model.fit import fit
-    from camtube.model.predict import pattern_values
-    from camtube.model.report_fit import fit_json, fit_text
+    from camtube.model.core.build import (
+        build_registry, fit_param_names, history_warning, parse_assignments, parse_fix, split_names,
+    )
+    from camtube.model.core.fit import FitError, fit
+    from camtube.model.core.predict import model_for_pattern, pattern_values
+    from camtube.model.data import check_fittable, find_slack, load_csv, prepare, remove_deadband, select_cycles
+    from camtube.model.report.fit import fit_json, fit_text
 
+    check_suffix(args.json, (".json",), "--json")
+    check_suffix(args.plot, (".png",), "--plot")
     pattern = load_from_args(args).pattern
-    model = build_model(pattern, args.effects, args.effect_file)
+    reg, _ = build_registry(args.effect_file)
+    model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects)])
     raw = load_csv(args.data)
     rows = prepare(raw, args.cycles, args.branch, args.deadband, args.deadband_threshold)
+    check_fittable(rows, f"{args.data} (cycles {args.cycles}, {args.branch} branch)")
     fixed = pattern_values(pattern)
     fixed.update(parse_fix(args.fix))
-    result = fit(model, rows, fit_param_names(model, args.fit_params), fixed)
+    init = parse_assignments(args.init, "--init")
+    names = fit_param_names(model, args.fit_params)
+    params = model.make_params(rows, names, fixed, initial=init, per_sample=split_names(args.per_sample))
+    warn = history_warning(model, args.branch, min((len(set(rows.cycle[sl].tolist()))
+                                                    for _, sl in rows.sample_slices()), default=0),
+                           params.varying)
+    result = fit(model, rows, params=params, grid=args.starts)
 
     sel = (f"cycles {args.cycles}, {args.branch} branch, "
            + ("slack deadband removed" if args.deadband else "deadband kept"))
     title = (f"{pattern.name}: {args.data} ({len(raw)} rows; fitted {result.n_points}: {sel})"
              + (f"; effects: {', '.join(e.name for e in model.effects)}" if model.effects else ""))
     print(fit_text(result, title))
+    if warn:
+        print(warn)
     if args.deadband:
         slack = find_slack(select_cycles(raw, args.cycles), args.deadband_threshold)
         for smp in rows.samples:
@@ -159,24 +147,27 @@ def cmd_fit(args: argparse.Namespace) -> int:
     if args.json:
         print(f"wrote {write_atomic(args.json, fit_json(result, meta))}")
     if args.plot:
-        from camtube.model.plot import fit_png
+        from camtube.model.report.plot import fit_png
 
         full = raw
         if args.deadband:
             full = remove_deadband(raw, args.deadband_threshold)
         png = fit_png(result, full, title=f"{pattern.name}: model vs measurement ({sel})")
         print(f"wrote {write_atomic(args.plot, png)}")
+    bad = result.unidentified
+    if bad:
+        raise FitError("these rows cannot identify " + "; ".join(f"{k}: {v}" for k, v in bad.items())
+                       + "; the values above are not estimates. Fix: hold them (--fix NAME=VALUE), drop the "
+                       "effect, or select rows where they matter (e.g. --cycles all --branch both --no-deadband)")
     return 0
 
 
 def cmd_synth(args: argparse.Namespace) -> int:
     from camtube.cliutil import load_from_args
-    from camtube.model.synth import noise_floor_deg, synthesize, write
+    from camtube.model.sim.synth import noise_floor_deg, synthesize, write
 
+    check_suffix(args.output, (".csv",), "-o/--output")
     pattern = load_from_args(args).pattern
-    if args.samples < 1 or args.cycles < 1:
-        print("camtube model synth: --samples and --cycles must be >= 1", file=sys.stderr)
-        return 2
     data = synthesize(pattern, args.samples, args.cycles, args.noise_angle, args.noise_force, args.seed,
                       modulus_gpa=args.modulus, speed_mm_s=args.speed, rate_hz=args.rate,
                       slack_mm=args.slack)

@@ -7,9 +7,12 @@ from __future__ import annotations
 
 import argparse
 import shlex
+from pathlib import Path
 
 
 def register(model_sub) -> None:
+    from camtube.model import EFFECT_NAMES
+
     d = model_sub.add_parser(
         "diagnose", help="find the physical effects the model is missing, rank them, say how to add them",
         description="Fit the current model to every selected row (both directions of motion, slack deadband "
@@ -25,11 +28,13 @@ def register(model_sub) -> None:
     d.add_argument("-q", "--quiet", action="store_true", help="do not print design warnings")
     d.add_argument("--cycles", default="all", metavar="SPEC",
                    help="cycles to use: all (default), last20, 31-50, 2-, ... (comma lists allowed)")
-    d.add_argument("--effects", default="", metavar="A,B", help="effects already in the model (default: none)")
+    d.add_argument("--effects", default="", metavar="A,B",
+                   help="effects already in the model (default: none); built-in: " + ", ".join(EFFECT_NAMES))
     d.add_argument("--effect-file", action="append", default=[], metavar="F.py",
                    help="a .py file defining Effect objects; its effects become candidates too (repeatable)")
     d.add_argument("--candidates", default="", metavar="A,B",
-                   help="effects to try (default: every registered effect not in the model)")
+                   help="effects to try (default: every registered effect not in the model, i.e. the built-in "
+                        + ", ".join(EFFECT_NAMES) + " and those of --effect-file)")
     d.add_argument("--fit", dest="fit_params", default="E_t", metavar="P1,P2",
                    help="base parameters fitted besides the effects' own (default E_t)")
     d.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
@@ -59,31 +64,27 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     from camtube.cliutil import load_from_args
     from camtube.errors import DataError
     from camtube.io import write_atomic
-    from camtube.model.cli import build_model, parse_fix, split_names
+    from camtube.model.core.build import build_registry, check_suffix, parse_fix, split_names
+    from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import load_csv, select_cycles
     from camtube.model.diagnose import diagnose
-    from camtube.model.fit import FitError
-    from camtube.model.predict import pattern_values
-    from camtube.model.report import diagnosis_json, diagnosis_text, write_report
+    from camtube.model.report.diagnosis import diagnosis_json, diagnosis_text, write_report
 
+    check_suffix(args.json, (".json",), "--json")
+    if args.report is not None and Path(args.report).exists() and not Path(args.report).is_dir():
+        raise DataError(f"--report {args.report}: is a file; the report is a directory (index.html and PNGs)")
+    if args.max_rows < 0 or args.max_effects < 0:
+        raise DataError("--max-rows and --max-effects must be >= 0")
     pattern = load_from_args(args).pattern
-    model = build_model(pattern, args.effects, args.effect_file)
+    reg, _ = build_registry(args.effect_file)
+    model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects)])
     raw = load_csv(args.data)
     rows = select_cycles(raw, args.cycles)
     fixed = pattern_values(pattern)
     fixed.update(parse_fix(args.fix))
-    cands = split_names(args.candidates) or None
-    if cands:
-        from camtube.model.api import get_effect
-
-        try:
-            cands = [get_effect(c) for c in cands]
-        except KeyError as exc:
-            raise FitError(exc.args[0]) from None
-    if args.max_rows < 0 or args.max_effects < 0:
-        raise DataError("--max-rows and --max-effects must be >= 0")
+    cands = [reg.get_effect(c) for c in split_names(args.candidates)] or None
     d = diagnose(model, rows, split_names(args.fit_params), fixed, candidates=cands,
-                 max_rows=args.max_rows, max_effects=args.max_effects)
+                 max_rows=args.max_rows, max_effects=args.max_effects, registry=reg)
     prefix = fit_command_prefix(args)
     title = f"{pattern.name}: {args.data} ({len(rows)} rows, cycles {args.cycles}, both directions, deadband kept)"
     print(diagnosis_text(d, prefix, title))

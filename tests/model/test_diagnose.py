@@ -22,20 +22,20 @@ TRAP = 0.05  # N mm of joint friction in every case: measured-force hysteresis t
 CASES = [
     ("slack-tube1", "tube1", Hidden(slack_mm=0.1, joint_friction_nmm=TRAP), {"slack"},
      {"slack.deadband_mm": (0.1, 0.1)}),
-    ("slack-tube3", "tube3", Hidden(slack_mm=0.3), {"slack"}, {"slack.deadband_mm": (0.3, 0.1)}),
+    ("slack-tube3", "tube3", Hidden(slack_mm=0.3, joint_friction_nmm=0.0), {"slack"}, {"slack.deadband_mm": (0.3, 0.1)}),
     ("play-tube2", "tube2", Hidden(play_mm=0.06, joint_friction_nmm=TRAP), {"play"}, {"play.play_mm": (0.06, 0.1)}),
-    ("play-tube1", "tube1", Hidden(play_mm=0.15), {"play"}, {"play.play_mm": (0.15, 0.1)}),
+    ("play-tube1", "tube1", Hidden(play_mm=0.15, joint_friction_nmm=0.0), {"play"}, {"play.play_mm": (0.15, 0.1)}),
     ("toe-tube1", "tube1", Hidden(toe_mm=0.2, joint_friction_nmm=TRAP), {"toe"}, {"toe.toe_mm": (0.2, 0.1)}),
-    ("toe-tube2", "tube2", Hidden(toe_mm=0.4), {"toe"}, {"toe.toe_mm": (0.4, 0.1)}),
+    ("toe-tube2", "tube2", Hidden(toe_mm=0.4, joint_friction_nmm=0.0), {"toe"}, {"toe.toe_mm": (0.4, 0.1)}),
     ("visco-tube2", "tube2", Hidden(visco_ratio=0.3, visco_tau_s=1.0, joint_friction_nmm=TRAP), {"viscoelastic"},
      {"viscoelastic.ratio": (0.3, 0.15), "viscoelastic.tau_s": (1.0, 0.2)}),
-    ("visco-tube3", "tube3", Hidden(visco_ratio=0.6, visco_tau_s=3.0), {"viscoelastic"},
+    ("visco-tube3", "tube3", Hidden(visco_ratio=0.6, visco_tau_s=3.0, joint_friction_nmm=0.0), {"viscoelastic"},
      {"viscoelastic.ratio": (0.6, 0.15), "viscoelastic.tau_s": (3.0, 0.2)}),
     ("creep-tube1", "tube1", Hidden(creep_mm_per_N=0.05, creep_tau_s=20.0, joint_friction_nmm=TRAP), {"creep"}, {}),
-    ("creep-tube2", "tube2", Hidden(creep_mm_per_N=0.03, creep_tau_s=40.0), {"creep"}, {}),
+    ("creep-tube2", "tube2", Hidden(creep_mm_per_N=0.03, creep_tau_s=40.0, joint_friction_nmm=0.0), {"creep"}, {}),
     ("slack+play-tube2", "tube2", Hidden(slack_mm=0.08, play_mm=0.06, joint_friction_nmm=TRAP), {"slack", "play"},
      {"slack.deadband_mm": (0.08, 0.1), "play.play_mm": (0.06, 0.1)}),
-    ("play+creep-tube3", "tube3", Hidden(play_mm=0.2, creep_mm_per_N=0.02, creep_tau_s=30.0), {"play", "creep"},
+    ("play+creep-tube3", "tube3", Hidden(play_mm=0.2, creep_mm_per_N=0.02, creep_tau_s=30.0, joint_friction_nmm=0.0), {"play", "creep"},
      {"play.play_mm": (0.2, 0.1)}),
 ]
 
@@ -87,20 +87,20 @@ def test_control_recommends_nothing(tube):
 def test_control_with_the_search_forced_finds_nothing_significant():
     """Even when the search runs (stop ratio 0), no effect passes the significance tests on pure noise."""
     p = load_pattern(PATTERNS / "tube2.yaml")
-    sim = simulate(p, Hidden(), n_cycles=10, seed=3)
+    sim = simulate(p, Hidden(joint_friction_nmm=0.0), n_cycles=10, seed=3)
     d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p), stop_ratio=0.0)
     assert d.recommended == () and d.rounds and not any(c.significant for c in d.candidates)
 
 
 def test_series_compliance_is_declared_confounded_with_e_t():
-    _, _, d = _run("tube1", Hidden(slack_mm=0.1))
+    _, _, d = _run("tube1", Hidden(slack_mm=0.1, joint_friction_nmm=0.0))
     ser = next(c for c in d.candidates if c.effect == "series")
     assert not ser.significant and any(s.startswith("E_t") for s in ser.confounded)
 
 
 def test_noise_floor_is_robust_to_model_error():
     p = load_pattern(PATTERNS / "tube2.yaml")
-    sim = simulate(p, Hidden(play_mm=0.1, visco_ratio=0.3), n_cycles=10, seed=2)
+    sim = simulate(p, Hidden(play_mm=0.1, visco_ratio=0.3, joint_friction_nmm=0.0), n_cycles=10, seed=2)
     base = model_for_pattern(p)
     resid = sim.data.angle_deg - base.predict(sim.data, pattern_values(p))
     assert abs(noise_floor(sim.data, resid) / sim.sensor_floor_deg - 1) < 0.15
@@ -108,7 +108,7 @@ def test_noise_floor_is_robust_to_model_error():
 
 def test_atlas_shows_direction_for_play():
     p = load_pattern(PATTERNS / "tube1.yaml")
-    sim = simulate(p, Hidden(play_mm=0.15), n_cycles=4, seed=1)
+    sim = simulate(p, Hidden(play_mm=0.15, joint_friction_nmm=0.0), n_cycles=4, seed=1)
     r = sim.data.angle_deg - model_for_pattern(p).predict(sim.data, pattern_values(p))
     at = residual_atlas(sim.data, r)
     dirn = at.panel("direction")
@@ -118,7 +118,7 @@ def test_atlas_shows_direction_for_play():
 
 def test_cli_json_report_and_fit_command(tmp_path, capsys):
     p = load_pattern(PATTERNS / "tube2.yaml")
-    sim = simulate(p, Hidden(slack_mm=0.08, play_mm=0.06), n_cycles=6, seed=5)
+    sim = simulate(p, Hidden(slack_mm=0.08, play_mm=0.06, joint_friction_nmm=0.0), n_cycles=6, seed=5)
     csv = tmp_path / "d.csv"
     csv.write_text(format_csv(sim.data))
     out, rep = tmp_path / "d.json", tmp_path / "rep"

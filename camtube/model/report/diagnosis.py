@@ -28,13 +28,20 @@ from pathlib import Path
 
 import numpy as np
 
-from camtube.model.atlas import describe, residual_atlas
-from camtube.model.diagnose import Candidate, Diagnosis
+from camtube.model.diagnose.atlas import describe, residual_atlas
+from camtube.model.diagnose.search import Candidate, Diagnosis
 
 
 def _num(x) -> float | None:
     x = float(x)
     return x if math.isfinite(x) else None
+
+
+def _times(value: float, floor: float) -> str:
+    """``'1.07 x'`` (value over the noise floor), or a phrase when the floor is zero (noise-free data)."""
+    if floor > 0 and math.isfinite(floor):
+        return f"{value / floor:.2f} x"
+    return "exact, no noise:" if value == 0 else "above zero; there is no"
 
 
 def _pm(value: float, err: float, unit: str) -> str:
@@ -115,7 +122,7 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
     cur = ", ".join(base.effects) or "none"
     lines.append(f"noise floor (white noise in the residual): {floor:.3f} deg")
     lines.append(f"current model (effects: {cur}): RMSE {base.rmse_deg:.3f} deg = "
-                 f"{base.rmse_deg / floor:.2f} x the noise floor; held-out {d.base_heldout_rmse_deg:.3f} deg")
+                 f"{_times(base.rmse_deg, floor)} the noise floor; held-out {d.base_heldout_rmse_deg:.3f} deg")
     where = describe(residual_atlas(d.data, base.residuals), floor)
     if where:
         lines.append("where it fails:")
@@ -150,7 +157,7 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
             if c is not None and c.confounded:
                 lines.append(f"       strongly correlated with: {', '.join(c.confounded)}")
             lines.append(f"       RMSE {prev.rmse_deg:.3f} -> {step.rmse_deg:.3f} deg "
-                         f"({step.rmse_deg / floor:.2f} x the noise floor)")
+                         f"({_times(step.rmse_deg, floor)} the noise floor)")
             prev = step
         cmd = add_command(d, command)
         if cmd:
@@ -208,7 +215,7 @@ def atlas_png(d: Diagnosis) -> bytes:
     final = residual_atlas(d.data, d.final.residuals) if d.recommended else None
     fig = _figure(13.0, 7.0)
     axes = fig.subplots(2, 3).ravel()
-    from camtube.model.atlas import variable
+    from camtube.model.diagnose.atlas import variable
 
     rng = np.random.default_rng(0)
     n = len(d.data)

@@ -1,8 +1,8 @@
 """Built-in effects: the physics the paper's base model leaves out.
 
-Importing this module registers every effect below (``camtube.model.api``
-imports it on first use of the registry). Each effect is a named term on one
-stage of the model chain (see :mod:`camtube.model.api`):
+Each effect is a named term on one stage of the model chain (see
+:mod:`camtube.model.core.model`); :data:`BUILTIN_EFFECTS` lists them for
+:func:`camtube.model.core.registry.builtin_registry`:
 
 =============  ==========  =====================================================
 name           stage       physics (parameters)
@@ -31,98 +31,16 @@ the stroke (one NumPy call per stroke reversal); the linear filter of
 from __future__ import annotations
 
 import math
-import weakref
 
 import numpy as np
 
 from camtube.design.geometry import backbone_angle_rad, centroid_mm
-from camtube.model.api import Context, Effect, Param, register
-from camtube.model.dataset import Dataset
+from camtube.model.core.model import Context, Effect
+from camtube.model.core.params import Param
+from camtube.model.data.dataset import Dataset
+from camtube.model.effects.history import first_order_lag, monotone_segments, play_operator  # noqa: F401
 
 # ----------------------------------------------------------------------------- helpers
-
-_SEGMENTS: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
-
-
-def monotone_segments(data: Dataset) -> list[tuple[int, int, int, bool]]:
-    """``(start, stop, direction, first_of_sample)`` of every run of constant direction.
-
-    Cached per :class:`Dataset` object (the fit evaluates the model many times on the same rows).
-    """
-    hit = _SEGMENTS.get(data)
-    if hit is not None:
-        return hit
-    d = data.direction
-    out = []
-    for _, sl in data.sample_slices():
-        dd = d[sl]
-        cut = np.flatnonzero(np.diff(dd)) + 1
-        starts = np.concatenate(([0], cut))
-        stops = np.concatenate((cut, [dd.size]))
-        for k, (a, b) in enumerate(zip(starts, stops)):
-            out.append((sl.start + int(a), sl.start + int(b), int(dd[a]), k == 0))
-    _SEGMENTS[data] = out
-    return out
-
-
-def play_operator(data: Dataset, x: np.ndarray, width_mm: float) -> np.ndarray:
-    """Play (backlash) operator of width ``width_mm`` on ``x`` (n,), per sample, exact.
-
-    The output lags ``width_mm`` behind the input while it grows and stays put
-    after a reversal until the input has come back by ``width_mm``:
-    ``y_k = clip(y_{k-1}, x_k - w, x_k)``, starting at ``x_0 - w``. Within a
-    monotone run of ``x`` the recursion is ``max(y_prev, x - w)`` (growing) or
-    ``min(y_prev, x)`` (shrinking), so each run is one NumPy call.
-    """
-    w = float(width_mm)
-    y = np.empty_like(x)
-    prev = 0.0
-    for a, b, dirn, first in monotone_segments(data):
-        xs = x[a:b]
-        if first:
-            prev = float(xs[0]) - (w if dirn > 0 else 0.0)
-        if dirn > 0:
-            seg = np.maximum(xs - w, prev)
-        else:
-            seg = np.minimum(xs, prev)
-        y[a:b] = seg
-        prev = float(seg[-1])
-    return y
-
-
-def first_order_lag(data: Dataset, u: np.ndarray, tau_s: float) -> np.ndarray:
-    """``v`` with ``tau dv/dt = u - v`` per sample (exact for piecewise-constant ``u``), ``v_0 = u_0``.
-
-    Uniform sampling uses :func:`scipy.signal.lfilter`; otherwise a loop.
-    """
-    from scipy.signal import lfilter
-
-    tau = max(float(tau_s), 1e-9)
-    v = np.empty_like(u)
-    t = np.asarray(data.time_s, float)
-    for _, sl in data.sample_slices():
-        us, ts = u[sl], t[sl]
-        if us.size == 0:
-            continue
-        dt = np.diff(ts)
-        if dt.size == 0:
-            v[sl] = us
-            continue
-        h = float(np.median(dt))
-        if h > 0 and np.all(np.abs(dt - h) <= 1e-6 * h + 1e-12):
-            a = math.exp(-h / tau)
-            v[sl], _ = lfilter([1.0 - a], [1.0, -a], us, zi=[a * us[0]])
-        else:
-            a = np.exp(-np.maximum(dt, 0.0) / tau)
-            out = np.empty_like(us)
-            out[0] = us[0]
-            acc = float(us[0])
-            for k in range(1, us.size):
-                acc = a[k - 1] * acc + (1.0 - a[k - 1]) * float(us[k])
-                out[k] = acc
-            v[sl] = out
-    return v
-
 
 def _stroke_span(data: Dataset) -> float:
     s = np.asarray(data.stroke_mm, float)
@@ -195,15 +113,15 @@ def _slack(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
     return np.maximum(stroke - p["deadband_mm"], 0.0)
 
 
-SLACK = register(Effect(
+SLACK = Effect(
     name="slack", stage="stroke",
     params=(Param("deadband_mm", "mm", 0.0, 10.0, _slack_guess,
-                  "motor stroke taken up before the tendon is taut"),),
+                  "motor stroke taken up before the tendon is taut", kind="length"),),
     apply=_slack,
     meaning="tendon slack: the first part of the stroke only takes up the slack, the joint does not move",
     signature="at low stroke the joint stays straight while the base model already bends it "
               "(negative residual at small stroke, then a constant offset)",
-))
+)
 
 
 def _play(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
@@ -211,16 +129,17 @@ def _play(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
     return np.maximum(play_operator(ctx.data, stroke, p["play_mm"]), 0.0)
 
 
-PLAY = register(Effect(
+PLAY = Effect(
     name="play", stage="stroke",
     params=(Param("play_mm", "mm", 0.0, 10.0, lambda d, c: 0.02 * _stroke_span(d),
-                  "lost motion between the motor and the tendon (full width of the play)"),),
+                  "lost motion between the motor and the tendon (full width of the play)", kind="length"),),
     apply=_play,
     meaning="lost motion (backlash, play) between the motor and the tendon: after each reversal the "
             "motor moves through the play before the tendon follows",
     signature="the residual flips sign with the direction of motion, with a constant size: "
               "loading lags, unloading leads (a parallelogram loop)",
-))
+    history=True,
+)
 
 
 def _creep(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
@@ -229,17 +148,19 @@ def _creep(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
     return np.maximum(stroke - p["creep_mm"] * -np.expm1(-t / max(p["tau_s"], 1e-9)), 0.0)
 
 
-CREEP = register(Effect(
+CREEP = Effect(
     name="creep", stage="stroke",
     params=(Param("creep_mm", "mm", -5.0, 5.0, lambda d, c: 0.01 * _stroke_span(d),
-                  "tendon lengthening reached after a long time (stroke lost)"),
+                  "tendon lengthening reached after a long time (stroke lost)", kind="length"),
             Param("tau_s", "s", 1e-2, 1e7, lambda d, c: _duration(d) / 4.0,
-                  "time constant of the creep (s since the start of the sample's record)")),
+                  "time constant of the creep (s since the start of the sample's record)", log=True,
+                  kind="time")),
     apply=_creep,
     meaning="creep (drift over cycles): the tendon lengthens slowly under load, so later cycles "
             "bend less for the same stroke; it settles with a time constant",
     signature="the residual trends with cycle number and time: early cycles differ from late ones",
-))
+    history=True,
+)
 
 
 # ----------------------------------------------------------------------------- elongation stage
@@ -248,7 +169,7 @@ def _friction(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
     return elong * (1.0 - p["mu"] * ctx.direction)
 
 
-FRICTION = register(Effect(
+FRICTION = Effect(
     name="friction", stage="elongation",
     params=(Param("mu", "", -0.9, 0.9, 0.02,
                   "fraction by which the tendon's mean tension falls below (loading) or rises above "
@@ -257,7 +178,7 @@ FRICTION = register(Effect(
     meaning="tendon-sheath friction between the load cell and the joint: the tendon's mean tension is "
             "lower than measured while pulling and higher while releasing (friction hysteresis)",
     signature="the residual flips sign with the direction of motion and grows with force",
-))
+)
 
 
 def _toe(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
@@ -273,16 +194,17 @@ def _toe(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
     return np.minimum(elong + toe, np.maximum(ctx.stroke_mm, elong))
 
 
-TOE = register(Effect(
+TOE = Effect(
     name="toe", stage="elongation",
     params=(Param("toe_mm", "mm", 0.0, 5.0, lambda d, c: 0.05 * _stroke_span(d),
-                  "elongation over which the tendon's fibres straighten (end of the toe region)"),),
+                  "elongation over which the tendon's fibres straighten (end of the toe region)",
+                  kind="length"),),
     apply=_toe,
     meaning="toe region of the tendon: crimped fibres straighten first, so the tendon is soft at low "
             "force (force grows with elongation squared) and reaches its linear stiffness after toe_mm",
     signature="the residual is curved against force: it moves quickly at low force and is constant at "
               "high force (the tendon stretches more than linear at the start)",
-))
+)
 
 
 def _visco(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
@@ -291,25 +213,27 @@ def _visco(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
     return np.minimum(elong + p["ratio"] * ctx.compliance_mm_per_N * lag, ctx.stroke_mm)
 
 
-VISCOELASTIC = register(Effect(
+VISCOELASTIC = Effect(
     name="viscoelastic", stage="elongation",
     params=(Param("ratio", "", 0.0, 20.0, 0.1,
-                  "delayed compliance as a fraction of the instantaneous one (standard linear solid)"),
+                  "delayed compliance as a fraction of the instantaneous one (standard linear solid)",
+                  starts=(0.05, 0.3, 1.5)),
             Param("tau_s", "s", 1e-3, 1e6, lambda d, c: _period(d) / 4.0,
-                  "retardation time of the delayed compliance")),
+                  "retardation time of the delayed compliance", log=True, kind="time")),
     apply=_visco,
     meaning="viscoelastic tendon (standard linear solid): part of the elongation follows the force "
             "with a delay, so the tendon is stiffer in fast loading and creeps at constant load",
     signature="the residual follows the force history: a loop against force (hysteresis) that depends "
               "on the loading rate",
-))
+    history=True,
+)
 
 
 def _series(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
     return elong + p["compliance_mm_per_N"] * ctx.force_N
 
 
-SERIES = register(Effect(
+SERIES = Effect(
     name="series", stage="elongation",
     params=(Param("compliance_mm_per_N", "mm/N", -2.0, 10.0, 0.02,
                   "extra compliance in series with the tendon (sheath or tube compression)"),),
@@ -317,7 +241,7 @@ SERIES = register(Effect(
     meaning="an extra compliance in series with the tendon (the sheath or the tube compresses)",
     signature="the residual is proportional to force, like a softer tendon",
     family="compliance",
-))
+)
 
 
 # ----------------------------------------------------------------------------- kinematics stage
@@ -330,7 +254,7 @@ def _kerf(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
     return theta * (g.moment_arm_mm / arm)
 
 
-KERF = register(Effect(
+KERF = Effect(
     name="kerf", stage="kinematics",
     params=(Param("kerf_mm", "mm", -0.5, 0.5, 0.02,
                   "widening of the notch arc by the laser kerf (on the outer surface)"),),
@@ -339,7 +263,7 @@ KERF = register(Effect(
             "arm change",
     signature="the residual is proportional to the angle (a gain error of the joint)",
     family="arm",
-))
+)
 
 
 def _flat(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
@@ -349,12 +273,12 @@ def _flat(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
     return theta * (g.moment_arm_mm / arm)
 
 
-FLAT_WALLS = register(Effect(
+FLAT_WALLS = Effect(
     name="flat_walls", stage="kinematics", params=(), apply=_flat,
     meaning="the notch walls are flat (one planar cut) rather than radial, so the backbone and the arm differ",
     signature="the residual is proportional to the angle (a gain error of the joint)",
     family="arm",
-))
+)
 
 
 def _chords(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
@@ -373,19 +297,19 @@ def _chords(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
     return t * n
 
 
-CHORDS = register(Effect(
+CHORDS = Effect(
     name="chords", stage="kinematics", params=(), apply=_chords,
     meaning="the tendon crosses each notch as a straight chord, not an arc, so it shortens a little "
             "less than arm x angle",
     signature="a small residual growing with the angle squared",
-))
+)
 
 
 def _hardstop(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
     return np.minimum(theta, math.radians(p["stop_deg"]))
 
 
-HARDSTOP = register(Effect(
+HARDSTOP = Effect(
     name="hardstop", stage="kinematics",
     params=(Param("stop_deg", "deg", 1.0, 720.0,
                   lambda d, c: math.degrees(c.n_notches * c.geometry.closure_angle_rad),
@@ -393,7 +317,7 @@ HARDSTOP = register(Effect(
     apply=_hardstop,
     meaning="the notches close: beyond this angle the joint stops bending (hard stop)",
     signature="at high stroke the measured angle levels off while the model keeps rising",
-))
+)
 
 
 # ----------------------------------------------------------------------------- measurement stages
@@ -402,29 +326,31 @@ def _bias(ctx: Context, angle: np.ndarray, p: dict) -> np.ndarray:
     return angle + p["bias_deg"]
 
 
-ANGLE_BIAS = register(Effect(
+ANGLE_BIAS = Effect(
     name="angle_bias", stage="angle",
     params=(Param("bias_deg", "deg", -90.0, 90.0, 0.0, "constant offset of the angle sensor"),),
     apply=_bias,
     meaning="the angle sensor (EM tracker) reads a constant offset",
     signature="a constant residual everywhere, also where the joint is straight",
     family="offset",
-))
+)
 
 
 def _zero(ctx: Context, force: np.ndarray, p: dict) -> np.ndarray:
     return force - p["zero_N"]
 
 
-FORCE_ZERO = register(Effect(
+FORCE_ZERO = Effect(
     name="force_zero", stage="force",
     params=(Param("zero_N", "N", -10.0, 10.0, 0.0, "load-cell reading at zero tension"),),
     apply=_zero,
     meaning="the load cell is not zeroed: it reads an offset at zero tension",
     signature="a constant residual (the offset times the tendon compliance over the arm)",
     family="offset",
-))
+)
 
-#: Built-in effect names in registration order.
-BUILTINS = tuple(e.name for e in (SLACK, PLAY, CREEP, FRICTION, TOE, VISCOELASTIC, SERIES, KERF,
-                                  FLAT_WALLS, CHORDS, HARDSTOP, ANGLE_BIAS, FORCE_ZERO))
+#: The built-in effects, in their documented order.
+BUILTIN_EFFECTS = (SLACK, PLAY, CREEP, FRICTION, TOE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS, HARDSTOP,
+                   ANGLE_BIAS, FORCE_ZERO)
+#: Built-in effect names in that order.
+BUILTINS = tuple(e.name for e in BUILTIN_EFFECTS)

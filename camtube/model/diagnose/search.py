@@ -54,9 +54,11 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from camtube.model.api import Effect, JointModel, get_effect, registry
-from camtube.model.dataset import Dataset
-from camtube.model.fit import fit
+from camtube.model.core.model import Effect, JointModel
+from camtube.model.core.registry import Registry, builtin_registry
+from camtube.model.data.csvfile import check_fittable
+from camtube.model.data.dataset import Dataset
+from camtube.model.core.fit import fit
 
 #: Parameter correlation above which two parameters cannot be told apart.
 CORR_LIMIT = 0.99
@@ -263,6 +265,7 @@ def diagnose(
     min_gain: float = 0.02,
     min_excess: float = 0.1,
     stop_ratio: float = 1.15,
+    registry: Registry | None = None,
 ) -> Diagnosis:
     """Find the effects missing from ``model`` (see the module docstring).
 
@@ -277,7 +280,10 @@ def diagnose(
     fixed : dict, optional
         Values of held parameters and starting values (e.g. E_t, L0 from the pattern).
     candidates : sequence, optional
-        Effects to try (default: every registered effect not in ``model``).
+        Effects (or names in ``registry``) to try (default: every effect of ``registry`` not in ``model``).
+    registry : Registry, optional
+        The effects known to this call (default: the built-ins; add a user's file's effects with
+        :meth:`Registry.with_effects`).
     max_rows : int
         Rows used by the candidate search (thinned evenly in time); 0 = all.
     max_effects : int
@@ -297,13 +303,15 @@ def diagnose(
 
     clock = {"start": time.perf_counter()}
     fixed = dict(fixed or {})
+    reg = registry if registry is not None else builtin_registry()
     if candidates is None:
-        pool = [e for n, e in registry().items()]
+        pool = list(reg.effects)
     else:
-        pool = [get_effect(c) if isinstance(c, str) else c for c in candidates]
+        pool = [reg.get_effect(c) if isinstance(c, str) else c for c in candidates]
     have = {e.name for e in model.effects}
     pool = [e for e in pool if e.name not in have]
 
+    check_fittable(data)
     full_names = _names_for(model, fit_params)
     base_full = fit(model, data, full_names, fixed)
     floor = noise_floor(data, base_full.residuals)

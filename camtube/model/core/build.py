@@ -1,0 +1,99 @@
+"""Setting up a model from user input: effect names and files, ``--fix``/``--init`` lists, fitted names.
+
+These used to live in the CLI modules; the CLI and the Python API share them.
+"""
+from __future__ import annotations
+
+from typing import Iterable, Sequence
+
+from camtube.model.core.model import FitError, JointModel
+from camtube.model.core.registry import Registry, registry_with_files
+
+
+def split_names(text: str | None) -> list[str]:
+    """``'a, b,none'`` -> ``['a', 'b']`` (comma list; 'none' means nothing)."""
+    return [t.strip() for t in (text or "").split(",") if t.strip() and t.strip().lower() != "none"]
+
+
+def fit_param_names(model: JointModel, text: str | None = None, base: Sequence[str] = ("E_t",)) -> list[str]:
+    """Parameters to fit: the ``--fit`` list, or by default ``base`` and every parameter of the model's effects."""
+    if text is not None:
+        return split_names(text)
+    return list(dict.fromkeys(list(base) + [n for e in model.effects for n in e.full_names()]))
+
+
+def parse_assignments(items: Iterable[str], option: str = "--fix") -> dict[str, float]:
+    """``['L0=70', 'E_t = 30']`` -> ``{'L0': 70.0, 'E_t': 30.0}``; a bad item raises naming ``option``."""
+    out = {}
+    for it in items:
+        name, sep, val = it.partition("=")
+        try:
+            out[name.strip()] = float(val)
+        except ValueError:
+            sep = ""
+        if not sep or not name.strip():
+            raise FitError(f"{option} {it!r}: use NAME=VALUE with a number, e.g. {option} L0=70")
+    return out
+
+
+def parse_fix(items: Iterable[str]) -> dict[str, float]:
+    """``--fix NAME=VALUE`` items -> ``{name: value}``."""
+    return parse_assignments(items, "--fix")
+
+
+def build_registry(effect_files: Iterable[str] = ()) -> tuple[Registry, tuple]:
+    """The built-in registry plus the effects of ``effect_files``; also the files' effects."""
+    return registry_with_files(effect_files)
+
+
+def build_model(pattern, effects: str | Sequence[str] = "", effect_files: Iterable[str] = (),
+                registry: Registry | None = None) -> JointModel:
+    """JointModel of ``pattern`` with ``effects`` (comma list or names) from the built-ins plus ``effect_files``."""
+    from camtube.model.core.predict import model_for_pattern
+
+    if registry is None:
+        registry, _ = build_registry(effect_files)
+    names = split_names(effects) if isinstance(effects, str) else list(effects)
+    return model_for_pattern(pattern, [registry.get_effect(n) for n in names])
+
+
+def history_warning(model: JointModel, branch: str, n_cycles: int, fitted: Sequence[str]) -> str:
+    """A warning when a history effect is fitted on rows that cannot identify it (one branch or one cycle).
+
+    Returns an empty string when the selection is fine.
+    """
+    hist = [e for e in model.effects if e.history and any(n in fitted for n in e.full_names())]
+    if not hist:
+        return ""
+    why = []
+    if branch != "both":
+        why.append(f"only the {branch} branch")
+    if n_cycles < 2:
+        why.append("a single cycle")
+    if not why:
+        return ""
+    return (f"warning: {', '.join(e.name for e in hist)} depend(s) on the history of the motion, but the fit uses "
+            f"{' and '.join(why)}: the parameters may be unidentifiable (infinite standard errors); "
+            "use --cycles all --branch both --no-deadband (the rows camtube model diagnose uses)")
+
+
+def check_suffix(path: str | None, suffixes: tuple[str, ...], option: str) -> None:
+    """Refuse an output file whose suffix does not match the format written to it.
+
+    Raises
+    ------
+    DataError
+        Naming the option, the path and the suffix to use.
+    """
+    from pathlib import Path
+
+    from camtube.errors import DataError
+
+    if path is None:
+        return
+    p = Path(path)
+    if p.suffix.lower() not in suffixes:
+        raise DataError(f"{option} {path}: writes {suffixes[0][1:].upper()}, so the file must end in "
+                        f"{' or '.join(suffixes)} (got {p.suffix or 'no suffix'!r})")
+    if p.is_dir():
+        raise DataError(f"{option} {path}: is a directory; fix: name a file")

@@ -1,0 +1,444 @@
+"""The joint model as a base plus named, composable effects.
+
+The base model (the source paper)::
+
+    L_t = L_kin + L_el,   L_kin = arm * theta,   L_el = F L0 / (E_t pi r_t^2)
+    => theta = (stroke - F L0 / (E_t pi r_t^2)) / arm,   arm = ybar + r_i - r_t
+
+An :class:`Effect` is a named term that changes one *stage* of this chain
+(or several: see below). The stages, in the order :meth:`JointModel.predict` runs them:
+
+``force``
+    the force signal before it is used (load-cell zero, ...):
+    ``apply(ctx, force_N, p) -> force_N``
+``stroke``
+    the stroke that reaches the tendon, from the motor stroke's history
+    (slack, backlash/play, creep over cycles, ...): ``apply(ctx, stroke_mm, p) -> stroke_mm``
+``elongation``
+    the tendon's force-elongation law (toe region, viscoelasticity, series
+    compliance, ...): ``apply(ctx, elongation_mm, p) -> elongation_mm``;
+    ``ctx.force_N`` is the (corrected) force
+``kinematics``
+    tendon length change -> joint angle (chords, hard stop, geometry
+    corrections, ...): ``apply(ctx, theta_rad, p) -> theta_rad``;
+    ``ctx.l_kin_mm`` is the kinematic length change (mm, the natural input:
+    ``theta = l_kin / arm`` for the base model), ``ctx.arm_mm`` the arm, ``ctx.geometry`` the joint geometry
+``angle``
+    the measured angle (sensor bias, ...): ``apply(ctx, angle_deg, p) -> angle_deg``
+
+Each effect's parameter values arrive in ``p`` keyed by the parameter's short
+name. An effect on several stages gives ``stage`` as a tuple and ``apply`` as a
+``{stage: function}`` mapping; its functions share the parameters.
+
+Effects are looked up by name in an explicit :class:`~camtube.model.core.registry.Registry`
+(built-ins plus the effects of the files a command loads); nothing here is process-wide state.
+
+Per-sample parameters (``slack.deadband_mm@S2``): :meth:`JointModel.predict`
+runs each sample with its own values (every effect already runs per sample).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Callable, Mapping, Sequence
+
+import numpy as np
+
+from camtube.design.geometry import JointGeometry
+from camtube.errors import CamtubeError
+from camtube.model.core.params import (
+    DEFAULT_E_T_GPA, DEFAULT_L0_MM, Param, Parameter, Parameters, split_name, tendon_compliance_mm_per_N,
+    values_for_sample,
+)
+from camtube.model.data.dataset import Dataset
+
+
+class FitError(CamtubeError, ValueError):
+    """A model could not be set up, evaluated or fitted (unknown parameter, no data, broken effect)."""
+
+
+STAGES = ("force", "stroke", "elongation", "kinematics", "angle")
+
+
+@dataclass
+class Context:
+    """What an effect may read while the model runs (one sample's rows, or all rows).
+
+    Attributes
+    ----------
+    data : Dataset
+        The rows being predicted (stroke, force, time, cycle, sample, ...).
+    geometry : JointGeometry
+        Geometry of the joint's notches (``moment_arm_mm``, ``phi_rad``, ...).
+    n_notches : int
+        Number of notches in the joint.
+    tendon_length_mm, tendon_area_mm2 : float
+        L0 and pi r_t^2.
+    modulus_gpa : float
+        Current E_t.
+    force_N : (n,) float
+        Force after the ``force`` stage.
+    stroke_mm : (n,) float
+        Stroke after the ``stroke`` stage.
+    l_kin_mm : (n,) float
+        Kinematic length change (stroke - elongation), set before ``kinematics``.
+    arm_mm : float
+        Moment arm in use (geometry's arm times ``arm_scale``), set before ``kinematics``.
+    direction : (n,) int
+        +1 loading, -1 unloading (from the measured stroke).
+
+    Ready-made signals (properties, per sample, computed on first use):
+    ``first_cycle`` (n,) bool, rows of each sample's first cycle;
+    ``peak_force_N`` (n,) float, the largest force so far;
+    ``time_since_reversal_s`` (n,) float, time since the stroke last changed direction.
+    """
+
+    data: Dataset
+    geometry: JointGeometry
+    n_notches: int
+    tendon_length_mm: float
+    tendon_area_mm2: float
+    modulus_gpa: float
+    force_N: np.ndarray | None = None
+    stroke_mm: np.ndarray | None = None
+    l_kin_mm: np.ndarray | None = None
+    direction: np.ndarray | None = None
+    arm_mm: float = 0.0
+    cache: dict = field(default_factory=dict)
+
+    @property
+    def compliance_mm_per_N(self) -> float:
+        """Base tendon compliance L0 / (E_t pi r_t^2) in mm/N (E_t in GPa = 1e3 N/mm^2)."""
+        return self.tendon_length_mm / (self.modulus_gpa * 1e3 * self.tendon_area_mm2)
+
+    @property
+    def first_cycle(self) -> np.ndarray:
+        """(n,) bool: rows in each sample's first cycle."""
+        out = np.zeros(len(self.data), bool)
+        cyc = np.asarray(self.data.cycle)
+        for _, sl in self.data.sample_slices():
+            out[sl] = cyc[sl] == cyc[sl].min()
+        return out
+
+    @property
+    def peak_force_N(self) -> np.ndarray:
+        """(n,) float: the largest force (after the ``force`` stage) so far, per sample."""
+        f = np.asarray(self.force_N if self.force_N is not None else self.data.force_N, float)
+        out = np.empty_like(f)
+        for _, sl in self.data.sample_slices():
+            out[sl] = np.maximum.accumulate(f[sl])
+        return out
+
+    @property
+    def time_since_reversal_s(self) -> np.ndarray:
+        """(n,) float: time (s) since the direction of motion last changed (since the start for the first run)."""
+        t = np.asarray(self.data.time_s, float)
+        d = self.data.direction
+        out = np.empty_like(t)
+        for _, sl in self.data.sample_slices():
+            dd, ts = d[sl], t[sl]
+            start = np.zeros(dd.size, int)
+            if dd.size:
+                change = np.flatnonzero(np.diff(dd)) + 1
+                start[change] = change
+                np.maximum.accumulate(start, out=start)
+            out[sl] = ts - ts[start]
+        return out
+
+
+@dataclass(frozen=True)
+class Effect:
+    """A named physical effect added to the base model.
+
+    Attributes
+    ----------
+    name : str
+        Registry name (``slack``); used on the command line (``--effects slack``).
+    stage : str | tuple[str, ...]
+        One of :data:`STAGES`, or several (then ``apply`` maps each stage to its function).
+    params : tuple[Param, ...]
+    apply : Callable[[Context, ndarray, dict[str, float]], ndarray] | Mapping[str, Callable]
+        The stage transform (or one per stage).
+    meaning : str
+        One sentence: the physics.
+    signature : str
+        The residual pattern it explains, in words.
+    family : str
+        Effects of one family cannot be told apart from each other by the data
+        alone (the diagnosis reports them together).
+    history : bool
+        The effect depends on the history of the motion (play, creep,
+        viscoelasticity): it needs whole cycles in both directions to be identified.
+    source : str
+        The file that defined it (empty for built-ins); named in error messages.
+    """
+
+    name: str
+    stage: str | tuple
+    params: tuple[Param, ...]
+    apply: Callable[[Context, np.ndarray, dict], np.ndarray] | Mapping
+    meaning: str = ""
+    signature: str = ""
+    family: str = ""
+    history: bool = False
+    source: str = ""
+
+    def __post_init__(self):
+        for st in self.stages:
+            if st not in STAGES:
+                raise ValueError(f"effect {self.name!r}: stage must be one of {STAGES}, not {st!r}")
+        if isinstance(self.apply, Mapping):
+            missing = [st for st in self.stages if st not in self.apply]
+            if missing:
+                raise ValueError(f"effect {self.name!r}: apply has no function for stage(s) {', '.join(missing)}")
+        elif len(self.stages) > 1:
+            raise ValueError(f"effect {self.name!r} acts on {len(self.stages)} stages: give apply as "
+                             "{stage: function}")
+
+    @property
+    def stages(self) -> tuple[str, ...]:
+        return (self.stage,) if isinstance(self.stage, str) else tuple(self.stage)
+
+    def function(self, stage: str) -> Callable:
+        return self.apply[stage] if isinstance(self.apply, Mapping) else self.apply
+
+    def full_names(self) -> tuple[str, ...]:
+        return tuple(f"{self.name}.{p.name}" for p in self.params)
+
+
+#: Base parameters (no prefix). ``E_t`` is fitted by default.
+BASE_PARAMS: tuple[Param, ...] = (
+    Param("E_t", "GPa", 0.5, 500.0, DEFAULT_E_T_GPA, "tendon Young's modulus", log=True, kind="modulus"),
+    Param("L0", "mm", 1.0, 10000.0, DEFAULT_L0_MM, "unloaded tendon length", log=True),
+    Param("arm_scale", "", 0.3, 3.0, 1.0, "factor on the moment arm ybar + r_i - r_t"),
+)
+
+
+def _call(effect: Effect, stage: str, ctx: Context, signal: np.ndarray, p: dict) -> np.ndarray:
+    """Run one effect's stage function; a broken effect gets a message naming it, its file and the problem."""
+    where = f"effect {effect.name!r}" + (f" ({effect.source})" if effect.source else "")
+    try:
+        out = effect.function(stage)(ctx, signal, p)
+    except KeyError as exc:
+        raise FitError(f"{where}, stage {stage}: asked for parameter {exc.args[0]!r}, but its params are "
+                       f"{', '.join(repr(q.name) for q in effect.params) or 'none'}") from None
+    out = np.asarray(out, float)
+    if out.shape != signal.shape:
+        raise FitError(f"{where}, stage {stage}: returned shape {out.shape}, expected {signal.shape} "
+                       "(one value per row)")
+    return out
+
+
+@dataclass(frozen=True)
+class JointModel:
+    """Base model plus effects, for one joint geometry.
+
+    Parameters are addressed by full name: base ``E_t``, ``L0``,
+    ``arm_scale``; effect ``<effect>.<param>``; per sample ``<name>@<sample>``.
+    """
+
+    geometry: JointGeometry
+    n_notches: int = 1
+    tendon_radius_mm: float = 0.04
+    effects: tuple[Effect, ...] = ()
+
+    def with_effects(self, effects: Sequence[Effect | str], registry=None) -> "JointModel":
+        """The model with ``effects`` (objects, or names looked up in ``registry``, default the built-ins)."""
+        from camtube.model.core.registry import builtin_registry
+
+        reg = registry if registry is not None else builtin_registry()
+        effs = tuple(reg.get_effect(e) if isinstance(e, str) else e for e in effects)
+        return replace(self, effects=effs)
+
+    @property
+    def param_specs(self) -> dict[str, Param]:
+        """Full name -> :class:`Param` of every parameter, base first."""
+        out = {p.name: p for p in BASE_PARAMS}
+        for e in self.effects:
+            for p in e.params:
+                out[f"{e.name}.{p.name}"] = p
+        return out
+
+    def spec(self, name: str) -> Param:
+        """The :class:`Param` of a full name (per-sample names share their base's)."""
+        return self.param_specs[split_name(name)[0]]
+
+    def effect_names(self) -> tuple[str, ...]:
+        return tuple(e.name for e in self.effects)
+
+    def context(self, data: Dataset, values: Mapping[str, float]) -> Context:
+        return Context(
+            data=data,
+            geometry=self.geometry,
+            n_notches=self.n_notches,
+            tendon_length_mm=float(values.get("L0", DEFAULT_L0_MM)),
+            tendon_area_mm2=math.pi * self.tendon_radius_mm**2,
+            modulus_gpa=float(values.get("E_t", DEFAULT_E_T_GPA)),
+            direction=data.direction,
+        )
+
+    def compliance_mm_per_N(self, values: Mapping[str, float]) -> float:
+        """Base tendon compliance (mm/N) at ``values`` (L0, E_t)."""
+        return tendon_compliance_mm_per_N(values.get("L0", DEFAULT_L0_MM), values.get("E_t", DEFAULT_E_T_GPA),
+                                          self.tendon_radius_mm)
+
+    def initial_values(self, data: Dataset, base: Mapping[str, float] | None = None) -> dict[str, float]:
+        """Initial value of every parameter (``base`` overrides, e.g. L0 from the pattern)."""
+        vals = {p.name: float(p.init) for p in BASE_PARAMS}
+        vals.update(base or {})
+        ctx = self.context(data, vals)
+        for name, spec in self.param_specs.items():
+            if name not in vals:
+                vals[name] = spec.initial(data, ctx)
+        return vals
+
+    def make_params(
+        self,
+        data: Dataset,
+        fit: Sequence[str] = ("E_t",),
+        fixed: Mapping[str, float] | None = None,
+        *,
+        initial: Mapping[str, float] | None = None,
+        bounds: Mapping[str, tuple[float, float]] | None = None,
+        per_sample: Sequence[str] = (),
+    ) -> Parameters:
+        """The :class:`Parameters` of this model: ``fit`` names vary, the others are held.
+
+        Parameters
+        ----------
+        data : Dataset
+            For data-dependent initial values and the sample names of per-sample copies.
+        fit : sequence of str
+            Full names to fit (a ``name@S`` entry makes that one per-sample copy).
+        fixed : dict
+            Values of held parameters and starting values of fitted ones.
+        initial : dict
+            Starting values (win over ``fixed``).
+        bounds : dict
+            ``{name: (lo, hi)}`` overriding the declarations.
+        per_sample : sequence of str
+            Full names (or effect names: all their parameters) fitted per sample.
+
+        Raises
+        ------
+        FitError
+            For an unknown name (with a "did you mean" hint).
+        """
+        specs = self.param_specs
+        known = list(specs)
+        fixed = dict(fixed or {})
+        initial = dict(initial or {})
+        bounds = dict(bounds or {})
+        ps = []
+        for nm in per_sample:
+            if nm in specs:
+                ps.append(nm)
+            elif nm in self.effect_names():
+                ps += [f"{nm}.{p.name}" for p in next(e for e in self.effects if e.name == nm).params]
+            else:
+                raise unknown_parameter(nm, known + list(self.effect_names()))
+        samples = data.samples
+        for nm in list(fit) + list(fixed) + list(initial) + list(bounds):
+            base, smp = split_name(nm)
+            if base not in specs:
+                raise unknown_parameter(base, known)
+            if smp is not None and smp not in samples:
+                raise FitError(f"parameter {nm!r}: the data have no sample {smp!r} (samples: {', '.join(samples)})")
+        start = self.initial_values(data, base={k: v for k, v in fixed.items() if "@" not in k})
+        start.update({k: float(v) for k, v in initial.items() if "@" not in k})
+        want = {split_name(n)[0] for n in fit}
+        items = []
+        for name, sp in specs.items():
+            lo, hi = bounds.get(name, (sp.lo, sp.hi))
+            items.append(Parameter(name, float(start[name]), name in want and name not in ps, float(lo), float(hi),
+                                   sp.unit, log=sp.log, starts=tuple(sp.starts), kind=sp.kind))
+        out = Parameters(tuple(items))
+        if ps:
+            out = out.per_sample(ps, samples)
+            out = Parameters(tuple(replace(p, vary=p.name.split("@")[0] in want) if p.sample else p
+                                   for p in out.items))
+        # explicit name@S entries in fit: per-sample copies of those only
+        single = [n for n in fit if "@" in n and n not in out]
+        for n in single:
+            base, smp = split_name(n)
+            p = out[base]
+            out = Parameters.of(list(out.items) + [replace(p, name=n, sample=smp, vary=True)])
+        for src in (fixed, initial):
+            out = out.with_values({k: v for k, v in src.items() if k in out and "@" in k})
+        for name, (lo, hi) in bounds.items():
+            if name in out:
+                out = out.set(name, lo=float(lo), hi=float(hi))
+        return out
+
+    def predict(self, data: Dataset, values: Mapping[str, float] | Parameters) -> np.ndarray:
+        """Model joint angle (deg), shape ``(n,)``, from measured stroke and force.
+
+        ``values``: ``{full name: value}`` or a :class:`Parameters`; per-sample
+        entries (``name@S``) override ``name`` for sample ``S``.
+        """
+        if isinstance(values, Parameters):
+            values = values.values
+        if any("@" in k for k in values):
+            out = np.empty(len(data))
+            for smp, sl, sub in _sample_views(data):
+                out[sl] = self._predict(sub, values_for_sample(values, smp))
+            return out
+        return self._predict(data, values)
+
+    def _predict(self, data: Dataset, values: Mapping[str, float]) -> np.ndarray:
+        ctx = self.context(data, values)
+        by_stage: dict[str, list[Effect]] = {s: [] for s in STAGES}
+        for e in self.effects:
+            for st in e.stages:
+                by_stage[st].append(e)
+
+        def params_of(e: Effect) -> dict[str, float]:
+            try:
+                return {p.name: float(values[f"{e.name}.{p.name}"]) for p in e.params}
+            except KeyError as exc:
+                raise FitError(f"no value for parameter {exc.args[0]!r} of effect {e.name!r}") from None
+
+        force = np.asarray(data.force_N, float)
+        for e in by_stage["force"]:
+            force = _call(e, "force", ctx, force, params_of(e))
+        ctx.force_N = force
+        stroke = np.asarray(data.stroke_mm, float)
+        for e in by_stage["stroke"]:
+            stroke = _call(e, "stroke", ctx, stroke, params_of(e))
+        ctx.stroke_mm = stroke
+        elong = force * ctx.compliance_mm_per_N
+        for e in by_stage["elongation"]:
+            elong = _call(e, "elongation", ctx, elong, params_of(e))
+        l_kin = stroke - elong
+        ctx.l_kin_mm = l_kin
+        arm = self.geometry.moment_arm_mm * float(values.get("arm_scale", 1.0))
+        ctx.arm_mm = arm
+        theta = l_kin / arm
+        for e in by_stage["kinematics"]:
+            theta = _call(e, "kinematics", ctx, theta, params_of(e))
+        angle = np.degrees(theta)
+        for e in by_stage["angle"]:
+            angle = _call(e, "angle", ctx, angle, params_of(e))
+        return angle
+
+
+import weakref  # noqa: E402  (kept beside its only use)
+
+_VIEWS: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
+
+
+def _sample_views(data: Dataset) -> list:
+    """``(sample, slice, sub-dataset)`` of each sample, cached per Dataset (fits evaluate the same rows often)."""
+    hit = _VIEWS.get(data)
+    if hit is None:
+        hit = [(smp, sl, data.take(np.arange(sl.start, sl.stop))) for smp, sl in data.sample_slices()]
+        _VIEWS[data] = hit
+    return hit
+
+
+def unknown_parameter(name: str, known: Sequence[str]) -> FitError:
+    import difflib
+
+    hint = difflib.get_close_matches(name, list(known), n=1)
+    return FitError(f"unknown model parameter {name!r}" + (f"; did you mean {hint[0]!r}?" if hint else "")
+                    + f" (this model has: {', '.join(known)})")

@@ -1,0 +1,202 @@
+"""Measurement CSV files: parse and validate (errors name the file and line), format, and refuse
+rows the model cannot be fitted to (see :mod:`camtube.model.data` for the format)."""
+from __future__ import annotations
+
+import csv
+import difflib
+import io
+from pathlib import Path
+
+import numpy as np
+
+from camtube.errors import DataError
+from camtube.model.data.dataset import Dataset
+
+#: Required CSV columns, in the order :func:`format_csv` writes them.
+COLUMNS = ("sample", "cycle", "time_s", "stroke_mm", "force_N", "angle_deg")
+_FLOAT_COLS = ("time_s", "stroke_mm", "force_N", "angle_deg")
+_FORMATS = {"time_s": "%.4f", "stroke_mm": "%.6f", "force_N": "%.6f", "angle_deg": "%.5f"}
+
+
+# ----------------------------------------------------------------------------- loading
+
+def _err(source: str, line: int | None, msg: str, fix: str = "") -> DataError:
+    where = f"{source}:{line}" if line is not None else source
+    return DataError(f"{where}: {msg}" + (f"; fix: {fix}" if fix else ""))
+
+
+def _to_float(col: tuple, name: str, lines: np.ndarray, source: str, finite: bool = True) -> np.ndarray:
+    """Column of strings -> (n,) float; the first bad cell raises with its line."""
+    try:
+        arr = np.array(col, dtype=float)
+    except ValueError:
+        for k, cell in enumerate(col):
+            try:
+                float(cell)
+            except ValueError:
+                what = "is empty" if not cell.strip() else f"is not a number: {cell!r}"
+                raise _err(source, int(lines[k]), f"column {name!r} {what}",
+                           "every cell of the measurement columns must be a number") from None
+        raise  # pragma: no cover - numpy and float() disagree
+    if finite:
+        bad = np.flatnonzero(~np.isfinite(arr))
+        if bad.size:
+            k = int(bad[0])
+            raise _err(source, int(lines[k]), f"column {name!r} is {col[k].strip()!r}",
+                       "NaN/inf are not measurements: drop the row or fill the gap")
+    return arr
+
+
+def parse_csv(text: str, source: str = "<csv>") -> Dataset:
+    """Parse measurement CSV text into a :class:`Dataset` (see the module docstring).
+
+    Parameters
+    ----------
+    text : str
+        The file's content.
+    source : str
+        Name used in error messages (the file path).
+
+    Raises
+    ------
+    DataError
+        Naming ``source:line`` and the column.
+    """
+    reader = csv.reader(io.StringIO(text))
+    header: list[str] | None = None
+    header_line = 0
+    rows: list[list[str]] = []
+    lines: list[int] = []
+    try:
+        for rec in reader:
+            ln = reader.line_num
+            if not rec or not any(c.strip() for c in rec) or rec[0].lstrip().startswith("#"):
+                continue
+            if header is None:
+                header = [c.strip() for c in rec]
+                header_line = ln
+                continue
+            if len(rec) != len(header):
+                raise _err(source, ln, f"{len(rec)} cells but the header (line {header_line}) has "
+                                       f"{len(header)} columns", "one cell per column on every line")
+            rows.append(rec)
+            lines.append(ln)
+    except csv.Error as exc:
+        raise _err(source, reader.line_num, f"not valid CSV ({exc})") from None
+    if header is None:
+        raise _err(source, None, "no header line: the file is empty",
+                   f"the first line must name the columns: {', '.join(COLUMNS)}")
+    dup = sorted({c for c in header if header.count(c) > 1})
+    if dup:
+        raise _err(source, header_line, f"duplicate column(s) {', '.join(dup)}")
+    missing = [c for c in COLUMNS if c not in header]
+    if missing:
+        hints = []
+        for c in missing:
+            m = difflib.get_close_matches(c, header, n=1, cutoff=0.5)
+            if m:
+                hints.append(f"{m[0]!r} -> {c!r}")
+        raise _err(source, header_line,
+                   f"missing column(s) {', '.join(missing)} (found: {', '.join(header)})",
+                   ("rename " + ", ".join(hints)) if hints else f"the header must contain {', '.join(COLUMNS)}")
+    if not rows:
+        raise _err(source, header_line, "no data rows after the header")
+
+    ln = np.asarray(lines, dtype=np.int64)
+    cols = dict(zip(header, zip(*rows)))
+    sample = np.array([s.strip() for s in cols["sample"]], dtype=object)
+    empty = np.flatnonzero(sample == "")
+    if empty.size:
+        raise _err(source, int(ln[empty[0]]), "column 'sample' is empty", "give every row a sample id")
+    cyc_f = _to_float(cols["cycle"], "cycle", ln, source)
+    bad = np.flatnonzero((cyc_f != np.round(cyc_f)) | (cyc_f < 1))
+    if bad.size:
+        k = int(bad[0])
+        raise _err(source, int(ln[k]), f"column 'cycle' must be a whole number >= 1, got {cols['cycle'][k].strip()!r}",
+                   "number the cycles 1, 2, 3, ...")
+    num = {c: _to_float(cols[c], c, ln, source) for c in _FLOAT_COLS}
+    extra: dict[str, np.ndarray] = {}
+    for c in header:
+        if c in COLUMNS:
+            continue
+        try:
+            extra[c] = np.array(cols[c], dtype=float)
+        except ValueError:
+            extra[c] = np.array([s.strip() for s in cols[c]], dtype=object)
+
+    # gather rows by sample (first appearance), keep file order within a sample
+    uniq, first, inv = np.unique(sample, return_index=True, return_inverse=True)
+    rank = np.empty(len(uniq), dtype=np.int64)
+    rank[np.argsort(first)] = np.arange(len(uniq))
+    order = np.argsort(rank[inv], kind="stable")
+    if np.any(order != np.arange(len(order))):
+        sample = sample[order]
+        ln = ln[order]
+        cyc_f = cyc_f[order]
+        num = {c: v[order] for c, v in num.items()}
+        extra = {c: v[order] for c, v in extra.items()}
+    same = sample[1:] == sample[:-1]
+    for name, arr, fix in (("time_s", num["time_s"], "sort each sample's rows by time"),
+                           ("cycle", cyc_f, "cycles must not decrease with time within a sample")):
+        back = np.flatnonzero(same & (np.diff(arr) < 0))
+        if back.size:
+            k = int(back[0]) + 1
+            raise _err(source, int(ln[k]),
+                       f"column {name!r} goes backwards within sample {sample[k]!r}: {arr[k]:g} after "
+                       f"{arr[k - 1]:g} (line {int(ln[k - 1])})", fix)
+    return Dataset(sample, cyc_f.astype(np.int64), num["time_s"], num["stroke_mm"], num["force_N"],
+                   num["angle_deg"], extra)
+
+
+def load_csv(path: str | Path) -> Dataset:
+    """Load and validate a measurement CSV file (see :func:`parse_csv`)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise DataError(f"{path}: no such measurement file") from None
+    except IsADirectoryError:
+        raise DataError(f"{path}: is a directory, not a measurement file; fix: name the CSV file") from None
+    except PermissionError:
+        raise DataError(f"{path}: cannot read the measurement file (permission denied)") from None
+    except OSError as exc:
+        raise DataError(f"{path}: cannot read the measurement file ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
+        raise DataError(f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start})") from None
+    return parse_csv(text, str(path))
+
+
+def check_fittable(data: Dataset, what: str = "the selected rows") -> None:
+    """Refuse rows the joint model cannot be fitted to: a stroke or an angle that never changes.
+
+    Raises
+    ------
+    DataError
+        Naming the column, its value range and the fix.
+    """
+    for col, unit in (("stroke_mm", "mm"), ("angle_deg", "deg")):
+        v = np.asarray(getattr(data, col), float)
+        if v.size and float(np.ptp(v)) <= 1e-12 * max(1.0, float(np.max(np.abs(v)))):
+            raise DataError(f"{what}: column {col!r} never changes (every value is {float(v[0]):g} {unit}): "
+                            "the model's parameters cannot be identified; fix: give rows where the joint "
+                            "is actuated (check the file and the --cycles selection)")
+
+
+def format_csv(data: Dataset) -> str:
+    """CSV text of ``data``: the required columns, then extra columns (deterministic, ``\\n`` endings).
+
+    Floats are written with fixed decimals: time 1e-4 s, stroke 1e-6 mm,
+    force 1e-6 N, angle 1e-5 deg; extra float columns with 9 significant digits.
+    """
+    out = io.StringIO()
+    w = csv.writer(out, lineterminator="\n")
+    names = list(COLUMNS) + list(data.extra)
+    w.writerow(names)
+    cols = [data.sample.astype(str), np.char.mod("%d", np.asarray(data.cycle, np.int64))]
+    for c in _FLOAT_COLS:
+        cols.append(np.char.mod(_FORMATS[c], np.asarray(getattr(data, c), float)))
+    for v in data.extra.values():
+        v = np.asarray(v)
+        cols.append(np.char.mod("%.9g", v) if v.dtype.kind in "fiu" else v.astype(str))
+    w.writerows(zip(*cols))
+    return out.getvalue()

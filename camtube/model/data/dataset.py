@@ -1,0 +1,100 @@
+"""Measurement data in memory: one row per instant, several samples and cycles.
+
+Loading and validating CSV files lives in :mod:`camtube.model.data`; this
+module only holds the value type every model function takes.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True, eq=False)
+class Dataset:
+    """Tendon stroke, force and joint angle over time.
+
+    Rows are ordered by sample, then time. All arrays have shape ``(n,)``.
+
+    Attributes
+    ----------
+    sample : (n,) str (object array)
+        Sample id of each row.
+    cycle : (n,) int
+        Actuation cycle number (1-based).
+    time_s : (n,) float
+        Time since the start of the sample's record (s), non-decreasing per sample.
+    stroke_mm : (n,) float
+        Tendon stroke (motor side), mm.
+    force_N : (n,) float
+        Tendon force (load cell), N.
+    angle_deg : (n,) float
+        Measured joint angle, deg.
+    extra : dict[str, (n,) array]
+        Extra CSV columns, kept as read.
+    """
+
+    sample: np.ndarray
+    cycle: np.ndarray
+    time_s: np.ndarray
+    stroke_mm: np.ndarray
+    force_N: np.ndarray
+    angle_deg: np.ndarray
+    extra: dict = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return int(self.stroke_mm.shape[0])
+
+    @property
+    def samples(self) -> list[str]:
+        """Sample ids in order of first appearance."""
+        _, idx = np.unique(self.sample, return_index=True)
+        return [str(self.sample[i]) for i in sorted(idx)]
+
+    def sample_slices(self) -> list[tuple[str, slice]]:
+        """``(sample, slice)`` of each sample's contiguous rows, in order."""
+        out = []
+        n = len(self)
+        if n == 0:
+            return out
+        change = np.flatnonzero(self.sample[1:] != self.sample[:-1]) + 1
+        starts = np.concatenate(([0], change))
+        ends = np.concatenate((change, [n]))
+        for s, e in zip(starts, ends):
+            out.append((str(self.sample[s]), slice(int(s), int(e))))
+        return out
+
+    @property
+    def direction(self) -> np.ndarray:
+        """(n,) int: +1 while the stroke grows (loading), -1 while it shrinks (unloading).
+
+        Taken from the sign of the stroke's change, carried over pauses; the
+        first row of a sample takes the sign of the first real change.
+        """
+        d = np.zeros(len(self), dtype=int)
+        for _, sl in self.sample_slices():
+            s = self.stroke_mm[sl]
+            if len(s) < 2:
+                d[sl] = 1
+                continue
+            ds = np.diff(s)
+            sg = np.sign(ds).astype(int)
+            # forward-fill zeros (pauses) with the last non-zero sign
+            idx = np.where(sg != 0, np.arange(len(sg)), 0)
+            np.maximum.accumulate(idx, out=idx)
+            sg = sg[idx]
+            first = sg[np.flatnonzero(sg)[0]] if np.any(sg) else 1
+            sg = np.where(sg == 0, first, sg)
+            d[sl] = np.concatenate(([sg[0]], sg))
+        return d
+
+    def take(self, mask: np.ndarray) -> "Dataset":
+        """Rows where ``mask`` (bool or index array) selects."""
+        return Dataset(
+            self.sample[mask], self.cycle[mask], self.time_s[mask], self.stroke_mm[mask],
+            self.force_N[mask], self.angle_deg[mask], {k: v[mask] for k, v in self.extra.items()},
+        )
+
+    def with_angle(self, angle_deg: np.ndarray) -> "Dataset":
+        return Dataset(self.sample, self.cycle, self.time_s, self.stroke_mm, self.force_N,
+                       np.asarray(angle_deg, float), self.extra)

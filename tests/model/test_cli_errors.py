@@ -1,0 +1,161 @@
+"""Everyday mistakes with ``camtube model``: one clear line, exit 2, no traceback, nothing written (issue 9)."""
+from __future__ import annotations
+
+import csv
+import os
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from camtube.cli import build_parser, main
+from tests.conftest import PATTERNS, ROOT
+
+TUBE2 = str(PATTERNS / "tube2.yaml")
+
+
+@pytest.fixture(scope="module")
+def data_csv(tmp_path_factory):
+    path = tmp_path_factory.mktemp("e") / "d.csv"
+    assert main(["model", "synth", "--pattern", TUBE2, "-o", str(path), "--cycles", "3", "-q"]) == 0
+    return path
+
+
+def _variant(src, dst, **cols):
+    with open(src, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    with open(dst, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        for r in rows:
+            r.update(cols)
+            w.writerow(r)
+    return dst
+
+
+def _fails_cleanly(argv, capsys, *words):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    for w in words:
+        assert w in err, err
+    return err
+
+
+@pytest.mark.parametrize("opt,value,word", [
+    ("--noise-angle", "-1", "--noise-angle"), ("--noise-force", "-0.1", "--noise-force"),
+    ("--speed", "0", "--speed"), ("--rate", "0", "--rate"), ("--rate", "1e9", "2,000,000"),
+    ("--slack", "-0.1", "--slack"), ("--slack", "9", "--slack"), ("--modulus", "0", "--modulus"),
+    ("--samples", "0", "--samples"), ("--cycles", "0", "--cycles"),
+])
+def test_synth_refuses_nonsense_and_writes_nothing(tmp_path, capsys, opt, value, word):
+    out = tmp_path / "x.csv"
+    err = _fails_cleanly(["model", "synth", "--pattern", TUBE2, "-o", str(out), "-q", opt, value], capsys, word)
+    assert "allowed" in err
+    assert not out.exists() and not list(tmp_path.iterdir())
+
+
+def test_synth_row_limit_is_checked_before_allocating(tmp_path, capsys):
+    # 1e9 Hz would need ~60 GB; the refusal must come at once (no allocation)
+    import time
+
+    t0 = time.perf_counter()
+    _fails_cleanly(["model", "synth", "--pattern", TUBE2, "-o", str(tmp_path / "x.csv"), "-q", "--rate", "1e9"],
+                   capsys, "rows")
+    assert time.perf_counter() - t0 < 5.0
+
+
+@pytest.mark.parametrize("argv_tail,word", [
+    (["--plot", "f.jpg"], ".png"), (["--json", "f.txt"], ".json"),
+])
+def test_fit_refuses_an_output_whose_suffix_is_another_format(data_csv, tmp_path, capsys, argv_tail, word):
+    tail = [str(tmp_path / a) if a.startswith("f.") else a for a in argv_tail]
+    _fails_cleanly(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", *tail], capsys, word)
+    assert not list(tmp_path.iterdir())
+
+
+def test_synth_refuses_a_non_csv_output(tmp_path, capsys):
+    _fails_cleanly(["model", "synth", "--pattern", TUBE2, "-o", str(tmp_path / "x.json"), "-q"], capsys, ".csv")
+
+
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+def test_a_directory_or_unreadable_path_is_one_line(tmp_path, capsys, cmd):
+    _fails_cleanly(["model", cmd, str(tmp_path), "--pattern", TUBE2, "-q"], capsys, "is a directory")
+    if hasattr(os, "geteuid") and os.geteuid() != 0:
+        f = tmp_path / "locked.csv"
+        f.write_text("sample,cycle\n")
+        f.chmod(0)
+        _fails_cleanly(["model", cmd, str(f), "--pattern", TUBE2, "-q"], capsys, "permission denied")
+
+
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+@pytest.mark.parametrize("kind", ["constant", "zero stroke"])
+def test_constant_or_zero_stroke_data_is_refused(data_csv, tmp_path, capsys, cmd, kind):
+    cols = ({"stroke_mm": "1.0", "force_N": "0.5", "angle_deg": "3.0"} if kind == "constant"
+            else {"stroke_mm": "0.0"})
+    f = _variant(data_csv, tmp_path / "v.csv", **cols)
+    for extra in ([], ["--no-deadband"]) if cmd == "fit" else ([],):
+        _fails_cleanly(["model", cmd, str(f), "--pattern", TUBE2, "-q", *extra], capsys,
+                       "'stroke_mm' never changes")
+
+
+def test_fit_of_an_unidentifiable_parameter_exits_2_and_names_it(data_csv, tmp_path, capsys):
+    # force all zero: E_t has no effect on the model (its stderr is infinite) -> not a success
+    f = _variant(data_csv, tmp_path / "noforce.csv", force_N="0.0")
+    js = tmp_path / "f.json"
+    err = _fails_cleanly(["model", "fit", str(f), "--pattern", TUBE2, "-q", "--json", str(js)], capsys,
+                         "cannot identify", "E_t")
+    assert "--fix" in err
+    # the same fit with E_t held is fine
+    assert main(["model", "fit", str(f), "--pattern", TUBE2, "-q", "--fit", "none"]) == 0
+
+
+def test_unidentified_names_parameters_at_a_bound():
+    from camtube.design.loader import load_pattern
+    from camtube.model.fit import fit
+    from camtube.model.predict import model_for_pattern, pattern_values
+    from camtube.model.synth import synthesize
+
+    p = load_pattern(TUBE2)
+    d = synthesize(p, 1, 2, seed=3, slack_mm=0.0)
+    m = model_for_pattern(p, ["slack"])
+    r = fit(m, d, ("E_t", "slack.deadband_mm"), pattern_values(p))
+    assert "slack.deadband_mm" in r.unidentified and "bound" in r.unidentified["slack.deadband_mm"]
+    assert "E_t" not in r.unidentified
+
+
+def test_diagnose_on_noise_free_data_reports_without_dividing_by_zero(tmp_path, capsys):
+    f = tmp_path / "clean.csv"
+    assert main(["model", "synth", "--pattern", TUBE2, "-o", str(f), "--cycles", "2", "-q",
+                 "--noise-angle", "0", "--noise-force", "0"]) == 0
+    capsys.readouterr()
+    assert main(["model", "diagnose", str(f), "--pattern", TUBE2, "-q", "--candidates", "slack"]) == 0
+    assert "noise floor" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+def test_help_lists_the_effect_names(cmd, capsys):
+    from camtube.model import EFFECT_NAMES
+    from camtube.model.effects import BUILTINS
+
+    assert tuple(EFFECT_NAMES) == tuple(BUILTINS)
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["model", cmd, "--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    for name in BUILTINS:
+        assert re.search(rf"\b{name}\b", out), name
+
+
+def test_python_snippets_of_docs_model_md_run(tmp_path):
+    text = (ROOT / "docs" / "model.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
+    assert blocks
+    (tmp_path / "patterns").symlink_to(PATTERNS)
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    for code in blocks:
+        run = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
+                             timeout=120)
+        assert run.returncode == 0, run.stderr
+    assert np.isfinite(float(run.stdout.split()[0]))
