@@ -531,7 +531,7 @@ def sentence(u: dict) -> str:
     if per is not None:
         pct = 100 * per["explained"] * excess / mse
         what = (f"is periodic in {LABELS[lead]} (period {_fmt(per['period'])} {per['unit']}, "
-                f"{per['amplitude_deg']:.2g} deg)")
+                f"{per['amplitude_deg']:.2f} deg)")
     else:
         pct = 100 * u["explained"].get(lead, 0.0) * excess / mse
         shape = u.get("shape", "")
