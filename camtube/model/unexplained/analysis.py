@@ -28,7 +28,7 @@ Method
    in the force (what a refit of the tendon compliance would take up; other
    sensitivities can be given), so a quadratic in the angle is not mistaken
    for one in the force. Variables explaining at least 10 % are listed, best
-   first; scores within 2 % of the leader go to the variable with fewer
+   first; scores within 3 % (relative) of the leader go to the variable with fewer
    bins (``first_cycle`` before ``cycle``, ``sample`` before ``time``).
 3. **Periodic parts.** A generalized Lomb-Scargle periodogram
    (:func:`scipy.signal.lombscargle`, floating mean) of the residual per
@@ -80,7 +80,7 @@ HINTS = {
 }
 FOLDS = 5
 MIN_SCORE = 0.10
-TIE = 0.02
+TIE = 0.03
 MAX_ROWS = 60000
 
 
@@ -229,13 +229,13 @@ def _follows(r: np.ndarray, v: dict, sid: np.ndarray, fold: np.ndarray, excess: 
         k = int(np.argmin(cv))
         best_lab[name] = labs[k]
         gain = (base - cv[k]) / excess if excess > 0 else 0.0
-        scores.append({"variable": name, "explained": float(min(gain, 1.0)), "bins": int(np.unique(labs[k]).size)})
+        scores.append({"variable": name, "explained": float(gain), "bins": int(np.unique(labs[k]).size)})
     # best first; within TIE of the best remaining score the variable with fewer bins leads
     rest = sorted(scores, key=lambda s: -s["explained"])
     ranked = []
     while rest:
         top = rest[0]["explained"]
-        group = [s for s in rest if s["explained"] >= top - TIE]
+        group = [s for s in rest if s["explained"] >= top - TIE * max(top, 0.0)]
         lead = min(group, key=lambda s: (s["bins"], SIMPLER.index(s["variable"])))
         ranked.append(lead)
         rest.remove(lead)
@@ -491,8 +491,14 @@ def analyse(residual_deg, variables: Mapping[str, np.ndarray], noise_floor_deg: 
     if leading in ("stroke", "angle", "force", "time", "cycle"):
         rng_lead = [float(np.min(v[leading])), float(np.max(v[leading]))]
     lead_score = next((s["explained"] for s in ranked if s["variable"] == leading), 0.0)
+    def same_partition(a: str, b: str) -> bool:
+        la, lb = labs[a], labs[b]
+        pairs = np.unique(la.astype(np.int64) * (int(lb.max()) + 1) + lb).size
+        return pairs == np.unique(la).size == np.unique(lb).size
+
     tied = [s["variable"] for s in ranked if s["variable"] != leading and s["variable"] in follows
-            and s["explained"] >= lead_score - 0.05 and lead_per is None]
+            and s["explained"] >= lead_score - 0.05 and lead_per is None
+            and not (leading in labs and same_partition(leading, s["variable"]))]
     ex = {s: (float(np.sqrt(np.mean(r[v["sample"] == s] ** 2))) ** 2 - floor**2) for s in names}
     top = max(ex.values()) if ex else 0.0
     carry = [str(s) for s in names if per_sample[str(s)] > stop_ratio * floor and ex[s] >= 0.2 * top]
@@ -529,11 +535,11 @@ def sentence(u: dict) -> str:
     excess = mse - u["noise_floor_deg"] ** 2
     per = next((p for p in u["periodic"] if p["variable"] == lead), None)
     if per is not None:
-        pct = 100 * per["explained"] * excess / mse
+        pct = 100 * min(per["explained"], 1.0) * excess / mse
         what = (f"is periodic in {LABELS[lead]} (period {_fmt(per['period'])} {per['unit']}, "
                 f"{per['amplitude_deg']:.2f} deg)")
     else:
-        pct = 100 * u["explained"].get(lead, 0.0) * excess / mse
+        pct = 100 * min(u["explained"].get(lead, 0.0), 1.0) * excess / mse
         shape = u.get("shape", "")
         what = f"follows {LABELS[lead]}" + (f" ({shape})" if shape else "")
         if u.get("tied"):
@@ -565,7 +571,7 @@ def describe(u: dict | None) -> list[str]:
              f"  {u['sentence']}"]
     if u["follows"]:
         lines.append("  it follows (cross-validated, share of the error above the floor): "
-                     + ", ".join(f"{f} {100 * u['explained'][f]:.0f}%" for f in u["follows"]))
+                     + ", ".join(f"{f} {min(100 * u['explained'][f], 100):.0f}%" for f in u["follows"]))
     for p in u["periodic"]:
         lines.append(f"  periodic in {p['variable']}: period {_fmt(p['period'])} {p['unit']}, amplitude "
                      f"{p['amplitude_deg']:.3g} deg ({100 * p['explained']:.0f}% of the error above the floor)")

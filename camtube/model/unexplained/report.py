@@ -62,6 +62,10 @@ def text_lines(d, json_path: str = "DIAG.json") -> list[str]:
     if u is None:
         return []
     lines = describe(u)
+    if d.recommended:
+        lines.append(f"  note: with {', '.join(d.recommended)} the error stays at "
+                     f"{d.final.rmse_deg / d.noise_floor_deg:.2f} x the floor; the recommended effect(s) may stand in "
+                     f"for the physics above: try the starter effect without them")
     if u.get("leading"):
         lines.append(f"  start an effect for it: camtube model effect new {suggested_name(u)} --from {json_path}"
                      f"  (the diagnosis's --json file)")

@@ -38,7 +38,7 @@ _READ = {
     "stroke": "x = np.asarray(ctx.data.stroke_mm, float)       # motor stroke, mm",
     "time": "x = np.asarray(ctx.data.time_s, float)          # s since the sample's start",
     "cycle": "x = np.asarray(ctx.data.cycle, float)           # cycle number",
-    "first_cycle": "x = _first_cycle(ctx.data).astype(float)      # 1 in each sample's first cycle, else 0",
+    "first_cycle": "x = ctx.first_cycle.astype(float)               # 1 in each sample's first cycle, else 0",
     "direction": "x = np.asarray(ctx.direction, float)           # +1 loading, -1 unloading",
     "force": "x = np.asarray(ctx.force_N, float)             # tendon force after the force stage, N",
     "sample": "x = np.isin(ctx.data.sample, SAMPLES).astype(float)  # 1 in the samples that carry it",
@@ -128,7 +128,8 @@ def starter_source(name: str, unexplained: dict | None = None, *, stage: str | N
             f'Param("cos_deg", "deg", -{bound}, {bound}, {_num(amp * math.sin(phase))}, "cosine part")',
             f'Param("{pname}", "{pu}", {_num(0.9 * period)}, {_num(1.1 * period)}, {_num(period)},\n'
             f'              "period against {LABELS[var]} (found: {period:.4g} {pu}; the fit is multimodal in the '
-            f'period: keep its bounds near the value found)")',
+            f'period: keep its bounds near the value found)",\n'
+            f'              starts=({_num(0.97 * period)}, {_num(period)}, {_num(1.03 * period)}))',
         ]
     elif shape == "step" or var in ("first_cycle", "direction", "sample"):
         body = 'term_deg = p["step_deg"] * x'
@@ -155,17 +156,6 @@ def starter_source(name: str, unexplained: dict | None = None, *, stage: str | N
     else:
         ret = f"return {sig} + _to_stage(ctx, term_deg)"
     helpers = ""
-    if var == "first_cycle":
-        helpers = '''
-
-def _first_cycle(data) -> np.ndarray:
-    """(n,) bool: rows in each sample's first cycle."""
-    out = np.zeros(len(data), bool)
-    cyc = np.asarray(data.cycle)
-    for _, sl in data.sample_slices():
-        out[sl] = cyc[sl] == cyc[sl].min()
-    return out
-'''
     samples_line = ""
     if var == "sample":
         samples_line = f"\n#: the samples that carry it (from the diagnosis)\nSAMPLES = {list(u.get('samples') or [])!r}\n"
@@ -187,8 +177,9 @@ Replace the term in _apply by the physics (keep the signature), then
     camtube model diagnose DATA.csv --pattern PATTERN --effect-file {name}.py
 
 Signals in apply: ctx.data (rows per sample in time order: ctx.data.sample_slices()),
-ctx.data.stroke_mm / time_s / cycle / sample, ctx.force_N, ctx.direction (+1 loading),
-ctx.compliance_mm_per_N, ctx.geometry (moment_arm_mm, ...); at kinematics also ctx.l_kin_mm, ctx.arm_mm.
+ctx.data.stroke_mm / time_s / cycle / sample, ctx.force_N, ctx.direction (+1 loading), ctx.first_cycle,
+ctx.peak_force_N (largest force so far), ctx.time_since_reversal_s, ctx.compliance_mm_per_N,
+ctx.geometry (moment_arm_mm, ...); at kinematics also ctx.l_kin_mm, ctx.arm_mm (theta = l_kin / arm).
 """
 from __future__ import annotations
 
