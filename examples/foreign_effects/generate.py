@@ -65,7 +65,7 @@ EFFECTS = ("none", "drive", "arm", "set", "oscillation", "rest_moment")
 DEFAULTS: dict[str, dict[str, float]] = {
     "none": {},
     "drive": {"amp_mm": 0.02, "period_mm": 0.5, "phase_rad": 0.4},
-    "arm": {"beta_per_rad": -0.9},
+    "arm": {"beta_per_rad": 0.6},
     "set": {"set_mm": 0.1, "soften": 0.2, "yield_frac": 0.5},
     "oscillation": {"amp_mm": 0.03, "period_s": 37.0, "phase_rad": 1.0},
     "rest_moment": {"moment_Nmm": 1.5},

@@ -24,12 +24,11 @@ Method
    which is a function of time); ``direction``, ``first_cycle`` and ``sample``
    are groups. A variable's score is the drop of the cross-validated error
    against a constant, as a fraction of the error above the floor
-   (``MSE - floor^2``). Each smoother is fitted together with a linear term
-   in the force (what a refit of the tendon compliance would take up; other
-   sensitivities can be given), so a quadratic in the angle is not mistaken
-   for one in the force. Variables explaining at least 10 % are listed, best
-   first; scores within 3 % (relative) of the leader go to the variable with fewer
-   bins (``first_cycle`` before ``cycle``, ``sample`` before ``time``).
+   (``MSE - floor^2``). Variables explaining at least 10 % are listed, best
+   first; among groupings (direction, sample, first cycle, cycle, time),
+   scores within 3 % (relative) of the leader go to the one with fewer bins
+   (``first_cycle`` before ``cycle``, ``sample`` before ``time``); the variable of
+   a significant periodic component leads when it is within 3 % of the leader.
 3. **Periodic parts.** A generalized Lomb-Scargle periodogram
    (:func:`scipy.signal.lombscargle`, floating mean) of the residual per
    sample against the motor stroke (after a quartic trend in stroke is
@@ -58,6 +57,7 @@ import numpy as np
 #: Variables ranked, in the issue's order.
 VARIABLES = ("stroke", "angle", "force", "direction", "cycle", "first_cycle", "time", "sample")
 #: Between variables that explain as much with as many bins, the simpler kind leads.
+CONTINUOUS = ("stroke", "angle", "force")
 SIMPLER = ("direction", "sample", "first_cycle", "cycle", "time", "stroke", "angle", "force")
 UNITS = {"stroke": "mm", "angle": "deg", "force": "N", "time": "s", "cycle": "cycles"}
 LABELS = {"stroke": "the motor stroke", "angle": "the bend angle", "force": "the tendon force",
@@ -236,7 +236,11 @@ def _follows(r: np.ndarray, v: dict, sid: np.ndarray, fold: np.ndarray, excess: 
     while rest:
         top = rest[0]["explained"]
         group = [s for s in rest if s["explained"] >= top - TIE * max(top, 0.0)]
-        lead = min(group, key=lambda s: (s["bins"], SIMPLER.index(s["variable"])))
+        if not all(s["variable"] in CONTINUOUS for s in group):   # bins only compare between groupings
+            group = [s for s in group if s["variable"] not in CONTINUOUS] or group
+            lead = min(group, key=lambda s: (s["bins"], SIMPLER.index(s["variable"])))
+        else:
+            lead = group[0]
         ranked.append(lead)
         rest.remove(lead)
     return ranked, best_lab
@@ -414,8 +418,9 @@ def analyse(residual_deg, variables: Mapping[str, np.ndarray], noise_floor_deg: 
     absorb : (n, k) float, optional
         Directions a refit of the model's own parameters moves the prediction (their sensitivities);
         each variable's smoother is fitted together with a linear term in them, so that a missing
-        effect is judged by the part the fitted parameters cannot take up. Default: the force
-        (the tendon compliance, E_t, is always fitted: its sensitivity is proportional to the force).
+        effect is judged by the part the fitted parameters cannot take up. Default: none (the
+        residual of a least-squares fit is already orthogonal to them; absorbing a measured signal
+        such as the force also absorbs its sensor noise, which favours the variables it is smooth in).
     stop_ratio : float
         Nothing is left when the RMSE is within this factor of the floor.
     seed : int
@@ -448,12 +453,12 @@ def analyse(residual_deg, variables: Mapping[str, np.ndarray], noise_floor_deg: 
                         else first_cycle_mask(v["sample"], v["cycle"]))
     names = _unique_in_order(v["sample"])
     per_sample = {str(s): float(np.sqrt(np.mean(r[v["sample"] == s] ** 2))) for s in names}
-    absorb = (v["force"][:, None] if absorb is None else np.asarray(absorb, float).reshape(n, -1))
+    absorb = None if absorb is None else np.asarray(absorb, float).reshape(n, -1)
     if n > MAX_ROWS:  # evenly thinned in time (every k-th row): keeps every sample and cycle
         keep = np.arange(0, n, int(math.ceil(n / MAX_ROWS)))
         r = r[keep]
         v = {k: a[keep] for k, a in v.items()}
-        absorb = absorb[keep]
+        absorb = None if absorb is None else absorb[keep]
         n = r.size
         mse = float(np.mean(r**2))
     sid = np.searchsorted(np.array(sorted(names)), v["sample"])
@@ -467,6 +472,13 @@ def analyse(residual_deg, variables: Mapping[str, np.ndarray], noise_floor_deg: 
     cnt = np.bincount(lab)
     smooth = (np.bincount(lab, weights=r) / np.maximum(cnt, 1))[lab]
     periodic = _periodic(r, v, sid, floor, excess, smooth)
+    if periodic and follows:
+        # a coherent sinusoid is the sharper statement: its variable leads when it explains about as much
+        pv = periodic[0]["variable"]
+        expl = {s["variable"]: s["explained"] for s in ranked}
+        if pv in follows and expl[pv] >= expl[follows[0]] - TIE * max(expl[follows[0]], 0.0):
+            follows.remove(pv)
+            follows.insert(0, pv)
     leading = follows[0] if follows else (periodic[0]["variable"] if periodic else "")
     lead_per = next((p for p in periodic if p["variable"] == leading), None)
     if leading in ("stroke", "angle", "force", "time", "cycle"):
