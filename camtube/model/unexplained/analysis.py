@@ -76,7 +76,7 @@ HINTS = {
     ("cycle", False): ("a change from cycle to cycle (wear, ratcheting)", "stroke"),
     ("first_cycle", False): ("a permanent set in the first cycle (the tendon seats or yields once)", "stroke"),
     ("time", False): ("a drift of the tendon length in time", "stroke"),
-    ("sample", False): ("samples that differ (a per-sample offset or per-sample parameters)", "angle"),
+    ("sample", False): ("per-sample parameters (camtube model fit --per-sample NAMES)", "angle"),
 }
 FOLDS = 5
 MIN_SCORE = 0.10

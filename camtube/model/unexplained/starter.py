@@ -158,7 +158,11 @@ def starter_source(name: str, unexplained: dict | None = None, *, stage: str | N
     helpers = ""
     samples_line = ""
     if var == "sample":
-        samples_line = f"\n#: the samples that carry it (from the diagnosis)\nSAMPLES = {list(u.get('samples') or [])!r}\n"
+        # a step between samples: every sample but the first (a shared offset is the built-in angle_bias)
+        names = list(u.get("per_sample_rmse_deg") or {}) or list(u.get("samples") or [])
+        samples_line = (f"\n#: samples offset against the first one ({names[0] if names else '?'}); "
+                        f"the diagnosis found it carried by {list(u.get('samples') or [])!r}\n"
+                        f"SAMPLES = {names[1:]!r}\n")
     found = u.get("sentence") or f"the residual follows {LABELS[var]}"
     stage_doc = {"stroke": "the stroke that reaches the tendon (mm), from the motor stroke",
                  "elongation": "the tendon's elongation (mm); ctx.force_N is the force",
