@@ -335,7 +335,8 @@ def _periodic(r: np.ndarray, v: dict, sid: np.ndarray, floor: float, excess: flo
     n = r.size
     # against the motor stroke: a quartic trend per sample removed, >= 3 periods in the span
     x = v["stroke"]
-    step = np.median(np.abs(np.diff(x))[np.abs(np.diff(x)) > 0]) if n > 2 else 0.0
+    dx = np.abs(np.diff(x))
+    step = float(np.median(dx[dx > 0])) if np.any(dx > 0) else 0.0
     span = float(np.ptp(x))
     if span > 0:
         rr = _detrend(x, r, sid, 4)
