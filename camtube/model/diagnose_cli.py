@@ -42,6 +42,14 @@ def register(model_sub) -> None:
     d.add_argument("--max-rows", type=int, default=4000, metavar="N",
                    help="rows used by the candidate search, thinned evenly in time (default 4000; 0 = all)")
     d.add_argument("--max-effects", type=int, default=4, metavar="N", help="most effects recommended (default 4)")
+    d.add_argument("--modulus-range", default="1,300", metavar="LO,HI",
+                   help="plausible tendon E_t in GPa; a fit outside is not trusted (default 1,300)")
+    d.add_argument("--no-stop-rule", dest="stop_rule", action="store_false",
+                   help="do not stop at 1.15 x the noise floor (the significance tests alone decide)")
+    d.add_argument("--no-per-sample", dest="per_sample", action="store_false",
+                   help="do not test per-sample parameters of the recommended effects")
+    d.add_argument("--init", action="append", default=[], metavar="NAME=VALUE",
+                   help="also start a candidate's parameter at VALUE (e.g. a period), repeatable")
     d.add_argument("--json", metavar="OUT.json", help="write the diagnosis as JSON")
     d.add_argument("--report", metavar="DIR", help="write an HTML report with PNG plots into DIR")
     d.set_defaults(func=cmd_diagnose)
@@ -64,7 +72,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     from camtube.cliutil import load_from_args
     from camtube.errors import DataError
     from camtube.io import write_atomic
-    from camtube.model.core.build import build_registry, check_suffix, parse_fix, split_names
+    from camtube.model.core.build import build_registry, check_suffix, parse_assignments, parse_fix, split_names
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import load_csv, select_cycles
     from camtube.model.diagnose import diagnose
@@ -83,8 +91,16 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     fixed = pattern_values(pattern)
     fixed.update(parse_fix(args.fix))
     cands = [reg.get_effect(c) for c in split_names(args.candidates)] or None
+    try:
+        lo, hi = (float(v) for v in args.modulus_range.split(","))
+    except ValueError:
+        raise DataError(f"--modulus-range {args.modulus_range!r}: use LO,HI in GPa, e.g. 1,300") from None
+    if not 0 < lo < hi:
+        raise DataError(f"--modulus-range {args.modulus_range!r}: need 0 < LO < HI (GPa)")
     d = diagnose(model, rows, split_names(args.fit_params), fixed, candidates=cands,
-                 max_rows=args.max_rows, max_effects=args.max_effects, registry=reg)
+                 max_rows=args.max_rows, max_effects=args.max_effects, registry=reg,
+                 stop_ratio=1.15 if args.stop_rule else None, modulus_range_gpa=(lo, hi),
+                 per_sample=args.per_sample, init=parse_assignments(args.init, "--init"))
     prefix = fit_command_prefix(args)
     title = f"{pattern.name}: {args.data} ({len(rows)} rows, cycles {args.cycles}, both directions, deadband kept)"
     print(diagnosis_text(d, prefix, title))

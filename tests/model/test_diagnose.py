@@ -143,3 +143,95 @@ def test_cli_json_report_and_fit_command(tmp_path, capsys):
     fitted = json.loads(fit_json.read_text())
     assert fitted["rmse_deg"] == pytest.approx(js["waterfall"][-1]["rmse_deg"], rel=1e-3)
     assert math.isclose(fitted["params"]["play.play_mm"]["value"], 0.06, rel_tol=0.1)
+
+
+# ----------------------------------------------------------------------------- trust (issue 11)
+
+def test_cycle_blocks_test_every_cycle_and_cycle_one_in_both_folds():
+    from camtube.model.diagnose.search import cycle_blocks
+
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    sim = simulate(p, Hidden(joint_friction_nmm=0.0), n_samples=2, n_cycles=10, seed=1)
+    d = sim.data
+    block, fold = cycle_blocks(d)
+    first = np.asarray(d.cycle) == 1
+    s1 = d.sample == "1"
+    # every row is a test row of exactly one fold; cycle 1 of sample 1 is tested in one fold, of sample 2 in the other
+    assert set(np.unique(fold)) == {0, 1}
+    assert np.unique(fold[first & s1]).size == 1 and np.unique(fold[first & ~s1]).size == 1
+    assert fold[first & s1][0] != fold[first & ~s1][0]
+    # blocks hold whole cycles
+    for b in np.unique(block):
+        cyc = set(np.asarray(d.cycle)[block == b].tolist())
+        assert all(((np.asarray(d.cycle) == c) & (block != b) & (d.sample == d.sample[block == b][0])).sum() == 0
+                   for c in cyc)
+
+
+def test_a_control_gets_nothing_even_with_the_stop_rule_off():
+    p = load_pattern(PATTERNS / "tube1.yaml")
+    sim = simulate(p, Hidden(), n_samples=2, n_cycles=8, seed=21)  # friction distractor on (the default)
+    d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p), stop_ratio=None)
+    assert d.recommended == (), [(c.effect, c.why) for c in d.candidates[:3]]
+    # and the candidates that fail say why
+    assert all(c.why for c in d.candidates if not c.significant)
+
+
+def test_samples_that_differ_get_their_own_values_and_the_output_says_so():
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    sim = simulate(p, [Hidden(slack_mm=0.04), Hidden(slack_mm=0.10)], n_samples=2, n_cycles=6, seed=8)
+    d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
+    assert d.recommended[0] == "slack" and "slack.deadband_mm" in d.per_sample
+    assert d.final.params["slack.deadband_mm@1"] == pytest.approx(0.04, rel=0.1)
+    assert d.final.params["slack.deadband_mm@2"] == pytest.approx(0.10, rel=0.1)
+    assert any("samples differ in slack.deadband_mm" in n for n in d.sample_notes)
+    base, final = d.waterfall[0].rmse_per_sample, d.final.rmse_per_sample
+    assert all(final[s] < base[s] for s in base)
+    assert d.final.rmse_deg <= 1.15 * sim.sensor_floor_deg
+
+
+def test_every_recommended_step_lowers_the_rmse_and_its_parameters_are_identified():
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    sim = simulate(p, Hidden(play_mm=0.05, toe_mm=0.3, toe_form="exponential"), n_samples=2, n_cycles=6, seed=4)
+    d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
+    assert d.recommended and d.recommended[0] in ("toe", "play")
+    for a, b in zip(d.waterfall, d.waterfall[1:]):
+        assert b.rmse_deg < a.rmse_deg
+    for k, v in d.final.stderr.items():
+        assert math.isfinite(v) and v > 0, k
+    assert 1.0 <= d.final.params["E_t"] <= 300.0
+
+
+def test_fit_warns_when_a_history_effect_is_fitted_on_the_default_selection(tmp_path, capsys):
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    sim = simulate(p, Hidden(play_mm=0.06), n_samples=1, n_cycles=3, seed=2)
+    csv = tmp_path / "d.csv"
+    csv.write_text(format_csv(sim.data))
+    main(["model", "fit", str(csv), "--pattern", str(PATTERNS / "tube2.yaml"), "-q", "--effects", "play"])
+    out = capsys.readouterr().out
+    assert "warning: play" in out and "--branch both" in out
+
+
+def test_diagnose_init_start_values_reach_a_multimodal_user_effect():
+    from camtube.model.core import Effect, Param
+    from camtube.model.core.registry import builtin_registry
+    from camtube.model.sim.synth import synthesize
+
+    def apply(ctx, s, p):
+        return s + p["amp_mm"] * np.sin(2 * np.pi * s / p["period_mm"])
+
+    wob = Effect(name="wobble", stage="stroke", apply=apply,
+                 params=(Param("amp_mm", "mm", 0.0, 0.1, 0.01), Param("period_mm", "mm", 0.1, 2.0, 0.3)))
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    d = synthesize(p, 2, 4, seed=4, slack_mm=0.0)
+    m = model_for_pattern(p, [wob])
+    truth = {**m.initial_values(d, pattern_values(p)), "wobble.amp_mm": 0.03, "wobble.period_mm": 0.7}
+    d = d.with_angle(m.predict(d, truth) + np.random.default_rng(0).normal(0, 0.25, len(d)))
+    reg = builtin_registry().with_effects([wob])
+    stuck = diagnose(model_for_pattern(p), d, ("E_t",), pattern_values(p), registry=reg, candidates=["wobble"],
+                     grid=0)
+    got = diagnose(model_for_pattern(p), d, ("E_t",), pattern_values(p), registry=reg, candidates=["wobble"],
+                   grid=0, init={"wobble.period_mm": 0.68})
+    assert stuck.final.rmse_deg > 1.5 * got.final.rmse_deg  # from its default start the period is not found
+    assert got.recommended == ("wobble",)
+    assert got.final.params["wobble.period_mm"] == pytest.approx(0.7, rel=0.01)
+    assert "--init wobble.period_mm=0.7" in " ".join(f"--init {k}={v:.2g}" for k, v in got.final.init.items())

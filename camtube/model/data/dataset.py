@@ -5,9 +5,14 @@ module only holds the value type every model function takes.
 """
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
+
+# speed: the direction of motion is derived data, cached per Dataset object (fits evaluate the model
+# hundreds of times on the same rows); see scripts/bench_diagnose.py
+_DIRECTION: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True, eq=False)
@@ -70,7 +75,18 @@ class Dataset:
 
         Taken from the sign of the stroke's change, carried over pauses; the
         first row of a sample takes the sign of the first real change.
+        Computed once per Dataset (the arrays are not modified after construction;
+        the cached copy is read-only).
         """
+        hit = _DIRECTION.get(self)
+        if hit is not None:
+            return hit
+        d = self._direction()
+        d.setflags(write=False)
+        _DIRECTION[self] = d
+        return d
+
+    def _direction(self) -> np.ndarray:
         d = np.zeros(len(self), dtype=int)
         for _, sl in self.sample_slices():
             s = self.stroke_mm[sl]

@@ -1,69 +1,78 @@
-"""Diagnosis of missing physics: which effect would make the model fit, and is it worth adding?
+"""Diagnosis of missing physics: which effect would make the model fit, and can the answer be trusted?
 
 ``diagnose(model, data, fit_params=("E_t",), fixed=None, *, candidates=None, ...) -> Diagnosis``
 
 Method
 ------
 1. **Current model.** ``model`` (base plus the effects already chosen) is
-   fitted to ``data`` (all selected rows: both directions, deadband kept, so
-   slack, play and creep stay visible).
+   fitted to every row of ``data`` (both directions, deadband kept, so slack,
+   play and creep stay visible) exactly as ``camtube model fit`` would.
 2. **Noise floor.** The sensor noise is white, the model error is smooth in
    time; so the noise shows in the high-order differences of the residual
    within each sample: ``sigma = 1.4826 MAD(diff^k r) / sqrt(C(2k, k))``
-   for ``k = 2, 3, 4`` (the smallest is kept; the median ignores kinks at reversals). A
-   perfect model leaves an RMSE of ``sigma``.
-3. **Candidates.** Each registered effect not yet in the model is added in
-   turn; the model's fitted parameters plus the effect's are fitted (on at
-   most ``max_rows`` rows, evenly thinned in time so histories survive).
-   Each candidate is scored by
-
-   * the **held-out RMSE**: fitted on the odd cycles, tested on the even ones
-     (alternate time blocks if there is one cycle), the model always run over
-     the whole history;
-   * **delta BIC** = ``n ln(SSE'/SSE) + dp ln n`` against the current model;
-   * its parameters with standard errors and their correlation with the
-     already fitted parameters.
-
-   Candidates are ranked by held-out RMSE.
-4. **Equivalences.** A candidate whose parameter correlates with a fitted
-   parameter by ``|r| > 0.99`` is reported as confounded with it (a series
-   compliance is a softer tendon: it then gains nothing and is not
-   significant). Two useful candidates whose held-out RMSEs are within 3% of
-   each other, or whose predictions differ by less than half the noise floor
-   (rms), cannot be told apart from each other; a declared
-   :attr:`Effect.family` is reported the same way. Among candidates that
-   cannot be told apart from the best one, the lowest BIC leads the ranking.
-5. **Greedy combination.** The best candidate is recommended and added if
-   it is significant: ``delta BIC < -bic_threshold``, its held-out RMSE falls
-   by at least ``min_gain`` (relative) and it explains at least
-   ``min_excess`` of the held-out error left above the noise floor. Then the
-   remaining candidates are tried on top, and so on. The search stops when
-   the held-out RMSE is within ``stop_ratio`` of the noise floor, when nothing
-   is significant, or after ``max_effects``.
-6. **Waterfall.** The current model and each recommended step are refitted
-   on all rows: RMSE overall and per sample, parameters with uncertainty.
+   for ``k = 2, 3, 4`` (the smallest is kept). Its uncertainty is the spread
+   of the same estimate over blocks of cycles.
+3. **Cross-validation by blocks of cycles.** Each sample's cycles are cut
+   into (up to) eight blocks; the blocks alternate between two folds, the
+   first block (with cycle 1) in fold 0 for the first sample and in fold 1
+   for the next, so every cycle, the first included, is tested by a fit that
+   did not see it (alternate time blocks for one-cycle data). The model
+   always runs over the whole history.
+4. **Candidates.** Each effect not yet in the model is added in turn and
+   fitted from several starts (the current fit plus the effect's defaults,
+   and the best point of a grid over each new parameter's declared range,
+   log-spaced for scales). A candidate is **significant** when
+   its held-out mean squared error falls by more than ``z`` times the
+   standard error of that fall (paired over the blocks), ``delta BIC`` is
+   below ``-bic_threshold`` and the fall is a real share of the error above
+   the floor. It is **trusted** when its new parameters are off their bounds
+   with finite standard errors and the data can resolve them: time
+   constants between three sample intervals and the record length, lengths
+   within the stroke span, ``E_t`` within ``modulus_range_gpa``. A candidate
+   that fails a check is listed with the reason and never recommended.
+5. **All-rows check.** The best trusted, significant candidate is refitted
+   on every row, exactly as the printed ``model fit`` command does (same
+   rows, same starts: ``--init`` values and ``--starts``). It is recommended
+   only when that refit lowers the RMSE, keeps its parameters identified and
+   resolvable, and does not undercut the noise floor by more than twice the
+   floor's uncertainty (fitting noise); otherwise the next candidate is tried.
+6. **Per-sample parameters.** With several samples, each recommended
+   effect's parameters are tried per sample; they are kept when the held-out
+   error falls significantly. The output says which samples differ (values
+   more than three combined standard errors apart) and names any sample the
+   final model leaves worse than the current one.
+   The next round retries only the candidates whose held-out RMSE fell by ``min_gain`` in this one.
+7. The search stops when the held-out RMSE is within ``stop_ratio`` of the
+   noise floor (``stop_ratio=None`` turns the rule off: the significance
+   tests alone must then stop it), when nothing qualifies, or after
+   ``max_effects``.
 
 No threshold depends on the data's scale: BIC is a likelihood ratio, the
-others are ratios of errors.
+others are ratios of errors or multiples of standard errors.
 """
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 from typing import Mapping, Sequence
 
 import numpy as np
 
+from camtube.model.core.fit import FitResult, fit
 from camtube.model.core.model import Effect, JointModel
 from camtube.model.core.registry import Registry, builtin_registry
 from camtube.model.data.csvfile import check_fittable
 from camtube.model.data.dataset import Dataset
-from camtube.model.core.fit import fit
 
 #: Parameter correlation above which two parameters cannot be told apart.
 CORR_LIMIT = 0.99
 #: Held-out RMSEs within this fraction of each other: the data cannot tell the candidates apart.
 EQUAL_HELDOUT = 0.03
+#: Grid values per new parameter in the multi-start fits (also ``--starts`` of the printed command).
+GRID = 3
+#: Significant digits of the start values printed with ``--init`` (and used by the diagnosis itself).
+INIT_DIGITS = 6
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,7 +103,7 @@ class Candidate:
     effects : tuple[str, ...]
         Every effect of the candidate model.
     rmse_deg, heldout_rmse_deg : float
-        In-sample RMSE (search rows) and held-out RMSE (test cycles).
+        In-sample RMSE (search rows) and held-out RMSE (every block tested once).
     delta_bic : float
         BIC of the candidate minus BIC of the current model (negative: better).
     params : dict
@@ -104,9 +113,12 @@ class Candidate:
     confounded : tuple[str, ...]
         Fitted parameters it cannot be told apart from (``name (r=...)``).
     significant : bool
-        Passes every criterion of step 5.
+        Passes every check (significance, identifiability, resolution); the all-rows
+        check decides whether it is recommended.
     why : str
-        Why it is not significant (empty if it is).
+        Why it is not significant or not trusted (empty if it passes).
+    gain_z : float
+        Fall of the held-out MSE over its standard error.
     """
 
     effect: str
@@ -121,6 +133,9 @@ class Candidate:
     why: str = ""
     predicted: np.ndarray | None = None
     values: dict = field(default_factory=dict)
+    gain_z: float = 0.0
+    block_mse: np.ndarray | None = None
+    per_sample: tuple = ()
 
 
 @dataclass(frozen=True, eq=False)
@@ -135,6 +150,8 @@ class Step:
     units: dict
     predicted: np.ndarray
     residuals: np.ndarray
+    per_sample: tuple = ()
+    init: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True, eq=False)
@@ -145,17 +162,26 @@ class Diagnosis:
     ----------
     data : Dataset
         The rows diagnosed.
-    noise_floor_deg : float
+    noise_floor_deg, noise_floor_se_deg : float
+        The estimated sensor floor and its standard error.
     base_rmse_deg, base_heldout_rmse_deg : float
         The current model's errors (search rows / held-out).
     rounds : tuple[tuple[Candidate, ...], ...]
         Ranked candidates of each greedy round (round 0: on the current model).
     recommended : tuple[str, ...]
         Effects to add, in order.
+    rejected : tuple[tuple[str, str], ...]
+        Candidates that passed the search but failed the all-rows check: (effect, reason).
     waterfall : tuple[Step, ...]
-        The current model, then one step per recommended effect.
+        The current model, then one step per recommended effect (the last is what the command reproduces).
     fit_params : tuple[str, ...]
         Parameters fitted besides the effects' own.
+    per_sample : tuple[str, ...]
+        Parameters fitted per sample in the final model.
+    sample_notes : tuple[str, ...]
+        Which samples differ and by how much; samples the final model leaves worse.
+    grid : int
+        Grid values per new parameter used by the fits (``--starts``).
     stop_reason : str
     seconds : dict
         Wall time of the parts (not written to JSON: output is deterministic).
@@ -174,6 +200,11 @@ class Diagnosis:
     fixed: dict = field(default_factory=dict)
     seconds: dict = field(default_factory=dict)
     catalog: dict = field(default_factory=dict)
+    noise_floor_se_deg: float = 0.0
+    rejected: tuple = ()
+    per_sample: tuple = ()
+    sample_notes: tuple = ()
+    grid: int = GRID
 
     @property
     def candidates(self) -> tuple:
@@ -187,21 +218,40 @@ class Diagnosis:
 
 # ----------------------------------------------------------------------------- pieces
 
+def _floor_of(parts: list) -> float:
+    best = math.inf
+    for k, norm in ((2, 6.0), (3, 20.0), (4, 70.0)):
+        ds = [np.diff(seg, k) for seg in parts if seg.size > k + 4]
+        if not ds:
+            continue
+        d = np.concatenate(ds)
+        best = min(best, 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(norm))
+    return best
+
+
 def noise_floor(data: Dataset, residual_deg: np.ndarray) -> float:
     """White-noise standard deviation (deg) of a residual ``(n,)``, from its high-order differences per sample."""
     r = np.asarray(residual_deg, float)
-    best = math.inf
-    for k, norm in ((2, 6.0), (3, 20.0), (4, 70.0)):
-        parts = []
-        for _, sl in data.sample_slices():
-            seg = r[sl]
-            if seg.size > k + 4:
-                parts.append(np.diff(seg, k))
-        if not parts:
-            continue
-        d = np.concatenate(parts)
-        best = min(best, 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(norm))
+    best = _floor_of([r[sl] for _, sl in data.sample_slices()])
     return best if math.isfinite(best) else float(np.std(r))
+
+
+def noise_floor_se(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarray) -> float:
+    """Standard error (deg) of :func:`noise_floor`, from its spread over the ``blocks`` (n,) int of the rows."""
+    r = np.asarray(residual_deg, float)
+    ids = np.unique(blocks)
+    vals = []
+    for b in ids:
+        m = blocks == b
+        idx = np.flatnonzero(m)
+        # contiguous runs only (a block is contiguous within a sample)
+        cut = np.flatnonzero(np.diff(idx) > 1) + 1
+        v = _floor_of([r[seg] for seg in np.split(idx, cut)])
+        if math.isfinite(v):
+            vals.append(v)
+    if len(vals) < 3:
+        return 0.05 * noise_floor(data, r)
+    return float(np.std(vals, ddof=1) / math.sqrt(len(vals)))
 
 
 def thin(data: Dataset, max_rows: int) -> Dataset:
@@ -213,41 +263,149 @@ def thin(data: Dataset, max_rows: int) -> Dataset:
     return data.take(np.arange(0, n, k))
 
 
-def holdout_mask(data: Dataset) -> np.ndarray:
-    """(n,) bool: training rows (odd cycles; alternate time blocks if a sample has one cycle)."""
+def cycle_blocks(data: Dataset, per_sample: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """Blocks of whole cycles and their fold: ``(block (n,) int, fold (n,) int in {0, 1})``.
+
+    Each sample's cycles are cut into up to ``per_sample`` contiguous blocks
+    (alternate time blocks when a sample has one cycle); blocks alternate
+    between the folds, starting with fold 0 for the first sample and fold 1
+    for the second (and so on), so cycle 1 is a test block in both folds'
+    turn when there are several samples.
+    """
     cyc = np.asarray(data.cycle)
-    train = np.zeros(len(data), bool)
-    for _, sl in data.sample_slices():
+    block = np.zeros(len(data), int)
+    fold = np.zeros(len(data), int)
+    nb = 0
+    for k, (_, sl) in enumerate(data.sample_slices()):
         c = cyc[sl]
-        if np.unique(c).size >= 2:
-            train[sl] = (c - c.min()) % 2 == 0
+        uc = np.unique(c)
+        m = c.size
+        if uc.size >= 2:
+            nbk = min(per_sample, uc.size)
+            rank = np.searchsorted(uc, c)
+            b = rank * nbk // uc.size
         else:
-            m = c.size
-            train[sl] = (np.arange(m) * 8 // max(m, 1)) % 2 == 0
-    return train
+            nbk = per_sample
+            b = np.arange(m) * nbk // max(m, 1)
+        block[sl] = nb + b
+        fold[sl] = (b + k) % 2
+        nb += nbk
+    return block, fold
 
 
-def _least_squares(model: JointModel, data: Dataset, names: Sequence[str], values: Mapping[str, float],
-                   rows: np.ndarray | None = None, max_nfev: int = 120) -> Fitted:
-    """Bounded least squares of ``names`` on ``rows`` (the model runs on all rows): :func:`fit`, searched loosely."""
-    r = fit(model, data, tuple(names), values, max_nfev=max_nfev, rows=rows, tol=1e-8)
-    return Fitted(model, r.fitted, dict(r.params), dict(r.stderr), r.correlation, r.sse, r.n_points,
+def block_strata(data: Dataset, block: np.ndarray) -> np.ndarray:
+    """The sample index of each block id (``np.unique(block)`` order)."""
+    smp = np.zeros(len(data), int)
+    for k, (_, sl) in enumerate(data.sample_slices()):
+        smp[sl] = k
+    ids, first = np.unique(block, return_index=True)
+    return smp[first]
+
+
+def holdout_mask(data: Dataset) -> np.ndarray:
+    """(n,) bool: rows of fold 0 (see :func:`cycle_blocks`): the training rows of the first fit."""
+    return cycle_blocks(data)[1] == 0
+
+
+def _rounded(values: Mapping[str, float]) -> dict[str, float]:
+    return {k: float(f"{float(v):.{INIT_DIGITS}g}") for k, v in values.items()}
+
+
+def refit_all_rows(model: JointModel, data: Dataset, names: Sequence[str], fixed: Mapping[str, float],
+                   init: Mapping[str, float], grid: int, per_sample: Sequence[str] = ()) -> FitResult:
+    """The fit ``camtube model fit ... --init NAME=VALUE ... --starts GRID [--per-sample ...]`` makes.
+
+    ``init`` is rounded to :data:`INIT_DIGITS` significant digits first, as the printed command has it.
+    """
+    params = model.make_params(data, names, fixed, initial=_rounded(init), per_sample=per_sample)
+    return fit(model, data, params=params, grid=grid)
+
+
+def _fitted(r: FitResult) -> Fitted:
+    return Fitted(r.model, r.fitted, dict(r.params), dict(r.stderr), r.correlation, r.sse, r.n_points,
                   r.rmse, r.bic, r.at_bound, r.predicted)
 
 
-def _heldout(model: JointModel, data: Dataset, names: Sequence[str], start: Mapping[str, float],
-             train: np.ndarray) -> float:
-    """Held-out RMSE (deg): fit on ``train`` rows from ``start``, test on the others."""
-    f = _least_squares(model, data, names, start, train, max_nfev=60)
-    r = np.asarray(data.angle_deg, float)[~train] - f.predicted[~train]
-    return float(np.sqrt(np.mean(r**2))) if r.size else f.rmse_deg
+def _search_fit(model: JointModel, data: Dataset, names: Sequence[str], values: Mapping[str, float],
+                fixed: Mapping[str, float], grid: int = 0, grid_names: Sequence[str] | None = None,
+                per_sample: Sequence[str] = (), rows: np.ndarray | None = None, max_nfev: int = 100,
+                keep: int = 1, starts: Sequence[Mapping[str, float]] = ()) -> FitResult:
+    params = model.make_params(data, names, fixed, initial={k: v for k, v in values.items()
+                                                          if k in model.param_specs or "@" in k},
+                               per_sample=per_sample)
+    params = params.with_values({k: v for k, v in values.items() if k in params})
+    starts = [{k: v for k, v in st.items() if k in params} for st in starts]
+    return fit(model, data, params=params, grid=grid, grid_names=grid_names, rows=rows, max_nfev=max_nfev,
+               tol=1e-8, keep=keep, starts=[st for st in starts if st])
+
+
+def _cv(model: JointModel, data: Dataset, names: Sequence[str], start: Mapping[str, float],
+        fixed: Mapping[str, float], fold: np.ndarray, block: np.ndarray,
+        per_sample: Sequence[str] = ()) -> tuple[float, np.ndarray]:
+    """Held-out RMSE (deg) and per-block held-out MSE: fit on one fold, test on the other, both ways."""
+    measured = np.asarray(data.angle_deg, float)
+    res = np.empty(len(data))
+    for f in (0, 1):
+        test = fold == f
+        if not test.any() or test.all():
+            continue
+        r = _search_fit(model, data, names, start, fixed, rows=~test, per_sample=per_sample, max_nfev=40)
+        res[test] = measured[test] - r.predicted[test]
+    if (fold == fold[0]).all():  # one fold only: fall back to the in-sample residual
+        r = _search_fit(model, data, names, start, fixed, per_sample=per_sample, max_nfev=40)
+        res = measured - r.predicted
+    ids = np.unique(block)
+    mse = np.array([float(np.mean(res[block == b] ** 2)) for b in ids])
+    return float(np.sqrt(np.mean(res**2))), mse
 
 
 def _names_for(model: JointModel, fit_params: Sequence[str]) -> tuple:
     out = list(fit_params)
     for e in model.effects:
-        out.extend(f"{e.name}.{p.name}" for p in e.params)
+        out.extend(e.full_names())
     return tuple(dict.fromkeys(out))
+
+
+def _resolution_problems(model: JointModel, names: Sequence[str], values: Mapping[str, float],
+                         stderr: Mapping[str, float], at_bound: Sequence[str], data: Dataset,
+                         modulus_range_gpa: tuple[float, float]) -> list[str]:
+    """Why the fitted ``names`` cannot be trusted: on a bound, infinite stderr, not resolvable by the data."""
+    t = np.asarray(data.time_s, float)
+    dts = [np.median(np.diff(t[sl])) for _, sl in data.sample_slices() if sl.stop - sl.start > 2]
+    dt = float(np.median(dts)) if dts else 0.0
+    record = max((float(np.ptp(t[sl])) for _, sl in data.sample_slices()), default=0.0)
+    span = float(np.ptp(np.asarray(data.stroke_mm, float))) if len(data) else 0.0
+    out = []
+    free_base = {nm.split("@")[0] for nm in names if nm not in at_bound and math.isfinite(stderr.get(nm, math.inf))}
+    for nm in names:
+        spec = model.spec(nm)
+        v = float(values[nm])
+        se = float(stderr.get(nm, math.inf))
+        unit = f" {spec.unit}" if spec.unit else ""
+        if ("@" in nm and nm.split("@")[0] in free_base and spec.lo == 0.0 and abs(v) <= 1e-6 * max(spec.hi, 1.0)
+                and nm in at_bound):
+            continue  # the effect is absent in this sample only (its value is zero): reported per sample
+        if nm in at_bound:
+            out.append(f"{nm} = {v:.4g}{unit} is on its bound")
+        elif not math.isfinite(se):
+            out.append(f"{nm} has an infinite standard error (the data do not depend on it)")
+        if spec.kind == "time":
+            if v < 3 * dt:
+                out.append(f"{nm} = {v:.3g} s is shorter than three sample intervals ({3 * dt:.3g} s)")
+            elif v > record:
+                out.append(f"{nm} = {v:.3g} s is longer than the record ({record:.3g} s)")
+        elif spec.kind == "length" and abs(v) > span:
+            out.append(f"{nm} = {v:.3g} mm exceeds the stroke span ({span:.3g} mm)")
+        elif spec.kind == "modulus" and not (modulus_range_gpa[0] <= v <= modulus_range_gpa[1]):
+            out.append(f"{nm} = {v:.4g} GPa is outside the plausible range {modulus_range_gpa[0]:g}-"
+                       f"{modulus_range_gpa[1]:g} GPa (widen it with --modulus-range)")
+    return out
+
+
+def _step(r: FitResult, per_sample: Sequence[str] = (), init: Mapping[str, float] | None = None) -> Step:
+    return Step(tuple(e.name for e in r.model.effects), r.rmse, dict(r.rmse_per_sample), dict(r.params),
+                dict(r.stderr), dict(r.units), r.predicted, r.residuals, tuple(per_sample),
+                _rounded(init or {}))
 
 
 # ----------------------------------------------------------------------------- the search
@@ -264,8 +422,13 @@ def diagnose(
     bic_threshold: float = 10.0,
     min_gain: float = 0.02,
     min_excess: float = 0.1,
-    stop_ratio: float = 1.15,
+    stop_ratio: float | None = 1.15,
     registry: Registry | None = None,
+    z: float = 2.0,
+    grid: int = GRID,
+    modulus_range_gpa: tuple[float, float] = (1.0, 300.0),
+    per_sample: bool = True,
+    init: Mapping[str, float] | None = None,
 ) -> Diagnosis:
     """Find the effects missing from ``model`` (see the module docstring).
 
@@ -288,19 +451,27 @@ def diagnose(
         Rows used by the candidate search (thinned evenly in time); 0 = all.
     max_effects : int
         Most effects recommended.
-    bic_threshold, min_gain, min_excess, stop_ratio : float
-        Significance: delta BIC below ``-bic_threshold``; held-out RMSE down by
-        ``min_gain`` (relative) and by ``min_excess`` of the held-out MSE above the
-        noise floor; stop when the held-out RMSE is within ``stop_ratio`` x the floor.
+    bic_threshold, min_gain, min_excess : float
+        Significance besides the ``z`` test: delta BIC below ``-bic_threshold``; held-out RMSE down by
+        ``min_gain`` (relative) and by ``min_excess`` of the held-out MSE above the noise floor.
+    stop_ratio : float or None
+        Stop when the held-out RMSE is within ``stop_ratio`` x the floor; None: no stop rule.
+    z : float
+        A step must lower the held-out MSE by more than ``z`` standard errors of that fall.
+    grid : int
+        Grid values per new parameter for the multi-start fits.
+    modulus_range_gpa : (float, float)
+        Plausible tendon moduli; a fitted E_t outside is not trusted.
+    per_sample : bool
+        Test per-sample parameters for the recommended effects (several samples only).
+    init : dict, optional
+        Extra start values ``{full name: value}`` for candidates' parameters (``--init``): each candidate
+        is also fitted from them (useful for multimodal parameters such as a period).
 
     Returns
     -------
     Diagnosis
     """
-    import time
-
-
-
     clock = {"start": time.perf_counter()}
     fixed = dict(fixed or {})
     reg = registry if registry is not None else builtin_registry()
@@ -310,27 +481,33 @@ def diagnose(
         pool = [reg.get_effect(c) if isinstance(c, str) else c for c in candidates]
     have = {e.name for e in model.effects}
     pool = [e for e in pool if e.name not in have]
-
     check_fittable(data)
+
     full_names = _names_for(model, fit_params)
-    base_full = fit(model, data, full_names, fixed)
+    base_full = refit_all_rows(model, data, full_names, fixed, {}, grid)
+    block_all, _ = cycle_blocks(data)
     floor = noise_floor(data, base_full.residuals)
+    floor_se = noise_floor_se(data, base_full.residuals, block_all)
     clock["base"] = time.perf_counter()
 
     search = thin(data, max_rows)
-    train = holdout_mask(search)
+    block, fold = cycle_blocks(search)
+    strata = block_strata(search, block)
     current = model
     cur_names = full_names
-    cur_vals = dict(base_full.params)
-    cur = _least_squares(current, search, cur_names, cur_vals)
-    cur_ho = _heldout(current, search, cur_names, cur.params, train)
-    base_rmse, base_ho = cur.rmse_deg, cur_ho
+    cur_ps: list[str] = []
+    cur = _search_fit(current, search, cur_names, base_full.params, fixed)
+    cur_ho, cur_mse = _cv(current, search, cur_names, cur.params, fixed, fold, block)
+    base_rmse, base_ho = cur.rmse, cur_ho
+    steps = [_step(base_full)]
+    prev_all = base_full
     rounds: list[tuple[Candidate, ...]] = []
     recommended: list[str] = []
+    rejected: list[tuple[str, str]] = []
     chosen: list[Effect] = []
     stop = ""
     while True:
-        if cur_ho <= stop_ratio * floor:
+        if stop_ratio is not None and cur_ho <= stop_ratio * floor:
             stop = (f"the held-out RMSE {cur_ho:.3f} deg is within {stop_ratio:g} x the noise floor "
                     f"{floor:.3f} deg: nothing left to explain")
             break
@@ -340,84 +517,185 @@ def diagnose(
         if not pool:
             stop = "no candidate effects left"
             break
-        ranked = _round(current, search, cur_names, cur, cur_ho, train, pool, floor,
-                        bic_threshold, min_gain, min_excess)
-        rounds.append(ranked)
-        best = next((c for c in ranked if c.significant), None)
-        if best is None:
-            top = ranked[0] if ranked else None
-            stop = ("no candidate improves the model significantly"
-                    + (f" (best: {top.effect}: {top.why})" if top is not None else ""))
+        ranked = _round(current, search, cur_names, cur, cur_ho, cur_mse, fold, block, pool, floor, fixed,
+                        bic_threshold, min_gain, min_excess, z, grid, modulus_range_gpa, cur_ps, strata,
+                        per_sample and len(search.samples) > 1, init)
+        ranked_base_ho = cur_ho
+        accepted = None
+        for c in ranked:
+            if not c.significant:
+                continue
+            eff = next(e for e in pool if e.name == c.effect)
+            m = current.with_effects(list(current.effects) + [eff])
+            names = cur_names + eff.full_names()
+            ps = cur_ps + list(c.per_sample)
+            init = {k: v for k, v in c.values.items() if k.split("@")[0] in names and (k in c.values)}
+            init = {k: v for k, v in init.items() if ("@" in k) or k not in ps}
+            r = refit_all_rows(m, data, names, fixed, init, grid, per_sample=ps)
+            problems = []
+            if not r.rmse < prev_all.rmse:
+                problems.append(f"its refit on all rows does not lower the RMSE ({prev_all.rmse:.3f} -> "
+                                f"{r.rmse:.3f} deg)")
+            # every fitted parameter, not only the new ones: a new effect may push E_t to its bound
+            problems += _resolution_problems(m, list(r.fitted), r.params, r.stderr, r.at_bound, data,
+                                             modulus_range_gpa)
+            # the floor seen through this model's residual (a model error inflates the estimate a little)
+            f_c = min(floor, noise_floor(data, r.residuals))
+            se_c = noise_floor_se(data, r.residuals, block_all)
+            if r.rmse < f_c - 2.0 * se_c:
+                problems.append(f"its RMSE {r.rmse:.3f} deg undercuts the noise floor {f_c:.3f} +- "
+                                f"{se_c:.3f} deg (it would fit noise)")
+            if problems:
+                rejected.append((c.effect, "; ".join(problems)))
+                continue
+            accepted = (c, eff, m, names, r, {k: v for k, v in init.items() if k in r.fitted}, ps)
             break
-        eff = next(e for e in pool if e.name == best.effect)
+        ranked = tuple(_mark_rejected(ranked, rejected))
+        rounds.append(ranked)
+        if accepted is None:
+            top = ranked[0] if ranked else None
+            stop = ("no candidate improves the model significantly and reliably"
+                    + (f" (best: {top.effect}: {top.why})" if top is not None and top.why else ""))
+            break
+        c, eff, m, names, r, init, ps = accepted
+        floor, floor_se = f_c, se_c
+        cur_ps = ps
+        rejected = [(e, w) for e, w in rejected if e != eff.name]
         recommended.append(eff.name)
         chosen.append(eff)
-        current = model.with_effects(list(model.effects) + chosen)
-        cur_names = cur_names + tuple(f"{eff.name}.{p.name}" for p in eff.params)
-        start = dict(best.values)
-        cur = _least_squares(current, search, cur_names, start)
-        cur_ho = best.heldout_rmse_deg
-        pool = [e for e in pool if e.name != best.effect]
+        current, cur_names, prev_all = m, names, r
+        steps.append(_step(r, cur_ps, init))
+        cur = _search_fit(current, search, cur_names, c.values, fixed, per_sample=cur_ps)
+        cur_ho, cur_mse = c.heldout_rmse_deg, c.block_mse
+        # the next round tries only the effects that helped in this one (held-out RMSE down by min_gain):
+        # one that explained nothing on the simpler model is not retried (speed; see the module docstring)
+        useful = {x.effect for x in ranked if x.heldout_rmse_deg <= (1.0 - min_gain) * ranked_base_ho}
+        pool = [e for e in pool if e.name != eff.name and e.name in useful]
     clock["search"] = time.perf_counter()
 
-    # waterfall on all rows
-    steps = []
-    vals = dict(base_full.params)
-    m = model
-    names = full_names
-    for k in range(len(recommended) + 1):
-        if k:
-            eff = chosen[k - 1]
-            m = m.with_effects(list(m.effects) + [eff])
-            names = names + tuple(f"{eff.name}.{p.name}" for p in eff.params)
-            vals.update({n: v for n, v in cur.params.items() if n in names})
-        r = base_full if k == 0 else fit(m, data, names, fixed, initial={n: vals[n] for n in names if n in vals})
-        vals.update(r.params)
-        steps.append(Step(tuple(e.name for e in m.effects), r.rmse, dict(r.rmse_per_sample), dict(r.params),
-                          dict(r.stderr), dict(r.units), r.predicted, r.residuals))
+    # per-sample parameters of the recommended effects
+    ps_names: list[str] = []
+    notes: list[str] = []
+    if per_sample and len(data.samples) > 1 and chosen:
+        ps_names, notes, final = _per_sample(current, data, search, cur_names, cur, cur_ho, cur_mse, fold, block,
+                                             chosen, fixed, floor, floor_se, prev_all, bic_threshold, z, grid,
+                                             cur_ps, strata)
+        if final is not None:
+            steps.append(final)
+        ps_names = list(steps[-1].per_sample)
+    base_ps = steps[0].rmse_per_sample
+    fin_ps = steps[-1].rmse_per_sample
+    for smp in base_ps:
+        if fin_ps.get(smp, 0.0) > 1.02 * base_ps[smp]:
+            notes.append(f"sample {smp} ends worse than with the current model: RMSE {base_ps[smp]:.3f} -> "
+                         f"{fin_ps[smp]:.3f} deg (the shared parameters suit the other samples)")
     clock["waterfall"] = time.perf_counter()
     secs = {"base": clock["base"] - clock["start"], "search": clock["search"] - clock["base"],
-            "waterfall": clock["waterfall"] - clock["search"], "total": clock["waterfall"] - clock["start"]}
+            "per_sample": clock["waterfall"] - clock["search"], "total": clock["waterfall"] - clock["start"]}
     catalog = {e.name: e for e in list(model.effects) + list(pool) + chosen}
+    for rnd in rounds:
+        for c in rnd:
+            if c.effect not in catalog and c.effect in reg:
+                catalog[c.effect] = reg[c.effect]
     return Diagnosis(data, model, floor, base_rmse, base_ho, tuple(rounds), tuple(recommended), tuple(steps),
-                     tuple(fit_params), stop, fixed, secs, catalog)
+                     tuple(fit_params), stop, fixed, secs, catalog, floor_se, tuple(dict(rejected).items()),
+                     tuple(ps_names),
+                     tuple(notes), grid)
 
 
-def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: Fitted, cur_ho: float,
-           train: np.ndarray, pool: list[Effect], floor: float, bic_threshold: float, min_gain: float,
-           min_excess: float) -> tuple[Candidate, ...]:
-    """Every effect of ``pool`` on top of ``current``, ranked by held-out RMSE."""
-    tried: list[Candidate] = []
+def _mark_rejected(ranked, rejected):
+    why = dict(rejected)
+    for c in ranked:
+        if c.effect in why and c.significant:
+            yield Candidate(c.effect, c.effects, c.rmse_deg, c.heldout_rmse_deg, c.delta_bic, c.params,
+                            c.equivalent, c.confounded, False, "all-rows check: " + why[c.effect], c.predicted,
+                            c.values, c.gain_z, c.block_mse, c.per_sample)
+        else:
+            yield c
+
+
+def _gain(cur_mse: np.ndarray, new_mse: np.ndarray, strata: np.ndarray | None = None) -> tuple[float, float]:
+    """Mean fall of the per-block held-out MSE and its standard error (paired over blocks).
+
+    With ``strata`` (the sample of each block) the standard error is the stratified one: samples may differ
+    (an effect present in one sample only), only the spread within a sample is noise.
+    """
+    d = np.asarray(cur_mse) - np.asarray(new_mse)
+    if d.size < 2:
+        return float(d.mean()) if d.size else 0.0, math.inf
+    if strata is None or np.unique(strata).size < 2:
+        return float(d.mean()), float(d.std(ddof=1) / math.sqrt(d.size))
+    var = 0.0
+    for sv in np.unique(strata):
+        ds = d[strata == sv]
+        v = float(ds.var(ddof=1)) if ds.size > 1 else float(d.var(ddof=1))
+        var += ds.size * v
+    return float(d.mean()), math.sqrt(var) / d.size
+
+
+def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResult, cur_ho: float,
+           cur_mse: np.ndarray, fold: np.ndarray, block: np.ndarray, pool: list[Effect], floor: float,
+           fixed: Mapping[str, float], bic_threshold: float, min_gain: float, min_excess: float, z: float,
+           grid: int, modulus_range_gpa: tuple[float, float], cur_ps: Sequence[str] = (),
+           strata: np.ndarray | None = None, try_per_sample: bool = False,
+           init: Mapping[str, float] | None = None) -> tuple[Candidate, ...]:
+    """Every effect of ``pool`` on top of ``current``, ranked by held-out RMSE.
+
+    With ``try_per_sample``, the best two effects are also fitted with per-sample parameters; that
+    version replaces the shared one when its held-out error is significantly lower.
+    """
+    fits = []
     for eff in pool:
         m = current.with_effects(list(current.effects) + [eff])
-        new = tuple(f"{eff.name}.{p.name}" for p in eff.params)
+        new = eff.full_names()
         start = m.initial_values(search, base=cur.params)
-        f = _least_squares(m, search, cur_names + new, start)
-        ho = _heldout(m, search, cur_names + new, f.params, train)
+        f = _search_fit(m, search, cur_names + new, start, fixed, grid=grid, grid_names=new, per_sample=cur_ps,
+                        starts=[init] if init else ())
+        ho, mse = _cv(m, search, cur_names + new, f.params, fixed, fold, block, per_sample=cur_ps)
+        fits.append([eff, m, new, f, ho, mse, ()])
+    if try_per_sample:
+        for row in sorted([r for r in fits if r[2]], key=lambda r: r[4])[:2]:
+            eff, m, new, f, ho, mse, _ = row
+            ps = list(cur_ps) + list(new)
+            f2 = _search_fit(m, search, cur_names + new, f.params, fixed, per_sample=ps)
+            ho2, mse2 = _cv(m, search, cur_names + new, f2.params, fixed, fold, block, per_sample=ps)
+            dm, se = _gain(mse, mse2, strata)
+            if dm > z * se and f2.bic < f.bic - bic_threshold:
+                row[3:7] = [f2, ho2, mse2, tuple(new)]
+    tried: list[Candidate] = []
+    for eff, m, new, f, ho, mse, eff_ps in fits:
         dbic = f.bic - cur.bic
-        params = {nm: (f.params[nm], f.stderr.get(nm, math.inf), m.param_specs[nm].unit) for nm in new}
+        shown = [n for n in f.fitted if n.split("@")[0] in new] if eff_ps else list(new)
+        params = {nm: (f.params[nm], f.stderr.get(nm, math.inf), m.spec(nm).unit) for nm in shown}
         conf = []
-        idx = {nm: i for i, nm in enumerate(f.names)}
+        idx = {nm: i for i, nm in enumerate(f.fitted)}
         for a in new:
             for b in cur_names:
+                if a not in idx or b not in idx:
+                    continue
                 rho = f.correlation[idx[a], idx[b]] if f.correlation.size else np.nan
                 if not np.isfinite(rho) or abs(rho) > CORR_LIMIT:
                     conf.append(f"{b} (r={rho:+.3f})" if np.isfinite(rho) else f"{b} (degenerate)")
         why = []
         gain = 1.0 - ho / cur_ho if cur_ho > 0 else 0.0
         excess = cur_ho**2 - floor**2
+        dm, se = _gain(cur_mse, mse, strata)
+        gz = dm / se if se > 0 and math.isfinite(se) else (math.inf if dm > 0 else 0.0)
         if not dbic < -bic_threshold:
             why.append(f"delta BIC {dbic:+.1f} is not below -{bic_threshold:g}")
         if gain < min_gain:
             why.append(f"held-out RMSE falls by {100 * gain:.1f}% < {100 * min_gain:g}%")
         elif excess > 0 and (cur_ho**2 - ho**2) < min_excess * excess:
             why.append(f"explains only {100 * (cur_ho**2 - ho**2) / excess:.0f}% of the error above the noise floor")
-        moving = [nm for nm in new if nm not in f.at_bound]
-        if new and not moving:
-            why.append("its parameters end on their bounds")
-        tried.append(Candidate(eff.name, tuple(e.name for e in m.effects), f.rmse_deg, ho, dbic, params,
+        if gain >= min_gain and not gz > z:
+            why.append(f"the held-out gain is {gz:.1f} standard errors, not more than {z:g} (within the noise)")
+        if new and not why:
+            why += _resolution_problems(m, list(f.fitted), f.params, f.stderr, f.at_bound, search,
+                                        modulus_range_gpa)
+        tried.append(Candidate(eff.name, tuple(e.name for e in m.effects), f.rmse, ho, dbic, params,
                                confounded=tuple(conf), significant=not why, why="; ".join(why),
-                               predicted=f.predicted, values=dict(f.params)))
+                               predicted=f.predicted, values=dict(f.params), gain_z=gz, block_mse=mse,
+                               per_sample=eff_ps))
     tried.sort(key=lambda c: (c.heldout_rmse_deg, c.effect))
     # equivalences: near-equal held-out error and predictions within half the noise floor
     fam = {e.name: e.family for e in pool}
@@ -435,11 +713,62 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: Fitted, 
             if same_fam or close:
                 eq.append(o.effect)
         out.append(Candidate(c.effect, c.effects, c.rmse_deg, c.heldout_rmse_deg, c.delta_bic, c.params,
-                             tuple(eq), c.confounded, c.significant, c.why, c.predicted, c.values))
+                             tuple(eq), c.confounded, c.significant, c.why, c.predicted, c.values, c.gain_z,
+                             c.block_mse, c.per_sample))
     # among candidates that cannot be told apart from the best, the lowest BIC (the simplest) leads
     if out and out[0].equivalent:
         group = [c for c in out if c is out[0] or c.effect in out[0].equivalent]
         lead = min(group, key=lambda c: (not c.significant, c.delta_bic, c.effect))
         out.remove(lead)
         out.insert(0, lead)
+    # trusted, significant candidates first (in that order), then the rest
+    out.sort(key=lambda c: not c.significant)
     return tuple(out)
+
+
+def _per_sample(current, data, search, cur_names, cur, cur_ho, cur_mse, fold, block, chosen, fixed, floor, floor_se,
+                prev_all, bic_threshold, z, grid, cur_ps=(), strata=None):
+    """Try each recommended effect's parameters per sample; returns (names, notes, final step or None)."""
+    ps: list[str] = list(cur_ps)
+    notes: list[str] = []
+    base_fit = cur
+    base_mse = cur_mse
+    changed = False
+    for eff in chosen:
+        if not eff.params or all(n in ps for n in eff.full_names()):
+            continue
+        trial = ps + [n for n in eff.full_names() if n not in ps]
+        f = _search_fit(current, search, cur_names, base_fit.params, fixed, per_sample=trial)
+        ho, mse = _cv(current, search, cur_names, f.params, fixed, fold, block, per_sample=trial)
+        dm, se = _gain(base_mse, mse, strata)
+        dbic = f.bic - base_fit.bic
+        if dm > z * se and dbic < -bic_threshold:
+            ps = trial
+            base_fit, base_mse = f, mse
+            changed = True
+    if not ps:
+        return [], notes, None
+    final = None
+    r = prev_all
+    if changed:
+        init = {k: v for k, v in base_fit.params.items() if k in base_fit.fitted}
+        r = refit_all_rows(current, data, cur_names, fixed, init, grid, per_sample=ps)
+        if not r.rmse < prev_all.rmse or r.rmse < floor - 2.0 * floor_se:
+            notes.append("per-sample parameters were better on held-out cycles but not on all rows: kept as before")
+            return list(cur_ps), notes, None
+        final = _step(r, ps, init)
+    samples = data.samples
+    for nm in ps:
+        vals = [(s, r.params[f"{nm}@{s}"], r.stderr.get(f"{nm}@{s}", math.inf)) for s in samples]
+        unit = current.spec(nm).unit
+        diff = []
+        for i in range(len(vals)):
+            for j in range(i + 1, len(vals)):
+                (sa, va, ea), (sb, vb, eb) = vals[i], vals[j]
+                if abs(va - vb) > 3.0 * math.hypot(ea, eb):
+                    diff.append(f"{sa} vs {sb}: {va:.4g} vs {vb:.4g} {unit}".rstrip())
+        if diff:
+            notes.append(f"samples differ in {nm}: " + "; ".join(diff))
+        else:
+            notes.append(f"{nm} per sample: " + ", ".join(f"{s} {v:.4g}" for s, v, _ in vals) + " (within errors)")
+    return ps, notes, final

@@ -235,7 +235,7 @@ def _series(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
 
 SERIES = Effect(
     name="series", stage="elongation",
-    params=(Param("compliance_mm_per_N", "mm/N", -2.0, 10.0, 0.02,
+    params=(Param("compliance_mm_per_N", "mm/N", 0.0, 10.0, 0.02,
                   "extra compliance in series with the tendon (sheath or tube compression)"),),
     apply=_series,
     meaning="an extra compliance in series with the tendon (the sheath or the tube compresses)",

@@ -13,7 +13,10 @@ import numpy as np
 
 from camtube.model.data.dataset import Dataset
 
+# speed: derived per-Dataset data, cached (fits evaluate the model hundreds of times on the same rows)
 _SEGMENTS: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
+_SEG_ARRAYS: "weakref.WeakKeyDictionary[Dataset, tuple]" = weakref.WeakKeyDictionary()
+_SAMPLING: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
 
 
 def monotone_segments(data: Dataset) -> list[tuple[int, int, int, bool]]:
@@ -37,6 +40,20 @@ def monotone_segments(data: Dataset) -> list[tuple[int, int, int, bool]]:
     return out
 
 
+def _segment_arrays(data: Dataset) -> tuple:
+    """Cached ``(starts, stops, dirs, firsts, lengths, row_dir)`` of :func:`monotone_segments` as arrays/lists."""
+    hit = _SEG_ARRAYS.get(data)
+    if hit is None:
+        segs = monotone_segments(data)
+        starts = np.array([s[0] for s in segs], np.int64)
+        stops = np.array([s[1] for s in segs], np.int64)
+        dirs = [s[2] for s in segs]
+        firsts = [s[3] for s in segs]
+        hit = (starts, stops, dirs, firsts, stops - starts, np.repeat(np.array(dirs, np.int64), stops - starts))
+        _SEG_ARRAYS[data] = hit
+    return hit
+
+
 def play_operator(data: Dataset, x: np.ndarray, width_mm: float) -> np.ndarray:
     """Play (backlash) operator of width ``width_mm`` on ``x`` (n,), per sample, exact.
 
@@ -44,22 +61,41 @@ def play_operator(data: Dataset, x: np.ndarray, width_mm: float) -> np.ndarray:
     after a reversal until the input has come back by ``width_mm``:
     ``y_k = clip(y_{k-1}, x_k - w, x_k)``, starting at ``x_0 - w``. Within a
     monotone run of ``x`` the recursion is ``max(y_prev, x - w)`` (growing) or
-    ``min(y_prev, x)`` (shrinking), so each run is one NumPy call.
+    ``min(y_prev, x)`` (shrinking), so only the value carried from one run to the
+    next needs a (scalar) loop over the runs; the rows are then filled by three
+    NumPy calls (speed: see ``scripts/bench_diagnose.py``).
     """
     w = float(width_mm)
-    y = np.empty_like(x)
+    x = np.asarray(x, float)
+    if x.size == 0:
+        return x.copy()
+    starts, stops, dirs, firsts, lengths, row_dir = _segment_arrays(data)
+    x_first = x[starts].tolist()
+    x_last = x[stops - 1].tolist()
+    carry = [0.0] * len(dirs)
     prev = 0.0
-    for a, b, dirn, first in monotone_segments(data):
-        xs = x[a:b]
-        if first:
-            prev = float(xs[0]) - (w if dirn > 0 else 0.0)
-        if dirn > 0:
-            seg = np.maximum(xs - w, prev)
-        else:
-            seg = np.minimum(xs, prev)
-        y[a:b] = seg
-        prev = float(seg[-1])
-    return y
+    for k, dirn in enumerate(dirs):
+        if firsts[k]:
+            prev = x_first[k] - (w if dirn > 0 else 0.0)
+        carry[k] = prev
+        prev = max(x_last[k] - w, prev) if dirn > 0 else min(x_last[k], prev)
+    prev_row = np.repeat(np.asarray(carry), lengths)
+    return np.where(row_dir > 0, np.maximum(x - w, prev_row), np.minimum(x, prev_row))
+
+
+def _sampling(data: Dataset) -> list:
+    """Cached per sample: ``(slice, h, uniform, dt)`` (median step, whether the sampling is uniform)."""
+    hit = _SAMPLING.get(data)
+    if hit is None:
+        t = np.asarray(data.time_s, float)
+        hit = []
+        for _, sl in data.sample_slices():
+            dt = np.diff(t[sl])
+            h = float(np.median(dt)) if dt.size else 0.0
+            uniform = bool(dt.size and h > 0 and np.all(np.abs(dt - h) <= 1e-6 * h + 1e-12))
+            hit.append((sl, h, uniform, dt))
+        _SAMPLING[data] = hit
+    return hit
 
 
 def first_order_lag(data: Dataset, u: np.ndarray, tau_s: float) -> np.ndarray:
@@ -71,17 +107,14 @@ def first_order_lag(data: Dataset, u: np.ndarray, tau_s: float) -> np.ndarray:
 
     tau = max(float(tau_s), 1e-9)
     v = np.empty_like(u)
-    t = np.asarray(data.time_s, float)
-    for _, sl in data.sample_slices():
-        us, ts = u[sl], t[sl]
+    for sl, h, uniform, dt in _sampling(data):
+        us = u[sl]
         if us.size == 0:
             continue
-        dt = np.diff(ts)
         if dt.size == 0:
             v[sl] = us
             continue
-        h = float(np.median(dt))
-        if h > 0 and np.all(np.abs(dt - h) <= 1e-6 * h + 1e-12):
+        if uniform:
             a = math.exp(-h / tau)
             v[sl], _ = lfilter([1.0 - a], [1.0, -a], us, zi=[a * us[0]])
         else:

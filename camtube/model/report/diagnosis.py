@@ -61,13 +61,20 @@ def fit_names(d: Diagnosis, effects) -> list[str]:
 
 
 def add_command(d: Diagnosis, prefix: str) -> str:
-    """The ``camtube model fit`` command that fits the model with the recommended effects."""
+    """The ``camtube model fit`` command that reproduces the final model: same rows, same starts, same numbers."""
+    import shlex
+
     effects = list(d.final.effects)
     if not effects or not prefix:
         return ""
     cmd = f"{prefix} --effects {','.join(effects)}"
     if tuple(d.fit_params) != ("E_t",):  # model fit's default: E_t plus every effect parameter
-        cmd += f" --fit {','.join(fit_names(d, effects))}"
+        cmd += f" --fit {','.join(fit_names(d, effects)) or 'none'}"
+    if d.final.per_sample:
+        cmd += f" --per-sample {','.join(d.final.per_sample)}"
+    for k, v in d.final.init.items():
+        cmd += " --init " + shlex.quote(f"{k}={v:.6g}")
+    cmd += f" --starts {d.grid}"
     return cmd
 
 
@@ -107,6 +114,10 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
     out["final"] = {"effects": list(final.effects), "rmse_deg": _num(final.rmse_deg),
                     "params": {k: {"value": _num(v), "stderr": _num(final.stderr[k]) if k in final.stderr else None,
                                    "unit": final.units.get(k, "")} for k, v in final.params.items()}}
+    out["noise_floor_se_deg"] = _num(d.noise_floor_se_deg)
+    out["rejected"] = [{"effect": e, "why": w} for e, w in d.rejected]
+    out["per_sample"] = list(d.per_sample)
+    out["sample_notes"] = list(d.sample_notes)
     out["stop_reason"] = d.stop_reason
     out["command"] = add_command(d, command)
     out["unexplained"] = unexplained_report.json_section(d)
@@ -124,7 +135,7 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
     base = d.waterfall[0]
     lines = [title] if title else []
     cur = ", ".join(base.effects) or "none"
-    lines.append(f"noise floor (white noise in the residual): {floor:.3f} deg")
+    lines.append(f"noise floor (white noise in the residual): {floor:.3f} +- {d.noise_floor_se_deg:.3f} deg")
     lines.append(f"current model (effects: {cur}): RMSE {base.rmse_deg:.3f} deg = "
                  f"{_times(base.rmse_deg, floor)} the noise floor; held-out {d.base_heldout_rmse_deg:.3f} deg")
     where = describe(residual_atlas(d.data, base.residuals), floor)
@@ -152,6 +163,12 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
             lines.append(f"  {k}. {name}: {e.signature}: {e.meaning}.")
             for p in e.params:
                 full = f"{name}.{p.name}"
+                if full in step.per_sample:
+                    lines.append(f"       {full}, per sample ({p.doc}):")
+                    for smp in step.rmse_per_sample:
+                        key = f"{full}@{smp}"
+                        lines.append(f"         {key} = {_pm(step.params[key], step.stderr.get(key, math.inf), p.unit)}")
+                    continue
                 lines.append(f"       {full} = {_pm(step.params[full], step.stderr.get(full, math.inf), p.unit)}"
                              f"  ({p.doc})")
             rnd = d.rounds[k - 1] if k - 1 < len(d.rounds) else ()
@@ -163,12 +180,27 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
             lines.append(f"       RMSE {prev.rmse_deg:.3f} -> {step.rmse_deg:.3f} deg "
                          f"({_times(step.rmse_deg, floor)} the noise floor)")
             prev = step
+        if d.per_sample and len(d.waterfall) > len(d.recommended) + 1:
+            step = d.final
+            lines.append(f"  per sample: {', '.join(d.per_sample)} (significantly better on held-out cycles)")
+            for full in d.per_sample:
+                for smp in step.rmse_per_sample:
+                    key = f"{full}@{smp}"
+                    unit = step.units.get(key, "")
+                    if key in step.params:
+                        lines.append(f"       {key} = {_pm(step.params[key], step.stderr.get(key, math.inf), unit)}")
+            lines.append(f"       RMSE {prev.rmse_deg:.3f} -> {step.rmse_deg:.3f} deg "
+                         f"({_times(step.rmse_deg, floor)} the noise floor)")
         cmd = add_command(d, command)
         if cmd:
             lines.append("add them:")
             lines.append(f"  {cmd}")
     else:
         lines.append("recommended: nothing")
+    for note in d.sample_notes:
+        lines.append(f"note: {note}")
+    for name, why in d.rejected:
+        lines.append(f"not recommended: {name}: {why}")
     lines.append(f"stop: {d.stop_reason}")
     lines += unexplained_report.text_lines(d)
     return "\n".join(lines)
@@ -278,7 +310,8 @@ def waterfall_png(d: Diagnosis) -> bytes:
     x = np.arange(len(groups))
     for k, s in enumerate(steps):
         vals = [s.rmse_deg] + [s.rmse_per_sample[g] for g in samples]
-        label = "current model" if k == 0 else "+ " + d.recommended[k - 1]
+        label = ("current model" if k == 0 else "+ " + d.recommended[k - 1] if k <= len(d.recommended)
+                 else "per-sample " + ", ".join(d.per_sample))
         ax.bar(x + (k - (len(steps) - 1) / 2) * width, vals, width, label=label)
     ax.axhline(d.noise_floor_deg, color="black", ls="--", lw=1, label="noise floor")
     ax.set_xticks(x, ["all"] + [f"sample {g}" for g in samples])
