@@ -16,10 +16,11 @@ def register(model_sub) -> None:
     d = model_sub.add_parser(
         "diagnose", help="find the physical effects the model is missing, rank them, say how to add them",
         description="Fit the current model to every selected row (both directions of motion, slack deadband "
-                    "kept), estimate the noise floor from the residual, try each candidate effect and greedy "
-                    "combinations (held-out RMSE on alternate cycles and BIC), and recommend the effects that "
-                    "bring the error to the noise floor, with their fitted parameters and the command that "
-                    "adds them. Angles deg, strokes mm, forces N.")
+                    "kept), estimate the noise floor from the residual, try each candidate effect from several "
+                    "starts (held-out error on alternating blocks of cycles, every cycle tested; BIC), and "
+                    "recommend only effects whose gain beats the noise, whose parameters are identified and "
+                    "resolvable, and whose refit on all rows lowers the RMSE; test per-sample values; print the "
+                    "model fit command that reproduces the result. Angles deg, strokes mm, forces N.")
     d.add_argument("data", metavar="DATA.csv",
                    help="columns sample, cycle, time_s, stroke_mm, force_N, angle_deg")
     d.add_argument("--pattern", required=True, metavar="PATTERN", help="pattern YAML of the joint (see patterns/)")
@@ -40,7 +41,8 @@ def register(model_sub) -> None:
     d.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
                    help="hold a parameter at a value (E_t GPa, L0 mm); repeatable")
     d.add_argument("--max-rows", type=int, default=4000, metavar="N",
-                   help="rows used by the candidate search, thinned evenly in time (default 4000; 0 = all)")
+                   help="rows used by the candidate search, thinned evenly in time (default 4000; at least 25 per "
+                        "cycle, up to 4x this; 0 = all)")
     d.add_argument("--max-effects", type=int, default=4, metavar="N", help="most effects recommended (default 4)")
     d.add_argument("--modulus-range", default="1,300", metavar="LO,HI",
                    help="plausible tendon E_t in GPa; a fit outside is not trusted (default 1,300)")

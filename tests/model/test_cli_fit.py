@@ -95,3 +95,25 @@ def test_model_group_lists_its_subcommands():
     parser = build_parser()
     text = [a for a in parser._subparsers._group_actions][0].choices["model"].format_help()
     assert "fit" in text and "synth" in text
+
+
+def test_fit_per_sample_init_and_starts(data_csv, tmp_path, capsys):
+    js = tmp_path / "p.json"
+    argv = ["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--cycles", "all", "--branch", "both",
+            "--no-deadband", "--effects", "slack", "--per-sample", "slack", "--init", "slack.deadband_mm@2=0.06",
+            "--starts", "3", "--json", str(js)]
+    assert main(argv) == 0
+    doc = json.loads(js.read_text())
+    for s in ("1", "2"):
+        prm = doc["params"][f"slack.deadband_mm@{s}"]
+        assert prm["fitted"] and abs(prm["value"] - 0.05) < 0.005 and prm["stderr"] > 0
+    assert not doc["params"]["slack.deadband_mm"]["fitted"]
+    # the same options give the same numbers
+    js2 = tmp_path / "p2.json"
+    assert main(argv[:-1] + [str(js2)]) == 0
+    assert json.loads(js2.read_text())["params"] == doc["params"]
+    capsys.readouterr()
+    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--init", "E_t"]) == 2
+    assert "--init 'E_t'" in capsys.readouterr().err
+    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--effects", "slack",
+                 "--per-sample", "slak"]) == 2

@@ -39,7 +39,6 @@ and ``predict(data) -> (m,)`` deg for any rows.
 from __future__ import annotations
 
 import contextlib
-import difflib
 import math
 from dataclasses import dataclass, field
 from typing import Mapping, Sequence

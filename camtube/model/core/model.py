@@ -39,6 +39,7 @@ runs each sample with its own values (every effect already runs per sample).
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, field, replace
 from typing import Callable, Mapping, Sequence
 
@@ -422,8 +423,7 @@ class JointModel:
         return angle
 
 
-import weakref  # noqa: E402  (kept beside its only use)
-
+# speed: per-sample views of a Dataset, cached (per-sample parameters run the model sample by sample)
 _VIEWS: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
 
 

@@ -76,23 +76,6 @@ INIT_DIGITS = 6
 
 
 @dataclass(frozen=True, eq=False)
-class Fitted:
-    """One least-squares fit of a model on some rows (internal to the search, also reported)."""
-
-    model: JointModel
-    names: tuple
-    params: dict
-    stderr: dict
-    correlation: np.ndarray
-    sse: float
-    n: int
-    rmse_deg: float
-    bic: float
-    at_bound: tuple
-    predicted: np.ndarray
-
-
-@dataclass(frozen=True, eq=False)
 class Candidate:
     """One effect tried on top of the current model.
 
@@ -254,9 +237,20 @@ def noise_floor_se(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarray) 
     return float(np.std(vals, ddof=1) / math.sqrt(len(vals)))
 
 
+#: The search keeps at least this many rows per cycle (it may then exceed ``max_rows``, up to 4x).
+MIN_ROWS_PER_CYCLE = 25
+
+
 def thin(data: Dataset, max_rows: int) -> Dataset:
-    """Every k-th row (time order kept) so that at most about ``max_rows`` remain."""
+    """Every k-th row (time order kept) so that at most about ``max_rows`` remain.
+
+    Long records keep at least :data:`MIN_ROWS_PER_CYCLE` rows per cycle (up to ``4 max_rows``) so
+    that history effects stay visible within each cycle.
+    """
     n = len(data)
+    if max_rows > 0:
+        cycles = sum(int(np.unique(np.asarray(data.cycle)[sl]).size) for _, sl in data.sample_slices())
+        max_rows = min(max(max_rows, MIN_ROWS_PER_CYCLE * cycles), 4 * max_rows)
     if max_rows <= 0 or n <= max_rows:
         return data
     k = int(math.ceil(n / max_rows))
@@ -321,18 +315,12 @@ def refit_all_rows(model: JointModel, data: Dataset, names: Sequence[str], fixed
     return fit(model, data, params=params, grid=grid)
 
 
-def _fitted(r: FitResult) -> Fitted:
-    return Fitted(r.model, r.fitted, dict(r.params), dict(r.stderr), r.correlation, r.sse, r.n_points,
-                  r.rmse, r.bic, r.at_bound, r.predicted)
-
-
 def _search_fit(model: JointModel, data: Dataset, names: Sequence[str], values: Mapping[str, float],
                 fixed: Mapping[str, float], grid: int = 0, grid_names: Sequence[str] | None = None,
                 per_sample: Sequence[str] = (), rows: np.ndarray | None = None, max_nfev: int = 100,
                 keep: int = 1, starts: Sequence[Mapping[str, float]] = ()) -> FitResult:
-    params = model.make_params(data, names, fixed, initial={k: v for k, v in values.items()
-                                                          if k in model.param_specs or "@" in k},
-                               per_sample=per_sample)
+    """A looser, capped fit of the search: starts at ``values`` (every name, per-sample copies included)."""
+    params = model.make_params(data, names, fixed, per_sample=per_sample)
     params = params.with_values({k: v for k, v in values.items() if k in params})
     starts = [{k: v for k, v in st.items() if k in params} for st in starts]
     return fit(model, data, params=params, grid=grid, grid_names=grid_names, rows=rows, max_nfev=max_nfev,
@@ -529,8 +517,7 @@ def diagnose(
             m = current.with_effects(list(current.effects) + [eff])
             names = cur_names + eff.full_names()
             ps = cur_ps + list(c.per_sample)
-            init = {k: v for k, v in c.values.items() if k.split("@")[0] in names and (k in c.values)}
-            init = {k: v for k, v in init.items() if ("@" in k) or k not in ps}
+            init = {k: v for k, v in c.values.items() if k.split("@")[0] in names}
             r = refit_all_rows(m, data, names, fixed, init, grid, per_sample=ps)
             problems = []
             if not r.rmse < prev_all.rmse:
