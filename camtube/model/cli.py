@@ -91,6 +91,8 @@ def register(sub) -> None:
             raise
     else:
         diag.register(model_sub)
+    from camtube.model.unexplained.cli import register_effect_commands
+    register_effect_commands(model_sub)
 
 
 def _add_pattern_option(p: argparse.ArgumentParser) -> None:

@@ -14,7 +14,9 @@ report directory with an index is complete).
      "rounds": [[candidate, ...], ...],        # candidates of each greedy round (first = "candidates")
      "recommended": [effect, ...],             # in order
      "waterfall": [{"effects", "rmse_deg", "per_sample"}],
-     "final": {"effects", "rmse_deg", "params"}, "stop_reason", "command"}
+     "final": {"effects", "rmse_deg", "params"}, "stop_reason", "command",
+     "unexplained": null | {"share", "follows", "periodic": [{"variable", "period", "unit", "amplitude_deg"}],
+                            "shape", "samples", ...}}   # camtube.model.unexplained
 
 Non-finite numbers are written as ``null``.
 """
@@ -30,6 +32,7 @@ import numpy as np
 
 from camtube.model.diagnose.atlas import describe, residual_atlas
 from camtube.model.diagnose.search import Candidate, Diagnosis
+from camtube.model.unexplained import report as unexplained_report
 
 
 def _num(x) -> float | None:
@@ -117,6 +120,7 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
     out["sample_notes"] = list(d.sample_notes)
     out["stop_reason"] = d.stop_reason
     out["command"] = add_command(d, command)
+    out["unexplained"] = unexplained_report.json_section(d)
     return out
 
 
@@ -198,6 +202,7 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
     for name, why in d.rejected:
         lines.append(f"not recommended: {name}: {why}")
     lines.append(f"stop: {d.stop_reason}")
+    lines += unexplained_report.text_lines(d)
     return "\n".join(lines)
 
 
@@ -337,7 +342,7 @@ white-space:pre-wrap}}table{{border-collapse:collapse;font-size:90%}}td,th{{bord
 img{{max-width:100%}}</style></head><body>
 <h1>{esc(title)}</h1>
 <pre>{esc(diagnosis_text(d, command))}</pre>
-<h2>Model vs measurement</h2><img src="model.png" alt="angle vs stroke">
+{unexplained_report.html_section(d)}<h2>Model vs measurement</h2><img src="model.png" alt="angle vs stroke">
 <h2>Residual atlas</h2>
 <p>Residual (measured - model) against each variable; lines are binned medians, the band the quartiles of the
 current model; dashed/dotted: loading/unloading.</p><img src="atlas.png" alt="residual atlas">

@@ -1,0 +1,82 @@
+"""The ``unexplained`` section of a diagnosis report (text, JSON, HTML), from a :class:`Diagnosis`.
+
+The diagnosis report (:mod:`camtube.model.report.diagnosis`) calls these three hooks;
+the analysis runs once per diagnosis (memoised on the object).
+"""
+from __future__ import annotations
+
+import html
+import math
+import weakref
+
+from camtube.model.unexplained.analysis import analyse, describe, variables_of
+
+_MEMO: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+#: A name for the starter effect, by what the residual follows.
+NAMES = {("stroke", True): "drive_error", ("time", True): "tendon_oscillation", ("angle", False): "arm_change",
+         ("first_cycle", False): "first_cycle_set", ("cycle", False): "cycle_drift", ("time", False): "drift",
+         ("stroke", False): "stroke_loss", ("force", False): "tendon_law", ("direction", False): "hysteresis",
+         ("sample", False): "sample_offset"}
+
+
+def of_diagnosis(d) -> dict | None:
+    """``unexplained`` of the diagnosis's final model (``None`` when it is within 1.15 x the noise floor)."""
+    try:
+        return _MEMO[d]
+    except (KeyError, TypeError):
+        pass
+    u = analyse(d.final.residuals, variables_of(d.data), d.noise_floor_deg)
+    try:
+        _MEMO[d] = u
+    except TypeError:
+        pass
+    return u
+
+
+def _clean(x):
+    if isinstance(x, float):
+        return x if math.isfinite(x) else None
+    if isinstance(x, dict):
+        return {str(k): _clean(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_clean(v) for v in x]
+    return x
+
+
+def json_section(d) -> dict | None:
+    """JSON-ready ``unexplained``: {share, follows, periodic [{variable, period, unit, amplitude_deg, ...}],
+    shape, samples, ...} or ``None``."""
+    u = of_diagnosis(d)
+    return None if u is None else _clean(u)
+
+
+def suggested_name(u: dict) -> str:
+    lead = u.get("leading", "")
+    per = any(p["variable"] == lead for p in u.get("periodic", []))
+    return NAMES.get((lead, per), NAMES.get((lead, False), "my_effect"))
+
+
+def text_lines(d, json_path: str = "DIAG.json") -> list[str]:
+    """Lines of the text report (empty when nothing is left)."""
+    u = of_diagnosis(d)
+    if u is None:
+        return []
+    lines = describe(u)
+    if d.recommended:
+        lines.append(f"  note: with {', '.join(d.recommended)} the error stays at "
+                     f"{d.final.rmse_deg / d.noise_floor_deg:.2f} x the floor; the recommended effect(s) may stand in "
+                     f"for the physics above: try the starter effect without them")
+    if u.get("leading"):
+        lines.append(f"  start an effect for it: camtube model effect new {suggested_name(u)} --from {json_path}"
+                     f"  (the diagnosis's --json file)")
+    return lines
+
+
+def html_section(d) -> str:
+    """An HTML ``<h2>`` section (empty string when nothing is left)."""
+    lines = text_lines(d)
+    if not lines:
+        return ""
+    return ("<h2>Unexplained</h2>\n<p>What the final model's residual still follows (cross-validated smoothing "
+            "per variable; Lomb-Scargle periods against stroke and time).</p>\n<pre>"
+            + html.escape("\n".join(lines)) + "</pre>\n")
