@@ -202,7 +202,7 @@ def load_drawing(path: str | os.PathLike, overrides: Iterable[str], options) -> 
     if rd.issues:
         raise PatternError(rd.issues)
     if not cuts:
-        raise PatternError([Issue(file, "the drawing has no cuts", None,
+        raise PatternError([Issue("cuts", "the drawing has no cuts", None,
                                   "closed outlines on notch/hole layers, open paths on slit layers",
                                   "draw the cuts, or map their layer with --layer NAME=notch|hole|slit", file)])
 
@@ -278,6 +278,9 @@ def _read_document(path, file: str):
     try:
         return ezdxf.readfile(str(path))
     except OSError as exc:
+        if Path(path).is_file():
+            raise PatternError([Issue("file", f"not a valid DXF file ({exc})", None, "a DXF file (R12 or later)",
+                                      "save the drawing as DXF again from your CAD program", file)]) from None
         raise PatternError([Issue("file", f"cannot read the drawing: {exc.strerror or exc}", file,
                                   "a readable DXF file", "check the path", file)]) from None
     except ezdxf.DXFError as exc:
@@ -487,28 +490,61 @@ def _find_outline(rd: _Reading, ro: float | None, length: float | None):
     cut_pieces = [p for p in rd.pieces if p.role != "ignore"]
     if not cut_pieces:
         return None, ro or 1.0, length or 1.0  # nothing to cut: refused as such by the caller
-    best = None
+    import numpy as np
+
+    # per cut piece: x range and the y of its centre (a cut may cross the seam line drawn whole)
+    b = np.array([q.bounds for q in cut_pieces], dtype=float)
+    xs0, xs1, yc = b[:, 0], b[:, 2], 0.5 * (b[:, 1] + b[:, 3])
+    index = {id(q): k for k, q in enumerate(cut_pieces)}
+    groups: list[tuple[tuple[float, float, float, float], list[_Piece]]] = []  # rectangles drawn twice: one group
     for p in rd.pieces:
         box = _rectangle(p)
         if box is None:
             continue
         x0, y0, x1, y1 = box
-        others = [q for q in cut_pieces if q is not p]
-        if not others:
+        # pieces around this rectangle (a frame, a larger outline) do not stop it being the outline
+        keep = ~((b[:, 0] <= x0 + TOL.gap) & (b[:, 2] >= x1 - TOL.gap) & (b[:, 1] <= y0 + TOL.gap)
+                 & (b[:, 3] >= y1 - TOL.gap))
+        if id(p) in index:
+            keep[index[id(p)]] = False
+        if not keep.any():
             continue
-        # every cut lies inside in x; in y a cut may cross the seam line drawn whole (its centre on the sheet)
-        inside = all(b[0] >= x0 - TOL.gap and b[2] <= x1 + TOL.gap and y0 - TOL.gap <= 0.5 * (b[1] + b[3]) <= y1
-                     + TOL.gap for b in (q.bounds for q in others))
-        area = (x1 - x0) * (y1 - y0)
-        if inside and (best is None or area < best[1] - TOL.gap):
-            best = (p, area, box)
-    if best is None:
+        inside = bool(np.all((xs0[keep] >= x0 - TOL.gap) & (xs1[keep] <= x1 + TOL.gap)
+                             & (yc[keep] >= y0 - TOL.gap) & (yc[keep] <= y1 + TOL.gap)))
+        if not inside:
+            continue
+        for g_box, members in groups:
+            if all(abs(u - v) <= TOL.gap for u, v in zip(g_box, box)):
+                members.append(p)
+                break
+        else:
+            groups.append((box, [p]))
+    if not groups:
         missing = [w for w, v in (("--outer-radius", ro), ("--length", length)) if v is None]
         if missing:
-            rd.refuse(rd.file, "no tube outline found (an axis-aligned rectangle L x 2 pi r_o around every cut)",
+            rd.refuse("tube outline", "no tube outline found (an axis-aligned rectangle L x 2 pi r_o around every cut)",
                       "draw the unrolled tube outline (any layer), or pass " + " and ".join(missing))
         return None, ro, length
-    piece, _, (x0, y0, x1, y1) = best
+
+    def fits(box) -> bool:
+        ok_r = ro is None or abs(box[3] - box[1] - 2.0 * math.pi * ro) <= TOL.outline
+        ok_l = length is None or abs(box[2] - box[0] - length) <= TOL.outline
+        return ok_r and ok_l
+
+    if ro is not None or length is not None:
+        matching = [g for g in groups if fits(g[0])]
+        # none fits: the largest is the outline the user drew, and the mismatch is reported on it
+        groups = matching or [max(groups, key=lambda g: (g[0][2] - g[0][0]) * (g[0][3] - g[0][1]))]
+    if len(groups) > 1:
+        names = "; ".join(f"{g[1][0].describe()} ({(g[0][2] - g[0][0]):.4g} x {(g[0][3] - g[0][1]):.4g} mm)"
+                          for g in groups)
+        rd.refuse("tube outline", f"{len(groups)} nested rectangles could each be the tube outline: {names}",
+                  "pass --outer-radius (and --length) to say which, or delete the extra rectangle "
+                  "(a cut drawn around another cut is refused anyway)",
+                  entities=[p for g in groups for p in g[1]])
+        return None, ro, length
+    (x0, y0, x1, y1), members = groups[0]
+    piece = members[0]
     h, w = y1 - y0, x1 - x0
     desc = piece.describe()
     if ro is not None and abs(h - 2.0 * math.pi * ro) > TOL.outline:
@@ -520,6 +556,10 @@ def _find_outline(rd: _Reading, ro: float | None, length: float | None):
         rd.refuse(desc, f"the tube outline is {w:.4f} mm long, but the tube length given is {length:g} mm",
                   f"pass --length {w:.4f} (or omit it), or redraw the outline", f"length within {TOL.outline:g} mm",
                   piece.entities)
+    for extra in members[1:]:  # the outline drawn twice (copy/paste, or on two layers)
+        for e in extra.entities:
+            e.status = "aside:outline drawn again"
+    rd.pieces = [p for p in rd.pieces if not any(p is m for m in members[1:])]
     for e in piece.entities:
         e.status = "outline"
     rd.pieces = [p for p in rd.pieces if p is not piece]
