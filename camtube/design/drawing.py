@@ -548,7 +548,8 @@ def _find_outline(rd: _Reading, ro: float | None, length: float | None):
     h, w = y1 - y0, x1 - x0
     desc = piece.describe()
     if ro is not None and abs(h - 2.0 * math.pi * ro) > TOL.outline:
-        rd.refuse(desc, f"the tube outline is {h / rd.factor:.6g} {rd.unit} = {h:.4f} mm high, i.e. 2 pi x "
+        drawn_h = f"{h / rd.factor:.6g} {rd.unit} = " if rd.unit != "mm" else ""
+        rd.refuse(desc, f"the tube outline is {drawn_h}{h:.4f} mm high, i.e. 2 pi x "
                   f"{h / (2 * math.pi):.4f} mm, but the outer radius {ro:g} mm needs 2 pi r_o = "
                   f"{2 * math.pi * ro:.4f} mm", f"pass --outer-radius {h / (2 * math.pi):.4f} (or omit it), or redraw "
                   "the outline", f"height 2 pi r_o within {TOL.outline:g} mm", piece.entities)
