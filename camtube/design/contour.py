@@ -34,7 +34,7 @@ class Contour:
     points : tuple[tuple[float, float], ...]
         Vertices (x_mm, y_mm), counter-clockwise.
     kind : str
-        ``notch``, ``hole`` or ``cut`` (from a foreign DXF).
+        ``notch``, ``hole``, ``slit`` (an open path) or ``cut`` (contours given without a pattern).
     cut_index : int
         Index of the cut in ``Pattern.cuts`` it comes from (-1 if unknown).
     closed : bool

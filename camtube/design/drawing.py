@@ -196,9 +196,9 @@ def load_drawing(path: str | os.PathLike, overrides: Iterable[str], options) -> 
         raise PatternError(rd.issues)
 
     cuts, origins, seam_joined = _cuts(rd, outline, ro, length)
-    for e in rd.entities:
-        if not e.status:
-            e.status = "aside:unused"  # pragma: no cover - every path above sets a status
+    lost = [e.describe() for e in rd.entities if not e.status]
+    if lost:  # every path above gives each entity a fate; one without is a bug, never a silent drop
+        raise RuntimeError(f"{file}: entities not accounted for: {', '.join(lost[:5])}")
     if rd.issues:
         raise PatternError(rd.issues)
     if not cuts:
