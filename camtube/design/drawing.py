@@ -62,9 +62,11 @@ UNIT_NAMES: dict[str, float] = {
 #: Entities that are never cut: set aside wherever they are (counted in the summary).
 ANNOTATIONS = frozenset({
     "TEXT", "MTEXT", "ATTRIB", "ATTDEF", "DIMENSION", "ARC_DIMENSION", "LARGE_RADIAL_DIMENSION", "LEADER",
-    "MULTILEADER", "MLEADER", "TOLERANCE", "HATCH", "MPOLYGON", "SOLID", "TRACE", "POINT", "IMAGE", "WIPEOUT",
+    "MULTILEADER", "MLEADER", "TOLERANCE", "POINT", "IMAGE", "WIPEOUT",
     "VIEWPORT", "XLINE", "RAY", "ACAD_TABLE", "UNDERLAY", "PDFUNDERLAY", "DWFUNDERLAY", "DGNUNDERLAY",
 })
+#: Filled areas: set aside when each of their boundaries is drawn as a cut too; refused on a cut layer otherwise.
+FILLS = frozenset({"HATCH", "MPOLYGON", "SOLID", "TRACE"})
 CURVES = frozenset({"LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE", "LWPOLYLINE", "POLYLINE", "HELIX"})
 
 #: Wall assumed when the drawing's process settings do not give ``tube.inner_radius`` (mm).
@@ -126,6 +128,7 @@ class _Reading:
     issues: list[Issue] = field(default_factory=list)
     inserts: int = 0
     joined: list[_Piece] = field(default_factory=list)
+    fills: list[tuple[_Entity, list[list[tuple[float, float]]]]] = field(default_factory=list)
 
     def role(self, layer: str) -> str:
         up = layer.upper()
@@ -191,6 +194,7 @@ def load_drawing(path: str | os.PathLike, overrides: Iterable[str], options) -> 
     for entity in doc.modelspace():
         _walk(rd, entity, "", "")
     _close_and_chain(rd)
+    _check_fills(rd)
     outline, ro, length = _find_outline(rd, ro_opt, len_opt)
     if rd.issues:
         raise PatternError(rd.issues)
@@ -342,6 +346,17 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str) -> None:
         rd.inserts += 1
         here = f"INSERT #{entity.dxf.handle}" if entity.dxf.handle else "INSERT"
         name = entity.dxf.name
+        block = entity.block()
+        if block is None or block.block.is_xref:
+            ent = _Entity("INSERT", entity.dxf.handle or "-", layer, via)
+            rd.entities.append(ent)
+            if rd.role(layer) == "ignore":
+                ent.status = "aside:ignored layer"
+            else:
+                what = "an external reference (XREF)" if block is not None else "a block missing from the drawing"
+                rd.refuse(ent.describe(), f"places {what} {name!r}: its content is not in this file",
+                          "bind the XREF into the drawing (XREF > Bind) and save again", entities=[ent])
+            return
         copies = list(entity.multi_insert()) if entity.mcount > 1 else [entity]
         for k, ins in enumerate(copies):
             tag = f"in block {name} of {here}" + (f" (copy {k + 1} of {len(copies)})" if len(copies) > 1 else "")
@@ -368,6 +383,17 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str) -> None:
     role = rd.role(layer)
     if t in ANNOTATIONS:
         ent.status = "aside:annotation"
+        return
+    if t in FILLS:
+        if role == "ignore":
+            ent.status = "aside:ignored layer"
+        else:
+            _fill(rd, entity, ent)
+        return
+    if t == "LWPOLYLINE" and role != "ignore" and (entity.dxf.get("const_width", 0.0) or any(
+            w0 or w1 for _, _, w0, w1 in entity.get_points("xyse"))):
+        rd.refuse(ent.describe(), "is a polyline with a width: the drawing shows a band, camtube would cut its "
+                  "centre line", "set the polyline's width to 0 (draw the cut's outline instead)", entities=[ent])
         return
     if t not in CURVES:
         if role == "ignore":
@@ -415,6 +441,46 @@ def _flatten(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
         found = True
     if not found:
         ent.status = "aside:zero length"
+
+
+def _fill(rd: _Reading, entity, ent: _Entity) -> None:
+    """Remember a filled area's boundary loops (mm); checked against the drawn cuts in :func:`_check_fills`."""
+    from ezdxf import path as ezpath
+
+    try:
+        paths = list(ezpath.from_hatch(entity)) if entity.dxftype() in ("HATCH", "MPOLYGON") else \
+            [ezpath.make_path(entity)]
+    except (TypeError, ValueError):
+        paths = []
+    loops = []
+    for p in paths:
+        for sub in (p.sub_paths() if p.has_sub_paths else [p]):
+            pts = [(v.x * rd.factor, v.y * rd.factor) for v in sub.flattening(TOL.chord / rd.factor, segments=4)]
+            if len(pts) >= 3:
+                loops.append(_dedupe(pts))
+    rd.fills.append((ent, loops))
+
+
+def _check_fills(rd: _Reading) -> None:
+    """A fill on a cut layer is set aside if every boundary of it is drawn as a closed piece; else refused."""
+    from shapely.geometry import Polygon
+
+    closed = [Polygon(p.points) for p in rd.pieces if p.closed and len(p.points) >= 3]
+    for ent, loops in rd.fills:
+        ok = bool(loops)
+        for loop in loops:
+            f = Polygon(loop)
+            tol = TOL.gap * max(f.length, 1.0)
+            if not any(abs(f.area - g.area) <= tol and f.symmetric_difference(g).area <= tol for g in closed
+                       if g.is_valid and f.is_valid):
+                ok = False
+                break
+        if ok:
+            ent.status = "aside:fill of a drawn outline"
+        else:
+            rd.refuse(ent.describe(), f"a filled area ({ent.dxftype}) whose boundary is not drawn as a closed outline",
+                      "draw the cut's outline (e.g. HATCHEDIT > recreate boundary), or move the fill to a "
+                      "CONSTRUCTION layer", entities=[ent])
 
 
 def _isclose(a, b, tol: float) -> bool:

@@ -173,3 +173,44 @@ def test_not_a_dxf_is_one_clear_error(tmp_path):
         load_drawing(bad, [], DrawingOptions())
     with pytest.raises(PatternError, match="cannot read the drawing"):
         load_drawing(tmp_path / "missing.dxf", [], DrawingOptions())
+
+
+def test_fills_are_set_aside_only_when_their_boundary_is_drawn(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    pts = [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)]
+    draw_polygon(s, pts, "NOTCHES")
+    s.msp.add_hatch(dxfattribs={"layer": "NOTCHES"}).paths.add_polyline_path([s.at(*p) for p in pts])
+    loaded = load_drawing(save(s, tmp_path), [], DrawingOptions())
+    assert len(loaded.pattern.cuts) == 1 and "1 (fill of a drawn outline)" in loaded.summary
+    # a hatch alone (the only trace of a hole) is not dropped silently
+    s.msp.add_hatch(dxfattribs={"layer": "HOLES"}).paths.add_polyline_path(
+        [s.at(6.0, 1.0), s.at(6.3, 1.0), s.at(6.3, 1.3), s.at(6.0, 1.3)])
+    with pytest.raises(PatternError, match=r"HATCH #\w+ on layer HOLES: a filled area .* not drawn"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+
+
+def test_thick_polylines_and_xrefs_are_refused(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    s.msp.add_lwpolyline([s.at(3.0, 1.0), s.at(3.0, 2.0)], dxfattribs={"layer": "SLITS", "const_width": 0.05})
+    with pytest.raises(PatternError, match=r"LWPOLYLINE #\w+ on layer SLITS: is a polyline with a width"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    s.doc.add_xref_def("other.dxf", "OTHER")
+    s.msp.add_blockref("OTHER", s.at(5, 1), dxfattribs={"layer": "NOTCHES"})
+    with pytest.raises(PatternError, match=r"INSERT #\w+ on layer NOTCHES: places an external reference"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+
+
+def test_an_arc_with_a_mirrored_extrusion_is_placed_where_it_is_drawn(tmp_path):
+    """AutoCAD's MIRROR gives circles extrusion (0, 0, -1) with the centre in OCS: (-x, y) is drawn at (x, y)."""
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(5.0, 1.0), (5.5, 1.0), (5.5, 2.0), (5.0, 2.0)], "NOTCHES")
+    s.msp.add_circle((-3.0, MID), 0.15, dxfattribs={"layer": "HOLES", "extrusion": (0, 0, -1)})
+    p = load_drawing(save(s, tmp_path), [], DrawingOptions()).pattern
+    (h,) = p.holes
+    assert h.x_mm == pytest.approx(3.0, abs=1e-9) and h.angle_deg == pytest.approx(180.0, abs=1e-6)
