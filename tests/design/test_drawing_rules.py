@@ -214,3 +214,20 @@ def test_an_arc_with_a_mirrored_extrusion_is_placed_where_it_is_drawn(tmp_path):
     p = load_drawing(save(s, tmp_path), [], DrawingOptions()).pattern
     (h,) = p.holes
     assert h.x_mm == pytest.approx(3.0, abs=1e-9) and h.angle_deg == pytest.approx(180.0, abs=1e-6)
+
+
+def test_a_circle_in_a_block_scaled_unevenly_and_turned_is_the_ellipse_it_shows(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(6.0, 1.0), (6.5, 1.0), (6.5, 2.0), (6.0, 2.0)], "NOTCHES")
+    blk = s.doc.blocks.new("ROUND")
+    blk.add_circle((0.0, 0.0), 0.1)
+    s.msp.add_blockref("ROUND", s.at(3.0, MID), dxfattribs={"layer": "HOLES", "xscale": 2.0, "yscale": 1.0,
+                                                             "rotation": 90.0})
+    p = load_drawing(save(s, tmp_path), [], DrawingOptions()).pattern
+    (h,) = p.holes
+    from shapely.geometry import Polygon
+
+    assert Polygon(h.outline).area == pytest.approx(math.pi * 0.2 * 0.1, rel=5e-4)
+    assert (h.width_mm, h.arc_mm) == pytest.approx((0.2, 0.4), abs=1e-6)  # turned 90 deg: the long axis is y
+    assert h.x_mm == pytest.approx(3.0, abs=1e-9) and h.angle_deg == pytest.approx(180.0, abs=1e-6)
