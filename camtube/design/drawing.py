@@ -647,7 +647,8 @@ def _cuts(rd: _Reading, outline: _Piece | None, ro: float, length: float):
     owners: list[_Piece] = []
     for p in rd.pieces:
         if p.role == "ignore":
-            why = "hidden layer" if p.layer.upper() in rd.hidden and p.layer.upper() not in rd.roles else "ignored layer"
+            up = p.layer.upper()
+            why = "hidden layer" if up in rd.hidden and up not in rd.roles else "ignored layer"
             for e in p.entities:
                 e.status = e.status or f"aside:{why}"
             continue

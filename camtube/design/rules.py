@@ -183,7 +183,8 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
     seen_keys: set[str] = set()
     for cut, origin in zip(pattern.cuts, origins):
         if _is_key(origin):
-            key_arc = "notch.arc" if origin == "notch" else (f"{origin}.arc" if cut.kind == "notch" else f"{origin}.size")
+            key_arc = "notch.arc" if origin == "notch" else (
+                f"{origin}.arc" if cut.kind == "notch" else f"{origin}.size")
             key_x = "notch.first_offset" if origin == "notch" else f"{origin}.x"
             fix_arc = "reduce the arc s"
         else:  # a drawn entity: the message names it

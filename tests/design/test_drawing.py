@@ -167,7 +167,8 @@ def test_slits_are_open_contours():
 
 def test_settings_from_set_and_a_process_file(tmp_path):
     loaded = load_source(EXAMPLES / "outline_layer0.dxf",
-                         [f"process={PATTERNS / 'femto-polyimide.yaml'}", "process.repeats=3", "tube.inner_radius=0.7", "name=t"],
+                         [f"process={PATTERNS / 'femto-polyimide.yaml'}", "process.repeats=3",
+                          "tube.inner_radius=0.7", "name=t"],
                          DrawingOptions())
     p = loaded.pattern
     assert p.name == "t" and p.tube.inner_radius_mm == 0.7 and p.process.repeats == 3
@@ -218,3 +219,13 @@ def test_cli_refusal_writes_nothing(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "duplicate" in err and "Traceback" not in err
     assert not out.exists()
+
+
+def test_committed_examples_are_what_the_generator_writes(tmp_path, monkeypatch, capsys):
+    import examples.dxf.make_examples as gen
+
+    monkeypatch.setattr(gen, "HERE", tmp_path)
+    monkeypatch.setattr(gen, "CASES", {})
+    assert gen.main() == 0
+    for f in sorted(tmp_path.iterdir()):
+        assert f.read_bytes() == (EXAMPLES / f.name).read_bytes(), f.name
