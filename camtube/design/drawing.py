@@ -403,6 +403,11 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str) -> None:
                       "or move it to a CONSTRUCTION layer", "LINE, ARC, CIRCLE, ELLIPSE, SPLINE, (LW)POLYLINE",
                       [ent])
         return
+    if t == "SPLINE" and role != "ignore" and entity.control_point_count() == 0:
+        rd.refuse(ent.describe(), "is a SPLINE given by fit points only: its shape depends on the CAD program that "
+                  "draws it", "save the drawing so the spline has control points, or convert it to a polyline",
+                  entities=[ent])
+        return
     _flatten(rd, entity, ent, layer, role)
 
 
@@ -587,6 +592,19 @@ def _find_outline(rd: _Reading, ro: float | None, length: float | None):
             groups.append((box, [p]))
     if not groups:
         missing = [w for w, v in (("--outer-radius", ro), ("--length", length)) if v is None]
+        if not missing:  # a rectangle of the tube's size that does not hold every cut: never guess the origin
+            for p in rd.pieces:
+                box = _rectangle(p)
+                if box is not None and abs(box[3] - box[1] - 2.0 * math.pi * ro) <= TOL.outline \
+                        and abs(box[2] - box[0] - length) <= TOL.outline:
+                    out = next((q for q, bb in zip(cut_pieces, b) if q is not p and (
+                        bb[0] < box[0] - TOL.gap or bb[2] > box[2] + TOL.gap
+                        or not box[1] - TOL.gap <= 0.5 * (bb[1] + bb[3]) <= box[3] + TOL.gap)), None)
+                    where = f"; {out.describe()} lies outside it" if out is not None else ""
+                    rd.refuse(p.describe(), f"is the size of the tube outline but does not enclose every cut{where}",
+                              "move the cut inside the outline (or delete it), or the outline around the cuts",
+                              entities=p.entities)
+                    return None, ro, length
         if missing:
             rd.refuse("tube outline", "no tube outline found (an axis-aligned rectangle L x 2 pi r_o around every cut)",
                       "draw the unrolled tube outline (any layer), or pass " + " and ".join(missing))

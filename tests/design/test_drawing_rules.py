@@ -106,10 +106,9 @@ def test_backbone_of_a_slanted_notch_is_its_widest_section(tmp_path):
 
 
 def test_cut_outside_the_tube_names_the_entity(tmp_path):
-    s = Sheet()
-    draw_outline(s)
+    s = Sheet()  # no outline: the tube is given, the drawing's origin is the tip
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
     draw_polygon(s, [(9.8, 1.0), (10.3, 1.0), (10.3, 2.0), (9.8, 2.0)], "NOTCHES")
-    # the outline no longer encloses the cut: give the tube explicitly, so the cut is judged against it
     with pytest.raises(PatternError, match=r"LWPOLYLINE #\w+ on layer NOTCHES: notch .* outside the tube"):
         load_drawing(save(s, tmp_path), [], DrawingOptions(outer_radius_mm=1.0, length_mm=10.0))
 
@@ -231,3 +230,21 @@ def test_a_circle_in_a_block_scaled_unevenly_and_turned_is_the_ellipse_it_shows(
     assert Polygon(h.outline).area == pytest.approx(math.pi * 0.2 * 0.1, rel=5e-4)
     assert (h.width_mm, h.arc_mm) == pytest.approx((0.2, 0.4), abs=1e-6)  # turned 90 deg: the long axis is y
     assert h.x_mm == pytest.approx(3.0, abs=1e-9) and h.angle_deg == pytest.approx(180.0, abs=1e-6)
+
+
+def test_an_outline_that_misses_a_cut_is_not_replaced_by_the_drawing_origin(tmp_path):
+    s = Sheet(origin=(0.0, 5.0))  # outline drawn 5 mm up: taking the drawing origin would turn every cut
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    draw_polygon(s, [(10.2, 1.0), (10.7, 1.0), (10.7, 2.0), (10.2, 2.0)], "NOTCHES")  # past the tube's end
+    with pytest.raises(PatternError, match=r"is the size of the tube outline but does not enclose every cut; "
+                                           r"LWPOLYLINE #\w+ on layer NOTCHES lies outside it"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions(outer_radius_mm=1.0, length_mm=10.0))
+
+
+def test_a_spline_by_fit_points_only_is_refused(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    s.msp.add_spline([(3, 1), (3.5, 1.5), (3, 2), (2.5, 1.5), (3, 1)], dxfattribs={"layer": "NOTCHES"})
+    with pytest.raises(PatternError, match=r"SPLINE #\w+ on layer NOTCHES: is a SPLINE given by fit points only"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
