@@ -1,9 +1,10 @@
-"""Design stage: pattern data model, YAML loading and design rules, joint geometry, unrolled contours.
+"""Design stage: pattern data model, YAML and drawing (DXF) input, design rules, joint geometry, unrolled contours.
 
-Owns: :class:`Tube`, :class:`Cut` (notches and square holes), :class:`Process`,
-:class:`Tendon`, :class:`Pattern`; the YAML schema and loader; the design
-rules; the geometry of a notched section; and the unrolled contours every
-other stage starts from.
+Owns: :class:`Tube`, :class:`Cut` (notches, square holes, drawn outlines and
+slits), :class:`Process`, :class:`Tendon`, :class:`Pattern`; the YAML schema and
+loader; the drawing reader (:mod:`camtube.design.drawing`); the design rules;
+the geometry of a notched section; and the unrolled contours every other stage
+starts from. :func:`camtube.design.source.load_source` is the one entry point.
 """
 from __future__ import annotations
 

@@ -34,7 +34,7 @@ class Contour:
     points : tuple[tuple[float, float], ...]
         Vertices (x_mm, y_mm), counter-clockwise.
     kind : str
-        ``notch``, ``hole`` or ``cut`` (from a foreign DXF).
+        ``notch``, ``hole``, ``slit`` (an open path) or ``cut`` (contours given without a pattern).
     cut_index : int
         Index of the cut in ``Pattern.cuts`` it comes from (-1 if unknown).
     closed : bool
@@ -101,7 +101,8 @@ def _is_rectangle(contour: Contour) -> bool:
     if len(contour.points) != 4 or not contour.closed:
         return False
     x0, y0, x1, y1 = contour.bounds
-    return all((abs(x - x0) <= TOL.zero or abs(x - x1) <= TOL.zero) and (abs(y - y0) <= TOL.zero or abs(y - y1) <= TOL.zero)
+    z = TOL.zero
+    return all((abs(x - x0) <= z or abs(x - x1) <= z) and (abs(y - y0) <= z or abs(y - y1) <= z)
                for x, y in contour.points)
 
 
@@ -229,7 +230,7 @@ def merge_seam_polygons(contours, circumference_mm: float, tol_mm: float) -> lis
                     ends_a = [pa[-1], pa[0]]
                     for ea in ends_a:
                         for eb in (pb[0], pb[-1]):
-                            if abs(ea[0] - eb[0]) <= tol_mm and abs(ea[1] - eb[1]) <= tol_mm and abs(ea[1] - c) <= tol_mm:
+                            if max(abs(ea[0] - eb[0]), abs(ea[1] - eb[1]), abs(ea[1] - c)) <= tol_mm:
                                 la = list(pa) if ea == pa[-1] else list(reversed(pa))
                                 lb = list(pb) if eb == pb[0] else list(reversed(pb))
                                 joined = Contour(tuple(la + lb[1:]), a.kind, a.cut_index, False)

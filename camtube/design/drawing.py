@@ -62,9 +62,11 @@ UNIT_NAMES: dict[str, float] = {
 #: Entities that are never cut: set aside wherever they are (counted in the summary).
 ANNOTATIONS = frozenset({
     "TEXT", "MTEXT", "ATTRIB", "ATTDEF", "DIMENSION", "ARC_DIMENSION", "LARGE_RADIAL_DIMENSION", "LEADER",
-    "MULTILEADER", "MLEADER", "TOLERANCE", "HATCH", "MPOLYGON", "SOLID", "TRACE", "POINT", "IMAGE", "WIPEOUT",
+    "MULTILEADER", "MLEADER", "TOLERANCE", "POINT", "IMAGE", "WIPEOUT",
     "VIEWPORT", "XLINE", "RAY", "ACAD_TABLE", "UNDERLAY", "PDFUNDERLAY", "DWFUNDERLAY", "DGNUNDERLAY",
 })
+#: Filled areas: set aside when each of their boundaries is drawn as a cut too; refused on a cut layer otherwise.
+FILLS = frozenset({"HATCH", "MPOLYGON", "SOLID", "TRACE"})
 CURVES = frozenset({"LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE", "LWPOLYLINE", "POLYLINE", "HELIX"})
 
 #: Wall assumed when the drawing's process settings do not give ``tube.inner_radius`` (mm).
@@ -126,6 +128,7 @@ class _Reading:
     issues: list[Issue] = field(default_factory=list)
     inserts: int = 0
     joined: list[_Piece] = field(default_factory=list)
+    fills: list[tuple[_Entity, list[list[tuple[float, float]]]]] = field(default_factory=list)
 
     def role(self, layer: str) -> str:
         up = layer.upper()
@@ -191,18 +194,19 @@ def load_drawing(path: str | os.PathLike, overrides: Iterable[str], options) -> 
     for entity in doc.modelspace():
         _walk(rd, entity, "", "")
     _close_and_chain(rd)
+    _check_fills(rd)
     outline, ro, length = _find_outline(rd, ro_opt, len_opt)
     if rd.issues:
         raise PatternError(rd.issues)
 
     cuts, origins, seam_joined = _cuts(rd, outline, ro, length)
-    for e in rd.entities:
-        if not e.status:
-            e.status = "aside:unused"  # pragma: no cover - every path above sets a status
+    lost = [e.describe() for e in rd.entities if not e.status]
+    if lost:  # every path above gives each entity a fate; one without is a bug, never a silent drop
+        raise RuntimeError(f"{file}: entities not accounted for: {', '.join(lost[:5])}")
     if rd.issues:
         raise PatternError(rd.issues)
     if not cuts:
-        raise PatternError([Issue(file, "the drawing has no cuts", None,
+        raise PatternError([Issue("cuts", "the drawing has no cuts", None,
                                   "closed outlines on notch/hole layers, open paths on slit layers",
                                   "draw the cuts, or map their layer with --layer NAME=notch|hole|slit", file)])
 
@@ -278,6 +282,9 @@ def _read_document(path, file: str):
     try:
         return ezdxf.readfile(str(path))
     except OSError as exc:
+        if Path(path).is_file():
+            raise PatternError([Issue("file", f"not a valid DXF file ({exc})", None, "a DXF file (R12 or later)",
+                                      "save the drawing as DXF again from your CAD program", file)]) from None
         raise PatternError([Issue("file", f"cannot read the drawing: {exc.strerror or exc}", file,
                                   "a readable DXF file", "check the path", file)]) from None
     except ezdxf.DXFError as exc:
@@ -339,6 +346,17 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str) -> None:
         rd.inserts += 1
         here = f"INSERT #{entity.dxf.handle}" if entity.dxf.handle else "INSERT"
         name = entity.dxf.name
+        block = entity.block()
+        if block is None or block.block.is_xref:
+            ent = _Entity("INSERT", entity.dxf.handle or "-", layer, via)
+            rd.entities.append(ent)
+            if rd.role(layer) == "ignore":
+                ent.status = "aside:ignored layer"
+            else:
+                what = "an external reference (XREF)" if block is not None else "a block missing from the drawing"
+                rd.refuse(ent.describe(), f"places {what} {name!r}: its content is not in this file",
+                          "bind the XREF into the drawing (XREF > Bind) and save again", entities=[ent])
+            return
         copies = list(entity.multi_insert()) if entity.mcount > 1 else [entity]
         for k, ins in enumerate(copies):
             tag = f"in block {name} of {here}" + (f" (copy {k + 1} of {len(copies)})" if len(copies) > 1 else "")
@@ -366,6 +384,17 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str) -> None:
     if t in ANNOTATIONS:
         ent.status = "aside:annotation"
         return
+    if t in FILLS:
+        if role == "ignore":
+            ent.status = "aside:ignored layer"
+        else:
+            _fill(rd, entity, ent)
+        return
+    if t == "LWPOLYLINE" and role != "ignore" and (entity.dxf.get("const_width", 0.0) or any(
+            w0 or w1 for _, _, w0, w1 in entity.get_points("xyse"))):
+        rd.refuse(ent.describe(), "is a polyline with a width: the drawing shows a band, camtube would cut its "
+                  "centre line", "set the polyline's width to 0 (draw the cut's outline instead)", entities=[ent])
+        return
     if t not in CURVES:
         if role == "ignore":
             ent.status = "aside:ignored layer"
@@ -373,6 +402,11 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str) -> None:
             rd.refuse(ent.describe(), f"a {t} cannot be read as a cut", "explode it into lines, arcs or polylines, "
                       "or move it to a CONSTRUCTION layer", "LINE, ARC, CIRCLE, ELLIPSE, SPLINE, (LW)POLYLINE",
                       [ent])
+        return
+    if t == "SPLINE" and role != "ignore" and entity.control_point_count() == 0:
+        rd.refuse(ent.describe(), "is a SPLINE given by fit points only: its shape depends on the CAD program that "
+                  "draws it", "save the drawing so the spline has control points, or convert it to a polyline",
+                  entities=[ent])
         return
     _flatten(rd, entity, ent, layer, role)
 
@@ -412,6 +446,46 @@ def _flatten(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
         found = True
     if not found:
         ent.status = "aside:zero length"
+
+
+def _fill(rd: _Reading, entity, ent: _Entity) -> None:
+    """Remember a filled area's boundary loops (mm); checked against the drawn cuts in :func:`_check_fills`."""
+    from ezdxf import path as ezpath
+
+    try:
+        paths = list(ezpath.from_hatch(entity)) if entity.dxftype() in ("HATCH", "MPOLYGON") else \
+            [ezpath.make_path(entity)]
+    except (TypeError, ValueError):
+        paths = []
+    loops = []
+    for p in paths:
+        for sub in (p.sub_paths() if p.has_sub_paths else [p]):
+            pts = [(v.x * rd.factor, v.y * rd.factor) for v in sub.flattening(TOL.chord / rd.factor, segments=4)]
+            if len(pts) >= 3:
+                loops.append(_dedupe(pts))
+    rd.fills.append((ent, loops))
+
+
+def _check_fills(rd: _Reading) -> None:
+    """A fill on a cut layer is set aside if every boundary of it is drawn as a closed piece; else refused."""
+    from shapely.geometry import Polygon
+
+    closed = [Polygon(p.points) for p in rd.pieces if p.closed and len(p.points) >= 3]
+    for ent, loops in rd.fills:
+        ok = bool(loops)
+        for loop in loops:
+            f = Polygon(loop)
+            tol = TOL.gap * max(f.length, 1.0)
+            if not any(abs(f.area - g.area) <= tol and f.symmetric_difference(g).area <= tol for g in closed
+                       if g.is_valid and f.is_valid):
+                ok = False
+                break
+        if ok:
+            ent.status = "aside:fill of a drawn outline"
+        else:
+            rd.refuse(ent.describe(), f"a filled area ({ent.dxftype}) whose boundary is not drawn as a closed outline",
+                      "draw the cut's outline (e.g. HATCHEDIT > recreate boundary), or move the fill to a "
+                      "CONSTRUCTION layer", entities=[ent])
 
 
 def _isclose(a, b, tol: float) -> bool:
@@ -487,32 +561,79 @@ def _find_outline(rd: _Reading, ro: float | None, length: float | None):
     cut_pieces = [p for p in rd.pieces if p.role != "ignore"]
     if not cut_pieces:
         return None, ro or 1.0, length or 1.0  # nothing to cut: refused as such by the caller
-    best = None
+    import numpy as np
+
+    # per cut piece: x range and the y of its centre (a cut may cross the seam line drawn whole)
+    b = np.array([q.bounds for q in cut_pieces], dtype=float)
+    xs0, xs1, yc = b[:, 0], b[:, 2], 0.5 * (b[:, 1] + b[:, 3])
+    index = {id(q): k for k, q in enumerate(cut_pieces)}
+    groups: list[tuple[tuple[float, float, float, float], list[_Piece]]] = []  # rectangles drawn twice: one group
     for p in rd.pieces:
         box = _rectangle(p)
         if box is None:
             continue
         x0, y0, x1, y1 = box
-        others = [q for q in cut_pieces if q is not p]
-        if not others:
+        # pieces around this rectangle (a frame, a larger outline) do not stop it being the outline
+        keep = ~((b[:, 0] <= x0 + TOL.gap) & (b[:, 2] >= x1 - TOL.gap) & (b[:, 1] <= y0 + TOL.gap)
+                 & (b[:, 3] >= y1 - TOL.gap))
+        if id(p) in index:
+            keep[index[id(p)]] = False
+        if not keep.any():
             continue
-        # every cut lies inside in x; in y a cut may cross the seam line drawn whole (its centre on the sheet)
-        inside = all(b[0] >= x0 - TOL.gap and b[2] <= x1 + TOL.gap and y0 - TOL.gap <= 0.5 * (b[1] + b[3]) <= y1
-                     + TOL.gap for b in (q.bounds for q in others))
-        area = (x1 - x0) * (y1 - y0)
-        if inside and (best is None or area < best[1] - TOL.gap):
-            best = (p, area, box)
-    if best is None:
+        inside = bool(np.all((xs0[keep] >= x0 - TOL.gap) & (xs1[keep] <= x1 + TOL.gap)
+                             & (yc[keep] >= y0 - TOL.gap) & (yc[keep] <= y1 + TOL.gap)))
+        if not inside:
+            continue
+        for g_box, members in groups:
+            if all(abs(u - v) <= TOL.gap for u, v in zip(g_box, box)):
+                members.append(p)
+                break
+        else:
+            groups.append((box, [p]))
+    if not groups:
         missing = [w for w, v in (("--outer-radius", ro), ("--length", length)) if v is None]
+        if not missing:  # a rectangle of the tube's size that does not hold every cut: never guess the origin
+            for p in rd.pieces:
+                box = _rectangle(p)
+                if box is not None and abs(box[3] - box[1] - 2.0 * math.pi * ro) <= TOL.outline \
+                        and abs(box[2] - box[0] - length) <= TOL.outline:
+                    out = next((q for q, bb in zip(cut_pieces, b) if q is not p and (
+                        bb[0] < box[0] - TOL.gap or bb[2] > box[2] + TOL.gap
+                        or not box[1] - TOL.gap <= 0.5 * (bb[1] + bb[3]) <= box[3] + TOL.gap)), None)
+                    where = f"; {out.describe()} lies outside it" if out is not None else ""
+                    rd.refuse(p.describe(), f"is the size of the tube outline but does not enclose every cut{where}",
+                              "move the cut inside the outline (or delete it), or the outline around the cuts",
+                              entities=p.entities)
+                    return None, ro, length
         if missing:
-            rd.refuse(rd.file, "no tube outline found (an axis-aligned rectangle L x 2 pi r_o around every cut)",
+            rd.refuse("tube outline", "no tube outline found (an axis-aligned rectangle L x 2 pi r_o around every cut)",
                       "draw the unrolled tube outline (any layer), or pass " + " and ".join(missing))
         return None, ro, length
-    piece, _, (x0, y0, x1, y1) = best
+
+    def fits(box) -> bool:
+        ok_r = ro is None or abs(box[3] - box[1] - 2.0 * math.pi * ro) <= TOL.outline
+        ok_l = length is None or abs(box[2] - box[0] - length) <= TOL.outline
+        return ok_r and ok_l
+
+    if ro is not None or length is not None:
+        matching = [g for g in groups if fits(g[0])]
+        # none fits: the largest is the outline the user drew, and the mismatch is reported on it
+        groups = matching or [max(groups, key=lambda g: (g[0][2] - g[0][0]) * (g[0][3] - g[0][1]))]
+    if len(groups) > 1:
+        names = "; ".join(f"{g[1][0].describe()} ({(g[0][2] - g[0][0]):.4g} x {(g[0][3] - g[0][1]):.4g} mm)"
+                          for g in groups)
+        rd.refuse("tube outline", f"{len(groups)} nested rectangles could each be the tube outline: {names}",
+                  "pass --outer-radius (and --length) to say which, or delete the extra rectangle "
+                  "(a cut drawn around another cut is refused anyway)",
+                  entities=[p for g in groups for p in g[1]])
+        return None, ro, length
+    (x0, y0, x1, y1), members = groups[0]
+    piece = members[0]
     h, w = y1 - y0, x1 - x0
     desc = piece.describe()
     if ro is not None and abs(h - 2.0 * math.pi * ro) > TOL.outline:
-        rd.refuse(desc, f"the tube outline is {h / rd.factor:.6g} {rd.unit} = {h:.4f} mm high, i.e. 2 pi x "
+        drawn_h = f"{h / rd.factor:.6g} {rd.unit} = " if rd.unit != "mm" else ""
+        rd.refuse(desc, f"the tube outline is {drawn_h}{h:.4f} mm high, i.e. 2 pi x "
                   f"{h / (2 * math.pi):.4f} mm, but the outer radius {ro:g} mm needs 2 pi r_o = "
                   f"{2 * math.pi * ro:.4f} mm", f"pass --outer-radius {h / (2 * math.pi):.4f} (or omit it), or redraw "
                   "the outline", f"height 2 pi r_o within {TOL.outline:g} mm", piece.entities)
@@ -520,6 +641,10 @@ def _find_outline(rd: _Reading, ro: float | None, length: float | None):
         rd.refuse(desc, f"the tube outline is {w:.4f} mm long, but the tube length given is {length:g} mm",
                   f"pass --length {w:.4f} (or omit it), or redraw the outline", f"length within {TOL.outline:g} mm",
                   piece.entities)
+    for extra in members[1:]:  # the outline drawn twice (copy/paste, or on two layers)
+        for e in extra.entities:
+            e.status = "aside:outline drawn again"
+    rd.pieces = [p for p in rd.pieces if not any(p is m for m in members[1:])]
     for e in piece.entities:
         e.status = "outline"
     rd.pieces = [p for p in rd.pieces if p is not piece]
@@ -540,7 +665,8 @@ def _cuts(rd: _Reading, outline: _Piece | None, ro: float, length: float):
     owners: list[_Piece] = []
     for p in rd.pieces:
         if p.role == "ignore":
-            why = "hidden layer" if p.layer.upper() in rd.hidden and p.layer.upper() not in rd.roles else "ignored layer"
+            up = p.layer.upper()
+            why = "hidden layer" if up in rd.hidden and up not in rd.roles else "ignored layer"
             for e in p.entities:
                 e.status = e.status or f"aside:{why}"
             continue

@@ -138,18 +138,22 @@ def section_arc_mm(cut: Cut) -> float:
     """
     if cut.outline is None or cut.kind == "slit":
         return cut.arc_mm
-    from shapely.geometry import LineString, Polygon
+    import numpy as np
 
-    poly = Polygon(cut.outline)
-    y0, y1 = min(p[1] for p in cut.outline) - 1.0, max(p[1] for p in cut.outline) + 1.0
-    xs = sorted({p[0] for p in cut.outline})
-    probes = [x + d for x in xs for d in (-1e-9, 1e-9)] + [0.5 * (a + b) for a, b in zip(xs, xs[1:])]
+    a = np.asarray(cut.outline, dtype=float)
+    b = np.roll(a, -1, axis=0)
+    xs = np.unique(a[:, 0])
+    probes = np.concatenate([xs - 1e-9, xs + 1e-9, 0.5 * (xs[1:] + xs[:-1])])
+    lo, hi = np.minimum(a[:, 0], b[:, 0]), np.maximum(a[:, 0], b[:, 0])
+    dx = np.where(b[:, 0] != a[:, 0], b[:, 0] - a[:, 0], 1.0)
     best = 0.0
-    for x in probes:
-        sec = poly.intersection(LineString([(x, y0), (x, y1)]))
-        if not sec.is_empty:
-            b = sec.bounds
-            best = max(best, b[3] - b[1])
+    for k in range(0, len(probes), 256):  # (probes x edges) in chunks
+        x = probes[k:k + 256, None]
+        crossing = (lo <= x) & (x <= hi) & (b[:, 0] != a[:, 0])
+        y = np.where(crossing, a[:, 1] + (x - a[:, 0]) / dx * (b[:, 1] - a[:, 1]), np.nan)
+        has = crossing.any(axis=1)
+        if has.any():
+            best = max(best, float(np.nanmax(np.nanmax(y[has], axis=1) - np.nanmin(y[has], axis=1))))
     return best
 
 
@@ -188,7 +192,8 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
     seen_keys: set[str] = set()
     for cut, origin in zip(pattern.cuts, origins):
         if _is_key(origin):
-            key_arc = "notch.arc" if origin == "notch" else (f"{origin}.arc" if cut.kind == "notch" else f"{origin}.size")
+            key_arc = "notch.arc" if origin == "notch" else (
+                f"{origin}.arc" if cut.kind == "notch" else f"{origin}.size")
             key_x = "notch.first_offset" if origin == "notch" else f"{origin}.x"
             fix_arc = "reduce the arc s"
         else:  # a drawn entity: the message names it

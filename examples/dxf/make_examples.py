@@ -214,7 +214,8 @@ def blocks():
     s.msp.add_blockref("N", s.at(10.0, MID), dxfattribs={"layer": "NOTCHES", "xscale": 0.8, "yscale": 0.8})
     shapes.append(affinity.translate(affinity.scale(base, 0.8, 0.8, origin=(0, 0)), 10.0, MID))
     save(s, "blocks.dxf")
-    case("blocks", "blocks.dxf", cuts=[truth("notch", g) for g in shapes], summary=["imported 9 notches", "INSERTs expanded"])
+    case("blocks", "blocks.dxf", cuts=[truth("notch", g) for g in shapes],
+         summary=["imported 9 notches", "INSERTs expanded"])
 
 
 def four_lines():
@@ -253,7 +254,8 @@ def open_outline():
     for a, b in zip(pts, pts[1:]):              # three sides only
         s.msp.add_line(s.at(*a), s.at(*b), dxfattribs={"layer": "NOTCHES"})
     save(s, "open_outline.dxf")
-    case("open_outline", "open_outline.dxf", refused=["3 LINEs", "layer NOTCHES", "open path", "(3, 1.94159) mm", "(3, 4.34159) mm", "2.4 mm apart"])
+    case("open_outline", "open_outline.dxf", refused=["3 LINEs", "layer NOTCHES", "open path", "(3, 1.94159) mm",
+                                                      "(3, 4.34159) mm", "2.4 mm apart"])
 
 
 def spline():

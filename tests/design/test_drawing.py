@@ -167,7 +167,8 @@ def test_slits_are_open_contours():
 
 def test_settings_from_set_and_a_process_file(tmp_path):
     loaded = load_source(EXAMPLES / "outline_layer0.dxf",
-                         [f"process={PATTERNS / 'femto-polyimide.yaml'}", "process.repeats=3", "tube.inner_radius=0.7", "name=t"],
+                         [f"process={PATTERNS / 'femto-polyimide.yaml'}", "process.repeats=3",
+                          "tube.inner_radius=0.7", "name=t"],
                          DrawingOptions())
     p = loaded.pattern
     assert p.name == "t" and p.tube.inner_radius_mm == 0.7 and p.process.repeats == 3
@@ -199,6 +200,9 @@ def test_design_dxf_with_drawn_cuts_reads_back_the_same(tmp_path):
         first = load_drawing(EXAMPLES / case["file"], [], options(case["options"])).pattern
         path = tmp_path / f"{name}.design.dxf"
         path.write_text(design_dxf(first))
+        if name == "slits":  # open polylines on their own layer
+            msp = ezdxf.readfile(path).modelspace()
+            assert len([e for e in msp.query("LWPOLYLINE[layer=='SLITS']") if not e.closed]) == len(first.cuts)
         again = load_drawing(path, [], DrawingOptions(layers=(("SLITS", "slit"),) if name == "slits" else ())).pattern
         assert len(again.cuts) == len(first.cuts)
         for a, b in zip(first.cuts, again.cuts):
@@ -210,11 +214,26 @@ def test_design_dxf_with_drawn_cuts_reads_back_the_same(tmp_path):
             assert ga[key] == pytest.approx(gb[key], rel=1e-9)
 
 
-def test_cli_refusal_writes_nothing(tmp_path, capsys):
+@pytest.mark.parametrize("name", REFUSED)
+def test_cli_refusal_writes_nothing(name, tmp_path, capsys):
     from camtube.cli import main
 
-    out = tmp_path / "o"
-    assert main(["toolpath", str(EXAMPLES / "duplicate.dxf"), "-o", str(out)]) == 2
+    case = EXPECTED["cases"][name]
+    argv = ["toolpath", str(EXAMPLES / case["file"]), "-o", str(tmp_path / "o")]
+    if "outer_radius_mm" in case["options"]:
+        argv += ["--outer-radius", str(case["options"]["outer_radius_mm"])]
+    assert set(case["options"]) <= {"outer_radius_mm"}
+    assert main(argv) == 2
     err = capsys.readouterr().err
-    assert "duplicate" in err and "Traceback" not in err
-    assert not out.exists()
+    assert case["refused"][0] in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_committed_examples_are_what_the_generator_writes(tmp_path, monkeypatch, capsys):
+    import examples.dxf.make_examples as gen
+
+    monkeypatch.setattr(gen, "HERE", tmp_path)
+    monkeypatch.setattr(gen, "CASES", {})
+    assert gen.main() == 0
+    for f in sorted(tmp_path.iterdir()):
+        assert f.read_bytes() == (EXAMPLES / f.name).read_bytes(), f.name

@@ -1,4 +1,4 @@
-"""CAD of drawn cuts: the mesh and the exact B-rep remove what the drawing shows (volumes against the generator's truth)."""
+"""CAD of drawn cuts: the mesh and the exact B-rep remove what the drawing shows (volumes vs the generator's truth)."""
 from __future__ import annotations
 
 import math

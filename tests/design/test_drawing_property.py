@@ -94,3 +94,57 @@ def test_random_patterns_in_random_styles_import_to_the_same_cuts(tmp_path, raw,
         assert (c.x_mm, c.width_mm, c.arc_mm) == pytest.approx((a.x_mm, a.width_mm, a.arc_mm), abs=1e-9)
         d = (a.angle_deg - c.angle_deg) % 360.0
         assert min(d, 360.0 - d) * math.pi / 180 * t.outer_radius_mm < 1e-9
+
+
+# ---------------------------------------------------------------- round-ended slots: arcs and lines chained
+def draw_slot(sheet, xc, yc, width, arc, style, layer="NOTCHES"):
+    """A slot ``width`` mm along x, ``arc`` mm around, round ends of radius width/2 at its y ends."""
+    r = width / 2.0
+    y0, y1 = yc - arc / 2 + r, yc + arc / 2 - r  # centres of the round ends
+    if style == "bulges":
+        pts = [(xc - r, y0, 0.0), (xc - r, y1, -1.0), (xc + r, y1, 0.0), (xc + r, y0, -1.0)]
+        d = [(*sheet.at(x, y), 0.0, 0.0, b) for x, y, b in pts]
+        sheet.msp.add_lwpolyline(d, format="xyseb", close=True, dxfattribs={"layer": layer})
+    elif style == "arcs_and_lines":  # how a CAD user draws a slot: two LINEs and two ARCs
+        k = sheet.length(1.0)
+        sheet.msp.add_line(sheet.at(xc - r, y0), sheet.at(xc - r, y1), dxfattribs={"layer": layer})
+        sheet.msp.add_line(sheet.at(xc + r, y1), sheet.at(xc + r, y0), dxfattribs={"layer": layer})
+        sheet.msp.add_arc(sheet.at(xc, y1), r * k, 0.0, 180.0, dxfattribs={"layer": layer})
+        sheet.msp.add_arc(sheet.at(xc, y0), r * k, 180.0, 360.0, dxfattribs={"layer": layer})
+    else:
+        raise ValueError(style)
+
+
+@settings(max_examples=25, deadline=None, derandomize=True, database=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(n=st.integers(1, 4), width=st.floats(0.2, 0.6), arc=st.floats(1.0, 3.0), angle=st.floats(90, 270),
+       style=st.sampled_from(["bulges", "arcs_and_lines"]), units=st.sampled_from(["mm", "inch"]),
+       origin=st.tuples(st.floats(-20, 20), st.floats(-20, 20)))
+def test_round_ended_slots_import_with_their_exact_area(tmp_path, n, width, arc, angle, style, units, origin):
+    ro = 1.0
+    circ = 2 * math.pi * ro
+    assume(arc > width + 0.05)
+    sheet = Sheet(units=units, origin=origin)
+    length = 1.0 + n * (width + 0.5)
+    draw_outline(sheet, length=length, circ=circ)
+    yc = math.radians(angle) * ro  # whole on the sheet: arc / 2 <= 1.5 < yc, circ - yc
+    xs = [1.0 + k * (width + 0.5) for k in range(n)]
+    for x in xs:
+        draw_slot(sheet, x, yc, width, arc, style)
+    path = tmp_path / "slots.dxf"
+    sheet.doc.saveas(path)
+    back = load_drawing(path, [], DrawingOptions()).pattern
+    from shapely.geometry import Polygon
+
+    r = width / 2
+    exact = width * (arc - 2 * r) + math.pi * r * r
+    assert len(back.notches) == n
+    if style == "arcs_and_lines":
+        assert f"{4 * n} loose entities joined into {n} loop" in load_drawing(path, [], DrawingOptions()).summary
+    for x, c in zip(xs, back.notches):
+        g = Polygon(c.outline)
+        assert g.area == pytest.approx(exact, rel=5e-4)  # chords lie inside the arcs by <= TOL.chord
+        assert g.area <= exact + 1e-12
+        assert (g.centroid.x, g.centroid.y) == pytest.approx((x, yc), abs=1e-6)
+        assert (c.width_mm, c.arc_mm) == pytest.approx((width, arc), abs=1e-6)
+        assert c.angle_deg == pytest.approx(angle, abs=1e-6)

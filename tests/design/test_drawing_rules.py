@@ -1,0 +1,250 @@
+"""Design rules on drawn cuts (web, overlap, nesting, backbone of a slanted notch), layers, seam slits.
+
+Each drawing is small and made here with ezdxf; expectations are checked
+against shapely on the same shapes.
+"""
+from __future__ import annotations
+
+import math
+
+import pytest
+from shapely.geometry import Point, box
+
+from camtube.design.drawing import load_drawing
+from camtube.design.rules import section_arc_mm
+from camtube.design.source import DrawingOptions
+from camtube.errors import PatternError
+from examples.dxf.make_examples import C, MID, Sheet, draw_outline, draw_polygon
+
+
+def save(sheet, tmp_path, name="t.dxf"):
+    path = tmp_path / name
+    sheet.doc.saveas(path)
+    return path
+
+
+def test_web_between_a_circle_hole_and_a_notch_is_measured_on_the_outlines(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, MID - 1.5), (3.5, MID - 1.5), (3.5, MID + 1.5), (3.0, MID + 1.5)], "NOTCHES")
+    # a hole 0.05 mm from the notch's edge (shapely says so): the bounding boxes would say the same,
+    # but only the true outline distance is reported
+    s.msp.add_circle(s.at(3.7, MID), 0.15, dxfattribs={"layer": "HOLES"})
+    d = box(3.0, MID - 1.5, 3.5, MID + 1.5).distance(Point(3.7, MID).buffer(0.15, quad_segs=256))
+    with pytest.raises(PatternError) as err:
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    text = str(err.value)
+    assert "CIRCLE #" in text and "layer HOLES" in text and "LWPOLYLINE #" in text
+    assert f"web {d:.4g} mm" in text
+
+
+def test_a_hole_drawn_inside_a_notch_is_an_overlap(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, MID - 1.5), (3.5, MID - 1.5), (3.5, MID + 1.5), (3.0, MID + 1.5)], "NOTCHES")
+    s.msp.add_circle(s.at(3.25, MID), 0.1, dxfattribs={"layer": "HOLES"})
+    path = save(s, tmp_path)
+    # the notch encloses every other cut too: which rectangle is the tube is ambiguous, never guessed
+    with pytest.raises(PatternError, match="2 nested rectangles could each be the tube outline"):
+        load_drawing(path, [], DrawingOptions())
+    with pytest.raises(PatternError, match=r"CIRCLE #\w+ on layer HOLES and LWPOLYLINE .* collides with"):
+        load_drawing(path, [], DrawingOptions(outer_radius_mm=1.0))
+
+
+def test_a_frame_around_the_outline_is_not_taken_for_it(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    s.doc.layers.add("BORDER")
+    draw_polygon(s, [(-5.0, -5.0), (20.0, -5.0), (20.0, 12.0), (-5.0, 12.0)], "BORDER")  # a drawing frame
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    path = save(s, tmp_path)
+    with pytest.raises(PatternError, match="nested rectangles could each be the tube outline"):
+        load_drawing(path, [], DrawingOptions())
+    # the radius says which; the frame, on a layer that cuts by default, is then refused as a cut outside the tube
+    with pytest.raises(PatternError, match=r"LWPOLYLINE #\w+ on layer BORDER: notch .* outside the tube"):
+        load_drawing(path, [], DrawingOptions(outer_radius_mm=1.0))
+    p = load_drawing(path, [], DrawingOptions(outer_radius_mm=1.0, layers=(("BORDER", "ignore"),))).pattern
+    assert p.tube.length_mm == pytest.approx(10.0) and len(p.cuts) == 1
+
+
+def test_an_outline_drawn_twice_is_one_outline(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    draw_outline(s, layer="0")
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    loaded = load_drawing(save(s, tmp_path), [], DrawingOptions())
+    assert len(loaded.pattern.cuts) == 1 and "1 (outline drawn again)" in loaded.summary
+
+
+def test_drawn_cuts_that_clear_the_web_are_accepted_even_when_their_boxes_would_clash(tmp_path):
+    """Two triangles nested like teeth: boxes overlap, outlines are 0.2 mm apart (shapely)."""
+    s = Sheet()
+    draw_outline(s)
+    a = [(3.0, MID - 1.0), (4.0, MID - 1.0), (3.0, MID + 1.0)]
+    b = [(4.2, MID - 1.0), (4.2, MID + 1.0), (3.2, MID + 1.0)]
+    draw_polygon(s, a, "NOTCHES")
+    draw_polygon(s, b, "NOTCHES")
+    p = load_drawing(save(s, tmp_path), [], DrawingOptions()).pattern
+    assert len(p.notches) == 2 and all(c.is_drawn for c in p.notches)
+
+
+def test_backbone_of_a_slanted_notch_is_its_widest_section(tmp_path):
+    """A parallelogram whose box is nearly a full turn but whose every section leaves a 1 mm backbone."""
+    s = Sheet()
+    draw_outline(s)
+    h = C - 1.0  # every section x = const cuts this much
+    pts = [(3.0, 0.2), (3.5, 0.8), (3.5, 0.8 + h), (3.0, 0.2 + h)]
+    draw_polygon(s, pts, "NOTCHES")
+    p = load_drawing(save(s, tmp_path), [], DrawingOptions()).pattern
+    (cut,) = p.notches
+    assert cut.arc_mm == pytest.approx(h + 0.6)  # the bounding box: backbone 0.4 mm by it
+    assert section_arc_mm(cut) == pytest.approx(h, abs=1e-6)
+    # the rule uses the section: with a 0.5 mm backbone rule, accepted; with 1.1 mm, refused naming the entity
+    load_drawing(save(s, tmp_path), ["rules.min_backbone_arc=0.5"], DrawingOptions())
+    with pytest.raises(PatternError, match=r"LWPOLYLINE #\w+ on layer NOTCHES: backbone arc .* = 1\.0000 mm"):
+        load_drawing(save(s, tmp_path), ["rules.min_backbone_arc=1.1"], DrawingOptions())
+
+
+def test_cut_outside_the_tube_names_the_entity(tmp_path):
+    s = Sheet()  # no outline: the tube is given, the drawing's origin is the tip
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    draw_polygon(s, [(9.8, 1.0), (10.3, 1.0), (10.3, 2.0), (9.8, 2.0)], "NOTCHES")
+    with pytest.raises(PatternError, match=r"LWPOLYLINE #\w+ on layer NOTCHES: notch .* outside the tube"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions(outer_radius_mm=1.0, length_mm=10.0))
+
+
+def test_hidden_and_construction_layers_are_set_aside_and_counted(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    s.doc.layers.add("OLD").off()
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    draw_polygon(s, [(5.0, 1.0), (5.5, 1.0), (5.5, 2.0), (5.0, 2.0)], "OLD")
+    draw_polygon(s, [(6.0, 1.0), (6.5, 1.0), (6.5, 2.0), (6.0, 2.0)], "CONSTRUCTION")
+    s.msp.add_mtext("note", dxfattribs={"layer": "NOTCHES", "insert": s.at(1, 1)})
+    loaded = load_drawing(save(s, tmp_path), [], DrawingOptions())
+    assert len(loaded.pattern.cuts) == 1
+    assert "from 5 entities" in loaded.summary
+    for phrase in ("1 (annotation)", "1 (hidden layer)", "1 (ignored layer)"):
+        assert phrase in loaded.summary
+    # the user can switch a hidden layer back on for camtube
+    again = load_drawing(save(s, tmp_path), [], DrawingOptions(layers=(("OLD", "notch"),)))
+    assert len(again.pattern.cuts) == 2
+
+
+def test_a_slit_across_the_seam_is_joined(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    s.msp.add_line(s.at(4.0, C - 0.5), s.at(4.0, C), dxfattribs={"layer": "SLITS"})
+    s.msp.add_line(s.at(4.0, 0.0), s.at(4.0, 0.7), dxfattribs={"layer": "SLITS"})
+    p = load_drawing(save(s, tmp_path), [], DrawingOptions()).pattern
+    (slit,) = p.slits
+    assert slit.arc_mm == pytest.approx(1.2) and slit.width_mm == 0.0
+    assert math.radians(slit.angle_deg) == pytest.approx(0.1, abs=1e-9)  # centre 0.1 mm past the seam, r_o = 1
+
+
+def test_a_closed_outline_on_a_slit_layer_is_refused(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "SLITS")
+    with pytest.raises(PatternError, match=r"LWPOLYLINE #\w+ on layer SLITS: a closed outline on a slit layer"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+
+
+def test_unreadable_entities_are_refused_on_cut_layers_and_set_aside_elsewhere(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    s.msp.add_3dface([(5, 1, 0), (5.5, 1, 0), (5.5, 2, 0), (5, 2, 0)], dxfattribs={"layer": "NOTCHES"})
+    with pytest.raises(PatternError, match=r"3DFACE #\w+ on layer NOTCHES: a 3DFACE cannot be read as a cut"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    s2 = Sheet()
+    draw_outline(s2)
+    draw_polygon(s2, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    s2.msp.add_3dface([(5, 1, 0), (5.5, 1, 0), (5.5, 2, 0), (5, 2, 0)], dxfattribs={"layer": "CONSTRUCTION"})
+    loaded = load_drawing(save(s2, tmp_path, "u.dxf"), [], DrawingOptions())
+    assert len(loaded.pattern.cuts) == 1 and "1 (ignored layer)" in loaded.summary
+
+
+def test_not_a_dxf_is_one_clear_error(tmp_path):
+    bad = tmp_path / "bad.dxf"
+    bad.write_text("this is not a drawing\n")
+    with pytest.raises(PatternError, match="not a valid DXF"):
+        load_drawing(bad, [], DrawingOptions())
+    with pytest.raises(PatternError, match="cannot read the drawing"):
+        load_drawing(tmp_path / "missing.dxf", [], DrawingOptions())
+
+
+def test_fills_are_set_aside_only_when_their_boundary_is_drawn(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    pts = [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)]
+    draw_polygon(s, pts, "NOTCHES")
+    s.msp.add_hatch(dxfattribs={"layer": "NOTCHES"}).paths.add_polyline_path([s.at(*p) for p in pts])
+    loaded = load_drawing(save(s, tmp_path), [], DrawingOptions())
+    assert len(loaded.pattern.cuts) == 1 and "1 (fill of a drawn outline)" in loaded.summary
+    # a hatch alone (the only trace of a hole) is not dropped silently
+    s.msp.add_hatch(dxfattribs={"layer": "HOLES"}).paths.add_polyline_path(
+        [s.at(6.0, 1.0), s.at(6.3, 1.0), s.at(6.3, 1.3), s.at(6.0, 1.3)])
+    with pytest.raises(PatternError, match=r"HATCH #\w+ on layer HOLES: a filled area .* not drawn"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+
+
+def test_thick_polylines_and_xrefs_are_refused(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    s.msp.add_lwpolyline([s.at(3.0, 1.0), s.at(3.0, 2.0)], dxfattribs={"layer": "SLITS", "const_width": 0.05})
+    with pytest.raises(PatternError, match=r"LWPOLYLINE #\w+ on layer SLITS: is a polyline with a width"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    s.doc.add_xref_def("other.dxf", "OTHER")
+    s.msp.add_blockref("OTHER", s.at(5, 1), dxfattribs={"layer": "NOTCHES"})
+    with pytest.raises(PatternError, match=r"INSERT #\w+ on layer NOTCHES: places an external reference"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+
+
+def test_an_arc_with_a_mirrored_extrusion_is_placed_where_it_is_drawn(tmp_path):
+    """AutoCAD's MIRROR gives circles extrusion (0, 0, -1) with the centre in OCS: (-x, y) is drawn at (x, y)."""
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(5.0, 1.0), (5.5, 1.0), (5.5, 2.0), (5.0, 2.0)], "NOTCHES")
+    s.msp.add_circle((-3.0, MID), 0.15, dxfattribs={"layer": "HOLES", "extrusion": (0, 0, -1)})
+    p = load_drawing(save(s, tmp_path), [], DrawingOptions()).pattern
+    (h,) = p.holes
+    assert h.x_mm == pytest.approx(3.0, abs=1e-9) and h.angle_deg == pytest.approx(180.0, abs=1e-6)
+
+
+def test_a_circle_in_a_block_scaled_unevenly_and_turned_is_the_ellipse_it_shows(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(6.0, 1.0), (6.5, 1.0), (6.5, 2.0), (6.0, 2.0)], "NOTCHES")
+    blk = s.doc.blocks.new("ROUND")
+    blk.add_circle((0.0, 0.0), 0.1)
+    s.msp.add_blockref("ROUND", s.at(3.0, MID), dxfattribs={"layer": "HOLES", "xscale": 2.0, "yscale": 1.0,
+                                                             "rotation": 90.0})
+    p = load_drawing(save(s, tmp_path), [], DrawingOptions()).pattern
+    (h,) = p.holes
+    from shapely.geometry import Polygon
+
+    assert Polygon(h.outline).area == pytest.approx(math.pi * 0.2 * 0.1, rel=5e-4)
+    assert (h.width_mm, h.arc_mm) == pytest.approx((0.2, 0.4), abs=1e-6)  # turned 90 deg: the long axis is y
+    assert h.x_mm == pytest.approx(3.0, abs=1e-9) and h.angle_deg == pytest.approx(180.0, abs=1e-6)
+
+
+def test_an_outline_that_misses_a_cut_is_not_replaced_by_the_drawing_origin(tmp_path):
+    s = Sheet(origin=(0.0, 5.0))  # outline drawn 5 mm up: taking the drawing origin would turn every cut
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    draw_polygon(s, [(10.2, 1.0), (10.7, 1.0), (10.7, 2.0), (10.2, 2.0)], "NOTCHES")  # past the tube's end
+    with pytest.raises(PatternError, match=r"is the size of the tube outline but does not enclose every cut; "
+                                           r"LWPOLYLINE #\w+ on layer NOTCHES lies outside it"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions(outer_radius_mm=1.0, length_mm=10.0))
+
+
+def test_a_spline_by_fit_points_only_is_refused(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    s.msp.add_spline([(3, 1), (3.5, 1.5), (3, 2), (2.5, 1.5), (3, 1)], dxfattribs={"layer": "NOTCHES"})
+    with pytest.raises(PatternError, match=r"SPLINE #\w+ on layer NOTCHES: is a SPLINE given by fit points only"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
