@@ -91,3 +91,16 @@ def test_readme_schema_table_is_current():
     text = (ROOT / "README.md").read_text()
     block = text.split("<!-- schema:start -->")[1].split("<!-- schema:end -->")[0].strip()
     assert block == markdown().strip(), "README schema is stale: paste the output of `camtube schema`"
+
+
+def test_preview_draws_slits_as_open_paths(tmp_path):
+    import xml.etree.ElementTree as ET
+
+    from tests.conftest import ROOT
+
+    out = tmp_path / "s.svg"
+    assert main(["preview", str(ROOT / "examples" / "dxf" / "slits.dxf"), "--layer", "KERF=slit", "-o", str(out),
+                 "-q"]) == 0
+    root = ET.parse(out).getroot()
+    lines = root.findall("{http://www.w3.org/2000/svg}polyline")
+    assert len(lines) == 9 and all(len(e.get("points").split()) == 2 for e in lines)

@@ -31,8 +31,10 @@ def unrolled_svg(pattern: Pattern, px_per_mm: float = 40.0, margin_px: float = 6
     def Y(y):
         return _fmt(margin_px + (h_mm - y) * px_per_mm)
 
-    def poly(points, colour, extra=""):
+    def poly(points, colour, extra="", closed=True):
         pts = " ".join(f"{X(x)},{Y(y)}" for x, y in points)
+        if not closed:  # a slit: the beam follows the path
+            return f'<polyline points="{pts}" fill="none" stroke="{colour}" stroke-width="1.6"{extra}/>'
         return f'<polygon points="{pts}" fill="{colour}" fill-opacity="0.25" stroke="{colour}" stroke-width="1.2"{extra}/>'
 
     out = [
@@ -45,7 +47,7 @@ def unrolled_svg(pattern: Pattern, px_per_mm: float = 40.0, margin_px: float = 6
     pts = " ".join(f"{X(x)},{Y(y)}" for x, y in o.points)
     out.append(f'<polygon points="{pts}" fill="#f5f5f5" stroke="#777" stroke-dasharray="6 4" stroke-width="1"/>')
     for con in sheet_contours(pattern):
-        out.append(poly(con.points, COLOURS.get(con.kind, COLOURS["cut"])))
+        out.append(poly(con.points, COLOURS.get(con.kind, COLOURS["cut"]), closed=con.closed))
     # axes: ticks every 1 mm in x, at 0, pi r_o, 2 pi r_o in y
     step = 1.0 if w_mm <= 30 else 5.0
     x = 0.0
