@@ -90,7 +90,7 @@ def toolpath_document(job):
     msp = doc.modelspace()
     for c in job.design:
         _add(msp, c, "CONSTRUCTION-DESIGN")
-    _add(msp, _outline(job), "CONSTRUCTION-OUTLINE")  # last construction entity: read_contours' size
+    _add(msp, _outline(job), "CONSTRUCTION-OUTLINE")  # last construction entity: the sheet size
     for p in job.passes:
         _add(msp, p.contour, layer_name(p.focus_level, p.drill_index))
     return doc
