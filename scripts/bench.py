@@ -5,6 +5,9 @@
 
 Each stage's own benchmark lives in ``scripts/bench_<stage>.py`` and is run
 here in a subprocess, so one command prints every figure the issues ask for.
+The plan stage (``bench_plan.py``) times what ``camtube toolpath`` does with every
+output written, at 10,000 and 100,000 notches, against its G-code alone, and prints
+each run's peak memory (the child process's peak resident set size).
 """
 from __future__ import annotations
 

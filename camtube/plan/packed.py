@@ -72,13 +72,13 @@ class Packed:
     geom_closed : (G,) bool
         True: closed path (the beam returns to its first vertex); False: an open
         path (a slit) cut from its first vertex to its last.
-    pass_geom, pass_cut : (P,) int
+    pass_geom, pass_cut : (P,) int32
         Path and design-cut index of each pass.
     pass_z : (P,) float
         Focus offset into the material (mm, >= 0).
     pass_speed, pass_power, pass_freq : (P,) float
         mm/s on the outer surface, W, kHz (may be read-only broadcast views).
-    pass_repeat, pass_focus, pass_drill : (P,) int
+    pass_repeat, pass_focus, pass_drill : (P,) int32, int8, int32
         Repeat, focus level (0 surface, 1 defocused) and drill index of each pass.
     pass_offset : (P,) float
         Inward offset of the pass's path from its design line (mm).
@@ -115,7 +115,7 @@ class Packed:
                   pass_freq, pass_repeat, pass_focus, pass_drill, pass_offset) -> "Packed":
         arr = lambda a, t: a if isinstance(a, np.ndarray) and a.dtype == t else np.ascontiguousarray(a, dtype=t)  # noqa: E731
         return cls(arr(vertices, float).reshape(-1, 2), arr(geom_offset, np.int64), arr(geom_closed, bool),
-                   arr(pass_geom, np.int64), arr(pass_cut, np.int64), arr(pass_z, float), arr(pass_speed, float),
+                   arr(pass_geom, np.int32), arr(pass_cut, np.int32), arr(pass_z, float), arr(pass_speed, float),
                    arr(pass_power, float), arr(pass_freq, float), arr(pass_repeat, np.int32),
                    arr(pass_focus, np.int8), arr(pass_drill, np.int32), arr(pass_offset, float))
 

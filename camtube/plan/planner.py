@@ -1,4 +1,4 @@
-"""The planner: cuts (a pattern, or the closed contours of any DXF) + a process -> a :class:`Job`.
+"""The planner: cuts (a pattern, or a sequence of contours) + a process -> a :class:`Job`.
 
 The paper's process, for every cut contour (notch or tendon hole)::
 
@@ -18,7 +18,12 @@ circumferential ranges overlap form one band; bands are visited in ``y`` order,
 alternately forward and backward in ``x``; interleaved rounds run the tour
 alternately forwards and backwards so a round starts where the previous ended.
 Every pass starts at the vertex of its path nearest the end of the previous
-cut in the tour (for rectangles: the nearest corner).
+cut in the tour (for rectangles: the nearest corner). A slit (an open contour) is
+cut end to end on its path (no offset), from the end nearer the beam.
+
+The passes are built as arrays (:func:`assemble`, vectorised for axis-aligned
+rectangles) and the Job's ``passes`` is a lazy view over them, so 10^6 passes cost
+no Python object each; the job-file reader regenerates them with the same function.
 """
 from __future__ import annotations
 
@@ -324,19 +329,26 @@ def pass_sequence(order: Sequence[int], n_cut: int, repeats: int, n_drill: int, 
     ``interleaved``: round ``k`` = (repeat, focus, drill) visits every cut, along ``order``
     on even rounds and backwards on odd ones.
     """
-    order = np.asarray(order, dtype=np.int64)
+    order = np.asarray(order, dtype=np.int32)
     per_cut = repeats * 2 * n_drill
-    k = np.arange(per_cut)
+    k = np.arange(per_cut, dtype=np.int32)
     r_k, f_k, d_k = k // (2 * n_drill), (k // n_drill) % 2, k % n_drill
     if ordering == "sequential":
         cut_a = np.repeat(order, per_cut)
         rep_a, foc_a, dri_a = (np.tile(a, n_cut) for a in (r_k, f_k, d_k))
-        dir_a = np.zeros(len(cut_a), dtype=np.int64)
+        dir_a = np.zeros(len(cut_a), dtype=np.int32)
     else:
         dir_k = k % 2
         cut_a = np.where(dir_k[:, None] == 0, order[None, :], order[::-1][None, :]).ravel()
         rep_a, foc_a, dri_a, dir_a = (np.repeat(a, n_cut) for a in (r_k, f_k, d_k, dir_k))
     return cut_a, rep_a, foc_a, dri_a, dir_a
+
+
+def _round_pairs(repeats: int, n_drill: int, ordering: str) -> set[tuple[int, int]]:
+    """The (tour direction, drill) pairs the rounds of :func:`pass_sequence` use."""
+    if ordering == "sequential":
+        return {(0, d) for d in range(n_drill)}
+    return {(k % 2, k % n_drill) for k in range(repeats * 2 * n_drill)}
 
 
 def assemble(design: Sequence[Contour], order: Sequence[int], starts: np.ndarray, repeats: int, ordering: str,
@@ -363,11 +375,20 @@ def assemble(design: Sequence[Contour], order: Sequence[int], starts: np.ndarray
     focus = np.array([0.0, float(process.defocus_mm)])
     n_cut, n_drill = len(design), len(offsets)
     cut_a, rep_a, foc_a, dri_a, dir_a = pass_sequence(order, n_cut, repeats, n_drill, ordering)
-    gid = (dir_a * n_cut + cut_a) * n_drill + dri_a  # path key: (tour direction, cut, drill)
-    used = np.unique(gid)
-    pass_geom = np.searchsorted(used, gid)
-    t_u, rest = np.divmod(used, n_cut * n_drill)
-    i_u, d_u = np.divmod(rest, n_drill)
+    # paths used: (tour direction t, cut i, drill d) for every cut and every (t, d) some round uses,
+    # numbered in (t, i, d) order without sorting the passes
+    n_dir = int(dir_a.max()) + 1 if len(dir_a) else 1
+    used_d = [sorted({int(d) for t, d in _round_pairs(repeats, n_drill, ordering) if t == tt}) for tt in range(n_dir)]
+    n_d = np.array([len(ds) for ds in used_d], dtype=np.int64)
+    base = np.concatenate(([0], np.cumsum(n_d * n_cut)[:-1])).astype(np.int64)
+    rank = np.zeros((n_dir, n_drill), dtype=np.int64)
+    for tt, ds in enumerate(used_d):
+        rank[tt, ds] = np.arange(len(ds))
+    pass_geom = (base[dir_a] + cut_a.astype(np.int64) * n_d[dir_a] + rank[dir_a, dri_a]).astype(np.int32)
+    del dir_a
+    t_u = np.concatenate([np.full(n_cut * len(ds), tt, dtype=np.int64) for tt, ds in enumerate(used_d)])
+    i_u = np.concatenate([np.repeat(np.arange(n_cut, dtype=np.int64), len(ds)) for ds in used_d])
+    d_u = np.concatenate([np.tile(np.asarray(ds, dtype=np.int64), n_cut) for ds in used_d])
 
     is_rect = np.fromiter((is_axis_rectangle(c) for c in design), dtype=bool, count=n_cut)
     closed = np.fromiter((c.closed for c in design), dtype=bool, count=n_cut)
@@ -379,7 +400,7 @@ def assemble(design: Sequence[Contour], order: Sequence[int], starts: np.ndarray
         path = pass_path(design[i], float(offsets[d]), int(starts[t, i]), d, i, ordering == "sequential")
         other[r] = np.asarray(path.points, dtype=float).reshape(-1, 2)
         sizes[r] = len(path.points)
-    geom_offset = np.zeros(len(used) + 1, dtype=np.int64)
+    geom_offset = np.zeros(len(t_u) + 1, dtype=np.int64)
     np.cumsum(sizes, out=geom_offset[1:])
     vertices = np.empty((int(geom_offset[-1]), 2))
     if len(rect_rows):
@@ -404,8 +425,10 @@ def assemble(design: Sequence[Contour], order: Sequence[int], starts: np.ndarray
     for r, v in other.items():
         vertices[geom_offset[r]:geom_offset[r + 1]] = v
     n = len(cut_a)
-    pass_offset = np.where(closed[cut_a], offsets[dri_a], 0.0)
+    pass_offset = offsets[dri_a] if closed.all() else np.where(closed[cut_a], offsets[dri_a], 0.0)
+    pass_z = focus[foc_a]
+    foc_a = foc_a.astype(np.int8)
     const = lambda v: np.broadcast_to(np.float64(v), (n,))  # noqa: E731  (read-only, no memory per pass)
-    return Packed.of_arrays(vertices, geom_offset, closed[i_u], pass_geom, cut_a, focus[foc_a],
+    return Packed.of_arrays(vertices, geom_offset, closed[i_u], pass_geom, cut_a, pass_z,
                             const(process.scan_speed_mm_s), const(process.power_w), const(process.frequency_khz),
                             rep_a, foc_a, dri_a, pass_offset)

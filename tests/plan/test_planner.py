@@ -146,12 +146,18 @@ def test_seam_crossing_cuts_are_cut_continuously(presets):
 def test_packed_cache_matches_the_passes(presets):
     job = plan_job(presets["tube1-bidirectional"])
     seeded = job_moves(job)
-    fresh = replace(job)  # a new Job object: Job.packed recomputed from its passes
+    # the same passes as Pass objects: Job.packed is then packed from the objects
+    fresh = replace(job, passes=tuple(job.passes))
     assert "packed" not in fresh.__dict__
     rebuilt = job_moves(fresh)
     for f in ("x", "y", "z", "kind", "laser", "pass_index", "speed"):
         assert np.array_equal(getattr(seeded, f), getattr(rebuilt, f)), f
     assert len(pack(job).geom_offset) - 1 == len({id(p.contour) for p in job.passes})
+    for f in ("pass_cut", "pass_z", "pass_repeat", "pass_focus", "pass_drill", "pass_offset", "pass_power"):
+        assert np.array_equal(getattr(job.packed, f), getattr(fresh.packed, f)), f
+    # the planner keeps no Pass object per pass: the view builds them on demand
+    assert type(job.passes).__name__ == "PassView" and job.passes[5] == fresh.passes[5]
+    assert job.cut_length_mm == pytest.approx(sum(p.length_mm for p in fresh.passes))
 
 
 def _dxf_of(contours, length, circ, tmp_path):
