@@ -155,3 +155,18 @@ def test_check_job_is_chunked_and_remembered(job):
     with pytest.raises(SafetyError, match=r"unsafe move\(s\)"):
         check_job(short)
     assert "_checked" not in short.__dict__
+
+
+def test_survey_checks_and_estimates_once_for_every_writer(job):
+    from dataclasses import replace
+
+    from camtube.plan.outputs import survey, toolpath_streams
+
+    fresh = replace(job)
+    est = survey(fresh)
+    assert fresh.__dict__["_checked"] is True and estimate(fresh) is est
+    assert est == estimate(replace(job))  # the same figures as the estimate alone
+    bad = replace(job, length_mm=1.0)
+    streams = toolpath_streams(bad)
+    with pytest.raises(SafetyError, match="leaves the tube"):
+        next(iter(streams[f"{job.name}.toolpath.dxf"]))
