@@ -170,3 +170,25 @@ def test_survey_checks_and_estimates_once_for_every_writer(job):
     streams = toolpath_streams(bad)
     with pytest.raises(SafetyError, match="leaves the tube"):
         next(iter(streams[f"{job.name}.toolpath.dxf"]))
+
+
+def test_writers_stream_in_bounded_chunks_without_pass_objects():
+    from camtube.design.contour import rectangle
+    from camtube.design.pattern import Process
+    from camtube.plan.moves import CHUNK_PASSES
+    from camtube.plan.outputs import toolpath_streams
+
+    n = 1000  # 32,000 passes: 8 chunks of passes
+    job = plan_job([rectangle(1.5 + i, 0.5, 1.8 + i, 2.5, "notch") for i in range(n)], Process(),
+                   outer_radius_mm=0.75, length_mm=n + 3.0)
+    assert len(job.passes) == 32 * n
+    for name, stream in toolpath_streams(job).items():
+        sizes = [len(c) for c in stream]
+        total = sum(sizes)
+        if name.endswith(".job.json"):  # one line per cut: small anyway
+            assert total < 200 * n
+            continue
+        assert len(sizes) >= len(job.passes) // CHUNK_PASSES, name
+        assert max(sizes) < 0.2 * total and max(sizes) < 3e6, (name, max(sizes), total)
+    # the writers worked from the arrays: no Pass or Contour object was made per pass
+    assert job.passes._contours == {}
