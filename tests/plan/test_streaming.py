@@ -192,3 +192,29 @@ def test_writers_stream_in_bounded_chunks_without_pass_objects():
         assert max(sizes) < 0.2 * total and max(sizes) < 3e6, (name, max(sizes), total)
     # the writers worked from the arrays: no Pass or Contour object was made per pass
     assert job.passes._contours == {}
+
+
+@pytest.mark.parametrize("dialect", [LINUXCNC, GRBL], ids=lambda d: d.name)
+def test_gate_reopens_after_a_lead_move_inside_a_pass(job, dialect):
+    """A corner strategy's over-travel between two cuts: gate off, lead out and back, gate on again
+    (with the dialect's formatted gate-on line, e.g. GRBL's ``M4 S200``)."""
+    mv = job_moves(job)
+    rows = mv.pass_rows()
+    i = int(rows[0]) + 3  # after the second cutting move of pass 0
+    assert mv.kind[i] == CUT and mv.kind[i + 1] == CUT
+    x, y = mv.x[i], mv.y[i]
+    ins = {"x": [x + 0.02, x], "y": [y, y], "z": [mv.z[i]] * 2, "kind": [LEAD] * 2, "laser": [False] * 2,
+           "pass_index": [0, 0], "vertex": [-1, -1], "speed": [job.process.scan_speed_mm_s] * 2}
+    edited = Moves(**{f: np.insert(getattr(mv, f), i + 1, np.asarray(v, dtype=getattr(mv, f).dtype))
+                      for f, v in ins.items()})
+    check_moves(job, edited)
+    text = gcode(job, dialect, moves=edited)
+    assert "\x00" not in text and "{" not in text
+    first = text.split("pass 0:")[1].split("pass 1:")[0]
+    on, off = dialect.laser_on.format(**dialect.fields(2.0, 60.0)), dialect.laser_off
+    assert first.count(on) == 2 and first.count(off) == 2
+    lines = first.splitlines()
+    k = lines.index(off)  # the first gate-off is followed by the two lead moves, then the gate opens again
+    assert lines[k + 1].startswith("G1") and lines[k + 2].startswith("G1") and lines[k + 3] == on
+    # the rest of the job is unchanged
+    assert text.split("pass 1:")[1] == gcode(job, dialect).split("pass 1:")[1]
