@@ -262,7 +262,8 @@ def iter_gcode(job, dialect: Dialect = LINUXCNC, *, progress: Progress = NO_PROG
         Reports one task, ``G-code <dialect>``, in passes.
     moves : Moves or sequence of consecutive Moves chunks, optional
         A move list to write instead of the job's own (a hand-edited one, e.g. with LEAD
-        moves); it is checked and estimated like the job's.
+        moves); it is checked and estimated like the job's. Each chunk holds whole passes
+        (``Moves.rows`` at pass boundaries, ``Moves.pass_rows``).
     memo : bool
         Reuse the text of a path's moves for later passes over the same path at the
         same speed (identical rows by construction of :func:`~camtube.plan.moves.job_moves`);

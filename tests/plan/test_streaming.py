@@ -55,7 +55,8 @@ def test_an_unsafe_chunk_is_never_yielded(job):
     from dataclasses import replace
 
     edited = replace(mv, x=x)
-    chunks = [edited.rows(0, bad_row - 50), edited.rows(bad_row - 50, len(mv))]
+    cut = int(mv.pass_rows()[290])  # chunks hold whole passes: 0..289, 290..
+    chunks = [edited.rows(0, cut), edited.rows(cut, len(mv))]
     it = iter_gcode(job, LINUXCNC, moves=chunks)
     header, first = next(it), next(it)
     assert "pass 0:" in first and "pass 300:" not in first
