@@ -37,6 +37,7 @@ from camtube.progress import NO_PROGRESS, Progress
 
 #: Distinct (path, speed) blocks whose text is kept for reuse (bounds the memo's memory).
 MEMO_MAX = 200_000
+_REOPEN = "\x00"  # placeholder of a gate-on inside a pass (see _Emitter._rows)
 
 
 @dataclass(frozen=True, eq=False)
@@ -151,7 +152,7 @@ class _Emitter:
                         + tail).format
         self.gates: dict[tuple[float, float], tuple[str, str]] = {}
         self.prev_key: tuple[float, float] | None = None
-        self.blocks: dict[tuple[int, float], tuple[str, str, bool]] = {}
+        self.blocks: dict[tuple[int, float], tuple[str, str, bool, bool]] = {}
 
     def _gate_on(self, key: tuple[float, float]) -> str:
         """Settings lines (where they change) + the gate-on line."""
@@ -165,10 +166,13 @@ class _Emitter:
         self.prev_key = key
         return out
 
-    def _rows(self, X, Y, Z, F, K, L, lo: int, hi: int) -> tuple[str, str, bool]:
-        """Text of rows [lo, hi) of one pass: (before the first gate-on, after it, gate opened at all).
+    def _rows(self, X, Y, Z, F, K, L, lo: int, hi: int) -> tuple[str, str, bool, bool]:
+        """Text of rows [lo, hi) of one pass: (before the first gate-on, after it, gate opened at all,
+        gate opened again later).
 
-        Starts with the gate closed and ends with it closed.
+        Starts with the gate closed and ends with it closed. A later gate-on (after a lead
+        move inside the pass) is the marker ``_REOPEN``, replaced by the pass's formatted
+        ``laser_on`` in :meth:`chunk` (the text is shared by passes of any power).
         """
         d = self.d
         parts: list[str] = []
@@ -180,7 +184,7 @@ class _Emitter:
                 if on and before is None:
                     before, parts = "".join(parts), []
                 else:
-                    parts.append((d.laser_on if on else d.laser_off) + "\n")
+                    parts.append((_REOPEN if on else d.laser_off) + "\n")
                 state = on
             k = K[i]
             if k == RAPID:
@@ -193,8 +197,8 @@ class _Emitter:
             parts.append(d.laser_off)
         text = "".join(parts)
         if before is None:
-            return text.rstrip("\n"), "", False
-        return before, text.rstrip("\n") if not state else text, True
+            return text.rstrip("\n"), "", False, False
+        return before, text.rstrip("\n") if not state else text, True, _REOPEN in text
 
     def chunk(self, mm: MachineMoves) -> str:
         """G-code of the passes in ``mm`` (checked machine moves), ending with a newline."""
@@ -230,10 +234,10 @@ class _Emitter:
                         blocks[bkey] = blk
             else:
                 blk = self._rows(X, Y, Z, F, K, L, i, r1)
-            before, after, opened = blk
+            before, after, opened, reopened = blk
             if opened:
                 text.append(before + self._gate_on((pw, fq)))
-                text.append(after)
+                text.append(after.replace(_REOPEN, self.gates[(pw, fq)][1]) if reopened else after)
             elif before:
                 text.append(before)
             out.append("\n".join(text))
@@ -258,7 +262,8 @@ def iter_gcode(job, dialect: Dialect = LINUXCNC, *, progress: Progress = NO_PROG
         Reports one task, ``G-code <dialect>``, in passes.
     moves : Moves or sequence of consecutive Moves chunks, optional
         A move list to write instead of the job's own (a hand-edited one, e.g. with LEAD
-        moves); it is checked and estimated like the job's.
+        moves); it is checked and estimated like the job's. Each chunk holds whole passes
+        (``Moves.rows`` at pass boundaries, ``Moves.pass_rows``).
     memo : bool
         Reuse the text of a path's moves for later passes over the same path at the
         same speed (identical rows by construction of :func:`~camtube.plan.moves.job_moves`);

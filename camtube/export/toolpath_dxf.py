@@ -32,7 +32,7 @@ from camtube.progress import NO_PROGRESS, Progress
 #: ACI colours of the (focus, drill) layers, in class order; cycles if there are more classes.
 COLOURS = (1, 3, 5, 6, 2, 4, 30, 200, 140, 210, 40, 170)
 #: Distinct paths whose vertex text is kept for reuse (bounds the memo's memory).
-MEMO_MAX = 200_000
+MEMO_MAX = 500_000
 
 
 def layer_name(focus_level: int, drill_index: int) -> str:

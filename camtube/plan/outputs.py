@@ -24,21 +24,56 @@ from camtube.export.dialects import DIALECTS, Dialect
 from camtube.progress import NO_PROGRESS, Progress
 
 
+def survey(job, progress: Progress = NO_PROGRESS):
+    """Safety-check the job's neutral moves and estimate its time in one pass over the chunks.
+
+    Both results are remembered on the Job (as :func:`~camtube.plan.safety.check_job` and
+    :func:`~camtube.plan.moves.estimate` remember them), so the writers that follow reuse
+    them; a second call costs nothing. Returns the :class:`~camtube.plan.moves.Estimate`.
+
+    Raises
+    ------
+    SafetyError
+        From the first unsafe chunk.
+    """
+    from camtube.plan.moves import estimate, iter_moves
+    from camtube.plan.safety import check_moves
+
+    if "_estimate" in job.__dict__ and job.__dict__.get("_checked"):
+        return job.__dict__["_estimate"]
+    with progress.task("safety check, estimate", total=len(job.passes)) as task:
+        def checked():
+            for mv in iter_moves(job):
+                check_moves(job, mv)
+                task.advance(len(mv.pass_rows()) - 1)
+                yield mv
+
+        est = estimate(job, checked())
+    job.__dict__["_checked"] = True
+    return job.cached("_estimate", lambda: est)
+
+
 def toolpath_streams(job, dialects: Sequence[Dialect] = tuple(DIALECTS.values()),
                      progress: Progress = NO_PROGRESS) -> dict[str, Iterator[str]]:
     """File name -> lazy iterator of text chunks of the job's toolpath outputs.
 
-    Nothing is computed until a stream is iterated; each stream safety-checks what
+    Nothing is computed until a stream is iterated; the first one iterated runs
+    :func:`survey` (check + estimate, shared by all), and each stream safety-checks what
     it writes (raising :class:`~camtube.errors.SafetyError` before yielding unsafe text).
     """
     from camtube.export.gcode import iter_gcode
     from camtube.export.jobfile import iter_job_json
     from camtube.export.toolpath_dxf import iter_toolpath_dxf
 
-    streams: dict[str, Iterator[str]] = {f"{job.name}.toolpath.dxf": iter_toolpath_dxf(job, progress=progress)}
+    def surveyed(make):
+        survey(job, progress)
+        yield from make()
+
+    streams: dict[str, Iterator[str]] = {
+        f"{job.name}.toolpath.dxf": surveyed(lambda: iter_toolpath_dxf(job, progress=progress))}
     for d in dialects:
-        streams[f"{job.name}{d.suffix}"] = iter_gcode(job, d, progress=progress)
-    streams[f"{job.name}.job.json"] = iter_job_json(job, progress=progress)
+        streams[f"{job.name}{d.suffix}"] = surveyed(lambda d=d: iter_gcode(job, d, progress=progress))
+    streams[f"{job.name}.job.json"] = surveyed(lambda: iter_job_json(job, progress=progress))
     return streams
 
 

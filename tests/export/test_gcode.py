@@ -10,7 +10,7 @@ import pytest
 
 from camtube.design.loader import load_pattern
 from camtube.export.dialects import DIALECTS, GRBL, LINUXCNC, Dialect, get_dialect
-from camtube.export.gcode import gcode, machine_moves
+from camtube.export.gcode import gcode
 from camtube.plan import plan_job
 from tests.conftest import PATTERNS
 

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import math
-import re
 
 import numpy as np
 import pytest
@@ -56,7 +55,8 @@ def test_an_unsafe_chunk_is_never_yielded(job):
     from dataclasses import replace
 
     edited = replace(mv, x=x)
-    chunks = [edited.rows(0, bad_row - 50), edited.rows(bad_row - 50, len(mv))]
+    cut = int(mv.pass_rows()[290])  # chunks hold whole passes: 0..289, 290..
+    chunks = [edited.rows(0, cut), edited.rows(cut, len(mv))]
     it = iter_gcode(job, LINUXCNC, moves=chunks)
     header, first = next(it), next(it)
     assert "pass 0:" in first and "pass 300:" not in first
@@ -156,3 +156,66 @@ def test_check_job_is_chunked_and_remembered(job):
     with pytest.raises(SafetyError, match=r"unsafe move\(s\)"):
         check_job(short)
     assert "_checked" not in short.__dict__
+
+
+def test_survey_checks_and_estimates_once_for_every_writer(job):
+    from dataclasses import replace
+
+    from camtube.plan.outputs import survey, toolpath_streams
+
+    fresh = replace(job)
+    est = survey(fresh)
+    assert fresh.__dict__["_checked"] is True and estimate(fresh) is est
+    assert est == estimate(replace(job))  # the same figures as the estimate alone
+    bad = replace(job, length_mm=1.0)
+    streams = toolpath_streams(bad)
+    with pytest.raises(SafetyError, match="leaves the tube"):
+        next(iter(streams[f"{job.name}.toolpath.dxf"]))
+
+
+def test_writers_stream_in_bounded_chunks_without_pass_objects():
+    from camtube.design.contour import rectangle
+    from camtube.design.pattern import Process
+    from camtube.plan.moves import CHUNK_PASSES
+    from camtube.plan.outputs import toolpath_streams
+
+    n = 1000  # 32,000 passes: 8 chunks of passes
+    job = plan_job([rectangle(1.5 + i, 0.5, 1.8 + i, 2.5, "notch") for i in range(n)], Process(),
+                   outer_radius_mm=0.75, length_mm=n + 3.0)
+    assert len(job.passes) == 32 * n
+    for name, stream in toolpath_streams(job).items():
+        sizes = [len(c) for c in stream]
+        total = sum(sizes)
+        if name.endswith(".job.json"):  # one line per cut: small anyway
+            assert total < 200 * n
+            continue
+        assert len(sizes) >= len(job.passes) // CHUNK_PASSES, name
+        assert max(sizes) < 0.2 * total and max(sizes) < 3e6, (name, max(sizes), total)
+    # the writers worked from the arrays: no Pass or Contour object was made per pass
+    assert job.passes._contours == {}
+
+
+@pytest.mark.parametrize("dialect", [LINUXCNC, GRBL], ids=lambda d: d.name)
+def test_gate_reopens_after_a_lead_move_inside_a_pass(job, dialect):
+    """A corner strategy's over-travel between two cuts: gate off, lead out and back, gate on again
+    (with the dialect's formatted gate-on line, e.g. GRBL's ``M4 S200``)."""
+    mv = job_moves(job)
+    rows = mv.pass_rows()
+    i = int(rows[0]) + 3  # after the second cutting move of pass 0
+    assert mv.kind[i] == CUT and mv.kind[i + 1] == CUT
+    x, y = mv.x[i], mv.y[i]
+    ins = {"x": [x + 0.02, x], "y": [y, y], "z": [mv.z[i]] * 2, "kind": [LEAD] * 2, "laser": [False] * 2,
+           "pass_index": [0, 0], "vertex": [-1, -1], "speed": [job.process.scan_speed_mm_s] * 2}
+    edited = Moves(**{f: np.insert(getattr(mv, f), i + 1, np.asarray(v, dtype=getattr(mv, f).dtype))
+                      for f, v in ins.items()})
+    check_moves(job, edited)
+    text = gcode(job, dialect, moves=edited)
+    assert "\x00" not in text and "{" not in text
+    first = text.split("pass 0:")[1].split("pass 1:")[0]
+    on, off = dialect.laser_on.format(**dialect.fields(2.0, 60.0)), dialect.laser_off
+    assert first.count(on) == 2 and first.count(off) == 2
+    lines = first.splitlines()
+    k = lines.index(off)  # the first gate-off is followed by the two lead moves, then the gate opens again
+    assert lines[k + 1].startswith("G1") and lines[k + 2].startswith("G1") and lines[k + 3] == on
+    # the rest of the job is unchanged
+    assert text.split("pass 1:")[1] == gcode(job, dialect).split("pass 1:")[1]
