@@ -76,6 +76,7 @@ class CadOutputs:
 
     files: dict
     report: object
+    notes: tuple = ()
 
     @property
     def passed(self) -> bool:
@@ -87,7 +88,7 @@ class CadOutputs:
         out = [f"verification: {'PASS' if r.passed else 'FAIL'} "
                f"({len(r.checks) - len(r.failures)}/{len(r.checks)} checks passed)"]
         out += [f"  FAIL {c.name}: {c.detail}" for c in r.failures]
-        return out
+        return out + [f"note: {n}" for n in self.notes]
 
 
 def cad_outputs(pattern: Pattern, job, *, step: bool = True, pictures: bool = True,
@@ -126,15 +127,21 @@ def cad_outputs(pattern: Pattern, job, *, step: bool = True, pictures: bool = Tr
                     step_volume_mm3=step_volume, segments=m.segments)
     files[f"{name}.verify.txt"] = report_text(report).encode("utf-8")
     files[f"{name}.verify.json"] = report_json(report).encode("utf-8")
+    notes = []
     if pictures:
-        from camtube.cad.render import tube_png, unrolled_png
+        from camtube.cad.render import TUBE_PNG_MAX_FACES, tube_png, unrolled_png
 
         notches = pattern.notches
         facing = (notches[0].angle_deg if notches else 180.0) + 60.0  # notches seen obliquely
-        files[f"{name}.tube.png"] = tube_png(m.design_mesh, facing_angle_deg=facing, title=f"{name} (design)")
+        if len(m.design_mesh.faces) <= TUBE_PNG_MAX_FACES:
+            files[f"{name}.tube.png"] = tube_png(m.design_mesh, facing_angle_deg=facing, title=f"{name} (design)")
+        else:
+            notes.append(f"{name}.tube.png not drawn: the mesh has {len(m.design_mesh.faces)} faces, more than "
+                         f"{TUBE_PNG_MAX_FACES} (a picture of {len(pattern.cuts)} cuts would be unreadable); "
+                         "the STL and the unrolled picture show it")
         files[f"{name}.unrolled.png"] = unrolled_png(job.design, pattern.tube.length_mm,
                                                      pattern.tube.outer_radius_mm, m.ascut, title=name)
-    return CadOutputs(files, report)
+    return CadOutputs(files, report, tuple(notes))
 
 
 def _step_volume(step: bytes) -> float:
