@@ -235,3 +235,29 @@ def test_diagnose_init_start_values_reach_a_multimodal_user_effect():
     assert got.recommended == ("wobble",)
     assert got.final.params["wobble.period_mm"] == pytest.approx(0.7, rel=0.01)
     assert "--init wobble.period_mm=0.7" in " ".join(f"--init {k}={v:.2g}" for k, v in got.final.init.items())
+
+
+def test_user_effect_is_multi_started_over_its_declared_range():
+    """A period starting at 0.5 mm finds a true 0.7 mm with the default starts (no --init): the scan of the range."""
+    from camtube.model.core import Effect, Param
+    from camtube.model.core.registry import builtin_registry
+    from camtube.model.sim.synth import synthesize
+
+    def apply(ctx, s, p):
+        return s + p["amp_mm"] * np.sin(2 * np.pi * s / p["period_mm"])
+
+    wob = Effect(name="wobble", stage="stroke", apply=apply,
+                 params=(Param("amp_mm", "mm", 0.0, 0.1, 0.01), Param("period_mm", "mm", 0.1, 2.0, 0.5)))
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    d = synthesize(p, 2, 4, seed=4, slack_mm=0.0)
+    m = model_for_pattern(p, [wob])
+    truth = {**m.initial_values(d, pattern_values(p)), "wobble.amp_mm": 0.03, "wobble.period_mm": 0.7}
+    d = d.with_angle(m.predict(d, truth) + np.random.default_rng(0).normal(0, 0.25, len(d)))
+    reg = builtin_registry().with_effects([wob])
+    stuck = diagnose(model_for_pattern(p), d, ("E_t",), pattern_values(p), registry=reg, candidates=["wobble"],
+                     grid=0)
+    got = diagnose(model_for_pattern(p), d, ("E_t",), pattern_values(p), registry=reg, candidates=["wobble"])
+    assert stuck.recommended == ()  # from its start value alone the fit stays in the 0.5 mm minimum
+    assert got.recommended == ("wobble",)
+    assert got.final.params["wobble.period_mm"] == pytest.approx(0.7, rel=0.01)
+    assert got.final.rmse_deg < 1.05 * 0.25
