@@ -62,10 +62,13 @@ def text_lines(d, json_path: str = "DIAG.json") -> list[str]:
     if u is None:
         return []
     lines = describe(u)
-    if d.recommended:
+    if d.recommended:  # not reached by the diagnosis (a recommended chain is within 1.15 x the floor)
         lines.append(f"  note: with {', '.join(d.recommended)} the error stays at "
                      f"{d.final.rmse_deg / d.noise_floor_deg:.2f} x the floor; the recommended effect(s) may stand in "
                      f"for the physics above: try the starter effect without them")
+    if getattr(d, "partial", ()):
+        lines.append(f"  this is the misfit of the current model; the partial effects ({', '.join(d.partial)}) "
+                     "lower it without explaining it: write the effect, starting from the command below")
     if u.get("leading"):
         lines.append(f"  start an effect for it: camtube model effect new {suggested_name(u)} --from {json_path}"
                      f"  (the diagnosis's --json file)")
