@@ -222,9 +222,10 @@ def _floor_estimates(parts: list) -> dict[tuple[str, int], float]:
     """Every estimate of the white-noise sigma (deg) of the residual ``parts`` (contiguous runs).
 
     ``("mad", k)``: ``1.4826 MAD(diff^k r) / sqrt(C(2k, k))`` (robust to the kinks at reversals);
-    ``("sd", k)``: the standard deviation of the same differences. Each is unbiased for white
-    Gaussian noise; they disagree when the noise is not quite white or Gaussian or when the model's
-    error leaks into the differences.
+    ``("sd", k)``: the standard deviation of the same differences; ``("sd_lag1", 2)``: the same for
+    noise with a correlation ``rho`` between neighbouring rows, ``rho`` solved from the lag-1
+    covariance of the 2nd differences. Each is unbiased for white Gaussian noise; they disagree when
+    the noise is not quite white or Gaussian or when the model's error leaks into the differences.
     """
     out: dict[tuple[str, int], float] = {}
     for k, norm in _ORDERS:
@@ -234,6 +235,15 @@ def _floor_estimates(parts: list) -> dict[tuple[str, int], float]:
         d = np.concatenate(ds)
         out[("mad", k)] = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(norm)
         out[("sd", k)] = float(np.std(d)) / math.sqrt(norm)
+        if k == 2:
+            # allow a correlation rho between neighbouring rows: var(diff^2) = s^2 (6 - 8 rho) and the lag-1
+            # covariance of diff^2 is s^2 (-4 + 7 rho); solved for s (rho = 0: white noise, the same as "sd")
+            var = float(np.var(d))
+            mu = float(np.mean(d))
+            lag = float(np.mean(np.concatenate([(x[:-1] - mu) * (x[1:] - mu) for x in ds])))
+            q = lag / var if var > 0 else -2.0 / 3.0
+            rho = float(np.clip((6.0 * q + 4.0) / (7.0 + 8.0 * q), -0.3, 0.3)) if 7.0 + 8.0 * q > 0 else 0.0
+            out[("sd_lag1", k)] = math.sqrt(var / (6.0 - 8.0 * rho))
     return out
 
 
@@ -254,8 +264,9 @@ def noise_floor_parts(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarra
 
     *Statistical*: the standard error of the estimate from its spread over the ``blocks`` ``(n,)`` int of
     the rows (blocks of cycles).
-    *Systematic*: the range (largest minus smallest) of six estimates of the same sigma -- the median
-    absolute deviation and the standard deviation of the 2nd, 3rd and 4th differences. For white Gaussian
+    *Systematic*: the range (largest minus smallest) of seven estimates of the same sigma -- the median
+    absolute deviation and the standard deviation of the 2nd, 3rd and 4th differences, and the standard
+    deviation of the 2nd differences allowing a correlation between neighbouring rows. For white Gaussian
     noise they agree within their statistical error; they part when the residual is not that: a weak
     correlation between neighbouring rows (the force noise passes into the angle error through the model,
     with a gain that changes along the stroke), noise whose size changes along the stroke (no force noise
