@@ -10,8 +10,11 @@ Method
 2. **Noise floor.** The sensor noise is white, the model error is smooth in
    time; so the noise shows in the high-order differences of the residual
    within each sample: ``sigma = 1.4826 MAD(diff^k r) / sqrt(C(2k, k))``
-   for ``k = 2, 3, 4`` (the smallest is kept). Its uncertainty is the spread
-   of the same estimate over blocks of cycles.
+   for ``k = 2, 3, 4`` (the smallest is kept). Its uncertainty has two parts
+   added in quadrature: statistical (the spread of the same estimate over
+   blocks of cycles) and systematic (the range of seven estimators that all
+   agree for white Gaussian noise: MAD and standard deviation of the 2nd-4th
+   differences, and one allowing a lag-1 correlation), see :func:`noise_floor_parts`.
 3. **Cross-validation by blocks of cycles.** Each sample's cycles are cut
    into (up to) eight blocks; the blocks alternate between two folds, the
    first block (with cycle 1) in fold 0 for the first sample and in fold 1
@@ -34,8 +37,9 @@ Method
    on every row, exactly as the printed ``model fit`` command does (same
    rows, same starts: ``--init`` values and ``--starts``). It is recommended
    only when that refit lowers the RMSE, keeps its parameters identified and
-   resolvable, and does not undercut the noise floor by more than twice the
-   floor's uncertainty (fitting noise); otherwise the next candidate is tried.
+   resolvable, and does not undercut the noise floor (re-estimated from its
+   residual) by more than twice the floor's uncertainty (fitting noise);
+   otherwise the next candidate is tried.
 6. **Per-sample parameters.** With several samples, each recommended
    effect's parameters are tried per sample; they are kept when the held-out
    error falls significantly. The output says which samples differ (values
@@ -46,6 +50,12 @@ Method
    noise floor (``stop_ratio=None`` turns the rule off: the significance
    tests alone must then stop it), when nothing qualifies, or after
    ``max_effects``.
+8. **Reach the floor or say so.** The chain of accepted effects is
+   recommended only when its all-rows RMSE is within :data:`REACH_RATIO`
+   (1.15) x the noise floor. Otherwise a structured misfit remains that the
+   library does not explain: the effects are listed as ``partial`` (each
+   lowers the error, none is a fix), nothing is recommended, and the
+   ``unexplained`` analysis describes what is left.
 
 No threshold depends on the data's scale: BIC is a likelihood ratio, the
 others are ratios of errors or multiples of standard errors.

@@ -73,8 +73,9 @@ def partial_lines(d: Diagnosis) -> list[str]:
     prev = steps[0]
     for k, name in enumerate(d.partial, 1):
         step = steps[k] if k < len(steps) else steps[-1]
-        params = ", ".join(f"{n} = {step.params[n]:.4g}" for n in step.params
-                           if n.split("@")[0].startswith(name + "."))
+        own = [n for n in step.params if n.split("@")[0].startswith(name + ".")]
+        own = [n for n in own if "@" in n or not any(m.startswith(n + "@") for m in own)]  # per-sample copies win
+        params = ", ".join(f"{n} = {step.params[n]:.4g}" for n in own)
         out.append(f"  {name}: lowers {prev.rmse_deg:.3f} -> {step.rmse_deg:.3f} deg "
                    f"({_times(step.rmse_deg, floor)} the noise floor) but leaves a structured misfit"
                    + (f" ({params})" if params else ""))
