@@ -87,7 +87,9 @@ def run_set(name, tube, hidden, want, truth, seed, n_cycles=50, rate_hz=10.0, ch
            "first": (first.effect + (f" (= {', '.join(first.equivalent)})" if first.equivalent else ""))
            if first else "-",
            "recommended": ", ".join(d.recommended) + (f" [per sample: {', '.join(d.per_sample)}]"
-                                                       if d.per_sample else "") or "nothing",
+                                                       if d.per_sample else "") or "nothing"
+           + (f" (partial: {', '.join(d.partial)}, {d.partial_steps[-1].rmse_deg / sim.sensor_floor_deg:.2f}x)"
+              if d.partial else ""),
            "rmse_before": d.waterfall[0].rmse_deg, "rmse_after": d.final.rmse_deg,
            "floor": d.noise_floor_deg, "sensor_floor": sim.sensor_floor_deg, "seconds": secs,
            "notes": list(d.sample_notes), "params": {}}

@@ -153,12 +153,21 @@ def _unknown(name: str, known: Sequence[str]) -> FitError:
     return unknown_parameter(name, known)
 
 
-def grid_starts(params: Parameters, names: Sequence[str], n: int = 3, cap: int = 27) -> list[dict[str, float]]:
+#: Points of the one-parameter scan across a declared range, per grid value (``grid=3``: 60 points).
+SCAN_PER_GRID = 20
+
+
+def grid_starts(params: Parameters, names: Sequence[str], n: int = 3, cap: int = 27,
+                scan: int = 0) -> list[dict[str, float]]:
     """Start points on a grid across the declared ranges of ``names`` (log-spaced for scales).
 
     The full grid (``n`` values per parameter) when it has at most ``cap``
     points; otherwise each parameter's ``n`` values with the others at their
-    current value. Deterministic.
+    current value. With ``scan``, each parameter that declares no
+    :attr:`~camtube.model.core.params.Param.starts` is also scanned alone at
+    ``scan`` values across its range (the others at their current value): a
+    multimodal parameter (a period) has local minima closer together than a
+    coarse grid. Deterministic.
     """
     import itertools
 
@@ -170,8 +179,14 @@ def grid_starts(params: Parameters, names: Sequence[str], n: int = 3, cap: int =
     for _, g in axes:
         total *= len(g)
     if total <= cap:
-        return [dict(zip([a for a, _ in axes], combo)) for combo in itertools.product(*[g for _, g in axes])]
-    return [{nm: v} for nm, g in axes for v in g]
+        out = [dict(zip([a for a, _ in axes], combo)) for combo in itertools.product(*[g for _, g in axes])]
+    else:
+        out = [{nm: v} for nm, g in axes for v in g]
+    if scan > n:
+        for nm, _ in axes:
+            if not params[nm].starts:
+                out += [{nm: v} for v in params[nm].grid(scan)]
+    return out
 
 
 def fit(
@@ -228,8 +243,10 @@ def fit(
     grid : int
         Grid values per parameter for a multi-start search over the declared
         ranges of ``grid_names`` (default: every varying effect parameter);
-        0 = no grid. Grid points are ranked by their SSE and the best ``keep``
-        are refined. Deterministic: the same call gives the same result.
+        0 = no grid. Each such parameter without declared ``starts`` is also
+        scanned alone at ``SCAN_PER_GRID * grid`` values (see :func:`grid_starts`).
+        Grid points are ranked by their SSE and the best ``keep`` are refined.
+        Deterministic: the same call gives the same result.
 
     Returns
     -------
@@ -296,7 +313,7 @@ def fit(
         else:
             gnames = [nm for nm in grid_names if nm in names]
         cands = []
-        for g in grid_starts(params, gnames, grid):
+        for g in grid_starts(params, gnames, grid, scan=SCAN_PER_GRID * grid):
             x = clip(np.array([float(g.get(nm, start[nm])) for nm in names], float))
             r = guarded(x)
             cands.append((float(np.dot(r, r)), len(cands), x))

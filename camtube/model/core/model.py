@@ -215,17 +215,41 @@ BASE_PARAMS: tuple[Param, ...] = (
 )
 
 
+def _user_line(effect: Effect, stage: str, exc: BaseException | None = None) -> str:
+    """``:LINE`` in the effect's own file: the deepest traceback frame there, else the stage function's ``def``."""
+    fn = effect.function(stage)
+    code = getattr(fn, "__code__", None)
+    files = {effect.source, getattr(code, "co_filename", None)} - {None, ""}
+    if exc is not None:
+        import traceback
+
+        frames = [f for f in traceback.extract_tb(exc.__traceback__) if f.filename in files]
+        if frames:
+            return f":{frames[-1].lineno}"
+    return f":{code.co_firstlineno}" if code is not None else ""
+
+
 def _call(effect: Effect, stage: str, ctx: Context, signal: np.ndarray, p: dict) -> np.ndarray:
-    """Run one effect's stage function; a broken effect gets a message naming it, its file and the problem."""
-    where = f"effect {effect.name!r}" + (f" ({effect.source})" if effect.source else "")
+    """Run one effect's stage function; a broken effect gets a message naming it, its file, the line and the problem."""
+    def where(exc: BaseException | None = None) -> str:
+        if not effect.source:
+            return f"effect {effect.name!r}"
+        return f"effect {effect.name!r} ({effect.source}{_user_line(effect, stage, exc)})"
+
     try:
         out = effect.function(stage)(ctx, signal, p)
     except KeyError as exc:
-        raise FitError(f"{where}, stage {stage}: asked for parameter {exc.args[0]!r}, but its params are "
+        raise FitError(f"{where(exc)}, stage {stage}: asked for parameter {exc.args[0]!r}, but its params are "
                        f"{', '.join(repr(q.name) for q in effect.params) or 'none'}") from None
+    except FitError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a user's effect may raise anything: report it with its line
+        if not effect.source:
+            raise
+        raise FitError(f"{where(exc)}, stage {stage}: {type(exc).__name__}: {exc}") from None
     out = np.asarray(out, float)
     if out.shape != signal.shape:
-        raise FitError(f"{where}, stage {stage}: returned shape {out.shape}, expected {signal.shape} "
+        raise FitError(f"{where()}, stage {stage}: returned shape {out.shape}, expected {signal.shape} "
                        "(one value per row)")
     return out
 

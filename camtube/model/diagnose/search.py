@@ -10,8 +10,11 @@ Method
 2. **Noise floor.** The sensor noise is white, the model error is smooth in
    time; so the noise shows in the high-order differences of the residual
    within each sample: ``sigma = 1.4826 MAD(diff^k r) / sqrt(C(2k, k))``
-   for ``k = 2, 3, 4`` (the smallest is kept). Its uncertainty is the spread
-   of the same estimate over blocks of cycles.
+   for ``k = 2, 3, 4`` (the smallest is kept). Its uncertainty has two parts
+   added in quadrature: statistical (the spread of the same estimate over
+   blocks of cycles) and systematic (the range of seven estimators that all
+   agree for white Gaussian noise: MAD and standard deviation of the 2nd-4th
+   differences, and one allowing a lag-1 correlation), see :func:`noise_floor_parts`.
 3. **Cross-validation by blocks of cycles.** Each sample's cycles are cut
    into (up to) eight blocks; the blocks alternate between two folds, the
    first block (with cycle 1) in fold 0 for the first sample and in fold 1
@@ -34,8 +37,9 @@ Method
    on every row, exactly as the printed ``model fit`` command does (same
    rows, same starts: ``--init`` values and ``--starts``). It is recommended
    only when that refit lowers the RMSE, keeps its parameters identified and
-   resolvable, and does not undercut the noise floor by more than twice the
-   floor's uncertainty (fitting noise); otherwise the next candidate is tried.
+   resolvable, and does not undercut the noise floor (re-estimated from its
+   residual) by more than twice the floor's uncertainty (fitting noise);
+   otherwise the next candidate is tried.
 6. **Per-sample parameters.** With several samples, each recommended
    effect's parameters are tried per sample; they are kept when the held-out
    error falls significantly. The output says which samples differ (values
@@ -46,6 +50,12 @@ Method
    noise floor (``stop_ratio=None`` turns the rule off: the significance
    tests alone must then stop it), when nothing qualifies, or after
    ``max_effects``.
+8. **Reach the floor or say so.** The chain of accepted effects is
+   recommended only when its all-rows RMSE is within :data:`REACH_RATIO`
+   (1.15) x the noise floor. Otherwise a structured misfit remains that the
+   library does not explain: the effects are listed as ``partial`` (each
+   lowers the error, none is a fix), nothing is recommended, and the
+   ``unexplained`` analysis describes what is left.
 
 No threshold depends on the data's scale: BIC is a likelihood ratio, the
 others are ratios of errors or multiples of standard errors.
@@ -71,6 +81,8 @@ CORR_LIMIT = 0.99
 EQUAL_HELDOUT = 0.03
 #: Grid values per new parameter in the multi-start fits (also ``--starts`` of the printed command).
 GRID = 3
+#: A chain of effects is recommended only when its all-rows RMSE is within this multiple of the noise floor.
+REACH_RATIO = 1.15
 #: Significant digits of the start values printed with ``--init`` (and used by the diagnosis itself).
 INIT_DIGITS = 6
 
@@ -165,6 +177,14 @@ class Diagnosis:
         Which samples differ and by how much; samples the final model leaves worse.
     grid : int
         Grid values per new parameter used by the fits (``--starts``).
+    partial : tuple[str, ...]
+        Effects that passed every check and lowered the error, but whose chain leaves the final RMSE above
+        :data:`REACH_RATIO` x the noise floor: a structured misfit remains, so they are not recommended
+        (``recommended`` is then empty and ``waterfall`` holds the current model only).
+    partial_steps : tuple[Step, ...]
+        The current model, then one step per partial effect (refitted on all rows), as ``waterfall`` would.
+    noise_floor_parts_deg : (float, float)
+        Statistical and systematic parts of ``noise_floor_se_deg`` (see :func:`noise_floor_parts`).
     stop_reason : str
     seconds : dict
         Wall time of the parts (not written to JSON: output is deterministic).
@@ -188,6 +208,9 @@ class Diagnosis:
     per_sample: tuple = ()
     sample_notes: tuple = ()
     grid: int = GRID
+    partial: tuple = ()
+    partial_steps: tuple = ()
+    noise_floor_parts_deg: tuple = ()
 
     @property
     def candidates(self) -> tuple:
@@ -201,15 +224,42 @@ class Diagnosis:
 
 # ----------------------------------------------------------------------------- pieces
 
-def _floor_of(parts: list) -> float:
-    best = math.inf
-    for k, norm in ((2, 6.0), (3, 20.0), (4, 70.0)):
+#: Orders of the differences and ``C(2k, k)``, the variance of a k-th difference of unit white noise.
+_ORDERS = ((2, 6.0), (3, 20.0), (4, 70.0))
+
+
+def _floor_estimates(parts: list) -> dict[tuple[str, int], float]:
+    """Every estimate of the white-noise sigma (deg) of the residual ``parts`` (contiguous runs).
+
+    ``("mad", k)``: ``1.4826 MAD(diff^k r) / sqrt(C(2k, k))`` (robust to the kinks at reversals);
+    ``("sd", k)``: the standard deviation of the same differences; ``("sd_lag1", 2)``: the same for
+    noise with a correlation ``rho`` between neighbouring rows, ``rho`` solved from the lag-1
+    covariance of the 2nd differences. Each is unbiased for white Gaussian noise; they disagree when
+    the noise is not quite white or Gaussian or when the model's error leaks into the differences.
+    """
+    out: dict[tuple[str, int], float] = {}
+    for k, norm in _ORDERS:
         ds = [np.diff(seg, k) for seg in parts if seg.size > k + 4]
         if not ds:
             continue
         d = np.concatenate(ds)
-        best = min(best, 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(norm))
-    return best
+        out[("mad", k)] = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(norm)
+        out[("sd", k)] = float(np.std(d)) / math.sqrt(norm)
+        if k == 2:
+            # allow a correlation rho between neighbouring rows: var(diff^2) = s^2 (6 - 8 rho) and the lag-1
+            # covariance of diff^2 is s^2 (-4 + 7 rho); solved for s (rho = 0: white noise, the same as "sd")
+            var = float(np.var(d))
+            mu = float(np.mean(d))
+            lag = float(np.mean(np.concatenate([(x[:-1] - mu) * (x[1:] - mu) for x in ds])))
+            q = lag / var if var > 0 else -2.0 / 3.0
+            rho = float(np.clip((6.0 * q + 4.0) / (7.0 + 8.0 * q), -0.3, 0.3)) if 7.0 + 8.0 * q > 0 else 0.0
+            out[("sd_lag1", k)] = math.sqrt(var / (6.0 - 8.0 * rho))
+    return out
+
+
+def _floor_of(parts: list) -> float:
+    est = [v for (kind, _), v in _floor_estimates(parts).items() if kind == "mad"]
+    return min(est) if est else math.inf
 
 
 def noise_floor(data: Dataset, residual_deg: np.ndarray) -> float:
@@ -219,22 +269,42 @@ def noise_floor(data: Dataset, residual_deg: np.ndarray) -> float:
     return best if math.isfinite(best) else float(np.std(r))
 
 
-def noise_floor_se(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarray) -> float:
-    """Standard error (deg) of :func:`noise_floor`, from its spread over the ``blocks`` (n,) int of the rows."""
+def noise_floor_parts(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarray) -> tuple[float, float]:
+    """The two parts (deg) of the uncertainty of :func:`noise_floor`: ``(statistical, systematic)``.
+
+    *Statistical*: the standard error of the estimate from its spread over the ``blocks`` ``(n,)`` int of
+    the rows (blocks of cycles).
+    *Systematic*: the range (largest minus smallest) of seven estimates of the same sigma -- the median
+    absolute deviation and the standard deviation of the 2nd, 3rd and 4th differences, and the standard
+    deviation of the 2nd differences allowing a correlation between neighbouring rows. For white Gaussian
+    noise they agree within their statistical error; they part when the residual is not that: a weak
+    correlation between neighbouring rows (the force noise passes into the angle error through the model,
+    with a gain that changes along the stroke), noise whose size changes along the stroke (no force noise
+    where the tendon is slack), or model error that leaks into the differences. Which of them is right is
+    not known from the data, so their whole range is the systematic uncertainty.
+    """
     r = np.asarray(residual_deg, float)
-    ids = np.unique(blocks)
+    est = list(_floor_estimates([r[sl] for _, sl in data.sample_slices()]).values())
+    systematic = float(max(est) - min(est)) if len(est) > 1 else 0.0
     vals = []
-    for b in ids:
-        m = blocks == b
-        idx = np.flatnonzero(m)
+    for b in np.unique(blocks):
+        idx = np.flatnonzero(blocks == b)
         # contiguous runs only (a block is contiguous within a sample)
         cut = np.flatnonzero(np.diff(idx) > 1) + 1
         v = _floor_of([r[seg] for seg in np.split(idx, cut)])
         if math.isfinite(v):
             vals.append(v)
     if len(vals) < 3:
-        return 0.05 * noise_floor(data, r)
-    return float(np.std(vals, ddof=1) / math.sqrt(len(vals)))
+        statistical = 0.05 * noise_floor(data, r)
+    else:
+        statistical = float(np.std(vals, ddof=1) / math.sqrt(len(vals)))
+    return statistical, systematic
+
+
+def noise_floor_se(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarray) -> float:
+    """Uncertainty (deg) of :func:`noise_floor`: statistical and systematic parts (:func:`noise_floor_parts`)
+    added in quadrature."""
+    return float(math.hypot(*noise_floor_parts(data, residual_deg, blocks)))
 
 
 #: The search keeps at least this many rows per cycle (it may then exceed ``max_rows``, up to 4x).
@@ -475,7 +545,8 @@ def diagnose(
     base_full = refit_all_rows(model, data, full_names, fixed, {}, grid)
     block_all, _ = cycle_blocks(data)
     floor = noise_floor(data, base_full.residuals)
-    floor_se = noise_floor_se(data, base_full.residuals, block_all)
+    floor_parts = noise_floor_parts(data, base_full.residuals, block_all)
+    floor_se = math.hypot(*floor_parts)
     clock["base"] = time.perf_counter()
 
     search = thin(data, max_rows)
@@ -528,10 +599,12 @@ def diagnose(
                                              modulus_range_gpa)
             # the floor seen through this model's residual (a model error inflates the estimate a little)
             f_c = min(floor, noise_floor(data, r.residuals))
-            se_c = noise_floor_se(data, r.residuals, block_all)
+            parts_c = noise_floor_parts(data, r.residuals, block_all)
+            se_c = math.hypot(*parts_c)
             if r.rmse < f_c - 2.0 * se_c:
                 problems.append(f"its RMSE {r.rmse:.3f} deg undercuts the noise floor {f_c:.3f} +- "
-                                f"{se_c:.3f} deg (it would fit noise)")
+                                f"{se_c:.3f} deg (statistical {parts_c[0]:.3f}, systematic {parts_c[1]:.3f}; "
+                                "it would fit noise)")
             if problems:
                 rejected.append((c.effect, "; ".join(problems)))
                 continue
@@ -545,7 +618,7 @@ def diagnose(
                     + (f" (best: {top.effect}: {top.why})" if top is not None and top.why else ""))
             break
         c, eff, m, names, r, init, ps = accepted
-        floor, floor_se = f_c, se_c
+        floor, floor_se, floor_parts = f_c, se_c, parts_c
         cur_ps = ps
         rejected = [(e, w) for e, w in rejected if e != eff.name]
         recommended.append(eff.name)
@@ -584,10 +657,21 @@ def diagnose(
         for c in rnd:
             if c.effect not in catalog and c.effect in reg:
                 catalog[c.effect] = reg[c.effect]
+    # recommended only when the chain reaches the floor: otherwise a structured misfit remains, and effects
+    # that merely lower it (a bias, a softer tendon standing in for missing physics) are listed as partial
+    partial: tuple = ()
+    partial_steps: tuple = ()
+    if recommended and not steps[-1].rmse_deg <= REACH_RATIO * floor:
+        partial, partial_steps = tuple(recommended), tuple(steps)
+        stop += (f"; with {', '.join(recommended)} the RMSE stays at {steps[-1].rmse_deg / floor:.2f} x the noise "
+                 f"floor (above {REACH_RATIO:g} x): a structured misfit remains, so nothing is recommended "
+                 f"(listed as partial)")
+        recommended, steps, ps_names = [], steps[:1], []
+        notes = [f"partial model: {n}" for n in notes]
     return Diagnosis(data, model, floor, base_rmse, base_ho, tuple(rounds), tuple(recommended), tuple(steps),
                      tuple(fit_params), stop, fixed, secs, catalog, floor_se, tuple(dict(rejected).items()),
                      tuple(ps_names),
-                     tuple(notes), grid)
+                     tuple(notes), grid, partial, partial_steps, floor_parts)
 
 
 def _mark_rejected(ranked, rejected):

@@ -7,12 +7,14 @@ report directory with an index is complete).
 ``diagnosis_dict(d, command="")`` is the JSON-ready summary (schema
 ``camtube.diagnose/1``)::
 
-    {"schema", "noise_floor_deg",
+    {"schema", "noise_floor_deg", "noise_floor_se_deg",
+     "noise_floor_se_parts_deg": {"statistical", "systematic"},
      "base": {"effects", "rmse_deg", "heldout_rmse_deg", "per_sample", "params"},
      "candidates": [{"effect", "rmse_deg", "heldout_rmse_deg", "delta_bic", "params": {name: {value, stderr, unit}},
                      "equivalent", "confounded", "significant", "why", "meaning", "signature"}],
      "rounds": [[candidate, ...], ...],        # candidates of each greedy round (first = "candidates")
-     "recommended": [effect, ...],             # in order
+     "recommended": [effect, ...],             # in order; only a chain within 1.15 x the noise floor
+     "partial": [{"effect", "rmse_before_deg", "rmse_deg", "floor_ratio", "params"}],  # lower it, not a fix
      "waterfall": [{"effects", "rmse_deg", "per_sample"}],
      "final": {"effects", "rmse_deg", "params"}, "stop_reason", "command",
      "unexplained": null | {"share", "follows", "periodic": [{"variable", "period", "unit", "amplitude_deg"}],
@@ -31,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from camtube.model.diagnose.atlas import describe, residual_atlas
-from camtube.model.diagnose.search import Candidate, Diagnosis
+from camtube.model.diagnose.search import REACH_RATIO, Candidate, Diagnosis
 from camtube.model.unexplained import report as unexplained_report
 
 
@@ -58,6 +60,40 @@ def fit_names(d: Diagnosis, effects) -> list[str]:
     for name in effects:
         names += [f"{name}.{p.name}" for p in d.catalog[name].params]
     return list(dict.fromkeys(names))
+
+
+def partial_lines(d: Diagnosis) -> list[str]:
+    """Text lines for the partial effects: they lower the error but leave a structured misfit (not a fix)."""
+    if not d.partial:
+        return []
+    floor = d.noise_floor_deg
+    steps = d.partial_steps
+    out = [f"partial (they lower the error but the model stays above {REACH_RATIO:g} x the noise floor: a "
+           "structured misfit remains that no built-in effect explains, see 'unexplained'; not recommended):"]
+    prev = steps[0]
+    for k, name in enumerate(d.partial, 1):
+        step = steps[k] if k < len(steps) else steps[-1]
+        own = [n for n in step.params if n.split("@")[0].startswith(name + ".")]
+        own = [n for n in own if "@" in n or not any(m.startswith(n + "@") for m in own)]  # per-sample copies win
+        params = ", ".join(f"{n} = {step.params[n]:.4g}" for n in own)
+        out.append(f"  {name}: lowers {prev.rmse_deg:.3f} -> {step.rmse_deg:.3f} deg "
+                   f"({_times(step.rmse_deg, floor)} the noise floor) but leaves a structured misfit"
+                   + (f" ({params})" if params else ""))
+        prev = step
+    return out
+
+
+def _partial_dicts(d: Diagnosis) -> list[dict]:
+    out = []
+    steps = d.partial_steps
+    for k, name in enumerate(d.partial, 1):
+        step = steps[k] if k < len(steps) else steps[-1]
+        out.append({"effect": name, "rmse_before_deg": _num(steps[k - 1].rmse_deg), "rmse_deg": _num(step.rmse_deg),
+                    "floor_ratio": _num(step.rmse_deg / d.noise_floor_deg) if d.noise_floor_deg > 0 else None,
+                    "params": {n: {"value": _num(v), "stderr": _num(step.stderr[n]) if n in step.stderr else None,
+                                   "unit": step.units.get(n, "")}
+                               for n, v in step.params.items() if n.split("@")[0].startswith(name + ".")}})
+    return out
 
 
 def add_command(d: Diagnosis, prefix: str) -> str:
@@ -115,6 +151,10 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
                     "params": {k: {"value": _num(v), "stderr": _num(final.stderr[k]) if k in final.stderr else None,
                                    "unit": final.units.get(k, "")} for k, v in final.params.items()}}
     out["noise_floor_se_deg"] = _num(d.noise_floor_se_deg)
+    if len(d.noise_floor_parts_deg) == 2:
+        out["noise_floor_se_parts_deg"] = {"statistical": _num(d.noise_floor_parts_deg[0]),
+                                           "systematic": _num(d.noise_floor_parts_deg[1])}
+    out["partial"] = _partial_dicts(d)
     out["rejected"] = [{"effect": e, "why": w} for e, w in d.rejected]
     out["per_sample"] = list(d.per_sample)
     out["sample_notes"] = list(d.sample_notes)
@@ -135,7 +175,9 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
     base = d.waterfall[0]
     lines = [title] if title else []
     cur = ", ".join(base.effects) or "none"
-    lines.append(f"noise floor (white noise in the residual): {floor:.3f} +- {d.noise_floor_se_deg:.3f} deg")
+    parts = d.noise_floor_parts_deg
+    lines.append(f"noise floor (white noise in the residual): {floor:.3f} +- {d.noise_floor_se_deg:.3f} deg"
+                 + (f" (statistical {parts[0]:.3f}, systematic {parts[1]:.3f})" if len(parts) == 2 else ""))
     lines.append(f"current model (effects: {cur}): RMSE {base.rmse_deg:.3f} deg = "
                  f"{_times(base.rmse_deg, floor)} the noise floor; held-out {d.base_heldout_rmse_deg:.3f} deg")
     where = describe(residual_atlas(d.data, base.residuals), floor)
@@ -197,6 +239,7 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
             lines.append(f"  {cmd}")
     else:
         lines.append("recommended: nothing")
+    lines += partial_lines(d)
     for note in d.sample_notes:
         lines.append(f"note: {note}")
     for name, why in d.rejected:

@@ -20,12 +20,16 @@ NAMES = {("stroke", True): "drive_error", ("time", True): "tendon_oscillation", 
 
 
 def of_diagnosis(d) -> dict | None:
-    """``unexplained`` of the diagnosis's final model (``None`` when it is within 1.15 x the noise floor)."""
+    """``unexplained`` of the diagnosis's final (or partial) model (``None`` when within 1.15 x the noise floor)."""
     try:
         return _MEMO[d]
     except (KeyError, TypeError):
         pass
-    u = analyse(d.final.residuals, variables_of(d.data), d.noise_floor_deg)
+    # the misfit no fitted effect explains: after the partial effects when there are some (they are fitted,
+    # but not recommended because the error stays above the floor), else after the recommended ones
+    steps = getattr(d, "partial_steps", ())
+    residual = steps[-1].residuals if getattr(d, "partial", ()) and steps else d.final.residuals
+    u = analyse(residual, variables_of(d.data), d.noise_floor_deg)
     try:
         _MEMO[d] = u
     except TypeError:
@@ -62,10 +66,13 @@ def text_lines(d, json_path: str = "DIAG.json") -> list[str]:
     if u is None:
         return []
     lines = describe(u)
-    if d.recommended:
+    if d.recommended:  # not reached by the diagnosis (a recommended chain is within 1.15 x the floor)
         lines.append(f"  note: with {', '.join(d.recommended)} the error stays at "
                      f"{d.final.rmse_deg / d.noise_floor_deg:.2f} x the floor; the recommended effect(s) may stand in "
                      f"for the physics above: try the starter effect without them")
+    if getattr(d, "partial", ()):
+        lines.append(f"  this is the misfit left with the partial effects ({', '.join(d.partial)}), which lower the "
+                     "error without explaining it: write the effect (start below) and diagnose again with it")
     if u.get("leading"):
         lines.append(f"  start an effect for it: camtube model effect new {suggested_name(u)} --from {json_path}"
                      f"  (the diagnosis's --json file)")

@@ -1,0 +1,101 @@
+"""Issue 12: a chain of effects is recommended only when it reaches 1.15 x the noise floor; the floor's
+uncertainty is honest (statistical + systematic), so a correct effect is not refused as noise fitting.
+
+Data: the independent foreign-effect simulator (examples/foreign_effects/generate.py), whose physics camtube's
+library lacks, and plain white noise with a known sigma.
+"""
+from __future__ import annotations
+
+import importlib.util
+import json
+import math
+import sys
+
+import numpy as np
+import pytest
+
+from camtube.design.loader import load_pattern
+from camtube.model.core.predict import model_for_pattern, pattern_values
+from camtube.model.core.registry import registry_with_files
+from camtube.model.data import Dataset
+from camtube.model.diagnose import diagnose
+from camtube.model.diagnose.search import REACH_RATIO, cycle_blocks, noise_floor, noise_floor_parts
+from camtube.model.report.diagnosis import diagnosis_dict, diagnosis_text
+from tests.conftest import PATTERNS, ROOT
+
+HERE = ROOT / "examples" / "foreign_effects"
+
+
+def _generator():
+    spec = importlib.util.spec_from_file_location("foreign_generate_reach", HERE / "generate.py")
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = mod
+    spec.loader.exec_module(mod)
+    return mod
+
+
+GEN = _generator()
+PATTERN = load_pattern(PATTERNS / "tube2.yaml")
+
+
+def _data(effect, params=None, seed=0, cycles=50, rate_hz=40.0):
+    rows, truth = GEN.simulate(effect, params, samples=2, cycles=cycles, seed=seed, joint=GEN.Joint(rate_hz=rate_hz))
+    return Dataset(rows["sample"], rows["cycle"].astype(int), rows["time"], rows["stroke"], rows["force"],
+                   rows["angle"]), truth
+
+
+def test_builtins_that_do_not_reach_the_floor_are_partial_not_recommended():
+    """The angle-dependent arm: built-ins lower the error but leave a structured misfit."""
+    data, truth = _data("arm", {"beta_per_rad": 0.6}, seed=3, cycles=12, rate_hz=20.0)
+    d = diagnose(model_for_pattern(PATTERN), data, ("E_t",), pattern_values(PATTERN))
+    assert d.recommended == ()
+    assert d.partial, d.stop_reason                      # something built-in helped, but not enough
+    steps = d.partial_steps
+    assert steps[-1].rmse_deg < steps[0].rmse_deg
+    assert steps[-1].rmse_deg > REACH_RATIO * d.noise_floor_deg
+    assert steps[-1].rmse_deg > 1.3 * truth.sensor_floor_deg    # independent truth: it really is above the floor
+    assert d.final is d.waterfall[0] and len(d.waterfall) == 1  # the final model is the current one
+    j = diagnosis_dict(d, "camtube model fit d.csv")
+    assert j["recommended"] == [] and [p["effect"] for p in j["partial"]] == list(d.partial)
+    assert j["command"] == ""
+    assert all(p["rmse_deg"] < p["rmse_before_deg"] for p in j["partial"])
+    assert j["unexplained"] is not None and j["unexplained"]["follows"][0] == "angle"
+    text = diagnosis_text(d, "camtube model fit d.csv")
+    assert "recommended: nothing" in text and "add them" not in text
+    assert "partial" in text and "structured misfit" in text
+
+
+def test_a_correct_user_effect_at_the_floor_is_not_refused_as_noise_fitting():
+    """2 x 50 cycles at 40 Hz: the right arm law reaches the true floor; the floor check must accept it."""
+    data, truth = _data("arm", {"beta_per_rad": 0.6}, seed=0)
+    reg, added = registry_with_files([HERE / "arm_change.py"])
+    d = diagnose(model_for_pattern(PATTERN), data, ("E_t",), pattern_values(PATTERN), registry=reg,
+                 candidates=["arm_change"])
+    assert d.recommended == ("arm_change",), d.rejected
+    assert d.final.params["arm_change.beta_per_rad"] == pytest.approx(0.6, rel=0.02)
+    assert d.final.rmse_deg <= REACH_RATIO * d.noise_floor_deg
+    stat, sys_ = d.noise_floor_parts_deg
+    assert sys_ > 0 and stat > 0 and d.noise_floor_se_deg == pytest.approx(math.hypot(stat, sys_))
+
+
+@pytest.mark.parametrize("rho", [0.0, -0.05, 0.05])
+def test_floor_uncertainty_covers_the_true_sigma(rho):
+    """White (rho 0) and weakly correlated noise of known sigma: the estimate is within 2 of its uncertainties,
+    and for white noise the systematic part is small."""
+    rng = np.random.default_rng(7)
+    n, sigma = 20000, 0.3
+    e = rng.normal(0.0, 1.0, n + 1)
+    x = (e[1:] + rho * e[:-1]) / math.sqrt(1.0 + rho**2) * sigma   # MA(1) noise with standard deviation sigma
+    sample = np.array(["A"] * (n // 2) + ["B"] * (n // 2), dtype=object)
+    cycle = np.tile(np.repeat(np.arange(1, 21), n // 40), 2)
+    t = np.tile(np.arange(n // 2) * 0.025, 2)
+    data = Dataset(sample, cycle, t, np.zeros(n), np.zeros(n), x)
+    block, _ = cycle_blocks(data)
+    est = noise_floor(data, x)
+    stat, syst = noise_floor_parts(data, x, block)
+    true = float(np.std(x))
+    assert abs(est - true) <= 2.0 * math.hypot(stat, syst), (est, true, stat, syst)
+    if rho == 0.0:
+        assert syst < 4.0 * stat
+    else:
+        assert syst > stat  # the estimators part when the noise is not white

@@ -1,0 +1,54 @@
+"""A broken user effect file: one line naming the file, the line in it, the effect and the problem; exit 2."""
+from __future__ import annotations
+
+import pytest
+
+from camtube.cli import main
+from tests.conftest import PATTERNS
+
+TUBE2 = str(PATTERNS / "tube2.yaml")
+
+HEAD = '''from camtube.model.api import Effect, Param
+import numpy as np
+
+
+def _apply(ctx, s, p):
+    x = np.asarray(s, float)
+'''
+TAIL = '''
+
+BROKEN = Effect(name="broken", stage="stroke", params=(Param("gain", "", 0.0, 2.0, 1.0, "gain"),), apply=_apply)
+'''
+# (body of _apply, words the message must hold); the faulty line is the first body line: line 7 of the file
+CASES = [
+    ('    y = x * p["gian"]\n    return y', ["'gian'", "'gain'"]),
+    ('    y = x / (p["gain"] - p["gain"]) if False else x.reshape(-1, 1)[:, 0] + undefined_name\n    return y',
+     ["NameError", "undefined_name"]),
+    ('    y = x[:-1] * p["gain"]\n    return y', ["shape"]),
+]
+
+
+@pytest.fixture(scope="module")
+def data_csv(tmp_path_factory):
+    path = tmp_path_factory.mktemp("e") / "d.csv"
+    assert main(["model", "synth", "--pattern", TUBE2, "-o", str(path), "--cycles", "2", "-q"]) == 0
+    return path
+
+
+@pytest.mark.parametrize("body,words", CASES)
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+def test_broken_effect_names_file_line_and_effect(tmp_path, capsys, data_csv, body, words, cmd):
+    src = HEAD + body + TAIL
+    f = tmp_path / "eff.py"
+    f.write_text(src, encoding="utf-8")
+    argv = ["model", cmd, str(data_csv), "--pattern", TUBE2, "-q", "--effect-file", str(f)]
+    argv += ["--effects", "broken"] if cmd == "fit" else ["--candidates", "broken"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert "Traceback" not in err and len(err.splitlines()) == 1, err
+    # the line: the faulty statement's (the function's def line for a wrong shape: the return is not a frame)
+    line = src.splitlines().index(body.splitlines()[0]) + 1
+    want = line if words != ["shape"] else src.splitlines().index("def _apply(ctx, s, p):") + 1
+    assert f"{f}:{want}" in err and "'broken'" in err, err
+    for w in words:
+        assert w in err, err
