@@ -200,6 +200,7 @@ TOE = Effect(
                   "elongation over which the tendon's fibres straighten (end of the toe region)",
                   kind="length"),),
     apply=_toe,
+    family="toe",
     meaning="toe region of the tendon: crimped fibres straighten first, so the tendon is soft at low "
             "force (force grows with elongation squared) and reaches its linear stiffness after toe_mm",
     signature="the residual is curved against force: it moves quickly at low force and is constant at "
@@ -211,6 +212,108 @@ def _visco(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
     lag = first_order_lag(ctx.data, np.asarray(ctx.force_N, float), p["tau_s"])
     # while the delayed elongation exceeds the stroke the tendon is slack: the joint stays straight
     return np.minimum(elong + p["ratio"] * ctx.compliance_mm_per_N * lag, ctx.stroke_mm)
+
+
+#: Grid points of the tabulated toe law of ``toe_shape`` (dense near zero elongation: x = x_max (i/N)^2).
+TOE_GRID = 1500
+
+
+def weibull_toe_force(x: np.ndarray, shape: float) -> np.ndarray:
+    """Normalised tension ``tau = C T / lam`` at normalised elongation ``x = e / lam`` of a Weibull-recruited tendon.
+
+    The fibres straighten at elongations distributed as Weibull (scale ``lam``, modulus ``shape``), so the
+    stiffness fraction is ``F(x) = 1 - exp(-x^shape)`` and
+    ``tau(x) = int_0^x F = x - Gamma(1 + 1/shape) P(1/shape, x^shape)`` (``P``: regularised lower
+    incomplete gamma function). Shape ``(n,)`` in, ``(n,)`` out (both dimensionless).
+    """
+    from scipy.special import gamma, gammainc
+
+    x = np.maximum(np.asarray(x, float), 0.0)
+    a = 1.0 / shape
+    xk = x**shape
+    out = x - gamma(1.0 + a) * gammainc(a, xk)
+    # small x: the difference cancels; the series int_0^x (u^k - u^2k / 2) du is exact to x^3k
+    small = xk < 1e-3
+    out[small] = x[small] * xk[small] * (1.0 / (shape + 1.0) - xk[small] / (2.0 * (2.0 * shape + 1.0)))
+    return out
+
+
+#: Time over which a toe law averages the measured force, as a fraction of the cycle period (see
+#: :func:`local_force_N`).
+TOE_FORCE_WINDOW = 1.0 / 20.0
+
+
+def local_force_N(ctx: Context) -> np.ndarray:
+    """(n,) force (N) averaged over a short centred window, per sample: the input of a steep tendon law.
+
+    The measured force is the tension plus white sensor noise. A toe law is steep at low tension
+    (its compliance grows without bound as the tension falls to zero), so evaluating it at the noisy
+    force turns a few mN of noise into a large, biased elongation error (errors in the variables).
+    The tension changes little within a small part of a cycle, so the law is evaluated at the force
+    averaged over :data:`TOE_FORCE_WINDOW` of the cycle period (a centred moving average of an odd
+    number of rows: no lag, a linear trend kept exactly; one row when the rows are sparser).
+    """
+    from scipy.ndimage import uniform_filter1d
+
+    key = "local_force_N"
+    f = np.asarray(ctx.force_N, float)
+    hit = ctx.cache.get(key)
+    if hit is not None and hit[0] is ctx.force_N:
+        return hit[1]
+    t = np.asarray(ctx.data.time_s, float)
+    window_s = TOE_FORCE_WINDOW * _period(ctx.data)
+    out = f.copy()
+    for _, sl in ctx.data.sample_slices():
+        if sl.stop - sl.start < 3:
+            continue
+        dt = float(np.median(np.diff(t[sl])))
+        rows = int(round(window_s / dt)) if dt > 0 else 1
+        rows = max(rows - (1 - rows % 2), 1)  # odd: centred
+        if rows > 1:
+            out[sl] = uniform_filter1d(f[sl], rows, mode="nearest")
+    ctx.cache[key] = (ctx.force_N, out)
+    return out
+
+
+def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
+    from scipy.special import gamma
+
+    mean = max(p["offset_mm"], 0.0)
+    k = p["shape"]
+    if mean <= 0.0:
+        return elong
+    c = ctx.compliance_mm_per_N
+    f = np.maximum(local_force_N(ctx), 0.0)
+    m = float(gamma(1.0 + 1.0 / k))        # mean straightening elongation in units of the Weibull scale
+    lam = mean / m                          # Weibull scale (mm)
+    tau = c * f / lam                       # normalised tension (the linear tendon's elongation / lam)
+    # tabulate tau(x) once, invert by interpolation; tau(x) >= x - m, so x_max covers every row
+    x_max = float(tau.max(initial=0.0)) + m + 1.0
+    xg = x_max * (np.arange(TOE_GRID + 1) / TOE_GRID) ** 2
+    tg = weibull_toe_force(xg, k)
+    x = np.interp(tau, tg, xg)
+    toe = lam * (x - tau)                   # elongation beyond the linear law, 0 .. offset_mm
+    # where the elongation exceeds the stroke the tendon is slack and the joint straight
+    return np.minimum(elong + toe, np.maximum(ctx.stroke_mm, elong))
+
+
+TOE_SHAPE = Effect(
+    name="toe_shape", stage="elongation",
+    params=(Param("offset_mm", "mm", 1e-3, 5.0, lambda d, c: 0.03 * _stroke_span(d),
+                  "mean elongation at which a fibre straightens: the linear part of the law is shifted by it",
+                  log=True, kind="length"),
+            Param("shape", "", 0.5, 10.0, 1.5,
+                  "Weibull modulus of the fibres' straightening elongations: 1 exponential toe, 2-4 an "
+                  "S-shaped (sigmoid) stiffening, large a sharp knee (like slack), below 1 a long, slow toe",
+                  log=True, starts=(0.8, 1.5, 3.5))),
+    apply=_toe_shape,
+    meaning="toe region with a fitted shape: the braid's fibres straighten one after another (their "
+            "straightening elongations Weibull-distributed), so the stiffness rises from zero to E_t over the "
+            "toe; the shape covers exponential, power-law and S-shaped toes",
+    signature="the residual is curved against force: it moves quickly at low force and is constant at "
+              "high force (the tendon stretches more than linear at the start)",
+    family="toe",
+)
 
 
 VISCOELASTIC = Effect(
@@ -350,7 +453,7 @@ FORCE_ZERO = Effect(
 )
 
 #: The built-in effects, in their documented order.
-BUILTIN_EFFECTS = (SLACK, PLAY, CREEP, FRICTION, TOE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS, HARDSTOP,
+BUILTIN_EFFECTS = (SLACK, PLAY, CREEP, FRICTION, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS, HARDSTOP,
                    ANGLE_BIAS, FORCE_ZERO)
 #: Built-in effect names in that order.
 BUILTINS = tuple(e.name for e in BUILTIN_EFFECTS)
