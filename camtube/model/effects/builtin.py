@@ -31,6 +31,7 @@ the stroke (one NumPy call per stroke reversal); the linear filter of
 from __future__ import annotations
 
 import math
+import weakref
 
 import numpy as np
 
@@ -214,7 +215,7 @@ def _visco(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
     return np.minimum(elong + p["ratio"] * ctx.compliance_mm_per_N * lag, ctx.stroke_mm)
 
 
-#: Grid points of the tabulated toe law of ``toe_shape`` (dense near zero elongation: x = x_max (i/N)^2).
+#: Grid points of the tabulated toe law of ``toe_shape`` (dense near zero: quadratic in the index).
 TOE_GRID = 1500
 
 
@@ -255,24 +256,59 @@ def local_force_N(ctx: Context) -> np.ndarray:
     """
     from scipy.ndimage import uniform_filter1d
 
-    key = "local_force_N"
     f = np.asarray(ctx.force_N, float)
-    hit = ctx.cache.get(key)
+    # speed: a fit evaluates the model many times with the same force array (no force-stage effect)
+    hit = _LOCAL_FORCE.get(ctx.data)
     if hit is not None and hit[0] is ctx.force_N:
         return hit[1]
-    t = np.asarray(ctx.data.time_s, float)
-    window_s = TOE_FORCE_WINDOW * _period(ctx.data)
     out = f.copy()
-    for _, sl in ctx.data.sample_slices():
-        if sl.stop - sl.start < 3:
-            continue
-        dt = float(np.median(np.diff(t[sl])))
-        rows = int(round(window_s / dt)) if dt > 0 else 1
-        rows = max(rows - (1 - rows % 2), 1)  # odd: centred
+    for sl, rows in _force_windows(ctx.data):
         if rows > 1:
             out[sl] = uniform_filter1d(f[sl], rows, mode="nearest")
-    ctx.cache[key] = (ctx.force_N, out)
+    _LOCAL_FORCE[ctx.data] = (ctx.force_N, out)
     return out
+
+
+_LOCAL_FORCE: "weakref.WeakKeyDictionary[Dataset, tuple]" = weakref.WeakKeyDictionary()
+_WINDOWS: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
+
+
+def _force_windows(data: Dataset) -> list:
+    """Cached per Dataset: ``(slice, rows)`` of each sample, ``rows`` the odd window of :func:`local_force_N`."""
+    hit = _WINDOWS.get(data)
+    if hit is None:
+        t = np.asarray(data.time_s, float)
+        window_s = TOE_FORCE_WINDOW * _period(data)
+        hit = []
+        for _, sl in data.sample_slices():
+            rows = 1
+            if sl.stop - sl.start >= 3:
+                dt = float(np.median(np.diff(t[sl])))
+                rows = int(round(window_s / dt)) if dt > 0 else 1
+                rows = max(rows - (1 - rows % 2), 1)  # odd: centred
+            hit.append((sl, rows))
+        _WINDOWS[data] = hit
+    return hit
+
+
+_TOE_TABLES: dict = {}
+
+
+def _toe_table(shape: float, x_min: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(x, tau(x))`` of :func:`weibull_toe_force` on ``TOE_GRID + 1`` points from 0 to at least ``x_min``.
+
+    Cached by shape and range (the range rounded up to a power of two): a fit's finite-difference steps in
+    the other parameters reuse the table.
+    """
+    x_max = 2.0 ** math.ceil(math.log2(max(x_min, 1e-6)))
+    key = (float(shape), x_max)
+    hit = _TOE_TABLES.get(key)
+    if hit is None:
+        if len(_TOE_TABLES) > 64:
+            _TOE_TABLES.clear()
+        xg = x_max * (np.arange(TOE_GRID + 1) / TOE_GRID) ** 2
+        hit = _TOE_TABLES[key] = (xg, weibull_toe_force(xg, shape))
+    return hit
 
 
 def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
@@ -288,10 +324,18 @@ def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
     lam = mean / m                          # Weibull scale (mm)
     tau = c * f / lam                       # normalised tension (the linear tendon's elongation / lam)
     # tabulate tau(x) once, invert by interpolation; tau(x) >= x - m, so x_max covers every row
-    x_max = float(tau.max(initial=0.0)) + m + 1.0
-    xg = x_max * (np.arange(TOE_GRID + 1) / TOE_GRID) ** 2
-    tg = weibull_toe_force(xg, k)
-    x = np.interp(tau, tg, xg)
+    t_max = float(tau.max(initial=0.0))
+    if t_max <= 0.0:
+        return elong
+    q = np.arange(TOE_GRID + 1) / TOE_GRID
+    xg, tg = _toe_table(k, t_max + m + 1.0)
+    # speed: x on a grid uniform in sqrt(tau) (one small interp), then rows by direct indexing
+    xj = np.interp(t_max * q**2, tg, xg)
+    pos = np.sqrt(tau * (1.0 / t_max)) * TOE_GRID
+    i = pos.astype(np.intp)
+    np.minimum(i, TOE_GRID - 1, out=i)
+    lo = xj.take(i)
+    x = lo + (pos - i) * (xj.take(i + 1) - lo)
     toe = lam * (x - tau)                   # elongation beyond the linear law, 0 .. offset_mm
     # where the elongation exceeds the stroke the tendon is slack and the joint straight
     return np.minimum(elong + toe, np.maximum(ctx.stroke_mm, elong))
