@@ -13,6 +13,8 @@ creep          stroke      tendon creep / drift over time (creep_mm, tau_s)
 friction       elongation  tendon-sheath friction: mean tension differs from the
                            load cell by a fraction, sign of motion (mu)
 toe            elongation  toe region of the tendon (quadratic, then linear) (toe_mm)
+toe_shape      elongation  toe region of fitted shape: Weibull fibre recruitment, at a short force
+                           average (offset_mm, shape)
 viscoelastic   elongation  standard linear solid: delayed elongation (ratio, tau_s)
 series         elongation  extra series compliance: sheath/tube compression (compliance_mm_per_N)
 kerf           kinematics  notch arc widened by the kerf: phi, hence the arm, change (kerf_mm)
