@@ -12,7 +12,8 @@ Run: ``python scripts/bench_diagnose.py [--batch tune|heldout|heldout2|speed|all
 ``tune``: the sets the method was tuned on. ``heldout``: a batch drawn with fresh seeds and parameters
 after the method was settled (seed 20261122; seen since, while ``toe_shape`` was built). ``heldout2``:
 drawn once ``toe_shape`` was settled (seed 20261123, seeds 7000-), with toe forms the library does not
-have (the truth's ``power`` and ``tanh`` toes). ``speed``: 10,000 and 200,000 rows (targets 5 s and 20 s).
+have (the truth's ``power`` and ``tanh`` toes); looked at since (the posterior-mean toe law followed).
+``heldout3``: drawn after that (seed 20261124, seeds 9000-), with Fung's exponential toe. ``speed``: 10,000 and 200,000 rows (targets 5 s and 20 s).
 """
 from __future__ import annotations
 
@@ -115,6 +116,31 @@ def heldout2_batch(seed: int = 20261123) -> list:
         ("viscoelastic", t(), Hidden(visco_ratio=(r := u(0.2, 0.6)), visco_tau_s=(tau := u(1.0, 4.0))),
          {"viscoelastic"}, {"viscoelastic.ratio": r, "viscoelastic.tau_s": tau}),
         ("slack", t(), Hidden(slack_mm=s1), {"slack"}, {"slack.deadband_mm": s1}),
+        ("control", t(), Hidden(), set(), {}),
+    ]
+
+
+def heldout3_batch(seed: int = 20261124) -> list:
+    """A third fresh batch, drawn once the posterior-mean toe law was settled (heldout2 had been looked at):
+    new seeds (9000-), new parameters, Fung's exponential toe (a form no camtube code had seen) and the
+    other truth toes with new values."""
+    rng = np.random.default_rng(seed)
+    u = lambda a, b: float(np.round(rng.uniform(a, b), 3))  # noqa: E731
+    tubes = ("tube1", "tube2", "tube3")
+    t = lambda: tubes[int(rng.integers(3))]  # noqa: E731
+    play, s1 = u(0.03, 0.12), u(0.04, 0.15)
+    return [
+        ("control", t(), Hidden(joint_friction_nmm=u(0.02, 0.1)), set(), {}),
+        ("fung-toe", t(), Hidden(toe_mm=u(0.2, 0.5), toe_form="fung"), TOES, {}),
+        ("fung-toe", t(), Hidden(toe_mm=u(0.2, 0.5), toe_form="fung"), TOES, {}),
+        ("fung-toe + play", "tube2", Hidden(toe_mm=u(0.2, 0.5), toe_form="fung", play_mm=play), TOES | {"play"},
+         {"play.play_mm": play}),
+        ("tanh-toe", t(), Hidden(toe_mm=u(0.1, 0.3), toe_form="tanh"), TOES, {}),
+        ("power-toe", t(), Hidden(toe_mm=u(0.2, 0.5), toe_form="power"), TOES, {}),
+        ("exp-toe", t(), Hidden(toe_mm=u(0.15, 0.45), toe_form="exponential"), TOES, {}),
+        ("slack per sample", "tube2", [Hidden(slack_mm=s1), Hidden(slack_mm=(s2 := u(0.1, 0.2)))], {"slack"},
+         {"slack.deadband_mm@1": s1, "slack.deadband_mm@2": s2}),
+        ("play", t(), Hidden(play_mm=play), {"play"}, {"play.play_mm": play}),
         ("control", t(), Hidden(), set(), {}),
     ]
 
@@ -232,12 +258,12 @@ def speed() -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--batch", default="tune", choices=("tune", "heldout", "heldout2", "speed", "all"))
+    ap.add_argument("--batch", default="tune", choices=("tune", "heldout", "heldout2", "heldout3", "speed", "all"))
     args = ap.parse_args()
     if args.batch in ("speed", "all", "tune"):
         speed()
     for batch, sets, seed0 in (("tune", TUNE, 100), ("heldout", heldout_batch, 5000),
-                               ("heldout2", heldout2_batch, 7000)):
+                               ("heldout2", heldout2_batch, 7000), ("heldout3", heldout3_batch, 9000)):
         if args.batch not in (batch, "all"):
             continue
         sets = sets if not callable(sets) else sets()

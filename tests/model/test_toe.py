@@ -157,3 +157,40 @@ def test_diagnosis_on_a_toe_form_the_library_does_not_have(tube2, form):
     assert d.final.rmse_deg <= 1.15 * floor, (d.final.rmse_deg, floor)
     for name, se in d.final.stderr.items():
         assert math.isfinite(se) and se > 0, name
+
+
+def test_near_zero_force_the_law_is_averaged_over_the_tensions_posterior(tube2):
+    """Rows with a force near zero: the model's toe elongation is the mean of the law over a normal of the
+    force noise's size truncated at zero (checked by trapezoidal integration of the noise-free law)."""
+    from scipy.stats import norm
+
+    from camtube.model.effects.builtin import local_force_sd_N
+
+    rng = np.random.default_rng(5)
+    n = 3000
+    f = rng.normal(0.0, 0.005, n) + np.repeat([0.0, 0.01, 0.05], n // 3)
+    # one cycle per row: the force window is one row (no average), only the posterior mean acts
+    data = Dataset(np.array(["a"] * n, dtype=object), np.arange(1, n + 1), np.arange(n) * 0.1, np.full(n, 5.0), f,
+                   np.zeros(n))
+    sd = local_force_sd_N(data)
+    assert sd[0] == pytest.approx(0.005, rel=0.1)  # the white noise of the force, from its differences
+    m = model_for_pattern(tube2, ["toe_shape"])
+    vals = m.initial_values(data, pattern_values(tube2)) | {"toe_shape.offset_mm": 0.3, "toe_shape.shape": 1.0}
+    c = m.compliance_mm_per_N(vals)
+    arm = m.geometry.moment_arm_mm
+    extra = 5.0 - np.radians(m.predict(data, vals)) * arm - c * f  # toe elongation (mm) per row
+    # the noise-free law on a fine force grid (no noise: one sample per force, constant rows)
+    grid = np.concatenate([[0.0], np.geomspace(1e-7, 0.2, 1500)])
+    law_data = _const_force_data(grid, rows=5)
+    law = (5.0 - np.radians(m.predict(law_data, vals)) * arm)[::5] - c * grid
+    checked = 0
+    for i in range(0, n, 97):
+        mu, s = f[i], sd[i]
+        if mu >= 4 * s:
+            assert extra[i] == pytest.approx(np.interp(mu, grid, law), rel=1e-3)  # the law at the force itself
+            continue
+        checked += 1
+        w = norm.pdf(grid, mu, s)
+        want = np.trapezoid(law * w, grid) / np.trapezoid(w, grid)
+        assert extra[i] == pytest.approx(want, rel=0.03), (i, mu)
+    assert checked > 10

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import math
 import weakref
+from typing import Callable
 
 import numpy as np
 
@@ -241,6 +242,10 @@ def weibull_toe_force(x: np.ndarray, shape: float) -> np.ndarray:
     return out
 
 
+#: Rows whose averaged force is below this many noise standard deviations take the posterior mean of the law.
+TOE_LOW_SD = 4.0
+#: Quantile nodes of that posterior mean.
+TOE_NODES = 16
 #: Time over which a toe law averages the measured force, as a fraction of the cycle period (see
 #: :func:`local_force_N`).
 TOE_FORCE_WINDOW = 1.0 / 20.0
@@ -264,7 +269,7 @@ def local_force_N(ctx: Context) -> np.ndarray:
     if hit is not None and hit[0] is ctx.force_N:
         return hit[1]
     out = f.copy()
-    for sl, rows in _force_windows(ctx.data):
+    for sl, rows, _ in _force_windows(ctx.data):
         if rows > 1:
             out[sl] = uniform_filter1d(f[sl], rows, mode="nearest")
     _LOCAL_FORCE[ctx.data] = (ctx.force_N, out)
@@ -275,11 +280,23 @@ _LOCAL_FORCE: "weakref.WeakKeyDictionary[Dataset, tuple]" = weakref.WeakKeyDicti
 _WINDOWS: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
 
 
+def _white_noise_sd(x: np.ndarray) -> float:
+    """Standard deviation of the white noise on a smooth signal ``x`` (n,): robust, from high-order differences."""
+    best = math.inf
+    for k, norm in ((2, 6.0), (3, 20.0), (4, 70.0)):
+        if x.size > k + 4:
+            d = np.diff(x, k)
+            best = min(best, 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(norm))
+    return best if math.isfinite(best) else 0.0
+
+
 def _force_windows(data: Dataset) -> list:
-    """Cached per Dataset: ``(slice, rows)`` of each sample, ``rows`` the odd window of :func:`local_force_N`."""
+    """Cached per Dataset: ``(slice, rows, sd_N)`` of each sample: the odd window of :func:`local_force_N` and
+    the standard deviation of the noise left on the averaged force (white noise / sqrt(rows))."""
     hit = _WINDOWS.get(data)
     if hit is None:
         t = np.asarray(data.time_s, float)
+        f = np.asarray(data.force_N, float)
         window_s = TOE_FORCE_WINDOW * _period(data)
         hit = []
         for _, sl in data.sample_slices():
@@ -288,9 +305,17 @@ def _force_windows(data: Dataset) -> list:
                 dt = float(np.median(np.diff(t[sl])))
                 rows = int(round(window_s / dt)) if dt > 0 else 1
                 rows = max(rows - (1 - rows % 2), 1)  # odd: centred
-            hit.append((sl, rows))
+            hit.append((sl, rows, _white_noise_sd(f[sl]) / math.sqrt(rows)))
         _WINDOWS[data] = hit
     return hit
+
+
+def local_force_sd_N(data: Dataset) -> np.ndarray:
+    """(n,) standard deviation (N) of the noise left on :func:`local_force_N`, per sample."""
+    out = np.zeros(len(data))
+    for sl, _, sd in _force_windows(data):
+        out[sl] = sd
+    return out
 
 
 _TOE_TABLES: dict = {}
@@ -313,6 +338,35 @@ def _toe_table(shape: float, x_min: float) -> tuple[np.ndarray, np.ndarray]:
     return hit
 
 
+def toe_elongation(ctx: Context, elong: np.ndarray, extra: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    """Add a toe law's elongation ``extra(force_N) -> mm`` (beyond the linear law) to ``elong`` (n,).
+
+    The law is evaluated at :func:`local_force_N`; near zero force, where it is steep, it is averaged
+    over the tension's posterior given the averaged force (a normal of the remaining noise's size,
+    :func:`local_force_sd_N`, truncated at zero: a tendon cannot push), by :data:`TOE_NODES` quantile
+    nodes. Where the elongation would exceed the stroke the tendon is slack and the joint straight.
+    """
+    fa = local_force_N(ctx)
+    f = np.maximum(fa, 0.0)
+    sd = local_force_sd_N(ctx.data)
+    low = np.flatnonzero(fa < TOE_LOW_SD * sd)
+    if low.size:
+        from scipy.special import ndtr, ndtri
+
+        mu, s = fa[low], sd[low]
+        p0 = ndtr(-mu / s)[:, None]
+        u = (np.arange(TOE_NODES) + 0.5) / TOE_NODES
+        fq = mu[:, None] + s[:, None] * ndtri(np.minimum(p0 + u[None, :] * (1.0 - p0), 1.0 - 1e-12))
+        f = np.concatenate([f, np.maximum(fq, 0.0).ravel()])
+    toe = extra(f)
+    n = elong.size
+    if low.size:
+        rows = toe[:n].copy()
+        rows[low] = toe[n:].reshape(low.size, TOE_NODES).mean(axis=1)
+        toe = rows
+    return np.minimum(elong + toe, np.maximum(ctx.stroke_mm, elong))
+
+
 def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
     from scipy.special import gamma
 
@@ -321,26 +375,26 @@ def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
     if mean <= 0.0:
         return elong
     c = ctx.compliance_mm_per_N
-    f = np.maximum(local_force_N(ctx), 0.0)
     m = float(gamma(1.0 + 1.0 / k))        # mean straightening elongation in units of the Weibull scale
     lam = mean / m                          # Weibull scale (mm)
-    tau = c * f / lam                       # normalised tension (the linear tendon's elongation / lam)
-    # tabulate tau(x) once, invert by interpolation; tau(x) >= x - m, so x_max covers every row
-    t_max = float(tau.max(initial=0.0))
-    if t_max <= 0.0:
-        return elong
-    q = np.arange(TOE_GRID + 1) / TOE_GRID
-    xg, tg = _toe_table(k, t_max + m + 1.0)
-    # speed: x on a grid uniform in sqrt(tau) (one small interp), then rows by direct indexing
-    xj = np.interp(t_max * q**2, tg, xg)
-    pos = np.sqrt(tau * (1.0 / t_max)) * TOE_GRID
-    i = pos.astype(np.intp)
-    np.minimum(i, TOE_GRID - 1, out=i)
-    lo = xj.take(i)
-    x = lo + (pos - i) * (xj.take(i + 1) - lo)
-    toe = lam * (x - tau)                   # elongation beyond the linear law, 0 .. offset_mm
-    # where the elongation exceeds the stroke the tendon is slack and the joint straight
-    return np.minimum(elong + toe, np.maximum(ctx.stroke_mm, elong))
+
+    def extra(f: np.ndarray) -> np.ndarray:
+        tau = c * f / lam                   # normalised tension (the linear tendon's elongation / lam)
+        # tabulate tau(x) once, invert by interpolation; tau(x) >= x - m, so x_max covers every row
+        t_max = float(tau.max(initial=0.0))
+        if t_max <= 0.0:
+            return np.zeros_like(tau)
+        q = np.arange(TOE_GRID + 1) / TOE_GRID
+        xg, tg = _toe_table(k, t_max + m + 1.0)
+        # speed: x on a grid uniform in sqrt(tau) (one small interp), then rows by direct indexing
+        xj = np.interp(t_max * q**2, tg, xg)
+        pos = np.sqrt(tau * (1.0 / t_max)) * TOE_GRID
+        i = pos.astype(np.intp)
+        np.minimum(i, TOE_GRID - 1, out=i)
+        lo = xj.take(i)
+        return lam * (lo + (pos - i) * (xj.take(i + 1) - lo) - tau)  # 0 .. offset_mm
+
+    return toe_elongation(ctx, elong, extra)
 
 
 TOE_SHAPE = Effect(

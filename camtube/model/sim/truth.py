@@ -42,7 +42,7 @@ from camtube.model.sim.synth import triangle_stroke
 
 
 #: Toe-region laws of the truth simulator (see :attr:`Hidden.toe_form`).
-TOE_FORMS = ("quadratic", "exponential", "power", "tanh")
+TOE_FORMS = ("quadratic", "exponential", "power", "tanh", "fung")
 
 
 @dataclass(frozen=True)
@@ -72,8 +72,9 @@ class Hidden:
         shifted by ``e_t``; ``toe_shape`` with modulus 1); ``power``: stiffness rising as
         ``(e / e_t)^2`` up to ``e_t`` (a convex, power-law toe: ``T = e^3 / (3 e_t^2 C)``, then
         ``(e - 2 e_t / 3) / C``); ``tanh``: stiffness ``tanh(e / e_t)``
-        (``T = e_t log cosh(e / e_t) / C``, asymptote shifted by ``e_t ln 2``). The last two are forms
-        the library does not have.
+        (``T = e_t log cosh(e / e_t) / C``, asymptote shifted by ``e_t ln 2``); ``fung``: Fung's
+        exponential toe, stiffness ``exp(3 (e / e_t - 1))`` up to ``e_t`` (5 % of the linear stiffness at
+        zero force, a sharp knee), then linear. The last three are forms the library does not have.
     cycle_creep_mm, cycle_creep_n : float
         Creep counted in cycles: the tendon has lengthened by
         ``cycle_creep_mm (1 - exp(-(k - 1) / cycle_creep_n))`` during cycle ``k`` (a step at each
@@ -132,6 +133,10 @@ def _tension(e: float, c: float, et: float, exponential: bool = False, form: str
         return (e + et * math.expm1(-e / et)) / c
     if form == "power" and et > 0.0:
         return (e**3 / (3.0 * et * et) if e < et else e - 2.0 * et / 3.0) / c
+    if form == "fung" and et > 0.0:
+        if e < et:
+            return et / 3.0 * (math.exp(3.0 * (e / et - 1.0)) - math.exp(-3.0)) / c
+        return (et / 3.0 * -math.expm1(-3.0) + e - et) / c
     if form == "tanh" and et > 0.0:
         x = e / et
         return et * (x + math.log1p(math.exp(-2.0 * x)) - math.log(2.0)) / c
