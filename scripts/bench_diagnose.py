@@ -7,13 +7,14 @@ effects, the first candidate (and what it is declared indistinguishable from), t
 RMSE before/after, the estimated and true sensor floors, whether the printed `camtube model fit` command
 reproduces the final RMSE (it is run), per-sample values, and the seconds of the diagnosis.
 
-Run: ``python scripts/bench_diagnose.py [--batch tune|heldout|heldout2|speed|all]``
+Run: ``python scripts/bench_diagnose.py [--batch tune|heldout|heldout2|heldout3|speed|all]``
 
 ``tune``: the sets the method was tuned on. ``heldout``: a batch drawn with fresh seeds and parameters
 after the method was settled (seed 20261122; seen since, while ``toe_shape`` was built). ``heldout2``:
 drawn once ``toe_shape`` was settled (seed 20261123, seeds 7000-), with toe forms the library does not
 have (the truth's ``power`` and ``tanh`` toes); looked at since (the posterior-mean toe law followed).
-``heldout3``: drawn after that (seed 20261124, seeds 9000-), with Fung's exponential toe. ``speed``: 10,000 and 200,000 rows (targets 5 s and 20 s).
+``heldout3``: drawn after that (seed 20261124, seeds 9000-), with Fung's exponential toe.
+``speed``: 10,000 and 200,000 rows (targets 5 s and 20 s).
 """
 from __future__ import annotations
 

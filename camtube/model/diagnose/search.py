@@ -46,7 +46,8 @@ Method
    The next round retries only the candidates whose held-out RMSE fell by ``min_gain`` in this one.
 7. The search stops when the held-out RMSE is within ``stop_ratio`` of the
    noise floor (the held-out RMSE at full resolution: the all-rows RMSE times the
-   held-out / in-sample ratio of the search rows, which see a coarser history) (``stop_ratio=None`` turns the rule off: the significance
+   held-out / in-sample ratio of the search rows, which see a coarser history)
+   (``stop_ratio=None`` turns the rule off: the significance
    tests alone must then stop it), when nothing qualifies, or after
    ``max_effects``.
 

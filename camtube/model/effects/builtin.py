@@ -553,7 +553,7 @@ FORCE_ZERO = Effect(
 )
 
 #: The built-in effects, in their documented order.
-BUILTIN_EFFECTS = (SLACK, PLAY, CREEP, FRICTION, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS, HARDSTOP,
-                   ANGLE_BIAS, FORCE_ZERO)
+BUILTIN_EFFECTS = (SLACK, PLAY, CREEP, FRICTION, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
+                   HARDSTOP, ANGLE_BIAS, FORCE_ZERO)
 #: Built-in effect names in that order.
 BUILTINS = tuple(e.name for e in BUILTIN_EFFECTS)
