@@ -33,6 +33,8 @@ Method
    constants between three sample intervals and the record length, lengths
    within the stroke span, ``E_t`` within ``modulus_range_gpa``. A candidate
    that fails a check is listed with the reason and never recommended.
+   Among candidates that cannot be told apart, the lowest BIC leads, unless one with fewer parameters
+   is within ``bic_threshold`` of it (then the simpler one leads).
 5. **All-rows check.** The best trusted, significant candidate is refitted
    on every row, exactly as the printed ``model fit`` command does (same
    rows, same starts: ``--init`` values and ``--starts``). It is recommended
@@ -47,7 +49,9 @@ Method
    final model leaves worse than the current one.
    The next round retries only the candidates whose held-out RMSE fell by ``min_gain`` in this one.
 7. The search stops when the held-out RMSE is within ``stop_ratio`` of the
-   noise floor (``stop_ratio=None`` turns the rule off: the significance
+   noise floor (the held-out RMSE at full resolution: the all-rows RMSE times the
+   held-out / in-sample ratio of the search rows, which see a coarser history)
+   (``stop_ratio=None`` turns the rule off: the significance
    tests alone must then stop it), when nothing qualifies, or after
    ``max_effects``.
 8. **Reach the floor or say so.** The chain of accepted effects is
@@ -566,8 +570,11 @@ def diagnose(
     chosen: list[Effect] = []
     stop = ""
     while True:
-        if stop_ratio is not None and cur_ho <= stop_ratio * floor:
-            stop = (f"the held-out RMSE {cur_ho:.3f} deg is within {stop_ratio:g} x the noise floor "
+        # the held-out RMSE at full resolution: the all-rows RMSE times the held-out / in-sample ratio of the
+        # search rows (thinned rows see a coarser history and a shorter force average than all rows do)
+        ho_full = prev_all.rmse * cur_ho / cur.rmse if cur.rmse > 0 else cur_ho
+        if stop_ratio is not None and ho_full <= stop_ratio * floor:
+            stop = (f"the held-out RMSE {ho_full:.3f} deg (all rows) is within {stop_ratio:g} x the noise floor "
                     f"{floor:.3f} deg: nothing left to explain")
             break
         if len(recommended) >= max_effects:
@@ -790,6 +797,11 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
     if out and out[0].equivalent:
         group = [c for c in out if c is out[0] or c.effect in out[0].equivalent]
         lead = min(group, key=lambda c: (not c.significant, c.delta_bic, c.effect))
+        # Occam: an indistinguishable candidate with fewer parameters whose BIC is within the threshold leads
+        simpler = [c for c in group if c.significant == lead.significant and len(c.params) < len(lead.params)
+                   and c.delta_bic <= lead.delta_bic + bic_threshold]
+        if simpler:
+            lead = min(simpler, key=lambda c: (len(c.params), c.delta_bic, c.effect))
         out.remove(lead)
         out.insert(0, lead)
     # trusted, significant candidates first (in that order), then the rest

@@ -13,6 +13,8 @@ creep          stroke      tendon creep / drift over time (creep_mm, tau_s)
 friction       elongation  tendon-sheath friction: mean tension differs from the
                            load cell by a fraction, sign of motion (mu)
 toe            elongation  toe region of the tendon (quadratic, then linear) (toe_mm)
+toe_shape      elongation  toe region of fitted shape: Weibull fibre recruitment, at a short force
+                           average (offset_mm, shape)
 viscoelastic   elongation  standard linear solid: delayed elongation (ratio, tau_s)
 series         elongation  extra series compliance: sheath/tube compression (compliance_mm_per_N)
 kerf           kinematics  notch arc widened by the kerf: phi, hence the arm, change (kerf_mm)
@@ -31,6 +33,8 @@ the stroke (one NumPy call per stroke reversal); the linear filter of
 from __future__ import annotations
 
 import math
+import weakref
+from typing import Callable
 
 import numpy as np
 
@@ -200,6 +204,7 @@ TOE = Effect(
                   "elongation over which the tendon's fibres straighten (end of the toe region)",
                   kind="length"),),
     apply=_toe,
+    family="toe",
     meaning="toe region of the tendon: crimped fibres straighten first, so the tendon is soft at low "
             "force (force grows with elongation squared) and reaches its linear stiffness after toe_mm",
     signature="the residual is curved against force: it moves quickly at low force and is constant at "
@@ -211,6 +216,204 @@ def _visco(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
     lag = first_order_lag(ctx.data, np.asarray(ctx.force_N, float), p["tau_s"])
     # while the delayed elongation exceeds the stroke the tendon is slack: the joint stays straight
     return np.minimum(elong + p["ratio"] * ctx.compliance_mm_per_N * lag, ctx.stroke_mm)
+
+
+#: Grid points of the tabulated toe law of ``toe_shape`` (dense near zero: quadratic in the index).
+TOE_GRID = 1500
+
+
+def weibull_toe_force(x: np.ndarray, shape: float) -> np.ndarray:
+    """Normalised tension ``tau = C T / lam`` at normalised elongation ``x = e / lam`` of a Weibull-recruited tendon.
+
+    The fibres straighten at elongations distributed as Weibull (scale ``lam``, modulus ``shape``), so the
+    stiffness fraction is ``F(x) = 1 - exp(-x^shape)`` and
+    ``tau(x) = int_0^x F = x - Gamma(1 + 1/shape) P(1/shape, x^shape)`` (``P``: regularised lower
+    incomplete gamma function). Shape ``(n,)`` in, ``(n,)`` out (both dimensionless).
+    """
+    from scipy.special import gamma, gammainc
+
+    x = np.maximum(np.asarray(x, float), 0.0)
+    a = 1.0 / shape
+    xk = x**shape
+    out = x - gamma(1.0 + a) * gammainc(a, xk)
+    # small x: the difference cancels; the series int_0^x (u^k - u^2k / 2) du is exact to x^3k
+    small = xk < 1e-3
+    out[small] = x[small] * xk[small] * (1.0 / (shape + 1.0) - xk[small] / (2.0 * (2.0 * shape + 1.0)))
+    return out
+
+
+#: Rows whose averaged force is below this many noise standard deviations take the posterior mean of the law.
+TOE_LOW_SD = 4.0
+#: Quantile nodes of that posterior mean.
+TOE_NODES = 16
+#: Time over which a toe law averages the measured force, as a fraction of the cycle period (see
+#: :func:`local_force_N`).
+TOE_FORCE_WINDOW = 1.0 / 20.0
+
+
+def local_force_N(ctx: Context) -> np.ndarray:
+    """(n,) force (N) averaged over a short centred window, per sample: the input of a steep tendon law.
+
+    The measured force is the tension plus white sensor noise. A toe law is steep at low tension
+    (its compliance grows without bound as the tension falls to zero), so evaluating it at the noisy
+    force turns a few mN of noise into a large, biased elongation error (errors in the variables).
+    The tension changes little within a small part of a cycle, so the law is evaluated at the force
+    averaged over :data:`TOE_FORCE_WINDOW` of the cycle period (a centred moving average of an odd
+    number of rows: no lag, a linear trend kept exactly; one row when the rows are sparser).
+    """
+    from scipy.ndimage import uniform_filter1d
+
+    f = np.asarray(ctx.force_N, float)
+    # speed: a fit evaluates the model many times with the same force array (no force-stage effect)
+    hit = _LOCAL_FORCE.get(ctx.data)
+    if hit is not None and hit[0] is ctx.force_N:
+        return hit[1]
+    out = f.copy()
+    for sl, rows, _ in _force_windows(ctx.data):
+        if rows > 1:
+            out[sl] = uniform_filter1d(f[sl], rows, mode="nearest")
+    _LOCAL_FORCE[ctx.data] = (ctx.force_N, out)
+    return out
+
+
+_LOCAL_FORCE: "weakref.WeakKeyDictionary[Dataset, tuple]" = weakref.WeakKeyDictionary()
+_WINDOWS: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
+
+
+def _white_noise_sd(x: np.ndarray) -> float:
+    """Standard deviation of the white noise on a smooth signal ``x`` (n,): robust, from high-order differences."""
+    best = math.inf
+    for k, norm in ((2, 6.0), (3, 20.0), (4, 70.0)):
+        if x.size > k + 4:
+            d = np.diff(x, k)
+            best = min(best, 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(norm))
+    return best if math.isfinite(best) else 0.0
+
+
+def _force_windows(data: Dataset) -> list:
+    """Cached per Dataset: ``(slice, rows, sd_N)`` of each sample: the odd window of :func:`local_force_N` and
+    the standard deviation of the noise left on the averaged force (white noise / sqrt(rows))."""
+    hit = _WINDOWS.get(data)
+    if hit is None:
+        t = np.asarray(data.time_s, float)
+        f = np.asarray(data.force_N, float)
+        window_s = TOE_FORCE_WINDOW * _period(data)
+        hit = []
+        for _, sl in data.sample_slices():
+            rows = 1
+            if sl.stop - sl.start >= 3:
+                dt = float(np.median(np.diff(t[sl])))
+                rows = int(round(window_s / dt)) if dt > 0 else 1
+                rows = max(rows - (1 - rows % 2), 1)  # odd: centred
+            hit.append((sl, rows, _white_noise_sd(f[sl]) / math.sqrt(rows)))
+        _WINDOWS[data] = hit
+    return hit
+
+
+def local_force_sd_N(data: Dataset) -> np.ndarray:
+    """(n,) standard deviation (N) of the noise left on :func:`local_force_N`, per sample."""
+    out = np.zeros(len(data))
+    for sl, _, sd in _force_windows(data):
+        out[sl] = sd
+    return out
+
+
+_TOE_TABLES: dict = {}
+
+
+def _toe_table(shape: float, x_min: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(x, tau(x))`` of :func:`weibull_toe_force` on ``TOE_GRID + 1`` points from 0 to at least ``x_min``.
+
+    Cached by shape and range (the range rounded up to a power of two): a fit's finite-difference steps in
+    the other parameters reuse the table.
+    """
+    x_max = 2.0 ** math.ceil(math.log2(max(x_min, 1e-6)))
+    key = (float(shape), x_max)
+    hit = _TOE_TABLES.get(key)
+    if hit is None:
+        if len(_TOE_TABLES) > 64:
+            _TOE_TABLES.clear()
+        xg = x_max * (np.arange(TOE_GRID + 1) / TOE_GRID) ** 2
+        hit = _TOE_TABLES[key] = (xg, weibull_toe_force(xg, shape))
+    return hit
+
+
+def toe_elongation(ctx: Context, elong: np.ndarray, extra: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    """Add a toe law's elongation ``extra(force_N) -> mm`` (beyond the linear law) to ``elong`` (n,).
+
+    The law is evaluated at :func:`local_force_N`; near zero force, where it is steep, it is averaged
+    over the tension's posterior given the averaged force (a normal of the remaining noise's size,
+    :func:`local_force_sd_N`, truncated at zero: a tendon cannot push), by :data:`TOE_NODES` quantile
+    nodes. Where the elongation would exceed the stroke the tendon is slack and the joint straight.
+    """
+    fa = local_force_N(ctx)
+    f = np.maximum(fa, 0.0)
+    sd = local_force_sd_N(ctx.data)
+    low = np.flatnonzero(fa < TOE_LOW_SD * sd)
+    if low.size:
+        from scipy.special import ndtr, ndtri
+
+        mu, s = fa[low], sd[low]
+        p0 = ndtr(-mu / s)[:, None]
+        u = (np.arange(TOE_NODES) + 0.5) / TOE_NODES
+        fq = mu[:, None] + s[:, None] * ndtri(np.minimum(p0 + u[None, :] * (1.0 - p0), 1.0 - 1e-12))
+        f = np.concatenate([f, np.maximum(fq, 0.0).ravel()])
+    toe = extra(f)
+    n = elong.size
+    if low.size:
+        rows = toe[:n].copy()
+        rows[low] = toe[n:].reshape(low.size, TOE_NODES).mean(axis=1)
+        toe = rows
+    return np.minimum(elong + toe, np.maximum(ctx.stroke_mm, elong))
+
+
+def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
+    from scipy.special import gamma
+
+    mean = max(p["offset_mm"], 0.0)
+    k = p["shape"]
+    if mean <= 0.0:
+        return elong
+    c = ctx.compliance_mm_per_N
+    m = float(gamma(1.0 + 1.0 / k))        # mean straightening elongation in units of the Weibull scale
+    lam = mean / m                          # Weibull scale (mm)
+
+    def extra(f: np.ndarray) -> np.ndarray:
+        tau = c * f / lam                   # normalised tension (the linear tendon's elongation / lam)
+        # tabulate tau(x) once, invert by interpolation; tau(x) >= x - m, so x_max covers every row
+        t_max = float(tau.max(initial=0.0))
+        if t_max <= 0.0:
+            return np.zeros_like(tau)
+        q = np.arange(TOE_GRID + 1) / TOE_GRID
+        xg, tg = _toe_table(k, t_max + m + 1.0)
+        # speed: x on a grid uniform in sqrt(tau) (one small interp), then rows by direct indexing
+        xj = np.interp(t_max * q**2, tg, xg)
+        pos = np.sqrt(tau * (1.0 / t_max)) * TOE_GRID
+        i = pos.astype(np.intp)
+        np.minimum(i, TOE_GRID - 1, out=i)
+        lo = xj.take(i)
+        return lam * (lo + (pos - i) * (xj.take(i + 1) - lo) - tau)  # 0 .. offset_mm
+
+    return toe_elongation(ctx, elong, extra)
+
+
+TOE_SHAPE = Effect(
+    name="toe_shape", stage="elongation",
+    params=(Param("offset_mm", "mm", 1e-3, 5.0, lambda d, c: 0.03 * _stroke_span(d),
+                  "mean elongation at which a fibre straightens: the linear part of the law is shifted by it",
+                  log=True, kind="length"),
+            Param("shape", "", 0.5, 10.0, 1.5,
+                  "Weibull modulus of the fibres' straightening elongations: 1 exponential toe, 2-4 an "
+                  "S-shaped (sigmoid) stiffening, large a sharp knee (like slack), below 1 a long, slow toe",
+                  log=True, starts=(0.8, 1.5, 3.5))),
+    apply=_toe_shape,
+    meaning="toe region with a fitted shape: the braid's fibres straighten one after another (their "
+            "straightening elongations Weibull-distributed), so the stiffness rises from zero to E_t over the "
+            "toe; the shape covers exponential, power-law and S-shaped toes",
+    signature="the residual is curved against force: it moves quickly at low force and is constant at "
+              "high force (the tendon stretches more than linear at the start)",
+    family="toe",
+)
 
 
 VISCOELASTIC = Effect(
@@ -350,7 +553,7 @@ FORCE_ZERO = Effect(
 )
 
 #: The built-in effects, in their documented order.
-BUILTIN_EFFECTS = (SLACK, PLAY, CREEP, FRICTION, TOE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS, HARDSTOP,
-                   ANGLE_BIAS, FORCE_ZERO)
+BUILTIN_EFFECTS = (SLACK, PLAY, CREEP, FRICTION, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
+                   HARDSTOP, ANGLE_BIAS, FORCE_ZERO)
 #: Built-in effect names in that order.
 BUILTINS = tuple(e.name for e in BUILTIN_EFFECTS)

@@ -41,6 +41,10 @@ from camtube.model.data.dataset import Dataset
 from camtube.model.sim.synth import triangle_stroke
 
 
+#: Toe-region laws of the truth simulator (see :attr:`Hidden.toe_form`).
+TOE_FORMS = ("quadratic", "exponential", "power", "tanh", "fung")
+
+
 @dataclass(frozen=True)
 class Hidden:
     """The physics the base model leaves out (all zero: the base model plus the friction trap).
@@ -63,9 +67,14 @@ class Hidden:
     angle_bias_deg, force_zero_N : float
         Sensor offsets.
     toe_form : str
-        ``quadratic`` (the library's law) or ``exponential``:
+        ``quadratic`` (the library's ``toe`` law); ``exponential``:
         ``T(e) = (e - e_t (1 - exp(-e / e_t))) / C`` (soft at zero force, the same linear asymptote
-        shifted by ``e_t``), a form the library does not have.
+        shifted by ``e_t``; ``toe_shape`` with modulus 1); ``power``: stiffness rising as
+        ``(e / e_t)^2`` up to ``e_t`` (a convex, power-law toe: ``T = e^3 / (3 e_t^2 C)``, then
+        ``(e - 2 e_t / 3) / C``); ``tanh``: stiffness ``tanh(e / e_t)``
+        (``T = e_t log cosh(e / e_t) / C``, asymptote shifted by ``e_t ln 2``); ``fung``: Fung's
+        exponential toe, stiffness ``exp(3 (e / e_t - 1))`` up to ``e_t`` (5 % of the linear stiffness at
+        zero force, a sharp knee), then linear. The last three are forms the library does not have.
     cycle_creep_mm, cycle_creep_n : float
         Creep counted in cycles: the tendon has lengthened by
         ``cycle_creep_mm (1 - exp(-(k - 1) / cycle_creep_n))`` during cycle ``k`` (a step at each
@@ -87,8 +96,8 @@ class Hidden:
     cycle_creep_n: float = 5.0
 
     def __post_init__(self):
-        if self.toe_form not in ("quadratic", "exponential"):
-            raise ValueError(f"toe_form must be 'quadratic' or 'exponential', not {self.toe_form!r}")
+        if self.toe_form not in TOE_FORMS:
+            raise ValueError(f"toe_form must be one of {', '.join(TOE_FORMS)}, not {self.toe_form!r}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -114,12 +123,23 @@ class Simulation:
     params: dict = field(default_factory=dict)
 
 
-def _tension(e: float, c: float, et: float, exponential: bool = False) -> float:
-    """Tendon tension (N) at elastic elongation ``e`` (mm): toe region then linear."""
+def _tension(e: float, c: float, et: float, exponential: bool = False, form: str | None = None) -> float:
+    """Tendon tension (N) at elastic elongation ``e`` (mm): toe region (``form``, see :data:`TOE_FORMS`;
+    ``exponential=True`` is ``form="exponential"``) then linear."""
     if e <= 0.0:
         return 0.0
-    if exponential and et > 0.0:
+    form = form or ("exponential" if exponential else "quadratic")
+    if form == "exponential" and et > 0.0:
         return (e + et * math.expm1(-e / et)) / c
+    if form == "power" and et > 0.0:
+        return (e**3 / (3.0 * et * et) if e < et else e - 2.0 * et / 3.0) / c
+    if form == "fung" and et > 0.0:
+        if e < et:
+            return et / 3.0 * (math.exp(3.0 * (e / et - 1.0)) - math.exp(-3.0)) / c
+        return (et / 3.0 * -math.expm1(-3.0) + e - et) / c
+    if form == "tanh" and et > 0.0:
+        x = e / et
+        return et * (x + math.log1p(math.exp(-2.0 * x)) - math.log(2.0)) / c
     if et > 0.0 and e < et:
         return e * e / (2.0 * et * c)
     return (e - 0.5 * et) / c
@@ -129,7 +149,7 @@ def _run(x: np.ndarray, t: np.ndarray, arm: float, k: float, c: float, h: Hidden
          cycle: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """One sample's angle (rad) and tension (N) for the motor stroke ``x`` (n,) at times ``t`` (n,)."""
     n = x.size
-    expo = h.toe_form == "exponential"
+    form = h.toe_form
     if cycle is not None and h.cycle_creep_mm != 0.0:
         cyc_loss = h.cycle_creep_mm * -np.expm1(-(np.asarray(cycle, float) - 1.0) / h.cycle_creep_n)
     else:
@@ -169,7 +189,7 @@ def _run(x: np.ndarray, t: np.ndarray, arm: float, k: float, c: float, h: Hidden
                 return 0.0
             for _ in range(48):
                 mid = 0.5 * (lo + hi)
-                tn = _tension(mid, c, et, expo)
+                tn = _tension(mid, c, et, form=form)
                 if p - mid - delayed(tn) - e_c - arm * theta_of(tn) > 0.0:
                     lo = mid
                 else:
@@ -179,7 +199,7 @@ def _run(x: np.ndarray, t: np.ndarray, arm: float, k: float, c: float, h: Hidden
         if mf > 0.0:
             # stick: the joint keeps its angle while the tension stays inside the friction band
             e_s = solve(lambda tn: theta)
-            t_s = _tension(e_s, c, et, expo)
+            t_s = _tension(e_s, c, et, form=form)
             stuck = abs(arm * t_s - k * theta) <= mf
             if stuck:
                 e_el = e_s
@@ -188,7 +208,7 @@ def _run(x: np.ndarray, t: np.ndarray, arm: float, k: float, c: float, h: Hidden
                 e_el = solve(lambda tn: max((arm * tn - sgn * mf) / k, 0.0))
         else:
             e_el = solve(lambda tn: arm * tn / k)
-        tension = _tension(e_el, c, et, expo)
+        tension = _tension(e_el, c, et, form=form)
         if mf > 0.0:
             if e_el <= 0.0:
                 # slack tendon: the joint springs back until friction holds it
