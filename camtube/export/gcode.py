@@ -1,4 +1,4 @@
-"""G-code post-processor: one emitter for every :class:`~camtube.export.dialects.Dialect`.
+"""G-code post-processor: one streaming emitter for every :class:`~camtube.export.dialects.Dialect`.
 
 The wrap to the rotary axis happens here and only here: ``A = degrees(y / r_o)``
 with the same x, A = 0 at y = 0. Passes are cut at the angles of their
@@ -7,27 +7,41 @@ unwrapped contour, whose centre lies in [0, 360) deg, so A stays within
 with cables or a limited range never needs an unwind (a rapid between cuts may
 turn the long way round, at most one turn; the time estimate includes it).
 
-:func:`gcode` builds the machine moves (coordinates rounded exactly as they are
-printed), converts them back to the unrolled frame, runs the safety check on
-them, and only then formats the text. Same job and dialect: byte-identical text.
+:func:`iter_gcode` yields the text chunk by chunk (:data:`~camtube.plan.moves.CHUNK_PASSES`
+passes at a time): for each chunk it builds the machine moves (coordinates rounded
+exactly as they are printed), converts them back to the unrolled frame, runs the
+safety check on them, and only then formats them; memory stays bounded however
+long the job. :func:`gcode` joins the chunks (small jobs, tests). Same job and
+dialect: byte-identical text.
+
+Rows by kind: RAPID ``G0 <x> <y>``; FOCUS ``G0 <z>``; CUT and LEAD ``G1 <x> <y> F..``.
+The beam gate follows the rows' ``laser`` flags: ``laser_on`` before the first
+laser-on row after laser-off rows (preceded by the settings lines where power or
+frequency change), ``laser_off`` before a laser-off row after laser-on rows and at
+the end of every pass, so a LEAD move (over-travel, lead-in) runs with the gate closed.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Iterable, Iterator, Sequence
 
 import numpy as np
 
 from camtube import __version__
 from camtube.export.dialects import LINUXCNC, Dialect
-from camtube.plan.moves import CUT, FOCUS, Moves, estimate, job_moves
+from camtube.fmt import format_duration_s
+from camtube.plan.moves import CUT, FOCUS, LEAD, RAPID, Moves, estimate, iter_moves, job_moves, time_warning
 from camtube.plan.packed import no_gc
 from camtube.plan.safety import check_moves
+from camtube.progress import NO_PROGRESS, Progress
+
+#: Distinct (path, speed) blocks whose text is kept for reuse (bounds the memo's memory).
+MEMO_MAX = 200_000
 
 
 @dataclass(frozen=True, eq=False)
 class MachineMoves:
-    """The moves of a job in one dialect's machine axes, rounded as printed.
+    """The moves of a job (or of a chunk of it) in one dialect's machine axes, rounded as printed.
 
     Attributes
     ----------
@@ -36,7 +50,9 @@ class MachineMoves:
     ax, ay, az : (m,) float
         Axis values (mm, or deg for a rotary second axis), rounded to ``dialect.decimals``.
     feed : (m,) float
-        F of every cutting move (1/min in G93, else mm/min or deg/min), rounded; 0 elsewhere.
+        F of every feed move (CUT, LEAD; 1/min in G93, else mm/min or deg/min), rounded; 0 elsewhere.
+    start : tuple[float, float, float]
+        Axis values before the first move (the rounded start of ``neutral``).
     """
 
     neutral: Moves
@@ -46,138 +62,236 @@ class MachineMoves:
     feed: np.ndarray
     dialect: Dialect
     outer_radius_mm: float
+    start: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def _unroll(self, ay):
+        return np.radians(ay) * self.outer_radius_mm if self.dialect.rotary else ay
 
     def unrolled(self) -> Moves:
         """The emitted moves back in the unrolled frame (what the safety check sees)."""
-        y = np.radians(self.ay) * self.outer_radius_mm if self.dialect.rotary else self.ay
         n = self.neutral
-        return Moves(self.ax, y, -self.az, n.kind, n.laser, n.pass_index, n.vertex, n.speed)
+        sx, sa, sz = self.start
+        start = (sx, float(self._unroll(np.float64(sa))), -sz + 0.0)
+        return Moves(self.ax, self._unroll(self.ay), -self.az, n.kind, n.laser, n.pass_index, n.vertex, n.speed,
+                     start)
 
 
 def machine_moves(job, dialect: Dialect = LINUXCNC, moves: Moves | None = None) -> MachineMoves:
-    """Map the job's moves to ``dialect``'s axes and feeds (vectorised)."""
+    """Map moves (default: all of the job's) to ``dialect``'s axes and feeds (vectorised)."""
     mv = job_moves(job) if moves is None else moves
     ro = job.outer_radius_mm
     dec = dialect.decimals
+    sx, sy, sz = mv.start
+    rot = (lambda y: np.degrees(y / ro)) if dialect.rotary else (lambda y: y)  # noqa: E731
     ax = np.round(mv.x, dec)
-    ay = np.round(np.degrees(mv.y / ro) if dialect.rotary else mv.y, dec)
+    ay = np.round(rot(mv.y), dec)
     az = np.round(-mv.z, dec) + 0.0  # + 0.0: no "-0.000000"
+    s_ax, s_ay, s_az = (float(np.round(np.float64(v), dec)) for v in (sx, rot(np.float64(sy)), -sz))
+    s_az += 0.0
     # surface length of each move from the printed coordinates
     ys = np.radians(ay) * ro if dialect.rotary else ay
-    dx = np.diff(np.concatenate(([0.0], ax)))
-    dy = np.diff(np.concatenate(([0.0], ys)))
-    dz = np.diff(np.concatenate(([0.0], az)))
+    s_ys = float(np.radians(s_ay) * ro) if dialect.rotary else s_ay
+    dx = np.diff(np.concatenate(([s_ax], ax)))
+    dy = np.diff(np.concatenate(([s_ys], ys)))
+    dz = np.diff(np.concatenate(([s_az], az)))
     surf = np.hypot(dx, dy)
-    cut = mv.kind == CUT
+    feedrow = (mv.kind == CUT) | (mv.kind == LEAD)
     feed = np.zeros(len(mv))
     with np.errstate(divide="ignore", invalid="ignore"):
         minutes = surf / (mv.speed * 60.0)
         if dialect.feed_mode == "inverse_time":
-            feed[cut] = 1.0 / minutes[cut]
+            feed[feedrow] = 1.0 / minutes[feedrow]
         else:
             # G94: F applies to the XYZ distance if the move has any, else to the rotary angle
             lin = np.hypot(dx, dz) if dialect.rotary else np.sqrt(dx * dx + dy * dy + dz * dz)
-            rot = np.abs(np.diff(np.concatenate(([0.0], ay)))) if dialect.rotary else np.zeros(len(mv))
-            per = np.where(lin > 0, lin, rot)
-            feed[cut] = per[cut] / minutes[cut]
+            rota = np.abs(np.diff(np.concatenate(([s_ay], ay)))) if dialect.rotary else np.zeros(len(mv))
+            per = np.where(lin > 0, lin, rota)
+            feed[feedrow] = per[feedrow] / minutes[feedrow]
     feed = np.round(feed, dialect.feed_decimals)
-    return MachineMoves(mv, ax, ay, az, feed, dialect, ro)
+    return MachineMoves(mv, ax, ay, az, feed, dialect, ro, (s_ax, s_ay, s_az))
 
 
-def _header(job, dialect: Dialect, mm: MachineMoves) -> list[str]:
-    est = estimate(job, mm.neutral)
+def _header(job, dialect: Dialect, est) -> list[str]:
     pr = job.process
     c = dialect.comment_line
     ax, ay, az = dialect.axes
     wrap = (f"{ay} = degrees(y / r_o) deg, r_o = {job.outer_radius_mm:g} mm" if dialect.rotary
             else f"{ay} = y mm (unrolled sheet)")
-    return [
+    lines = [
         c(f"camtube {__version__} job {job.name}, dialect {dialect.name}: {dialect.description}"),
         c(f"frame: {ax} = x mm from the tip, {wrap}, {az} = -focus offset into the material mm"),
         c(f"process: {pr.power_w:g} W, {pr.frequency_khz:g} kHz, {pr.scan_speed_mm_s:g} mm/s on the outer surface, "
           f"{pr.drill_passes} drill cuts {pr.drill_offset_mm:g} mm apart, defocus {pr.defocus_mm:g} mm, "
           f"{job.repeats} repeats, ordering {job.ordering}"),
         c(f"{est.cuts} cuts, {est.passes} passes, cut length {est.cut_length_mm:.3f} mm, estimated "
-          f"{est.total_s:.1f} s, lower bound {est.lower_bound_s:.1f} s, ratio {est.ratio:.4f}"),
+          f"{format_duration_s(est.total_s)}, lower bound {format_duration_s(est.lower_bound_s)}, "
+          f"ratio {est.ratio:.4f}"),
     ]
+    warning = time_warning(job, est)
+    if warning:
+        lines.append(c("WARNING: " + warning))
+    return lines
 
 
-def emit(job, mm: MachineMoves, memo: bool = True, progress: Callable[[int, int], None] | None = None) -> str:
-    """Format checked machine moves as G-code text (no safety check: use :func:`gcode`).
+class _Emitter:
+    """Formats checked machine moves chunk after chunk; keeps the state that crosses chunks."""
 
-    ``memo`` reuses the text of a path's cutting moves for later passes over
-    the same path at the same speed (their rows are identical by
-    construction); ``memo=False`` formats every row (tests compare both).
-    """
-    d = dialect = mm.dialect
-    n = mm.neutral
-    ax, ay, az = d.axes
-    f = f"{{:.{d.decimals}f}}"
-    ff = f"{{:.{d.feed_decimals}f}}"
-    focus = f"G0 {az}{f}".format
-    cut = f"G1 {ax}{f} {ay}{f} F{ff}".format
-    X, Y, Z, F = mm.ax.tolist(), mm.ay.tolist(), mm.az.tolist(), mm.feed.tolist()
-    kind = n.kind.tolist()
-    rows = n.pass_rows().tolist()
-    pk = job.packed
-    geom, speed = pk.pass_geom.tolist(), pk.pass_speed.tolist()
-    out = _header(job, dialect, mm)
-    out.extend(d.preamble)
-    # the pass comment holds no parentheses, so it needs no escaping in either comment style
-    lead, tail = ("(", ")") if d.comment == "paren" else ("; ", "")
-    head = (lead + "pass {}: cut {} {}, repeat {}, focus {} at {:g} mm, drill {} offset {:.4f} mm" + tail
-            + "\nG0 " + ax + f + " " + ay + f + "{}\n{}\n{}\n" + d.laser_off).format
-    passes = job.passes
-    total = len(passes)
-    # per-pass focus line ("" when the focus does not change)
-    r0s = rows[:-1]
-    focus_txt = ["\n" + focus(Z[r + 1]) if kind[r + 1] == FOCUS else "" for r in r0s]
-    # gate and settings lines per (power, frequency), settings only where they change
-    gates: dict[tuple[float, float], tuple[str, str]] = {}
-    pre: list[str] = []
-    prev = None
-    for ps in passes:
-        key = (ps.power_w, ps.frequency_khz)
-        if key not in gates:
+    def __init__(self, job, dialect: Dialect, memo: bool) -> None:
+        d = self.d = dialect
+        self.job, self.memo = job, memo
+        ax, ay, az = d.axes
+        f = f"{{:.{d.decimals}f}}"
+        ff = f"{{:.{d.feed_decimals}f}}"
+        self.rapid = f"G0 {ax}{f} {ay}{f}".format
+        self.focus = f"G0 {az}{f}".format
+        self.feed = f"G1 {ax}{f} {ay}{f} F{ff}".format
+        # the pass comment holds no parentheses, so it needs no escaping in either comment style
+        lead, tail = ("(", ")") if d.comment == "paren" else ("; ", "")
+        self.comment = (lead + "pass {}: cut {} {}, repeat {}, focus {} at {:g} mm, drill {} offset {:.4f} mm"
+                        + tail).format
+        self.gates: dict[tuple[float, float], tuple[str, str]] = {}
+        self.prev_key: tuple[float, float] | None = None
+        self.blocks: dict[tuple[int, float], tuple[str, str, bool]] = {}
+
+    def _gate_on(self, key: tuple[float, float]) -> str:
+        """Settings lines (where they change) + the gate-on line."""
+        d = self.d
+        g = self.gates.get(key)
+        if g is None:
             fields = d.fields(*key)
-            gates[key] = ("".join(x.format(**fields) + "\n" for x in d.settings), d.laser_on.format(**fields))
-        pre.append((gates[key][0] if key != prev else "") + gates[key][1])
-        prev = key
-    blocks: dict[tuple[int, float], str] = {}
+            g = self.gates[key] = ("".join(x.format(**fields) + "\n" for x in d.settings),
+                                   d.laser_on.format(**fields))
+        out = (g[0] if key != self.prev_key else "") + g[1]
+        self.prev_key = key
+        return out
 
-    def block(p: int) -> str:
-        start = rows[p] + (2 if focus_txt[p] else 1)
-        if memo:
-            bkey = (geom[p], speed[p])
-            blk = blocks.get(bkey)
-            if blk is None:
-                blk = blocks[bkey] = "\n".join([cut(X[i], Y[i], F[i]) for i in range(start, rows[p + 1])])
-            return blk
-        return "\n".join([cut(X[i], Y[i], F[i]) for i in range(start, rows[p + 1])])
+    def _rows(self, X, Y, Z, F, K, L, lo: int, hi: int) -> tuple[str, str, bool]:
+        """Text of rows [lo, hi) of one pass: (before the first gate-on, after it, gate opened at all).
 
-    step = 4096
-    for lo in range(0, total, step):
-        hi = min(total, lo + step)
-        out.extend([
-            head(p, ps.cut_index, ps.kind, ps.repeat, ps.focus_level, ps.focus_offset_mm, ps.drill_index,
-                 ps.offset_mm, X[rows[p]], Y[rows[p]], focus_txt[p], pre[p], block(p))
-            for p, ps in zip(range(lo, hi), passes[lo:hi])])
-        if progress is not None:
-            progress(hi, total)
-    out.extend(d.postamble)
-    out.append("")
-    return "\n".join(out)
+        Starts with the gate closed and ends with it closed.
+        """
+        d = self.d
+        parts: list[str] = []
+        before = None
+        state = False
+        for i in range(lo, hi):
+            on = L[i]
+            if on != state:
+                if on and before is None:
+                    before, parts = "".join(parts), []
+                else:
+                    parts.append((d.laser_on if on else d.laser_off) + "\n")
+                state = on
+            k = K[i]
+            if k == RAPID:
+                parts.append(self.rapid(X[i], Y[i]) + "\n")
+            elif k == FOCUS:
+                parts.append(self.focus(Z[i]) + "\n")
+            else:
+                parts.append(self.feed(X[i], Y[i], F[i]) + "\n")
+        if state:
+            parts.append(d.laser_off)
+        text = "".join(parts)
+        if before is None:
+            return text.rstrip("\n"), "", False
+        return before, text.rstrip("\n") if not state else text, True
+
+    def chunk(self, mm: MachineMoves) -> str:
+        """G-code of the passes in ``mm`` (checked machine moves), ending with a newline."""
+        n = mm.neutral
+        if len(n) == 0:
+            return ""
+        pk = self.job.packed
+        X, Y, Z, F = mm.ax.tolist(), mm.ay.tolist(), mm.az.tolist(), mm.feed.tolist()
+        K, L = n.kind.tolist(), n.laser.tolist()
+        rows = n.pass_rows().tolist()
+        p0 = n.first_pass
+        p1 = p0 + len(rows) - 1
+        s = slice(p0, p1)
+        cols = [pk.pass_cut[s], pk.pass_repeat[s], pk.pass_focus[s], pk.pass_z[s], pk.pass_drill[s],
+                pk.pass_offset[s], pk.pass_geom[s], pk.pass_speed[s], pk.pass_power[s], pk.pass_freq[s]]
+        design = self.job.design
+        comment, rapid, focus = self.comment, self.rapid, self.focus
+        blocks, memo = self.blocks, self.memo
+        out: list[str] = []
+        for k, (cut, rep, foc, z, dri, off, geom, speed, pw, fq) in enumerate(zip(*(c.tolist() for c in cols))):
+            r0, r1 = rows[k], rows[k + 1]
+            text = [comment(p0 + k, cut, design[cut].kind, rep, foc, z, dri, off)]
+            i = r0
+            while i < r1 and K[i] in (RAPID, FOCUS) and not L[i]:  # the pass's leading rapid and focus rows
+                text.append(rapid(X[i], Y[i]) if K[i] == RAPID else focus(Z[i]))
+                i += 1
+            if memo:
+                bkey = (geom, speed)
+                blk = blocks.get(bkey)
+                if blk is None:
+                    blk = self._rows(X, Y, Z, F, K, L, i, r1)
+                    if len(blocks) < MEMO_MAX:
+                        blocks[bkey] = blk
+            else:
+                blk = self._rows(X, Y, Z, F, K, L, i, r1)
+            before, after, opened = blk
+            if opened:
+                text.append(before + self._gate_on((pw, fq)))
+                text.append(after)
+            elif before:
+                text.append(before)
+            out.append("\n".join(text))
+        return "\n".join(out) + "\n"
 
 
-def gcode(job, dialect: Dialect = LINUXCNC, progress: Callable[[int, int], None] | None = None) -> str:
-    """Safety-checked G-code of ``job`` in ``dialect``.
+def _chunks(job, moves) -> Iterable[Moves]:
+    if moves is None:
+        return iter_moves(job)
+    return [moves] if isinstance(moves, Moves) else moves
+
+
+def iter_gcode(job, dialect: Dialect = LINUXCNC, *, progress: Progress = NO_PROGRESS,
+               moves: Moves | Sequence[Moves] | None = None, memo: bool = True) -> Iterator[str]:
+    """Safety-checked G-code of ``job`` in ``dialect``, as consecutive text chunks.
+
+    Parameters
+    ----------
+    job : Job
+    dialect : Dialect
+    progress : camtube.progress.Progress
+        Reports one task, ``G-code <dialect>``, in passes.
+    moves : Moves or sequence of consecutive Moves chunks, optional
+        A move list to write instead of the job's own (a hand-edited one, e.g. with LEAD
+        moves); it is checked and estimated like the job's.
+    memo : bool
+        Reuse the text of a path's moves for later passes over the same path at the
+        same speed (identical rows by construction of :func:`~camtube.plan.moves.job_moves`);
+        ``False`` formats every row. Always off for a given ``moves``.
+
+    Raises
+    ------
+    SafetyError
+        A chunk's emitted moves fail :func:`camtube.plan.safety.check_moves`; that chunk's
+        text is never yielded (the file layer discards the partial file).
+    """
+    est = estimate(job) if moves is None else estimate(job, moves)
+    yield "\n".join(_header(job, dialect, est) + list(dialect.preamble)) + "\n"
+    em = _Emitter(job, dialect, memo and moves is None)
+    with progress.task(f"G-code {dialect.name}", total=len(job.passes)) as task:
+        for mv in _chunks(job, moves):
+            mm = machine_moves(job, dialect, mv)
+            check_moves(job, mm.unrolled())
+            with no_gc():
+                text = em.chunk(mm)
+            rows = mv.pass_rows()
+            task.advance(len(rows) - 1)
+            yield text
+    yield "\n".join(dialect.postamble) + "\n"
+
+
+def gcode(job, dialect: Dialect = LINUXCNC, *, progress: Progress = NO_PROGRESS,
+          moves: Moves | Sequence[Moves] | None = None, memo: bool = True) -> str:
+    """Safety-checked G-code of ``job`` in ``dialect`` as one string (see :func:`iter_gcode`).
 
     Raises
     ------
     SafetyError
         The emitted moves fail :func:`camtube.plan.safety.check_moves`; no text is returned.
     """
-    mm = machine_moves(job, dialect)
-    check_moves(job, mm.unrolled())
-    with no_gc():
-        return emit(job, mm, progress=progress)
+    return "".join(iter_gcode(job, dialect, progress=progress, moves=moves, memo=memo))

@@ -41,8 +41,8 @@ def _points(contour) -> list:
 
 def job_dict(job) -> dict:
     """The job file content as plain data (fixed key order)."""
-    mv = check_job(job)
-    est = estimate(job, mv)
+    check_job(job)
+    est = estimate(job)
     pr = job.process
     process = {
         "power_w": float(pr.power_w), "frequency_khz": float(pr.frequency_khz),
@@ -74,6 +74,10 @@ def job_dict(job) -> dict:
         "ordering": job.ordering, "repeats": int(job.repeats), "process": process, "summary": summary,
         "design": design, "passes": passes,
     }
+
+
+def iter_job_json(job, progress=None):
+    yield job_json(job)
 
 
 def job_json(job) -> str:

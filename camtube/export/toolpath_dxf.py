@@ -49,6 +49,10 @@ def toolpath_document(job):
     return doc
 
 
+def iter_toolpath_dxf(job, progress=None):
+    yield toolpath_dxf(job)
+
+
 def toolpath_dxf(job) -> str:
     """DXF text of :func:`toolpath_document` (deterministic)."""
     return to_string(toolpath_document(job))

@@ -1,15 +1,21 @@
 """The Job: an ordered list of laser passes in the unrolled frame.
 
-A :class:`Pass` is one closed trip of the beam around one contour at one
-set of laser settings. Its ``contour`` is in the *unwrapped* unrolled frame of
-the designer (x from the tip, y arc length on the outer surface, mm; y may
-leave ``[0, 2 pi r_o)`` for a cut straddling the seam, because the rotary axis
-is continuous). The path starts and ends at ``contour.points[0]``.
+A :class:`Pass` is one trip of the beam along one path at one set of laser
+settings. Its ``contour`` is in the *unwrapped* unrolled frame of the designer
+(x from the tip, y arc length on the outer surface, mm; y may leave
+``[0, 2 pi r_o)`` for a cut straddling the seam, because the rotary axis is
+continuous). A closed path starts and ends at ``contour.points[0]``; an open
+one (a slit) runs from its first point to its last.
+
+A planned job keeps its passes as arrays (:class:`~camtube.plan.packed.Packed`);
+``job.passes`` is then a lazy :class:`~camtube.plan.packed.PassView` that builds
+Pass objects only when they are asked for.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Sequence
 
 from camtube.design.contour import Contour
 from camtube.design.pattern import Process
@@ -22,7 +28,8 @@ class Pass:
     Attributes
     ----------
     contour : Contour
-        Closed path the beam follows, starting at ``contour.points[0]``.
+        Path the beam follows, starting at ``contour.points[0]`` (closed, or an
+        open slit cut from its first point to its last).
     cut_index : int
         Index of the cut in the job's ``design`` (and ``Pattern.cuts``).
     kind : str
@@ -36,7 +43,7 @@ class Pass:
     drill_index : int
         0-based cut within the drill group.
     offset_mm : float
-        Inward offset of the path from the design line (drill steps, kerf).
+        Inward offset of the path from the design line (drill steps, kerf); 0 for a slit.
     power_w, frequency_khz, speed_mm_s : float
         Laser settings; ``speed_mm_s`` is on the outer surface.
     """
@@ -72,8 +79,9 @@ class Job:
         Tube length (nothing may be cut beyond it).
     design : tuple[Contour, ...]
         The design cut regions (unwrapped), indexed by ``Pass.cut_index``.
-    passes : tuple[Pass, ...]
-        In execution order.
+    passes : Sequence[Pass]
+        In execution order: a tuple, or the planner's lazy
+        :class:`~camtube.plan.packed.PassView` over :attr:`packed`.
     process : Process
         The process the passes were planned from.
     repeats : int
@@ -86,18 +94,29 @@ class Job:
     outer_radius_mm: float
     length_mm: float
     design: tuple[Contour, ...]
-    passes: tuple[Pass, ...]
+    passes: Sequence[Pass]
     process: Process
     repeats: int
     ordering: str
 
     @property
     def cut_length_mm(self) -> float:
-        return sum(p.length_mm for p in self.passes)
+        """Total length of every pass (mm)."""
+        pk = self.packed
+        return float(pk.geom_length_mm[pk.pass_geom].sum())
 
     @cached_property
     def packed(self):
-        """:class:`camtube.plan.packed.Packed` arrays of the passes (computed once, cached)."""
-        from camtube.plan.packed import pack
+        """:class:`camtube.plan.packed.Packed` arrays of the passes (the planner's, or packed once and cached)."""
+        from camtube.plan.packed import PassView, pack
 
+        if isinstance(self.passes, PassView):
+            return self.passes.packed
         return pack(self)
+
+    def cached(self, key: str, make):
+        """``make()``, computed once per Job object (the Job is immutable; e.g. its time estimate)."""
+        d = self.__dict__
+        if key not in d:
+            d[key] = make()
+        return d[key]

@@ -1,4 +1,4 @@
-"""Write a job's files: every text is produced (and safety-checked) before any file is written.
+"""A job's toolpath files as streams of text chunks, and writing them all-or-nothing.
 
 File names in the output directory, for a job called ``NAME``:
 
@@ -6,49 +6,133 @@ File names in the output directory, for a job called ``NAME``:
 - ``NAME<suffix>`` per dialect: ``NAME.ngc`` (LinuxCNC rotary), ``NAME.nc`` (GRBL flat bed);
 - ``NAME.job.json``: the machine-neutral job file;
 - ``NAME.design.dxf``: the design drawing (``build`` only, when a pattern is given).
+
+:func:`toolpath_streams` gives every file as a lazy iterator of text chunks: each
+chunk of passes is built, safety-checked and formatted only when the file layer
+pulls it, and then dropped, so a job of 10^6 passes is written in bounded memory.
+Hand the dict to ``camtube.io.write_set`` (or :func:`write_toolpaths`), which
+writes temporary files and publishes them only when every stream has finished
+(a SafetyError in any chunk leaves nothing behind).
 """
 from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Iterable, Iterator, Sequence
 
 from camtube.export.dialects import DIALECTS, Dialect
-from camtube.io import write_atomic
+from camtube.progress import NO_PROGRESS, Progress
 
 
-def toolpath_texts(job, dialects: Sequence[Dialect] = tuple(DIALECTS.values()),
-                   progress: Callable[[int, int], None] | None = None) -> dict[str, str]:
-    """File name -> text of the job's toolpath outputs (raises SafetyError before returning anything)."""
-    from camtube.export.gcode import gcode
-    from camtube.export.jobfile import job_json
-    from camtube.export.toolpath_dxf import toolpath_dxf
+def toolpath_streams(job, dialects: Sequence[Dialect] = tuple(DIALECTS.values()),
+                     progress: Progress = NO_PROGRESS) -> dict[str, Iterator[str]]:
+    """File name -> lazy iterator of text chunks of the job's toolpath outputs.
 
-    texts = {f"{job.name}.toolpath.dxf": toolpath_dxf(job)}
+    Nothing is computed until a stream is iterated; each stream safety-checks what
+    it writes (raising :class:`~camtube.errors.SafetyError` before yielding unsafe text).
+    """
+    from camtube.export.gcode import iter_gcode
+    from camtube.export.jobfile import iter_job_json
+    from camtube.export.toolpath_dxf import iter_toolpath_dxf
+
+    streams: dict[str, Iterator[str]] = {f"{job.name}.toolpath.dxf": iter_toolpath_dxf(job, progress=progress)}
     for d in dialects:
-        texts[f"{job.name}{d.suffix}"] = gcode(job, d, progress=progress)
-    texts[f"{job.name}.job.json"] = job_json(job)
-    return texts
+        streams[f"{job.name}{d.suffix}"] = iter_gcode(job, d, progress=progress)
+    streams[f"{job.name}.job.json"] = iter_job_json(job, progress=progress)
+    return streams
 
 
-def write_texts(texts: dict[str, str], outdir: str | os.PathLike) -> list[Path]:
-    """Write every text atomically into ``outdir``; return the paths in order."""
-    return [write_atomic(Path(outdir) / name, text) for name, text in texts.items()]
+def toolpath_texts(job, dialects: Sequence[Dialect] = tuple(DIALECTS.values())) -> dict[str, str]:
+    """File name -> whole text of the job's toolpath outputs (small jobs, tests, golden files)."""
+    return {name: "".join(chunks) for name, chunks in toolpath_streams(job, dialects).items()}
+
+
+def write_streams(streams: dict[str, str | bytes | Iterable[str]], outdir: str | os.PathLike) -> list[Path]:
+    """Write every stream into ``outdir``; publish all files only when all succeeded.
+
+    Each file is streamed into a temporary file beside its target (text as UTF-8,
+    ``\\n`` line endings unchanged); when every stream is complete the files are
+    renamed into place. On any error (a SafetyError mid-stream, a full disk, Ctrl-C)
+    the temporary files are removed and no target is touched. (``camtube.io.write_set``
+    is the project-wide form of this.)
+    """
+    import tempfile
+
+    from camtube.io import _publish
+
+    out = Path(outdir)
+    out.mkdir(parents=True, exist_ok=True)
+    staged: list[tuple[str, Path]] = []
+    try:
+        for name, data in streams.items():
+            path = out / name
+            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=out)
+            staged.append((tmp, path))
+            with os.fdopen(fd, "wb") as fh:
+                if isinstance(data, (str, bytes)):
+                    data = [data]
+                for chunk in data:
+                    fh.write(chunk.encode("utf-8") if isinstance(chunk, str) else chunk)
+                fh.flush()
+                os.fsync(fh.fileno())
+        for tmp, path in staged:
+            _publish(tmp, path)
+    except BaseException:
+        for tmp, _ in staged:
+            try:
+                os.unlink(tmp)
+            except FileNotFoundError:
+                pass
+        raise
+    return [path for _, path in staged]
 
 
 def write_toolpaths(job, outdir: str | os.PathLike, dialects: Sequence[Dialect] = tuple(DIALECTS.values()),
-                    pattern=None, progress: Callable[[int, int], None] | None = None) -> list[Path]:
+                    pattern=None, progress: Progress | None = None) -> list[Path]:
     """Check and write the job's toolpath DXF, G-code (each dialect) and job file (+ design DXF if ``pattern``).
+
+    Streams every file (bounded memory) and publishes them together.
 
     Raises
     ------
     SafetyError
         The job is unsafe; no file has been written.
     """
-    texts = {}
+    progress = _as_progress(progress)
+    streams: dict[str, str | Iterable[str]] = {}
     if pattern is not None:
         from camtube.export.dxf import design_dxf
 
-        texts[f"{job.name}.design.dxf"] = design_dxf(pattern)
-    texts.update(toolpath_texts(job, dialects, progress))
-    return write_texts(texts, outdir)
+        streams[f"{job.name}.design.dxf"] = design_dxf(pattern)
+    streams.update(toolpath_streams(job, dialects, progress))
+    return write_streams(streams, outdir)
+
+
+def _as_progress(progress) -> Progress:
+    """A Progress object (None -> no-op; a bare ``f(done, total)`` callable is wrapped)."""
+    if progress is None:
+        return NO_PROGRESS
+    if isinstance(progress, Progress):
+        return progress
+    return _CallableProgress(progress)
+
+
+class _CallableProgress(Progress):
+    """Adapter for a ``f(done, total)`` callable (the CLI's earlier interface)."""
+
+    def __init__(self, fn) -> None:
+        self._fn = fn
+
+    def task(self, label: str, total: int):
+        from camtube.progress import Task
+
+        fn = self._fn
+
+        class _T(Task):
+            done = 0
+
+            def advance(self, n: int = 1) -> None:
+                self.done += n
+                fn(min(self.done, total), total)
+
+        return _T()

@@ -33,8 +33,9 @@ from camtube.design.contour import Contour, cut_contours
 from camtube.design.geometry import beam_depth_mm
 from camtube.design.pattern import Pattern, Process
 from camtube.errors import Issue, PatternError
-from camtube.plan.job import Job, Pass
-from camtube.plan.packed import Packed, is_axis_rectangle, no_gc, points_bounds
+from camtube.plan.job import Job
+from camtube.plan.packed import Packed, PassView, is_axis_rectangle, no_gc, points_bounds
+from camtube.progress import NO_PROGRESS, Progress
 from camtube.tol import TOL
 
 ORDERINGS = ("interleaved", "sequential")
@@ -156,23 +157,57 @@ def _nearest_vertex(points, p: tuple[float, float]) -> int:
     return d.index(min(d))
 
 
-def _chain_starts(design: Sequence[Contour], order: Sequence[int], start: tuple[float, float]) -> dict[int, int]:
-    """Start vertex of each contour in ``order``: nearest to the previous contour's start."""
+def _chain_starts(design: Sequence[Contour], order: Sequence[int], start: tuple[float, float],
+                  slit_returns: bool = False) -> tuple[dict[int, int], tuple[float, float]]:
+    """Start vertex of each contour in ``order`` (nearest to where the previous one left the beam).
+
+    A closed contour starts at its vertex nearest the previous end and ends there; an
+    open one (a slit) starts at its nearer end (index 0 or n - 1) and ends at the other
+    (or at the same end if ``slit_returns``: an even number of alternating passes).
+    Returns the starts and the point where the last contour leaves the beam.
+    """
     out: dict[int, int] = {}
     p = start
     for i in order:
-        pts = design[i].points
-        k = _nearest_vertex(pts, p)
+        c = design[i]
+        pts = c.points
+        if c.closed:
+            k = _nearest_vertex(pts, p)
+            p = pts[k]
+        else:
+            last = len(pts) - 1
+            k = 0 if _nearest_vertex((pts[0], pts[last]), p) == 0 else last
+            p = pts[k] if slit_returns else pts[last - k]
         out[i] = k
-        p = pts[k]
-    return out
+    return out, p
 
 
 def _rotate(contour: Contour, k: int) -> Contour:
     if k == 0:
         return contour
     pts = contour.points
-    return Contour(pts[k:] + pts[:k], contour.kind, contour.cut_index)
+    return Contour(pts[k:] + pts[:k], contour.kind, contour.cut_index, contour.closed)
+
+
+def pass_path(design: Contour, offset_mm: float, start: int, drill_index: int = 0, index: int = -1,
+              alternate: bool = False) -> Contour:
+    """The path of one pass over ``design``: the planner's (and the job-file reader's) one rule.
+
+    Closed contour: moved ``offset_mm`` inward (:func:`offset_contour`) and started at the
+    vertex matching ``design.points[start]`` (the same vertex for a rectangle, else the
+    nearest one). Open contour (a slit): the path itself, no offset, cut from the end
+    ``start`` (0 or n - 1) to the other; with ``alternate`` (sequential ordering, where a
+    slit's passes follow each other) odd drill passes run back, so consecutive passes
+    need no long rapid.
+    """
+    if not design.closed:
+        pts = design.points
+        if (start != 0) != (alternate and drill_index % 2 == 1):
+            pts = pts[::-1]
+        return Contour(tuple(pts), design.kind, design.cut_index, False)
+    c = offset_contour(design, offset_mm, index)
+    k = start if (c is design or is_axis_rectangle(design)) else _nearest_vertex(c.points, design.points[start])
+    return _rotate(c, k)
 
 
 # ---------------------------------------------------------------- the planner
@@ -226,6 +261,7 @@ def plan_job(
     outer_radius_mm: float | None = None,
     length_mm: float | None = None,
     name: str | None = None,
+    progress: Progress = NO_PROGRESS,
 ) -> Job:
     """Plan the multi-pass laser job of a pattern or of a DXF's closed contours.
 
@@ -243,17 +279,20 @@ def plan_job(
         from the DXF's construction outline).
     name : str, optional
         Job name; defaults to the pattern name or the DXF's file stem.
+    progress : camtube.progress.Progress, optional
+        Reports the planning (default: nothing).
 
     Returns
     -------
     Job
-        ``len(cuts) * repeats * 2 * drill_passes`` passes in execution order.
+        ``len(cuts) * repeats * 2 * drill_passes`` passes in execution order, kept as
+        arrays (``job.packed``; ``job.passes`` builds Pass objects on demand).
     """
     with no_gc():
-        return _plan(source, process, ordering, outer_radius_mm, length_mm, name)
+        return _plan(source, process, ordering, outer_radius_mm, length_mm, name, progress)
 
 
-def _plan(source, process, ordering, outer_radius_mm, length_mm, name) -> Job:
+def _plan(source, process, ordering, outer_radius_mm, length_mm, name, progress) -> Job:
     if ordering not in ORDERINGS:
         raise PatternError([Issue("ordering", "unknown ordering", ordering, " | ".join(ORDERINGS),
                                   f"use one of {', '.join(ORDERINGS)}")])
@@ -263,31 +302,39 @@ def _plan(source, process, ordering, outer_radius_mm, length_mm, name) -> Job:
         raise PatternError([Issue("process.drill_passes", "must be at least 1", proc.drill_passes, ">= 1",
                                   "set process.drill_passes to 1 or more")])
     design = src.contours
+    for i, c in enumerate(design):
+        if len(c.points) < (3 if c.closed else 2):
+            raise PatternError([Issue(_describe(c, i), "too few points for a " + ("closed contour" if c.closed
+                                      else "slit"), len(c.points), ">= 3 (closed) or >= 2 (slit)",
+                                      "draw the cut with more points or remove it")])
     repeats = repeats_for(proc, depth_for_contours(src.outer_radius_mm, design))
-    offsets = pass_offsets_mm(proc)
-    focus = (0.0, float(proc.defocus_mm))
-    n_cut, n_drill = len(design), len(offsets)
+    n_total = len(design) * repeats * 2 * proc.drill_passes
+    with progress.task("planning", total=n_total) as task:
+        fwd = tour(design)
+        # sequential: a slit's passes alternate direction; an even number of them ends where it began
+        returns = ordering == "sequential" and proc.drill_passes % 2 == 0
+        s0, end = _chain_starts(design, fwd, (0.0, 0.0), returns)
+        starts = [s0]
+        if ordering == "interleaved":
+            # backward rounds start where forward rounds end and vice versa
+            s1, end = _chain_starts(design, fwd[::-1], end)
+            starts = [_chain_starts(design, fwd, end)[0], s1]
+        task.advance(n_total // 4)
+        start_arr = np.array([[st[i] for i in range(len(design))] for st in starts], dtype=np.int64)
+        packed = assemble(design, fwd, start_arr, repeats, ordering, proc)
+        task.advance(n_total - n_total // 4)
+    return Job(src.name, src.outer_radius_mm, src.length_mm, design, PassView(packed, design), proc, repeats,
+               ordering)
 
-    fwd = tour(design)
-    starts = [_chain_starts(design, fwd, (0.0, 0.0))]
-    if ordering == "interleaved":
-        # backward rounds start where forward rounds end and vice versa
-        starts.append(_chain_starts(design, fwd[::-1], design[fwd[-1]].points[starts[0][fwd[-1]]]))
-        starts[0] = _chain_starts(design, fwd, design[fwd[0]].points[starts[1][fwd[0]]])
 
-    geom_list: list[Contour] = []  # index (direction * n_cut + cut) * n_drill + drill
-    shifted = [[offset_contour(c, o, i) for o in offsets] for i, c in enumerate(design)]
-    for direction, st in enumerate(starts):
-        for i in range(n_cut):
-            k0 = st[i]
-            p0 = design[i].points[k0]
-            for d in range(n_drill):
-                c = shifted[i][d]
-                k = k0 if (c is design[i] or is_axis_rectangle(design[i])) else _nearest_vertex(c.points, p0)
-                geom_list.append(_rotate(c, k))
+def pass_sequence(order: Sequence[int], n_cut: int, repeats: int, n_drill: int, ordering: str):
+    """The pass order as arrays (one row per pass): cut, repeat, focus level, drill, tour direction.
 
-    # the pass sequence as arrays: cut, repeat, focus level, drill, tour direction (one row per pass)
-    order = np.asarray(fwd, dtype=np.int64)
+    ``sequential``: every pass of a cut (repeat, focus, drill), then the next cut in ``order``.
+    ``interleaved``: round ``k`` = (repeat, focus, drill) visits every cut, along ``order``
+    on even rounds and backwards on odd ones.
+    """
+    order = np.asarray(order, dtype=np.int64)
     per_cut = repeats * 2 * n_drill
     k = np.arange(per_cut)
     r_k, f_k, d_k = k // (2 * n_drill), (k // n_drill) % 2, k % n_drill
@@ -295,28 +342,80 @@ def _plan(source, process, ordering, outer_radius_mm, length_mm, name) -> Job:
         cut_a = np.repeat(order, per_cut)
         rep_a, foc_a, dri_a = (np.tile(a, n_cut) for a in (r_k, f_k, d_k))
         dir_a = np.zeros(len(cut_a), dtype=np.int64)
-    else:  # round k visits every cut, forwards on even rounds, backwards on odd ones
+    else:
         dir_k = k % 2
         cut_a = np.where(dir_k[:, None] == 0, order[None, :], order[::-1][None, :]).ravel()
         rep_a, foc_a, dri_a, dir_a = (np.repeat(a, n_cut) for a in (r_k, f_k, d_k, dir_k))
-    gid = (dir_a * n_cut + cut_a) * n_drill + dri_a  # index into geom_list (built direction, cut, drill)
+    return cut_a, rep_a, foc_a, dri_a, dir_a
 
-    pw, fq, sp = float(proc.power_w), float(proc.frequency_khz), float(proc.scan_speed_mm_s)
-    kinds = [c.kind for c in design]
-    new = object.__new__
-    passes = []
-    append = passes.append
-    for g, i, r, f, d in zip(gid.tolist(), cut_a.tolist(), rep_a.tolist(), foc_a.tolist(), dri_a.tolist()):
-        p = new(Pass)
-        # Pass is frozen: fill its fields directly (2x faster than __init__ for 10^5+ passes).
-        p.__dict__.update(contour=geom_list[g], cut_index=i, kind=kinds[i], repeat=r, focus_level=f,
-                          focus_offset_mm=focus[f], drill_index=d, offset_mm=offsets[d], power_w=pw,
-                          frequency_khz=fq, speed_mm_s=sp)
-        append(p)
-    job = Job(src.name, src.outer_radius_mm, src.length_mm, design, tuple(passes), proc, repeats, ordering)
-    n = len(passes)
-    packed = Packed.build(
-        geoms=geom_list, pass_geom=gid, pass_cut=cut_a, pass_z=np.asarray(focus)[foc_a],
-        pass_speed=np.full(n, sp), pass_power=np.full(n, pw), pass_freq=np.full(n, fq))
-    job.__dict__["packed"] = packed  # seed Job.packed (a cache of arrays derived from the passes)
-    return job
+
+def assemble(design: Sequence[Contour], order: Sequence[int], starts: np.ndarray, repeats: int, ordering: str,
+             process: Process) -> Packed:
+    """The passes of a job as :class:`Packed` arrays, from its cuts, tour and start vertices.
+
+    Parameters
+    ----------
+    design : sequence of Contour
+        The cut regions (closed) and slits (open), indexed by cut.
+    order : (n,) int
+        Tour (visiting order of the cuts).
+    starts : (n_dir, n) int
+        Start vertex of each cut per tour direction (1 row for sequential, 2 for interleaved).
+    repeats : int
+    ordering : str
+    process : Process
+        Drill passes and offsets, defocus, kerf, power, frequency, speed.
+
+    Vectorised for axis-aligned rectangles (the patterns' cuts); other contours and slits
+    go through :func:`pass_path` one path at a time. Only paths some pass uses are built.
+    """
+    offsets = np.asarray(pass_offsets_mm(process), dtype=float)
+    focus = np.array([0.0, float(process.defocus_mm)])
+    n_cut, n_drill = len(design), len(offsets)
+    cut_a, rep_a, foc_a, dri_a, dir_a = pass_sequence(order, n_cut, repeats, n_drill, ordering)
+    gid = (dir_a * n_cut + cut_a) * n_drill + dri_a  # path key: (tour direction, cut, drill)
+    used = np.unique(gid)
+    pass_geom = np.searchsorted(used, gid)
+    t_u, rest = np.divmod(used, n_cut * n_drill)
+    i_u, d_u = np.divmod(rest, n_drill)
+
+    is_rect = np.fromiter((is_axis_rectangle(c) for c in design), dtype=bool, count=n_cut)
+    closed = np.fromiter((c.closed for c in design), dtype=bool, count=n_cut)
+    sizes = np.where(is_rect[i_u], 4, 0)
+    rect_rows = np.flatnonzero(is_rect[i_u])
+    other: dict[int, np.ndarray] = {}
+    for r in np.flatnonzero(~is_rect[i_u]).tolist():
+        t, i, d = int(t_u[r]), int(i_u[r]), int(d_u[r])
+        path = pass_path(design[i], float(offsets[d]), int(starts[t, i]), d, i, ordering == "sequential")
+        other[r] = np.asarray(path.points, dtype=float).reshape(-1, 2)
+        sizes[r] = len(path.points)
+    geom_offset = np.zeros(len(used) + 1, dtype=np.int64)
+    np.cumsum(sizes, out=geom_offset[1:])
+    vertices = np.empty((int(geom_offset[-1]), 2))
+    if len(rect_rows):
+        rect_cuts = np.flatnonzero(is_rect)
+        pts = np.zeros((n_cut, 4, 2))
+        pts[rect_cuts] = np.array([design[i].points for i in rect_cuts.tolist()], dtype=float).reshape(-1, 4, 2)
+        lo, hi = pts.min(axis=1), pts.max(axis=1)  # (n, 2) each
+        width = np.minimum(hi[:, 0] - lo[:, 0], hi[:, 1] - lo[:, 1])
+        vanish = is_rect[:, None] & (width[:, None] - 2 * offsets[None, :] <= TOL.zero)
+        if vanish.any():
+            i, d = np.argwhere(vanish)[0].tolist()
+            raise _vanish(design[i], float(offsets[d]), i)
+        ii, o = i_u[rect_rows], offsets[d_u[rect_rows]][:, None]
+        p, a, b = pts[ii], lo[ii][:, None, :], hi[ii][:, None, :]
+        # each corner moves diagonally inward; vertex order kept, then started at the start vertex
+        moved = np.where(p == a, a + o[..., None], b - o[..., None])
+        k = starts[t_u[rect_rows], ii]
+        idx = (k[:, None] + np.arange(4)[None, :]) % 4
+        moved = np.take_along_axis(moved, idx[..., None], axis=1)
+        rows = geom_offset[rect_rows][:, None] + np.arange(4)[None, :]
+        vertices[rows.ravel()] = moved.reshape(-1, 2)
+    for r, v in other.items():
+        vertices[geom_offset[r]:geom_offset[r + 1]] = v
+    n = len(cut_a)
+    pass_offset = np.where(closed[cut_a], offsets[dri_a], 0.0)
+    const = lambda v: np.broadcast_to(np.float64(v), (n,))  # noqa: E731  (read-only, no memory per pass)
+    return Packed.of_arrays(vertices, geom_offset, closed[i_u], pass_geom, cut_a, focus[foc_a],
+                            const(process.scan_speed_mm_s), const(process.power_w), const(process.frequency_khz),
+                            rep_a, foc_a, dri_a, pass_offset)

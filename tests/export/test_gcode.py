@@ -10,7 +10,7 @@ import pytest
 
 from camtube.design.loader import load_pattern
 from camtube.export.dialects import DIALECTS, GRBL, LINUXCNC, Dialect, get_dialect
-from camtube.export.gcode import emit, gcode, machine_moves
+from camtube.export.gcode import gcode, machine_moves
 from camtube.plan import plan_job
 from tests.conftest import PATTERNS
 
@@ -32,8 +32,7 @@ def test_same_input_same_bytes(dialect):
 
 @pytest.mark.parametrize("dialect", list(DIALECTS.values()), ids=lambda d: d.name)
 def test_memoised_blocks_equal_row_by_row_formatting(bidir, dialect):
-    mm = machine_moves(bidir, dialect)
-    assert emit(bidir, mm, memo=True) == emit(bidir, mm, memo=False)
+    assert gcode(bidir, dialect, memo=True) == gcode(bidir, dialect, memo=False)
 
 
 def test_wrap_is_degrees_of_y_over_r(bidir):

@@ -1,0 +1,39 @@
+"""One formatter for figures shown to people (shared by every report, header and warning).
+
+:func:`format_duration_s` writes a duration as seconds with hours:minutes:seconds beside
+it, so a long laser job reads at a glance (``908802 s (252:26:42)``).
+"""
+from __future__ import annotations
+
+import math
+
+
+def hms(seconds: float) -> str:
+    """``h:mm:ss`` of ``seconds`` (rounded to the nearest second; hours are not wrapped at 24).
+
+    >>> hms(908802)
+    '252:26:42'
+    """
+    if not math.isfinite(seconds):
+        return "-:--:--"
+    s = int(round(abs(seconds)))
+    h, rest = divmod(s, 3600)
+    m, sec = divmod(rest, 60)
+    return f"{'-' if seconds < 0 and s else ''}{h}:{m:02d}:{sec:02d}"
+
+
+def format_duration_s(seconds: float) -> str:
+    """A duration for people: seconds, then ``(h:mm:ss)``.
+
+    Below 1000 s the seconds keep one decimal (``92.7 s (0:01:33)``); from 1000 s on
+    they are whole (``908802 s (252:26:42)``).
+
+    Parameters
+    ----------
+    seconds : float
+        Duration in s.
+    """
+    if not math.isfinite(seconds):
+        return f"{seconds} s"
+    digits = 1 if abs(seconds) < 1000 else 0
+    return f"{seconds:.{digits}f} s ({hms(seconds)})"
