@@ -124,8 +124,8 @@ def _header(job, dialect: Dialect, est) -> list[str]:
           f"{pr.drill_passes} drill cuts {pr.drill_offset_mm:g} mm apart, defocus {pr.defocus_mm:g} mm, "
           f"{job.repeats} repeats, ordering {job.ordering}"),
         c(f"{est.cuts} cuts, {est.passes} passes, cut length {est.cut_length_mm:.3f} mm, estimated "
-          f"{format_duration_s(est.total_s)}, lower bound {format_duration_s(est.lower_bound_s)}, "
-          f"ratio {est.ratio:.4f}"),
+          f"{format_duration_s(est.total_s)}" + (f" on machine {est.machine}" if est.machine else "")
+          + f", lower bound {format_duration_s(est.lower_bound_s)}, ratio {est.ratio:.4f}"),
     ]
     warning = time_warning(job, est)
     if warning:
@@ -270,7 +270,12 @@ def iter_gcode(job, dialect: Dialect = LINUXCNC, *, progress: Progress = NO_PROG
         A chunk's emitted moves fail :func:`camtube.plan.safety.check_moves`; that chunk's
         text is never yielded (the file layer discards the partial file).
     """
-    est = estimate(job) if moves is None else estimate(job, moves)
+    from camtube.machine.corners import strategy_moves
+    from camtube.plan.motion_time import job_estimate
+
+    if moves is None and dialect.profile is not None:
+        moves = strategy_moves(job, dialect.profile)  # the profile's corner strategy (None: the job's moves)
+    est = job_estimate(job, dialect, moves)
     yield "\n".join(_header(job, dialect, est) + list(dialect.preamble)) + "\n"
     em = _Emitter(job, dialect, memo and moves is None)
     with progress.task(f"G-code {dialect.name}", total=len(job.passes)) as task:

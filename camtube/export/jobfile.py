@@ -10,7 +10,6 @@ import json
 import math
 
 from camtube import __version__
-from camtube.plan.moves import estimate
 from camtube.plan.safety import check_job
 
 SCHEMA = "camtube.job/1"
@@ -39,10 +38,19 @@ def _points(contour) -> list:
     return [[float(x), float(y)] for x, y in contour.points]
 
 
-def job_dict(job) -> dict:
-    """The job file content as plain data (fixed key order)."""
+def job_dict(job, dialect=None) -> dict:
+    """The job file content as plain data (fixed key order).
+
+    ``dialect``: the G-code dialect (and so the machine profile) the job is made for; its
+    profile is recorded under ``machine`` and its motion-aware time is ``summary.total_time_s``
+    (default: the default LinuxCNC profile).
+    """
+    from camtube.export.dialects import LINUXCNC
+    from camtube.plan.motion_time import job_estimate
+
     check_job(job)
-    est = estimate(job)
+    dialect = LINUXCNC if dialect is None else dialect
+    est = job_estimate(job, dialect)
     pr = job.process
     process = {
         "power_w": float(pr.power_w), "frequency_khz": float(pr.frequency_khz),
@@ -57,6 +65,7 @@ def job_dict(job) -> dict:
         "cuts": est.cuts, "passes": est.passes, "cut_length_mm": est.cut_length_mm, "cut_time_s": est.cut_s,
         "rapid_time_s": est.rapid_s, "focus_time_s": est.focus_s, "total_time_s": est.total_s,
         "lower_bound_s": est.lower_bound_s, "ratio": est.ratio,
+        "constant_speed_time_s": est.constant_speed_s,
     }
     design = [{"index": i, "kind": c.kind, "points": _points(c)} for i, c in enumerate(job.design)]
     passes = [{
@@ -71,18 +80,19 @@ def job_dict(job) -> dict:
         "frame": "x along the tube from the tip; y arc length on the outer surface (unwrapped); "
                  "rotary angle = y / outer_radius_mm rad",
         "outer_radius_mm": float(job.outer_radius_mm), "length_mm": float(job.length_mm),
-        "ordering": job.ordering, "repeats": int(job.repeats), "process": process, "summary": summary,
+        "ordering": job.ordering, "repeats": int(job.repeats), "process": process,
+        "machine": dialect.profile.record() if dialect.profile is not None else None, "summary": summary,
         "design": design, "passes": passes,
     }
 
 
-def iter_job_json(job, progress=None):
-    yield job_json(job)
+def iter_job_json(job, progress=None, dialect=None):
+    yield job_json(job, dialect)
 
 
-def job_json(job) -> str:
+def job_json(job, dialect=None) -> str:
     """Safety-checked job file text (raises :class:`~camtube.errors.SafetyError`)."""
-    d = job_dict(job)
+    d = job_dict(job, dialect)
     lines = ["{"]
     items = list(d.items())
     for n, (k, v) in enumerate(items):

@@ -8,8 +8,11 @@ import re
 import pytest
 
 from camtube.design.loader import load_pattern
+from camtube.export.dialects import LINUXCNC
+from camtube.export.gcode import gcode
 from camtube.export.jobfile import SCHEMA, job_json
 from camtube.plan import estimate, plan_job
+from camtube.plan.motion_time import estimate_program
 from tests.conftest import PATTERNS
 
 
@@ -27,8 +30,16 @@ def test_schema_and_content(job):
     e = estimate(job)
     s = d["summary"]
     assert s["passes"] == 576 and s["cuts"] == 18
-    assert s["ratio"] == pytest.approx(e.ratio, abs=1e-6)
-    assert s["total_time_s"] == pytest.approx(s["cut_time_s"] + s["rapid_time_s"] + s["focus_time_s"], abs=3e-6)
+    assert s["constant_speed_time_s"] == pytest.approx(e.total_s, abs=1e-6)
+    assert s["constant_speed_time_s"] == pytest.approx(s["cut_time_s"] + s["rapid_time_s"] + s["focus_time_s"],
+                                                       abs=3e-6)
+    # the total is motion-aware for the recorded machine: the same figure from the written G-code's text
+    assert d["machine"]["name"] == LINUXCNC.profile.name
+    assert d["machine"]["axes"]["X"]["max_acceleration"] == LINUXCNC.profile.axis("X").max_acceleration
+    assert s["total_time_s"] == pytest.approx(estimate_program(gcode(job, LINUXCNC), LINUXCNC.profile).total_s,
+                                              abs=2e-6)
+    assert s["total_time_s"] > s["lower_bound_s"]
+    assert s["ratio"] == pytest.approx(s["total_time_s"] / s["lower_bound_s"], abs=1e-6)
     for k, (pd, ps) in enumerate(zip(d["passes"], job.passes)):
         assert pd["index"] == k and pd["cut_index"] == ps.cut_index and pd["drill_index"] == ps.drill_index
         assert [v for q in pd["points"] for v in q] == pytest.approx(
