@@ -153,15 +153,20 @@ class _Emitter:
         self.prev_key: tuple[float, float] | None = None
         self.blocks: dict[tuple[int, float], tuple[str, str, bool]] = {}
 
-    def _gate_on(self, key: tuple[float, float]) -> str:
-        """Settings lines (where they change) + the gate-on line."""
+    def _gate_on(self, key: tuple[float, float]) -> tuple[str, str]:
+        """(settings lines where they change, the gate-on line).
+
+        The settings (``M68`` on LinuxCNC) are not motion-synchronised: the controller stops to
+        apply them, so they go before the pass's first feed move (before a lead-in, not between
+        the lead-in and the edge it brings up to speed).
+        """
         d = self.d
         g = self.gates.get(key)
         if g is None:
             fields = d.fields(*key)
             g = self.gates[key] = ("".join(x.format(**fields) + "\n" for x in d.settings),
                                    d.laser_on.format(**fields))
-        out = (g[0] if key != self.prev_key else "") + g[1]
+        out = (g[0] if key != self.prev_key else ""), g[1]
         self.prev_key = key
         return out
 
@@ -232,7 +237,8 @@ class _Emitter:
                 blk = self._rows(X, Y, Z, F, K, L, i, r1)
             before, after, opened = blk
             if opened:
-                text.append(before + self._gate_on((pw, fq)))
+                settings, gate_on = self._gate_on((pw, fq))
+                text.append(settings + before + gate_on)
                 text.append(after)
             elif before:
                 text.append(before)

@@ -52,8 +52,13 @@ def lead_length_mm(ux: np.ndarray, uy: np.ndarray, speed: np.ndarray, profile, o
     return LEAD_MARGIN * speed * speed / (2.0 * a) + LEAD_CYCLES * profile.servo_period_s * speed
 
 
-def overtravel(job, mv: Moves, profile) -> Moves:
-    """The moves of a chunk with every CUT edge given a lead-in and a lead-out (see the module docstring)."""
+def overtravel(job, mv: Moves, profile, final: bool = False) -> Moves:
+    """The moves of a chunk with every CUT edge given a lead-in and a lead-out (see the module docstring).
+
+    ``final``: the chunk ends the job; a beam-off rapid back to the last edge's end follows the
+    last lead-out (LinuxCNC brakes the last edge of a program early when its lead-out is the
+    program's last move).
+    """
     if len(mv) == 0:
         return mv
     x0, y0, z0 = mv.starts()
@@ -116,6 +121,9 @@ def overtravel(job, mv: Moves, profile) -> Moves:
             else:  # a rapid, focus or lead row between cuts: keep it
                 add(X[r], Y[r], Z[r], k, bool(mv.laser[r]), p, V[r], S[r])
         i = j
+    if final and cuts:
+        r = cuts[-1]
+        add(X[r], Y[r], Z[r], RAPID, False, P[r], V[r], 0.0)
     f = lambda c, t: np.asarray(c, dtype=t)  # noqa: E731
     return Moves(f(cols[0], float), f(cols[1], float), f(cols[2], float), f(cols[3], np.int8), f(cols[4], bool),
                  f(cols[5], np.int64), f(cols[6], np.int64), f(cols[7], float), mv.start)
@@ -129,12 +137,16 @@ class StrategyMoves:
 
     def __iter__(self) -> Iterator[Moves]:
         start = None
-        for mv in iter_moves(self.job):
+        it = iter_moves(self.job)
+        nxt = next(it, None)
+        while nxt is not None:
+            mv, nxt = nxt, next(it, None)
             if start is not None:  # the previous chunk ended at a lead-out, not at the pass's last vertex
                 mv = Moves(mv.x, mv.y, mv.z, mv.kind, mv.laser, mv.pass_index, mv.vertex, mv.speed, start)
-            out = overtravel(self.job, mv, self.profile) if self.profile.corner_strategy == "overtravel" else mv
-            start = out.end
-            yield out
+            if self.profile.corner_strategy == "overtravel":
+                mv = overtravel(self.job, mv, self.profile, final=nxt is None)
+            start = mv.end
+            yield mv
 
 
 def strategy_moves(job, profile):

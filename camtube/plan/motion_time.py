@@ -7,8 +7,9 @@ The model follows LinuxCNC's trajectory planner for straight moves (``emccanon``
   length; the rotary axis is slaved to it;
 - its velocity limit is the requested one (G0: the axes' maxima; G1 in G93:
   length x F / 60; in G94: F / 60) capped so that no axis exceeds its maximum
-  velocity, ``min_i L v_i / |d_i|``; its acceleration limit likewise
-  ``min_i L a_i / |d_i|``;
+  velocity, ``min_i L v_i / |d_i|``, and, for a move with XYZ motion, at the
+  fastest linear axis' velocity (``[TRAJ] MAX_LINEAR_VELOCITY``); its
+  acceleration limit likewise ``min_i L a_i / |d_i|``;
 - ``exact_stop`` (G61): every move starts and ends at rest (a trapezoid, or a
   triangle when too short to reach speed);
 - a path tolerance (G64 P..): consecutive *collinear* pure-XYZ moves join at
@@ -94,6 +95,12 @@ def move_limits(d: np.ndarray, letters, profile, requested_v: np.ndarray):
             move = ad[:, j] > 0
             vlim = np.where(move, np.minimum(vlim, L * lim.max_velocity / ad[:, j]), vlim)
             alim = np.where(move, np.minimum(alim, L * lim.max_acceleration / ad[:, j]), alim)
+    # LinuxCNC's [TRAJ] MAX_LINEAR_VELOCITY (the runner sets it to the fastest linear axis) caps the
+    # XYZ path speed of every move that has XYZ motion, e.g. a diagonal rapid
+    lin_letters = [c for c in letters if c in _LINEAR]
+    if lin_letters:
+        v_traj = max(profile.axis(c).max_velocity for c in lin_letters)
+        vlim = np.where(L_lin > 1e-9, np.minimum(vlim, v_traj), vlim)
     vmax = np.minimum(vlim, requested_v)
     return L, vmax, alim
 
