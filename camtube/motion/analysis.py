@@ -22,6 +22,7 @@ import json
 import math
 import os
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -69,7 +70,7 @@ class JobGeometry:
     def from_job_file(cls, path: str | os.PathLike) -> "JobGeometry":
         """From a ``camtube.job/1`` file (``NAME.job.json``)."""
         try:
-            d = json.loads(open(path, encoding="utf-8").read())
+            d = json.loads(Path(path).read_text(encoding="utf-8"))
             corners = np.concatenate([np.column_stack([np.asarray(p["points"], float),
                                                        np.full(len(p["points"]), p["focus_offset_mm"])])
                                       for p in d["passes"]])

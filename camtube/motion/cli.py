@@ -14,7 +14,7 @@ def register(sub) -> None:
                     "machine profile's limits, in real time (a job of N s takes N s), recording the commanded "
                     "axes and the laser gate every servo cycle. Reports the run time against the estimate, the "
                     "beam-on path length against the job's cut length (mm), the share of the beam-on path within "
-                    "+-5 %% of the scan speed, the farthest beam-on position outside the cut regions (um) and the "
+                    "+-5 % of the scan speed, the farthest beam-on position outside the cut regions (um) and the "
                     "largest distance by which the beam misses a drawn corner (um). Needs linuxcnc-uspace; "
                     "exits 2 with one line when it is missing.")
     p.add_argument("program", metavar="JOB.ngc", help="G-code written by camtube toolpath (LinuxCNC dialect)")

@@ -33,8 +33,9 @@ from camtube.errors import CamtubeError
 
 #: LinuxCNC's own Python (the ``linuxcnc`` module is built for it).
 SYSTEM_PYTHON = "/usr/bin/python3"
-#: A program runs in pieces of at most this many moves: LinuxCNC 2.9's task process (milltask) was seen
-#: to die here once the motion queue filled (~1,740 queued moves), leaving the rest of the program unrun.
+#: A program runs in pieces of at most this many moves: LinuxCNC 2.9's task process (milltask) was seen to
+#: die when it waited on a full motion queue longer than [EMCMOT] COMM_TIMEOUT, leaving the rest unrun
+#: (the configuration also sets COMM_TIMEOUT far beyond any job).
 PIECE_MOVES = 800
 #: Stationary stretches longer than this (s) are pauses between pieces, not run time.
 IDLE_S = 0.005
@@ -143,7 +144,7 @@ def config_texts(profile, workdir: str | os.PathLike, driver: str) -> dict[str, 
         "[DISPLAY]", f"DISPLAY = {driver}",
         "[TASK]", "TASK = milltask", "CYCLE_TIME = 0.010",
         "[RS274NGC]", f"PARAMETER_FILE = {w / 'sim.var'}",
-        "[EMCMOT]", "EMCMOT = motmod", "COMM_TIMEOUT = 30.0", f"SERVO_PERIOD = {servo_ns}",
+        "[EMCMOT]", "EMCMOT = motmod", "COMM_TIMEOUT = 100000", f"SERVO_PERIOD = {servo_ns}",
         "[EMCIO]", "EMCIO = io", "CYCLE_TIME = 0.100", f"TOOL_TABLE = {w / 'tool.tbl'}",
         "[HAL]", f"HALFILE = {w / 'camtube.hal'}",
         "[TRAJ]", f"COORDINATES = {coords}", "LINEAR_UNITS = mm", "ANGULAR_UNITS = degree",
