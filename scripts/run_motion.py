@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import shutil
 import sys
 import tempfile
 import time
@@ -25,7 +26,7 @@ PRESETS = ("tube1", "tube2", "tube3", "tube1-bidirectional")
 MACHINES = ("linuxcnc-surface", "linuxcnc-rotary")
 
 
-def run_one(machine: str, preset: str) -> dict:
+def run_one(machine: str, preset: str, workdir=None) -> dict:
     from camtube.design.loader import load_pattern
     from camtube.export.dialects import dialect_from_profile
     from camtube.machine import load_profile
@@ -44,7 +45,7 @@ def run_one(machine: str, preset: str) -> dict:
         write_streams(keep, tmp)
         ngc = Path(tmp) / f"{job.name}{dialect.suffix}"
         est = estimate_program(ngc.read_text(), profile)
-        rec = run_program(ngc, profile, timeout_s=4 * est.total_s + 120)
+        rec = run_program(ngc, profile, timeout_s=4 * est.total_s + 120, workdir=workdir)
         rep = analyse(rec, JobGeometry.from_job_file(Path(tmp) / f"{job.name}.job.json"), profile,
                       estimate_s=est.total_s)
     d = rep.as_dict()
@@ -73,9 +74,10 @@ def main() -> int:
     ap.add_argument("--table", metavar="JSONL", help="only print the table of a results file")
     args = ap.parse_args()
     if args.table:
-        print(table([json.loads(x) for x in Path(args.table).read_text().splitlines() if x.strip()]))
+        rows = [json.loads(x) for x in Path(args.table).read_text().splitlines() if x.strip()]
+        print(table([r for r in rows if "error" not in r]))
         return 0
-    from camtube.motion.linuxcnc import unavailable_reason
+    from camtube.motion.linuxcnc import MotionRunError, unavailable_reason
 
     why = unavailable_reason()
     if why:
@@ -85,7 +87,15 @@ def main() -> int:
     for preset in args.preset or PRESETS:
         for machine in args.machine or MACHINES:
             t0 = time.time()
-            r = run_one(machine, preset)
+            work = Path(tempfile.mkdtemp(prefix=f"camtube-run-motion-{machine}-{preset}-"))
+            try:
+                r = run_one(machine, preset, work)
+            except MotionRunError as exc:  # report the failed run, keep its log, go on with the next
+                print(f"{machine} {preset}: FAILED ({exc}); configuration and log kept in {work}", flush=True)
+                with open(args.out, "a") as fh:
+                    fh.write(json.dumps({"machine": machine, "preset": preset, "error": str(exc)}) + "\n")
+                continue
+            shutil.rmtree(work, ignore_errors=True)
             rows.append(r)
             with open(args.out, "a") as fh:
                 fh.write(json.dumps(r) + "\n")
