@@ -1,7 +1,7 @@
 ; camtube 0.1.0 job tube1-bidirectional, dialect grbl: GRBL 1.1 flat-bed laser, unrolled test cut: X = x, Y = y mm, Z focus; G94; M4 S/M5
 ; frame: X = x mm from the tip, Y = y mm (unrolled sheet), Z = -focus offset into the material mm
 ; process: 2 W, 60 kHz, 25 mm/s on the outer surface, 4 drill cuts 0.005 mm apart, defocus 0.1 mm, 4 repeats, ordering interleaved
-; 18 cuts, 576 passes, cut length 3452.160 mm, estimated 151.0 s (0:02:31), lower bound 138.1 s (0:02:18), ratio 1.0935
+; 18 cuts, 576 passes, cut length 3452.160 mm, estimated 230.1 s (0:03:50) on machine grbl-flat, lower bound 138.1 s (0:02:18), ratio 1.6665
 G21 G90 G17 G94
 M5
 G0 Z0

@@ -1,7 +1,7 @@
 ; camtube 0.1.0 job tube1, dialect grbl: GRBL 1.1 flat-bed laser, unrolled test cut: X = x, Y = y mm, Z focus; G94; M4 S/M5
 ; frame: X = x mm from the tip, Y = y mm (unrolled sheet), Z = -focus offset into the material mm
 ; process: 2 W, 60 kHz, 25 mm/s on the outer surface, 4 drill cuts 0.005 mm apart, defocus 0.1 mm, 4 repeats, ordering interleaved
-; 11 cuts, 352 passes, cut length 2148.480 mm, estimated 92.7 s (0:01:33), lower bound 85.9 s (0:01:26), ratio 1.0790
+; 11 cuts, 352 passes, cut length 2148.480 mm, estimated 137.5 s (0:02:17) on machine grbl-flat, lower bound 85.9 s (0:01:26), ratio 1.5994
 G21 G90 G17 G94
 M5
 G0 Z0

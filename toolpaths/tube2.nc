@@ -1,7 +1,7 @@
 ; camtube 0.1.0 job tube2, dialect grbl: GRBL 1.1 flat-bed laser, unrolled test cut: X = x, Y = y mm, Z focus; G94; M4 S/M5
 ; frame: X = x mm from the tip, Y = y mm (unrolled sheet), Z = -focus offset into the material mm
 ; process: 2 W, 60 kHz, 25 mm/s on the outer surface, 4 drill cuts 0.005 mm apart, defocus 0.1 mm, 6 repeats, ordering interleaved
-; 11 cuts, 528 passes, cut length 3577.920 mm, estimated 153.4 s (0:02:33), lower bound 143.1 s (0:02:23), ratio 1.0721
+; 11 cuts, 528 passes, cut length 3577.920 mm, estimated 220.6 s (0:03:41) on machine grbl-flat, lower bound 143.1 s (0:02:23), ratio 1.5416
 G21 G90 G17 G94
 M5
 G0 Z0

@@ -1,7 +1,7 @@
 ; camtube 0.1.0 job tube3, dialect grbl: GRBL 1.1 flat-bed laser, unrolled test cut: X = x, Y = y mm, Z focus; G94; M4 S/M5
 ; frame: X = x mm from the tip, Y = y mm (unrolled sheet), Z = -focus offset into the material mm
 ; process: 2 W, 60 kHz, 25 mm/s on the outer surface, 4 drill cuts 0.005 mm apart, defocus 0.1 mm, 8 repeats, ordering interleaved
-; 11 cuts, 704 passes, cut length 6703.360 mm, estimated 282.8 s (0:04:43), lower bound 268.1 s (0:04:28), ratio 1.0546
+; 11 cuts, 704 passes, cut length 6703.360 mm, estimated 372.6 s (0:06:13) on machine grbl-flat, lower bound 268.1 s (0:04:28), ratio 1.3897
 G21 G90 G17 G94
 M5
 G0 Z0

@@ -16,12 +16,16 @@
     Y = y (mm), Z focus; G94 feed in mm/min; beam ``M4 S..`` (dynamic power;
     S = W x ``spindle_per_watt``, S1000 = 10 W by default) / ``M5``.
 
+The shipped dialects are built from the machine profiles ``machines/linuxcnc-rotary.yaml``
+and ``machines/grbl-flat.yaml`` (:func:`dialect_from_profile`); a profile of your own
+gives a dialect the same way.
+
 Z is the focus height relative to the outer surface: ``Z = -focus_offset``
 (a defocus 0.1 mm into the material is Z = -0.1).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
 
@@ -54,6 +58,8 @@ class Dialect:
         ``(text)`` or ``; text``.
     spindle_per_watt : float
         S value per watt for ``{spindle}``.
+    profile : MachineProfile | None
+        The machine profile the dialect was built from (limits, blending, corner strategy).
     """
 
     name: str
@@ -71,6 +77,7 @@ class Dialect:
     feed_decimals: int = 3
     comment: Literal["paren", "semicolon"] = "paren"
     spindle_per_watt: float = 0.0
+    profile: object = field(default=None, compare=False, repr=False)
 
     def comment_line(self, text: str) -> str:
         """``text`` as a comment line (parentheses removed from paren comments)."""
@@ -82,35 +89,48 @@ class Dialect:
         return {"power_w": power_w, "frequency_khz": frequency_khz, "spindle": power_w * self.spindle_per_watt}
 
 
-LINUXCNC = Dialect(
-    name="linuxcnc",
-    suffix=".ngc",
-    description="LinuxCNC rotary stage: X mm along the tube, A deg, Z focus; G93; gate M62/M63 P0",
-    rotary=True,
-    axes=("X", "A", "Z"),
-    preamble=("G21 G90 G17 G40 G49 G80", "G64 P0.001", "M65 P0", "G93", "G0 Z0"),
-    postamble=("M65 P0", "G94", "M2"),
-    laser_on="M62 P0",
-    laser_off="M63 P0",
-    settings=("M68 E0 Q{power_w:.3f}", "M68 E1 Q{frequency_khz:.3f}"),
-    feed_mode="inverse_time",
-    comment="paren",
-)
+def blending_line(profile) -> str | None:
+    """The G-code line that sets ``profile.blending`` (None: leave the controller's own)."""
+    if profile.blending == "exact_stop":
+        return "G61"
+    if profile.blending == "controller":
+        return None
+    return f"G64 P{profile.blending:g}"
 
-GRBL = Dialect(
-    name="grbl",
-    suffix=".nc",
-    description="GRBL 1.1 flat-bed laser, unrolled test cut: X = x, Y = y mm, Z focus; G94; M4 S/M5",
-    rotary=False,
-    axes=("X", "Y", "Z"),
-    preamble=("G21 G90 G17 G94", "M5", "G0 Z0"),
-    postamble=("M5", "M2"),
-    laser_on="M4 S{spindle:.0f}",
-    laser_off="M5",
-    feed_mode="units_per_minute",
-    comment="semicolon",
-    spindle_per_watt=100.0,
-)
+
+def dialect_from_profile(profile) -> Dialect:
+    """The :class:`Dialect` of a :class:`~camtube.machine.MachineProfile` (preamble, gate, settings, style).
+
+    ``linuxcnc``: G93 inverse time, gate ``M62``/``M63 P<gate_output>`` (``M65`` at once in the
+    preamble and postamble), power and frequency on ``M68 E<power_output>``/``E<frequency_output>``.
+    ``grbl``: G94, beam ``<spindle> S<W x s_per_watt>`` / ``M5``.
+    """
+    ax, ay, az = profile.axes
+    blend = blending_line(profile)
+    common = dict(name=profile.dialect, suffix=profile.suffix, description=profile.description,
+                  rotary=profile.rotary, axes=profile.axes, comment=profile.comment, decimals=profile.decimals,
+                  feed_decimals=profile.feed_decimals, profile=profile)
+    if profile.dialect == "linuxcnc":
+        g = profile.gate_output
+        settings = tuple(line for out, line in ((profile.power_output, "M68 E{} Q{{power_w:.3f}}"),
+                                                (profile.frequency_output, "M68 E{} Q{{frequency_khz:.3f}}"))
+                         if out is not None for line in [line.format(out)])
+        pre = ("G21 G90 G17 G40 G49 G80",) + ((blend,) if blend else ()) + (f"M65 P{g}", "G93", f"G0 {az}0")
+        return Dialect(preamble=pre, postamble=(f"M65 P{g}", "G94", "M2"), laser_on=f"M62 P{g}",
+                       laser_off=f"M63 P{g}", settings=settings, feed_mode="inverse_time", **common)
+    pre = ("G21 G90 G17 G94",) + ((blend,) if blend else ()) + ("M5", f"G0 {az}0")
+    return Dialect(preamble=pre, postamble=("M5", "M2"), laser_on=f"{profile.spindle} S{{spindle:.0f}}",
+                   laser_off="M5", feed_mode="units_per_minute", spindle_per_watt=profile.s_per_watt, **common)
+
+
+def _shipped(name: str) -> Dialect:
+    from camtube.machine.profile import load_profile
+
+    return dialect_from_profile(load_profile(name))
+
+
+LINUXCNC = _shipped("linuxcnc-rotary")
+GRBL = _shipped("grbl-flat")
 
 DIALECTS: dict[str, Dialect] = {d.name: d for d in (LINUXCNC, GRBL)}
 

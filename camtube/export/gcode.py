@@ -125,8 +125,8 @@ def _header(job, dialect: Dialect, est) -> list[str]:
           f"{pr.drill_passes} drill cuts {pr.drill_offset_mm:g} mm apart, defocus {pr.defocus_mm:g} mm, "
           f"{job.repeats} repeats, ordering {job.ordering}"),
         c(f"{est.cuts} cuts, {est.passes} passes, cut length {est.cut_length_mm:.3f} mm, estimated "
-          f"{format_duration_s(est.total_s)}, lower bound {format_duration_s(est.lower_bound_s)}, "
-          f"ratio {est.ratio:.4f}"),
+          f"{format_duration_s(est.total_s)}" + (f" on machine {est.machine}" if est.machine else "")
+          + f", lower bound {format_duration_s(est.lower_bound_s)}, ratio {est.ratio:.4f}"),
     ]
     warning = time_warning(job, est)
     if warning:
@@ -154,15 +154,20 @@ class _Emitter:
         self.prev_key: tuple[float, float] | None = None
         self.blocks: dict[tuple[int, float], tuple[str, str, bool, bool]] = {}
 
-    def _gate_on(self, key: tuple[float, float]) -> str:
-        """Settings lines (where they change) + the gate-on line."""
+    def _gate_on(self, key: tuple[float, float]) -> tuple[str, str]:
+        """(settings lines where they change, the gate-on line).
+
+        The settings (``M68`` on LinuxCNC) are not motion-synchronised: the controller stops to
+        apply them, so they go before the pass's first feed move (before a lead-in, not between
+        the lead-in and the edge it brings up to speed).
+        """
         d = self.d
         g = self.gates.get(key)
         if g is None:
             fields = d.fields(*key)
             g = self.gates[key] = ("".join(x.format(**fields) + "\n" for x in d.settings),
                                    d.laser_on.format(**fields))
-        out = (g[0] if key != self.prev_key else "") + g[1]
+        out = (g[0] if key != self.prev_key else ""), g[1]
         self.prev_key = key
         return out
 
@@ -236,8 +241,9 @@ class _Emitter:
                 blk = self._rows(X, Y, Z, F, K, L, i, r1)
             before, after, opened, reopened = blk
             if opened:
-                text.append(before + self._gate_on((pw, fq)))
-                text.append(after.replace(_REOPEN, self.gates[(pw, fq)][1]) if reopened else after)
+                settings, gate_on = self._gate_on((pw, fq))
+                text.append(settings + before + gate_on)
+                text.append(after.replace(_REOPEN, gate_on) if reopened else after)
             elif before:
                 text.append(before)
             out.append("\n".join(text))
@@ -275,7 +281,12 @@ def iter_gcode(job, dialect: Dialect = LINUXCNC, *, progress: Progress = NO_PROG
         A chunk's emitted moves fail :func:`camtube.plan.safety.check_moves`; that chunk's
         text is never yielded (the file layer discards the partial file).
     """
-    est = estimate(job) if moves is None else estimate(job, moves)
+    from camtube.machine.corners import strategy_moves
+    from camtube.plan.motion_time import job_estimate
+
+    if moves is None and dialect.profile is not None:
+        moves = strategy_moves(job, dialect.profile)  # the profile's corner strategy (None: the job's moves)
+    est = job_estimate(job, dialect, moves)
     yield "\n".join(_header(job, dialect, est) + list(dialect.preamble)) + "\n"
     em = _Emitter(job, dialect, memo and moves is None)
     with progress.task(f"G-code {dialect.name}", total=len(job.passes)) as task:

@@ -21,7 +21,6 @@ import numpy as np
 
 from camtube import __version__
 from camtube.errors import DataError
-from camtube.plan.moves import estimate
 from camtube.plan.safety import check_job
 from camtube.progress import NO_PROGRESS, Progress
 
@@ -80,15 +79,27 @@ def _classes(job) -> list[dict]:
             for f in (0, 1) for d, o in enumerate(pass_offsets_mm(pr))]
 
 
-def _head(job) -> dict:
-    """Everything but the cuts (fixed key order)."""
-    est = estimate(job)
+def _head(job, dialect=None) -> dict:
+    """Everything but the cuts (fixed key order).
+
+    ``dialect``: the G-code dialect (and so the machine profile) the job is made for
+    (default: the default LinuxCNC profile). Its profile is recorded under ``machine``, and
+    ``summary.total_time_s`` is the motion-aware time on it (``constant_speed_time_s``: every
+    move at its nominal speed).
+    """
+    from camtube.export.dialects import LINUXCNC
+    from camtube.plan.motion_time import job_estimate
+
+    dialect = LINUXCNC if dialect is None else dialect
+    est = job_estimate(job, dialect)
     tour, _ = _recipe(job)
     summary = {
         "cuts": est.cuts, "passes": est.passes, "cut_length_mm": est.cut_length_mm, "cut_time_s": est.cut_s,
         "rapid_time_s": est.rapid_s, "focus_time_s": est.focus_s, "lead_time_s": est.lead_s,
         "total_time_s": est.total_s, "lower_bound_s": est.lower_bound_s, "ratio": est.ratio,
+        "constant_speed_time_s": est.constant_speed_s,
     }
+    machine = dialect.profile.record() if getattr(dialect, "profile", None) is not None else None
     return {
         "schema": SCHEMA, "generator": f"camtube {__version__}", "name": job.name,
         "units": {"length": "mm", "time": "s", "speed": "mm/s", "power": "W", "frequency": "kHz"},
@@ -96,7 +107,7 @@ def _head(job) -> dict:
                  "rotary angle = y / outer_radius_mm rad",
         "outer_radius_mm": float(job.outer_radius_mm), "length_mm": float(job.length_mm),
         "ordering": job.ordering, "repeats": int(job.repeats), "process": _process_dict(job.process),
-        "summary": summary, "classes": _classes(job), "tour": tour.tolist(),
+        "machine": machine, "summary": summary, "classes": _classes(job), "tour": tour.tolist(),
     }
 
 
@@ -105,13 +116,14 @@ def _cut_line(i: int, c, start: list[int]) -> str:
                         "points": [[float(x), float(y)] for x, y in c.points]})
 
 
-def iter_job_json(job, progress: Progress = NO_PROGRESS) -> Iterator[str]:
+def iter_job_json(job, progress: Progress = NO_PROGRESS, dialect=None) -> Iterator[str]:
     """Safety-checked job file text of a planned job, in chunks (raises :class:`~camtube.errors.SafetyError`).
 
     The whole neutral move list is checked (chunk by chunk) before the first chunk of text.
+    ``dialect``: the machine the job is made for (see :func:`_head`).
     """
     check_job(job)
-    head = _head(job)
+    head = _head(job, dialect)
     _, starts = _recipe(job)
     lines = ["{"]
     for k, v in head.items():
@@ -134,14 +146,14 @@ def iter_job_json(job, progress: Progress = NO_PROGRESS) -> Iterator[str]:
     yield " ]\n}\n"
 
 
-def job_json(job) -> str:
+def job_json(job, dialect=None) -> str:
     """Safety-checked job file text (raises :class:`~camtube.errors.SafetyError`)."""
-    return "".join(iter_job_json(job))
+    return "".join(iter_job_json(job, dialect=dialect))
 
 
-def job_dict(job) -> dict:
+def job_dict(job, dialect=None) -> dict:
     """The job file content as plain data (fixed key order)."""
-    return json.loads(job_json(job))
+    return json.loads(job_json(job, dialect))
 
 
 # ---------------------------------------------------------------- reading

@@ -189,6 +189,11 @@ class Estimate:
     passes, cuts : int
     lead_s : float
         Laser-off feed moves (LEAD) at their own speed.
+    motion_s : float or None
+        The motion-aware time for a machine profile (trapezoidal moves with its axis limits
+        and blending, :mod:`camtube.plan.motion_time`); when set it is :attr:`total_s`.
+    machine : str or None
+        Name of the profile ``motion_s`` was computed for.
     """
 
     cut_s: float
@@ -199,10 +204,17 @@ class Estimate:
     passes: int
     cuts: int
     lead_s: float = 0.0
+    motion_s: float | None = None
+    machine: str | None = None
+
+    @property
+    def constant_speed_s(self) -> float:
+        """Every move at its nominal speed (no acceleration): cut + rapid + focus + lead."""
+        return self.cut_s + self.rapid_s + self.focus_s + self.lead_s
 
     @property
     def total_s(self) -> float:
-        return self.cut_s + self.rapid_s + self.focus_s + self.lead_s
+        return self.constant_speed_s if self.motion_s is None else self.motion_s
 
     @property
     def ratio(self) -> float:

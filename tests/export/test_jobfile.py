@@ -16,6 +16,7 @@ from camtube.export.dialects import LINUXCNC
 from camtube.export.gcode import gcode
 from camtube.export.jobfile import SCHEMA, iter_job_json, job_json, read_job
 from camtube.plan import estimate, plan_job
+from camtube.plan.motion_time import estimate_program
 from tests.conftest import PATTERNS
 
 
@@ -34,9 +35,17 @@ def test_schema_and_content(job):
     e = estimate(job)
     s = d["summary"]
     assert s["passes"] == 576 and s["cuts"] == 18
-    assert s["ratio"] == e.ratio and s["cut_length_mm"] == e.cut_length_mm  # exact round trip
-    assert s["total_time_s"] == pytest.approx(s["cut_time_s"] + s["rapid_time_s"] + s["focus_time_s"]
-                                              + s["lead_time_s"], rel=1e-12)
+    assert s["cut_length_mm"] == e.cut_length_mm  # exact round trip
+    assert s["constant_speed_time_s"] == pytest.approx(e.total_s, rel=1e-12)
+    assert s["constant_speed_time_s"] == pytest.approx(s["cut_time_s"] + s["rapid_time_s"] + s["focus_time_s"]
+                                                       + s["lead_time_s"], rel=1e-12)
+    # the total is motion-aware for the recorded machine: the same figure from the written G-code's text
+    assert d["machine"]["name"] == LINUXCNC.profile.name
+    assert d["machine"]["axes"]["X"]["max_acceleration"] == LINUXCNC.profile.axis("X").max_acceleration
+    assert s["total_time_s"] == pytest.approx(estimate_program(gcode(job, LINUXCNC), LINUXCNC.profile).total_s,
+                                              abs=2e-6)
+    assert s["total_time_s"] > s["lower_bound_s"]
+    assert s["ratio"] == pytest.approx(s["total_time_s"] / s["lower_bound_s"], abs=1e-6)
     for i, (c, design) in enumerate(zip(d["cuts"], job.design)):
         assert c["index"] == i and c["kind"] == design.kind and c["closed"] is True
         assert [tuple(p) for p in c["points"]] == list(design.points)

@@ -43,7 +43,12 @@ def test_time_warning_fires_above_max_time_h(job):
     assert "(0:00:36)" in w
     text = gcode(short)
     header = text.split("(pass 0:")[0]
-    assert "WARNING: the estimated laser time" in header and "[0:01:33]" in header  # paren comments use []
+    # the header's figure is the motion-aware time on the dialect's machine; paren comments use []
+    from camtube.export.dialects import LINUXCNC
+    from camtube.plan.motion_time import job_estimate
+
+    hms = format_duration_s(job_estimate(short, LINUXCNC).total_s).split("(")[1].rstrip(")")
+    assert "WARNING: the estimated laser time" in header and f"[{hms}]" in header
     assert "WARNING" not in gcode(job)
 
 

@@ -1,0 +1,389 @@
+"""Machine profiles: what a laser machine can do and how it wants its G-code, as data.
+
+A profile is a YAML file (``machines/NAME.yaml`` ships the defaults, any file
+can be given) holding a ``machine:`` mapping, parsed once into a frozen
+:class:`MachineProfile`. Unknown keys are errors with a "did you mean"; every
+error names the file, the line, the key, the allowed values and the fix
+(:class:`camtube.errors.PatternError`, so the CLI prints it and exits 2).
+
+Keys (units in the comments of the shipped files; ``docs/motion.md`` has the table):
+
+``description``, ``dialect`` (``linuxcnc`` | ``grbl``), ``suffix``, ``rotary``,
+``axes`` (axial, circumferential, focus letters), ``limits.<LETTER>.max_velocity``
+(mm/s or deg/s) and ``.max_acceleration`` (mm/s^2 or deg/s^2), ``blending``
+(``exact_stop``, a path tolerance in mm, or ``controller``), ``corner_strategy``
+(``overtravel`` | ``none``), ``servo_period_s``, ``laser`` (``gate_output``,
+``power_output``, ``frequency_output`` for LinuxCNC; ``spindle`` M3/M4 and
+``s_per_watt`` for GRBL), ``rotary_range_deg``, ``wrap``, ``comment``
+(``paren`` | ``semicolon``), ``decimals``, ``feed_decimals``.
+"""
+from __future__ import annotations
+
+import difflib
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from camtube.errors import Issue, PatternError
+
+#: Folder of the shipped profiles (``machines/`` at the top of the repository).
+MACHINES_DIR = Path(__file__).resolve().parents[2] / "machines"
+DEFAULT_MACHINE = "linuxcnc-rotary"
+DIALECT_KINDS = ("linuxcnc", "grbl")
+CORNER_STRATEGIES = ("overtravel", "none")
+COMMENT_STYLES = ("paren", "semicolon")
+
+
+@dataclass(frozen=True)
+class AxisLimits:
+    """Limits of one machine axis.
+
+    Attributes
+    ----------
+    max_velocity : float
+        mm/s for a linear axis, deg/s for a rotary one.
+    max_acceleration : float
+        mm/s^2 or deg/s^2.
+    """
+
+    max_velocity: float
+    max_acceleration: float
+
+
+@dataclass(frozen=True)
+class MachineProfile:
+    """One laser machine, as data (see the module docstring for the YAML keys).
+
+    Attributes
+    ----------
+    name : str
+        Profile name (the file stem).
+    description : str
+    dialect : {"linuxcnc", "grbl"}
+        G-code family the emitter writes.
+    suffix : str
+        File suffix of the G-code, with the dot.
+    rotary : bool
+        True: the circumferential axis is rotary, ``degrees(y / r_o)``.
+    axes : tuple[str, str, str]
+        Letters of the axial, circumferential and focus axes.
+    limits : tuple[tuple[str, AxisLimits], ...]
+        Per axis letter (look up with :meth:`axis`).
+    blending : str | float
+        ``"exact_stop"`` (G61), a path tolerance in mm (G64 P..), or
+        ``"controller"`` (nothing written; the controller's own junction handling).
+    corner_strategy : {"overtravel", "none"}
+        ``overtravel``: every cut edge is run at the scan speed from a beam-off
+        lead-in to a beam-off lead-out along its own line (uniform dose, see
+        :mod:`camtube.machine.corners`); ``none``: edges run back to back.
+    servo_period_s : float
+        Controller servo period (s): the motion-synchronised gate switches on this clock.
+    gate_output, power_output, frequency_output : int | None
+        LinuxCNC digital output of the gate (M62/M63 P..) and analog outputs of
+        power (W) and frequency (kHz) (M68 E..); None where not used.
+    spindle : str | None
+        GRBL beam-on code (``M3`` or ``M4``); None for LinuxCNC.
+    s_per_watt : float
+        S value per watt for the spindle code.
+    rotary_range_deg : tuple[float, float] | None
+        Travel of the rotary axis (deg).
+    wrap : str
+        ``none``: the rotary axis is continuous, never re-zeroed.
+    comment : {"paren", "semicolon"}
+    decimals, feed_decimals : int
+    source : str | None
+        File the profile was read from.
+    """
+
+    name: str
+    description: str
+    dialect: str
+    suffix: str
+    rotary: bool
+    axes: tuple[str, str, str]
+    limits: tuple[tuple[str, AxisLimits], ...]
+    blending: str | float = "exact_stop"
+    corner_strategy: str = "none"
+    servo_period_s: float = 0.001
+    gate_output: int | None = None
+    power_output: int | None = None
+    frequency_output: int | None = None
+    spindle: str | None = None
+    s_per_watt: float = 0.0
+    rotary_range_deg: tuple[float, float] | None = None
+    wrap: str = "none"
+    comment: str = "paren"
+    decimals: int = 6
+    feed_decimals: int = 3
+    source: str | None = None
+
+    def axis(self, letter: str) -> AxisLimits:
+        """Limits of axis ``letter`` (``KeyError`` if the profile has none)."""
+        for k, v in self.limits:
+            if k == letter:
+                return v
+        raise KeyError(f"machine {self.name!r} has no limits for axis {letter!r}")
+
+    @property
+    def exact_stop(self) -> bool:
+        return self.blending == "exact_stop"
+
+    def record(self) -> dict:
+        """What a job file stores about the machine it was made for (plain data, fixed order)."""
+        return {
+            "name": self.name, "dialect": self.dialect, "rotary": self.rotary,
+            "axes": {k: {"max_velocity": float(v.max_velocity), "max_acceleration": float(v.max_acceleration),
+                         "unit": "deg" if (self.rotary and k == self.axes[1]) else "mm"}
+                     for k, v in self.limits},
+            "blending": self.blending if isinstance(self.blending, str) else float(self.blending),
+            "corner_strategy": self.corner_strategy, "servo_period_s": float(self.servo_period_s),
+        }
+
+
+# ---------------------------------------------------------------- validation
+_LIMIT_KEYS = ("max_velocity", "max_acceleration")
+_LASER_KEYS = ("gate_output", "power_output", "frequency_output", "spindle", "s_per_watt")
+_KEYS = ("description", "dialect", "suffix", "rotary", "axes", "limits", "blending", "corner_strategy",
+         "servo_period_s", "laser", "rotary_range_deg", "wrap", "comment", "decimals", "feed_decimals")
+_REQUIRED = ("dialect", "axes", "limits")
+
+
+def _line_map(text: str) -> dict[str, int]:
+    """Dotted key -> 1-based line, from the YAML node tree."""
+    import yaml
+
+    out: dict[str, int] = {}
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError:
+        return out
+
+    def walk(node, prefix):
+        if isinstance(node, yaml.MappingNode):
+            for k, v in node.value:
+                key = f"{prefix}.{k.value}" if prefix else str(k.value)
+                out[key] = k.start_mark.line + 1
+                walk(v, key)
+
+    if root is not None:
+        walk(root, "")
+    return out
+
+
+def _hint(word: str, options) -> str:
+    m = difflib.get_close_matches(str(word), list(options), n=1, cutoff=0.5)
+    return f"did you mean '{m[0]}'?" if m else f"remove it (known: {', '.join(options)})"
+
+
+class _Checker:
+    def __init__(self, file: str | None, lines: dict[str, int]):
+        self.file, self.lines, self.issues = file, lines, []
+
+    def add(self, key, message, value=None, allowed="", fix=""):
+        full = f"machine.{key}" if key else "machine"
+        self.issues.append(Issue(full, message, value, allowed, fix, self.file,
+                                 self.lines.get(full, self.lines.get("machine"))))
+
+    def unknown(self, mapping: dict, allowed, prefix: str) -> None:
+        for k in mapping:
+            if k not in allowed:
+                self.add(f"{prefix}{k}", "unknown key", None, ", ".join(allowed), _hint(k, allowed))
+
+    def number(self, v, key, lo=0.0, strict=True, integer=False):
+        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+        if ok and integer and float(v) != int(v):
+            ok = False
+        if ok and (v <= lo if strict else v < lo):
+            ok = False
+        if not ok:
+            what = "a whole number" if integer else "a finite number"
+            rng = f"{what} {'>' if strict else '>='} {lo:g}"
+            self.add(key, f"must be {rng}", v, rng, f"set {key} to {rng}")
+            return None
+        return int(v) if integer else float(v)
+
+    def choice(self, v, key, options):
+        if v not in options:
+            self.add(key, "not an allowed value", v, " | ".join(map(str, options)), _hint(v, options))
+            return None
+        return v
+
+
+def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str, int] | None = None
+                  ) -> MachineProfile:
+    """Validate the raw YAML data of a profile file and build it.
+
+    Raises
+    ------
+    PatternError
+        Every problem found, each naming the file, line, key, allowed values and fix.
+    """
+    ck = _Checker(file, lines or {})
+    if not isinstance(raw, dict) or set(raw) != {"machine"} or not isinstance(raw.get("machine"), dict):
+        ck.add("", "a machine profile is one mapping under the top-level key 'machine:'", None,
+               "machine: {dialect: ..., axes: [...], limits: {...}}", "start the file with 'machine:'")
+        raise PatternError(ck.issues)
+    m = raw["machine"]
+    ck.unknown(m, _KEYS, "")
+    for k in _REQUIRED:
+        if k not in m:
+            ck.add(k, "required key missing", None, "", f"add machine.{k}")
+    if ck.issues:
+        raise PatternError(ck.issues)
+    dialect = ck.choice(m["dialect"], "dialect", DIALECT_KINDS)
+    rotary = m.get("rotary", dialect == "linuxcnc")
+    if not isinstance(rotary, bool):
+        ck.add("rotary", "must be true or false", rotary, "true | false", "write rotary: true or rotary: false")
+    axes = m["axes"]
+    if not (isinstance(axes, list) and len(axes) == 3 and all(isinstance(a, str) and len(a) == 1
+                                                              and a.upper() in "XYZABCUVW" for a in axes)
+            and len(set(axes)) == 3):
+        ck.add("axes", "must list three different axis letters: axial, circumferential, focus", axes,
+               "three of X Y Z A B C U V W", "e.g. axes: [X, A, Z]")
+        axes = ["X", "A", "Z"]
+    axes = tuple(a.upper() for a in axes)
+    limits = []
+    lim = m["limits"]
+    if not isinstance(lim, dict):
+        ck.add("limits", "must map each axis letter to max_velocity and max_acceleration", lim, "",
+               "e.g. limits: {X: {max_velocity: 50, max_acceleration: 500}}")
+        lim = {}
+    for letter in axes:
+        if letter not in lim:
+            ck.add(f"limits.{letter}", "no limits for this axis", None, "max_velocity > 0, max_acceleration > 0",
+                   f"add limits.{letter}: {{max_velocity: .., max_acceleration: ..}}")
+    for letter, v in lim.items():
+        key = f"limits.{letter}"
+        if letter not in axes:
+            ck.add(key, "not one of the profile's axes", letter, ", ".join(axes), _hint(letter, axes))
+            continue
+        if not isinstance(v, dict):
+            ck.add(key, "must be a mapping", v, "max_velocity, max_acceleration", "e.g. {max_velocity: 50, ...}")
+            continue
+        ck.unknown(v, _LIMIT_KEYS, key + ".")
+        vals = [ck.number(v.get(k), f"{key}.{k}") for k in _LIMIT_KEYS]
+        if None not in vals:
+            limits.append((letter, AxisLimits(*vals)))
+    blending = m.get("blending", "exact_stop")
+    if not (blending in ("exact_stop", "controller")
+            or (isinstance(blending, (int, float)) and not isinstance(blending, bool) and math.isfinite(blending)
+                and blending >= 0)):
+        ck.add("blending", "not an allowed value", blending, "exact_stop | controller | a tolerance >= 0 mm",
+               "write blending: exact_stop, or a path tolerance such as 0.001")
+    elif not isinstance(blending, str):
+        blending = float(blending)
+    if dialect == "grbl" and blending not in ("controller", "exact_stop"):
+        ck.add("blending", "GRBL has no path tolerance (G64)", blending, "controller | exact_stop",
+               "write blending: controller")
+    corner = ck.choice(m.get("corner_strategy", "none"), "corner_strategy", CORNER_STRATEGIES)
+    if corner == "overtravel" and dialect != "linuxcnc":
+        ck.add("corner_strategy", "overtravel needs motion-synchronised gating (dialect linuxcnc)", corner,
+               "none for grbl", "write corner_strategy: none")
+    servo = ck.number(m.get("servo_period_s", 0.001), "servo_period_s")
+    laser = m.get("laser", {}) or {}
+    if not isinstance(laser, dict):
+        ck.add("laser", "must be a mapping", laser, ", ".join(_LASER_KEYS), "e.g. laser: {gate_output: 0}")
+        laser = {}
+    ck.unknown(laser, _LASER_KEYS, "laser.")
+    outs = {}
+    for k in ("gate_output", "power_output", "frequency_output"):
+        if k in laser:
+            outs[k] = ck.number(laser[k], f"laser.{k}", 0, strict=False, integer=True)
+    spindle, spw = laser.get("spindle"), 0.0
+    if dialect == "linuxcnc":
+        if "gate_output" not in laser:
+            ck.add("laser.gate_output", "LinuxCNC gates the beam with a digital output", None, "0..3",
+                   "add laser.gate_output: 0")
+        if spindle is not None or "s_per_watt" in laser:
+            ck.add("laser.spindle", "LinuxCNC profiles gate the beam with outputs, not a spindle", spindle,
+                   "gate_output/power_output/frequency_output", "remove laser.spindle and laser.s_per_watt")
+    elif dialect == "grbl":
+        if outs:
+            ck.add("laser." + next(iter(outs)), "GRBL has no motion-synchronised outputs", None, "spindle, s_per_watt",
+                   "use laser.spindle: M4 and laser.s_per_watt")
+        spindle = ck.choice(spindle if spindle is not None else "M4", "laser.spindle", ("M3", "M4"))
+        spw = ck.number(laser.get("s_per_watt"), "laser.s_per_watt") or 0.0
+    rng = m.get("rotary_range_deg")
+    if rng is not None:
+        if not (isinstance(rng, list) and len(rng) == 2 and all(isinstance(v, (int, float)) for v in rng)
+                and rng[0] < rng[1]):
+            ck.add("rotary_range_deg", "must be [min, max] in deg with min < max", rng, "[min, max] deg",
+                   "e.g. rotary_range_deg: [-360, 720]")
+            rng = None
+        else:
+            rng = (float(rng[0]), float(rng[1]))
+    wrap = ck.choice(m.get("wrap", "none"), "wrap", ("none",))
+    comment = ck.choice(m.get("comment", "paren"), "comment", COMMENT_STYLES)
+    dec = ck.number(m.get("decimals", 6), "decimals", 0, strict=False, integer=True)
+    fdec = ck.number(m.get("feed_decimals", 3), "feed_decimals", 0, strict=False, integer=True)
+    suffix = m.get("suffix", ".ngc" if dialect == "linuxcnc" else ".nc")
+    if not (isinstance(suffix, str) and suffix.startswith(".") and len(suffix) > 1):
+        ck.add("suffix", "must be a file suffix starting with a dot", suffix, ".ngc, .nc, ...", "e.g. suffix: .ngc")
+    desc = m.get("description", "")
+    if not isinstance(desc, str):
+        ck.add("description", "must be text", desc, "text", "quote it")
+    if ck.issues:
+        raise PatternError(ck.issues)
+    return MachineProfile(
+        name=name, description=desc, dialect=dialect, suffix=suffix, rotary=rotary, axes=axes,
+        limits=tuple(limits), blending=blending, corner_strategy=corner, servo_period_s=servo,
+        gate_output=outs.get("gate_output"), power_output=outs.get("power_output"),
+        frequency_output=outs.get("frequency_output"), spindle=spindle if dialect == "grbl" else None,
+        s_per_watt=spw, rotary_range_deg=rng, wrap=wrap, comment=comment, decimals=dec, feed_decimals=fdec,
+        source=file)
+
+
+def read_profile(path: str | os.PathLike) -> MachineProfile:
+    """Read and validate one profile file (raises :class:`PatternError`)."""
+    import yaml
+
+    file = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise PatternError([Issue("file", f"cannot read machine profile: {exc.strerror}", file,
+                                  "a readable YAML file", "check the path, or give a name from `camtube machines`")]
+                           ) from None
+    try:
+        raw = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        raise PatternError([Issue("yaml", f"not valid YAML: {getattr(exc, 'problem', exc)}", None, "YAML mapping",
+                                  "fix the syntax at the line shown", file, mark.line + 1 if mark else None)]
+                           ) from None
+    return build_profile(raw, Path(path).stem, file, _line_map(text))
+
+
+def profile_names() -> tuple[str, ...]:
+    """Names of the shipped profiles (sorted)."""
+    if not MACHINES_DIR.is_dir():
+        return ()
+    return tuple(sorted(p.stem for p in MACHINES_DIR.glob("*.yaml")))
+
+
+def load_profile(name_or_path: str | os.PathLike | None = None) -> MachineProfile:
+    """A shipped profile by name (``linuxcnc-rotary``), or a profile file by path; None: the default.
+
+    Raises
+    ------
+    PatternError
+        Unknown name (with a "did you mean"), unreadable file or invalid profile.
+    """
+    if name_or_path is None:
+        name_or_path = DEFAULT_MACHINE
+    s = os.fspath(name_or_path)
+    if os.sep in s or "/" in s or s.endswith((".yaml", ".yml")) or Path(s).is_file():
+        return read_profile(s)
+    path = MACHINES_DIR / f"{s}.yaml"
+    if not path.is_file():
+        names = profile_names()
+        raise PatternError([Issue("--machine", "no such machine profile", s, ", ".join(names) or "a YAML file",
+                                  _hint(s, names) if names else "give the path of a profile YAML")])
+    return read_profile(path)
+
+
+def default_profile(dialect: str) -> MachineProfile:
+    """The shipped profile whose G-code family is ``dialect`` (``linuxcnc`` -> the default)."""
+    return load_profile(DEFAULT_MACHINE if dialect == "linuxcnc" else "grbl-flat")

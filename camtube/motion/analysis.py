@@ -1,0 +1,259 @@
+"""What a recorded run did, measured against the job it was made from.
+
+The beam model: the gate and the commanded positions are set in the same servo
+cycle, so the beam is on while the stage moves from sample ``k`` to sample
+``k + 1`` exactly when the gate is set at sample ``k`` (kept samples are
+joined by straight lines: the recorder drops only cycles on straight,
+constant-speed stretches with a steady gate). All lengths are on the outer
+surface of the tube (``y = radians(A) r_o`` for a rotary stage), mm.
+
+Figures (:class:`MotionReport`):
+
+- run time (first to last cycle with motion) against the estimate and the lower bound;
+- beam-on path length against the job's cut length;
+- share of the beam-on path run within +-5 % of the scan speed;
+- farthest beam-on position outside the design cut regions (the tube is periodic in y);
+- largest distance from a drawn corner (every vertex of every pass path, matched by
+  focus level) to the beam-on path at that focus.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from camtube.errors import DataError
+
+SPEED_BAND = 0.05
+
+
+@dataclass(frozen=True, eq=False)
+class JobGeometry:
+    """The parts of a job the analysis compares a run with.
+
+    Attributes
+    ----------
+    name : str
+    outer_radius_mm, scan_speed_mm_s, cut_length_mm : float
+    regions : list of (k, 2) float
+        Design cut regions (unwrapped unrolled frame, mm).
+    corners : (c, 3) float
+        Every vertex of every pass path: x, y (mm), focus offset into the material (mm).
+    estimate_s, lower_bound_s : float
+        The job's time estimate and lower bound (s), NaN if unknown.
+    """
+
+    name: str
+    outer_radius_mm: float
+    scan_speed_mm_s: float
+    cut_length_mm: float
+    regions: tuple
+    corners: np.ndarray
+    estimate_s: float
+    lower_bound_s: float
+
+    @classmethod
+    def from_job(cls, job, estimate_s: float = math.nan) -> "JobGeometry":
+        """From a planned :class:`~camtube.plan.job.Job`."""
+        corners = np.concatenate([np.column_stack([np.asarray(p.contour.points, float),
+                                                   np.full(len(p.contour.points), p.focus_offset_mm)])
+                                  for p in job.passes]) if job.passes else np.zeros((0, 3))
+        return cls(job.name, float(job.outer_radius_mm), float(job.process.scan_speed_mm_s),
+                   float(job.cut_length_mm), tuple(np.asarray(c.points, float) for c in job.design), corners,
+                   float(estimate_s), float(job.cut_length_mm / job.process.scan_speed_mm_s))
+
+    @classmethod
+    def from_job_file(cls, path: str | os.PathLike) -> "JobGeometry":
+        """From a job file (``NAME.job.json``, ``camtube.job/2``), expanded into its passes by
+        :func:`camtube.export.jobfile.read_job`; the estimate is the file's ``summary.total_time_s``."""
+        from camtube.export.jobfile import read_job
+
+        try:
+            d = json.loads(Path(path).read_text(encoding="utf-8"))
+        except OSError as exc:
+            raise DataError(f"{path}: cannot read the job file: {exc.strerror}") from None
+        except ValueError as exc:
+            raise DataError(f"{path}: not a camtube job file ({exc}); give the NAME.job.json written next to "
+                            "the G-code") from None
+        job = read_job(d) if isinstance(d, dict) else read_job(path)
+        try:
+            estimate_s = float(d["summary"]["total_time_s"])
+        except (KeyError, TypeError, ValueError):
+            estimate_s = math.nan
+        return cls.from_job(job, estimate_s)
+
+
+@dataclass(frozen=True)
+class MotionReport:
+    """Figures of one run (s, mm, mm/s); see the module docstring."""
+
+    name: str
+    machine: str
+    run_time_s: float
+    estimate_s: float
+    lower_bound_s: float
+    beam_on_time_s: float
+    beam_on_length_mm: float
+    cut_length_mm: float
+    scan_speed_mm_s: float
+    speed_share: float
+    median_speed_mm_s: float
+    max_outside_mm: float
+    max_corner_miss_mm: float
+    corners: int
+    samples: int
+    wall_s: float
+
+    @property
+    def estimate_error(self) -> float:
+        """estimate / run time - 1."""
+        return self.estimate_s / self.run_time_s - 1.0
+
+    @property
+    def length_error(self) -> float:
+        """beam-on length / cut length - 1."""
+        return self.beam_on_length_mm / self.cut_length_mm - 1.0
+
+    def table(self) -> str:
+        """Plain-text table of the figures."""
+        rows = [
+            ("job / machine", f"{self.name} / {self.machine}", ""),
+            ("run time (LinuxCNC)", f"{self.run_time_s:.3f}", f"s (real time {self.wall_s:.1f} s)"),
+            ("estimate", f"{self.estimate_s:.3f}", f"s ({100 * self.estimate_error:+.2f} % of the run time)"),
+            ("lower bound", f"{self.lower_bound_s:.3f}", f"s (run time / lower bound "
+                                                        f"{self.run_time_s / self.lower_bound_s:.3f})"),
+            ("beam-on time", f"{self.beam_on_time_s:.3f}", "s"),
+            ("beam-on path", f"{self.beam_on_length_mm:.4f}", f"mm ({100 * self.length_error:+.3f} % of the "
+                                                              f"cut length {self.cut_length_mm:.4f} mm)"),
+            ("within +-5 % of scan speed", f"{100 * self.speed_share:.2f}", f"% of the beam-on path (scan "
+                                                                            f"{self.scan_speed_mm_s:g} mm/s, median "
+                                                                            f"{self.median_speed_mm_s:.2f})"),
+            ("beam on outside cut regions", f"{1000 * self.max_outside_mm:.3f}", "um at most"),
+            ("drawn corner missed by", f"{1000 * self.max_corner_miss_mm:.3f}", f"um at most ({self.corners} "
+                                                                                "corners)"),
+        ]
+        w = max(len(r[0]) for r in rows)
+        return "\n".join(f"{a:<{w}}  {b} {c}".rstrip() for a, b, c in rows)
+
+    def as_dict(self) -> dict:
+        d = dict(self.__dict__)
+        d.update(estimate_error=self.estimate_error, length_error=self.length_error)
+        return d
+
+
+def _surface(rec, ro: float, rotary: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    y = np.radians(rec.circ) * ro if rotary else rec.circ
+    return rec.axial, y, -rec.focus
+
+
+def _outside_mm(px: np.ndarray, py: np.ndarray, regions, circ: float) -> float:
+    """Largest distance (mm) of the points from the union of the regions, periodic in y with period ``circ``."""
+    import shapely
+
+    if len(px) == 0:
+        return 0.0
+    polys = [shapely.Polygon(np.column_stack([r[:, 0], r[:, 1] + k * circ])) for r in regions for k in (-1, 0, 1, 2)]
+    union = shapely.union_all(polys)
+    shapely.prepare(union)
+    yy = np.mod(py, circ)
+    pts = np.unique(np.round(np.column_stack([px, yy]), 9), axis=0)
+    inside = shapely.contains_xy(union, pts[:, 0], pts[:, 1])
+    out = pts[~inside]
+    if len(out) == 0:
+        return 0.0
+    return float(shapely.distance(union, shapely.points(out)).max())
+
+
+def _seg_dist(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    ab = b - a
+    L2 = np.einsum("ij,ij->i", ab, ab)
+    t = np.where(L2 > 0, np.einsum("ij,ij->i", p - a, ab) / np.where(L2 > 0, L2, 1.0), 0.0)
+    t = np.clip(t, 0.0, 1.0)
+    q = a + ab * t[:, None]
+    return np.hypot(*(p - q).T)
+
+
+def _corner_miss_mm(corners: np.ndarray, a: np.ndarray, b: np.ndarray, fz: np.ndarray, circ: float) -> float:
+    """Largest distance from a corner to the nearest beam-on segment (a -> b) at the corner's focus."""
+    from scipy.spatial import cKDTree
+
+    if len(corners) == 0:
+        return 0.0
+    worst = 0.0
+    shift = np.floor(a[:, 1] / circ) * circ  # bring every segment near [0, C) by whole turns
+    a = a - np.column_stack([np.zeros(len(a)), shift])
+    b = b - np.column_stack([np.zeros(len(b)), shift])
+    for f in np.unique(np.round(corners[:, 2], 6)):
+        segs = np.flatnonzero(np.abs(fz - f) < 1e-4)
+        cs = corners[np.abs(corners[:, 2] - f) < 1e-6][:, :2]
+        cs = np.unique(np.round(np.column_stack([cs[:, 0], np.mod(cs[:, 1], circ)]), 9), axis=0)
+        if len(segs) == 0:
+            return math.inf
+        sa, sb = a[segs], b[segs]
+        ends = np.concatenate([sa, sb])
+        owner = np.concatenate([np.arange(len(sa)), np.arange(len(sa))])
+        tree = cKDTree(ends)
+        best = np.full(len(cs), np.inf)
+        k = min(8, len(ends))
+        for dy in (-circ, 0.0, circ):
+            q = cs + [0.0, dy]
+            _, idx = tree.query(q, k=k)
+            idx = idx.reshape(len(cs), k)
+            for j in range(k):
+                s = owner[idx[:, j]]
+                best = np.minimum(best, _seg_dist(q, sa[s], sb[s]))
+        worst = max(worst, float(best.max()))
+    return worst
+
+
+def analyse(rec, geom: JobGeometry, profile, estimate_s: float | None = None) -> MotionReport:
+    """Measure a :class:`~camtube.motion.linuxcnc.Recording` against the job it ran.
+
+    Parameters
+    ----------
+    rec : Recording
+    geom : JobGeometry
+    profile : MachineProfile
+        The profile the run used (rotary or flat).
+    estimate_s : float, optional
+        The estimate to compare with (default: the job's).
+    """
+    ro = geom.outer_radius_mm
+    circ = 2.0 * math.pi * ro if profile.rotary else math.inf
+    x, y, z = _surface(rec, ro, profile.rotary)
+    on = rec.gate[:-1]
+    dx, dy = np.diff(x), np.diff(y)
+    seg = np.hypot(dx, dy)
+    dt = np.diff(rec.cycle) * rec.period_s
+    lo = seg[on]
+    length = float(lo.sum())
+    speed = lo / dt[on]
+    v = geom.scan_speed_mm_s
+    within = np.abs(speed / v - 1.0) <= SPEED_BAND
+    share = float(lo[within].sum() / length) if length > 0 else 0.0
+    if length > 0:  # length-weighted median speed
+        order = np.argsort(speed)
+        c = np.cumsum(lo[order])
+        median = float(speed[order][np.searchsorted(c, 0.5 * c[-1])])
+    else:
+        median = 0.0
+    ia = np.flatnonzero(on)
+    a = np.column_stack([x[ia], y[ia]])
+    b = np.column_stack([x[ia + 1], y[ia + 1]])
+    if profile.rotary:
+        pts = np.unique(np.concatenate([a, b]), axis=0)
+        outside = _outside_mm(pts[:, 0], pts[:, 1], geom.regions, circ)
+        miss = _corner_miss_mm(geom.corners, a, b, z[ia], circ)
+    else:
+        big = 1e9
+        pts = np.unique(np.concatenate([a, b]), axis=0)
+        outside = _outside_mm(pts[:, 0], pts[:, 1], geom.regions, big)
+        miss = _corner_miss_mm(geom.corners, a, b, z[ia], big)
+    est = geom.estimate_s if estimate_s is None else float(estimate_s)
+    return MotionReport(geom.name, profile.name, rec.run_time_s, est, geom.lower_bound_s, float(dt[on].sum()),
+                        length, geom.cut_length_mm, v, share, median, outside, miss, len(geom.corners), len(rec),
+                        rec.wall_s)

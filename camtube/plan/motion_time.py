@@ -1,0 +1,304 @@
+"""Motion-aware time estimate: trapezoidal moves with a machine profile's limits and blending.
+
+The model follows LinuxCNC's trajectory planner for straight moves (``emccanon``
++ ``tp``):
+
+- a move's path length is its XYZ length when it has one, else its rotary (ABC)
+  length; the rotary axis is slaved to it;
+- its velocity limit is the requested one (G0: the axes' maxima; G1 in G93:
+  length x F / 60; in G94: F / 60) capped so that no axis exceeds its maximum
+  velocity, ``min_i L v_i / |d_i|``, and, for a move with XYZ motion, at the
+  fastest linear axis' velocity (``[TRAJ] MAX_LINEAR_VELOCITY``); its
+  acceleration limit likewise ``min_i L a_i / |d_i|``;
+- ``exact_stop`` (G61): every move starts and ends at rest (a trapezoid, or a
+  triangle when too short to reach speed);
+- a path tolerance (G64 P..): consecutive *collinear* pure-XYZ moves join at
+  speed (LinuxCNC treats them as tangent); at any other junction the machine
+  is taken to stop (a conservative bound: LinuxCNC blends such corners, and
+  blends any junction with rotary motion parabolically at half acceleration,
+  which this model does not follow).
+
+The velocity along a chain of joined moves is the usual forward/backward pass:
+start and end at rest, at each junction the lower of the two limits, limited by
+what the acceleration allows over the moves around it. Times in s, lengths in
+mm (deg for a pure rotary move).
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+_LINEAR = "XYZUVW"
+
+
+@dataclass(frozen=True)
+class MotionEstimate:
+    """Motion-aware time of a move list or program (s).
+
+    Attributes
+    ----------
+    total_s : float
+        Time of every move, start to end.
+    moves : int
+        Number of moves.
+    stops : int
+        Number of junctions where the machine comes to rest.
+    """
+
+    total_s: float
+    moves: int
+    stops: int
+
+
+def _segment_times(L, v0, v1, vmax, a):
+    """Times (s) of moves of length ``L`` entering at ``v0``, leaving at ``v1``, cruising at most at ``vmax``.
+
+    All (m,) arrays; the entry and exit speeds are reachable (checked by the caller's passes).
+    """
+    # peak speed if the move accelerates then decelerates without a cruise
+    vp = np.sqrt(np.maximum(a * L + 0.5 * (v0 * v0 + v1 * v1), 0.0))
+    vc = np.minimum(vp, vmax)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d_acc = (vc * vc - v0 * v0) / (2 * a)
+        d_dec = (vc * vc - v1 * v1) / (2 * a)
+        cruise = np.maximum(L - d_acc - d_dec, 0.0)
+        t = (vc - v0) / a + (vc - v1) / a + np.where(vc > 0, cruise / vc, 0.0)
+    return np.where(L > 0, t, 0.0)
+
+
+def move_limits(d: np.ndarray, letters, profile, requested_v: np.ndarray):
+    """(length, vmax, amax) of straight moves in machine axes.
+
+    Parameters
+    ----------
+    d : (m, k) float
+        Displacement of each move per axis (mm or deg), in the order of ``letters``.
+    letters : sequence of str
+        Axis letters of the columns.
+    profile : MachineProfile
+    requested_v : (m,) float
+        Requested path velocity (units of the move's length per s); ``inf`` for a rapid.
+    """
+    lin = np.array([c in _LINEAR for c in letters])
+    ad = np.abs(d)
+    L_lin = np.sqrt((d[:, lin] ** 2).sum(1)) if lin.any() else np.zeros(len(d))
+    L_rot = np.sqrt((d[:, ~lin] ** 2).sum(1)) if (~lin).any() else np.zeros(len(d))
+    L = np.where(L_lin > 1e-9, L_lin, L_rot)
+    vlim = np.full(len(d), np.inf)
+    alim = np.full(len(d), np.inf)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for j, c in enumerate(letters):
+            lim = profile.axis(c)
+            move = ad[:, j] > 0
+            vlim = np.where(move, np.minimum(vlim, L * lim.max_velocity / ad[:, j]), vlim)
+            alim = np.where(move, np.minimum(alim, L * lim.max_acceleration / ad[:, j]), alim)
+    # LinuxCNC's [TRAJ] MAX_LINEAR_VELOCITY (the runner sets it to the fastest linear axis) caps the
+    # XYZ path speed of every move that has XYZ motion, e.g. a diagonal rapid
+    lin_letters = [c for c in letters if c in _LINEAR]
+    if lin_letters:
+        v_traj = max(profile.axis(c).max_velocity for c in lin_letters)
+        vlim = np.where(L_lin > 1e-9, np.minimum(vlim, v_traj), vlim)
+    vmax = np.minimum(vlim, requested_v)
+    return L, vmax, alim
+
+
+def trajectory_time(d: np.ndarray, letters, profile, requested_v: np.ndarray, joined: np.ndarray) -> MotionEstimate:
+    """Time of a sequence of straight moves.
+
+    Parameters
+    ----------
+    d : (m, k) float
+        Per-axis displacement of each move.
+    letters : sequence of str
+    profile : MachineProfile
+    requested_v : (m,) float
+        Requested path velocity (``inf`` for rapids).
+    joined : (m,) bool
+        ``joined[i]``: move ``i`` runs into move ``i + 1`` without stopping (the last is ignored).
+    """
+    m = len(d)
+    if m == 0:
+        return MotionEstimate(0.0, 0, 0)
+    L, vmax, a = move_limits(d, letters, profile, requested_v)
+    keep = L > 1e-12
+    L, vmax, a, joined = L[keep], vmax[keep], a[keep], joined[keep].copy()
+    m = len(L)
+    if m == 0:
+        return MotionEstimate(0.0, 0, 0)
+    joined[-1] = False
+    # junction speed limits: v_j[i] = speed at the end of move i
+    vj = np.where(joined, np.minimum(vmax, np.concatenate((vmax[1:], [0.0]))), 0.0)
+    # backward pass (must be able to stop / slow down), then forward pass (can only speed up so fast)
+    vjl = vj.tolist()
+    Ll, al = L.tolist(), a.tolist()
+    nxt = 0.0
+    for i in range(m - 1, -1, -1):
+        if vjl[i] > 0:
+            vjl[i] = min(vjl[i], math.sqrt(nxt * nxt + 2 * al[i + 1] * Ll[i + 1]))
+        nxt = vjl[i]
+    prev = 0.0
+    for i in range(m):
+        if vjl[i] > 0:
+            vjl[i] = min(vjl[i], math.sqrt(prev * prev + 2 * al[i] * Ll[i]))
+        prev = vjl[i]
+    v1 = np.array(vjl)
+    v0 = np.concatenate(([0.0], v1[:-1]))
+    t = _segment_times(L, v0, v1, vmax, a)
+    return MotionEstimate(float(t.sum()), m, int(np.count_nonzero(v1 == 0)))
+
+
+def _collinear_cartesian(d: np.ndarray, letters) -> np.ndarray:
+    """(m,) bool: move i and move i + 1 are collinear, same direction, and have no rotary motion."""
+    lin = np.array([c in _LINEAR for c in letters])
+    cart = np.all(d[:, ~lin] == 0, axis=1) if (~lin).any() else np.ones(len(d), bool)
+    n = np.linalg.norm(d, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = d / n[:, None]
+    dot = np.einsum("ij,ij->i", u[:-1], u[1:])
+    out = np.zeros(len(d), bool)
+    out[:-1] = (dot > 1 - 1e-9) & cart[:-1] & cart[1:] & (n[:-1] > 0) & (n[1:] > 0)
+    return out
+
+
+def estimate_machine_moves(mm, profile) -> MotionEstimate:
+    """Motion-aware time of :class:`~camtube.export.gcode.MachineMoves` (one chunk or a whole job)."""
+    from camtube.plan.moves import FOCUS, RAPID
+
+    n = mm.neutral
+    pos = np.column_stack([mm.ax, mm.ay, mm.az])
+    start = np.asarray(mm.start, float)[None, :]
+    d = np.diff(np.concatenate([start, pos]), axis=0)
+    letters = mm.dialect.axes
+    rapid = (n.kind == RAPID) | (n.kind == FOCUS)
+    req = _requested_velocity(d, letters, mm.feed, ~rapid, mm.dialect.feed_mode)
+    joined = _joined(d, letters, profile)
+    # every pass starts from rest (a pass boundary is a chunk boundary: the estimate does not depend on chunking)
+    joined[:-1] &= n.pass_index[1:] == n.pass_index[:-1]
+    return trajectory_time(d, letters, profile, req, joined)
+
+
+def _joined(d, letters, profile) -> np.ndarray:
+    if profile.blending == "exact_stop":
+        return np.zeros(len(d), bool)
+    return _collinear_cartesian(d, letters)
+
+
+def _requested_velocity(d, letters, feed, is_feed, feed_mode) -> np.ndarray:
+    lin = np.array([c in _LINEAR for c in letters])
+    L_lin = np.sqrt((d[:, lin] ** 2).sum(1))
+    L_rot = np.sqrt((d[:, ~lin] ** 2).sum(1)) if (~lin).any() else np.zeros(len(d))
+    L = np.where(L_lin > 1e-9, L_lin, L_rot)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v = L * feed / 60.0 if feed_mode == "inverse_time" else feed / 60.0
+    return np.where(is_feed, v, np.inf)
+
+
+# ---------------------------------------------------------------- G-code programs
+_WORD = re.compile(r"([A-Z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
+
+
+def estimate_program(text: str, profile) -> MotionEstimate:
+    """Motion-aware time of a G-code program (the subset camtube writes).
+
+    Understands ``G0``/``G1`` with the profile's three axis letters and ``F``,
+    ``G93``/``G94``, ``G61``/``G64`` (modal), comments in parentheses or after
+    ``;``; other words (M-codes, settings) take no time.
+    """
+    letters = profile.axes
+    pos = {c: 0.0 for c in letters}
+    mode = "exact_stop" if profile.blending == "exact_stop" else "blend"
+    inverse = False
+    motion = 0
+    feed = 0.0
+    rows_d, rows_f, rows_feed, rows_stop, rows_inv = [], [], [], [], []
+    for raw in text.splitlines():
+        line = re.sub(r"\(.*?\)", "", raw.split(";", 1)[0]).upper()
+        if not line.strip():
+            continue
+        words = _WORD.findall(line)
+        target = dict(pos)
+        has_axis = False
+        for w, v in words:
+            val = float(v)
+            if w == "G":
+                g = round(val, 1)
+                if g in (0, 1):
+                    motion = int(g)
+                elif g == 93:
+                    inverse = True
+                elif g == 94:
+                    inverse = False
+                elif g == 61 or g == 61.1:
+                    mode = "exact_stop"
+                elif g == 64:
+                    mode = "blend"
+            elif w == "F":
+                feed = val
+            elif w in target:
+                target[w] = val
+                has_axis = True
+        if not has_axis:
+            continue
+        rows_d.append([target[c] - pos[c] for c in letters])
+        rows_feed.append(motion == 1)
+        rows_f.append(feed if motion == 1 else 0.0)
+        rows_stop.append(mode == "exact_stop")
+        rows_inv.append(inverse)
+        pos = target
+    if not rows_d:
+        return MotionEstimate(0.0, 0, 0)
+    d = np.array(rows_d)
+    is_feed = np.array(rows_feed)
+    f = np.array(rows_f)
+    inv = np.array(rows_inv)
+    req = np.where(inv, _requested_velocity(d, letters, f, is_feed, "inverse_time"),
+                   _requested_velocity(d, letters, f, is_feed, "per_minute"))
+    joined = _collinear_cartesian(d, letters) & ~np.array(rows_stop)
+    return trajectory_time(d, letters, profile, req, joined)
+
+
+# ---------------------------------------------------------------- jobs
+def job_motion_s(job, dialect, moves=None) -> float:
+    """Motion-aware time (s) of ``job`` written in ``dialect`` (its profile's limits and blending).
+
+    ``moves``: the move chunks the emitter writes (default: the job's own, or the profile's
+    corner strategy); each chunk starts and ends at rest at a pass boundary.
+    """
+    from camtube.export.gcode import machine_moves
+    from camtube.machine.corners import strategy_moves
+    from camtube.plan.moves import iter_moves
+
+    profile = dialect.profile
+    if moves is None:
+        moves = strategy_moves(job, profile)
+    from camtube.plan.moves import Moves
+
+    chunks = iter_moves(job) if moves is None else ([moves] if isinstance(moves, Moves) else moves)
+    return sum(estimate_machine_moves(machine_moves(job, dialect, mv), profile).total_s for mv in chunks)
+
+
+def job_estimate(job, dialect, moves=None):
+    """:func:`camtube.plan.moves.estimate` of the moves ``dialect`` writes, with ``motion_s`` for its profile.
+
+    Cached per Job and profile when ``moves`` is None.
+    """
+    from dataclasses import replace
+
+    from camtube.machine.corners import strategy_moves
+    from camtube.plan.moves import estimate
+
+    profile = getattr(dialect, "profile", None)
+
+    def make():
+        mv = moves if moves is not None else (strategy_moves(job, profile) if profile is not None else None)
+        est = estimate(job) if mv is None else estimate(job, mv)
+        if profile is None:
+            return est
+        return replace(est, motion_s=job_motion_s(job, dialect, mv), machine=profile.name)
+
+    if moves is None and profile is not None:
+        return job.cached(f"_motion_estimate:{profile.source or profile.name}", make)
+    return make()

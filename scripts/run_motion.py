@@ -1,0 +1,111 @@
+"""Run the shipped presets on LinuxCNC's motion controller (real time: about an hour) and print the table.
+
+    python scripts/run_motion.py                                  # both LinuxCNC profiles, every preset
+    python scripts/run_motion.py --machine linuxcnc-surface --preset tube1
+    python scripts/run_motion.py --table out/motion.jsonl         # print the table of earlier results
+
+For each (machine, preset): plan the preset, write its G-code for the machine and the job file,
+estimate the time from the G-code (``camtube.plan.motion_time``), run it with ``camtube.motion``
+and measure the recording against the job. One JSON line per run is appended to ``--out`` as soon
+as it finishes; the markdown table (the one in docs/motion.md) is printed at the end.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+PRESETS = ("tube1", "tube2", "tube3", "tube1-bidirectional")
+MACHINES = ("linuxcnc-surface", "linuxcnc-rotary")
+
+
+def run_one(machine: str, preset: str, workdir=None) -> dict:
+    from camtube.design.loader import load_pattern
+    from camtube.export.dialects import dialect_from_profile
+    from camtube.machine import load_profile
+    from camtube.motion.analysis import JobGeometry, analyse
+    from camtube.motion.linuxcnc import run_program
+    from camtube.plan import plan_job
+    from camtube.plan.motion_time import estimate_program
+    from camtube.plan.outputs import toolpath_streams, write_streams
+
+    profile = load_profile(machine)
+    dialect = dialect_from_profile(profile)
+    job = plan_job(load_pattern(ROOT / "patterns" / f"{preset}.yaml"))
+    with tempfile.TemporaryDirectory(prefix="camtube-run-motion-") as tmp:
+        streams = toolpath_streams(job, (dialect,))
+        keep = {k: v for k, v in streams.items() if k.endswith((dialect.suffix, ".job.json"))}
+        write_streams(keep, tmp)
+        ngc = Path(tmp) / f"{job.name}{dialect.suffix}"
+        est = estimate_program(ngc.read_text(), profile)
+        rec = run_program(ngc, profile, timeout_s=4 * est.total_s + 120, workdir=workdir)
+        rep = analyse(rec, JobGeometry.from_job_file(Path(tmp) / f"{job.name}.job.json"), profile,
+                      estimate_s=est.total_s)
+    d = rep.as_dict()
+    d["preset"] = preset
+    return d
+
+
+def table(rows: list[dict]) -> str:
+    head = ("| machine | preset | LinuxCNC run s | estimate s (error) | lower bound s | run / bound | beam-on path "
+            "vs cut length | within +-5 % of scan speed | beam on outside regions um | corner missed by um |")
+    out = [head, "|" + "---|" * 10]
+    for r in rows:
+        out.append(f"| {r['machine']} | {r['preset']} | {r['run_time_s']:.2f} | {r['estimate_s']:.2f} "
+                   f"({100 * r['estimate_error']:+.2f} %) | {r['lower_bound_s']:.2f} | "
+                   f"{r['run_time_s'] / r['lower_bound_s']:.3f} | {100 * r['length_error']:+.3f} % | "
+                   f"{100 * r['speed_share']:.2f} % | {1000 * r['max_outside_mm']:.3f} | "
+                   f"{1000 * r['max_corner_miss_mm']:.3f} |")
+    return "\n".join(out)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--machine", action="append", help=f"profile(s) (default {', '.join(MACHINES)})")
+    ap.add_argument("--preset", action="append", help=f"preset(s) (default {', '.join(PRESETS)})")
+    ap.add_argument("--out", default="motion-results.jsonl", help="JSON lines file the results are appended to")
+    ap.add_argument("--table", metavar="JSONL", help="only print the table of a results file")
+    args = ap.parse_args()
+    if args.table:
+        rows = [json.loads(x) for x in Path(args.table).read_text().splitlines() if x.strip()]
+        print(table([r for r in rows if "error" not in r]))
+        return 0
+    from camtube.motion.linuxcnc import MotionRunError, unavailable_reason
+
+    why = unavailable_reason()
+    if why:
+        print(why, file=sys.stderr)
+        return 2
+    rows = []
+    for preset in args.preset or PRESETS:
+        for machine in args.machine or MACHINES:
+            t0 = time.time()
+            work = Path(tempfile.mkdtemp(prefix=f"camtube-run-motion-{machine}-{preset}-"))
+            try:
+                r = run_one(machine, preset, work)
+            except MotionRunError as exc:  # report the failed run, keep its log, go on with the next
+                print(f"{machine} {preset}: FAILED ({exc}); configuration and log kept in {work}", flush=True)
+                with open(args.out, "a") as fh:
+                    fh.write(json.dumps({"machine": machine, "preset": preset, "error": str(exc)}) + "\n")
+                continue
+            shutil.rmtree(work, ignore_errors=True)
+            rows.append(r)
+            with open(args.out, "a") as fh:
+                fh.write(json.dumps(r) + "\n")
+            print(f"{machine} {preset}: run {r['run_time_s']:.2f} s, estimate {100 * r['estimate_error']:+.2f} %, "
+                  f"length {100 * r['length_error']:+.3f} %, speed share {100 * r['speed_share']:.2f} %, "
+                  f"outside {1000 * r['max_outside_mm']:.3f} um, corner {1000 * r['max_corner_miss_mm']:.3f} um "
+                  f"({time.time() - t0:.0f} s)", flush=True)
+    print(table(rows))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
