@@ -68,7 +68,7 @@ class Result:
         Files written, in order.
     job : camtube.plan.Job
     estimate : camtube.plan.Estimate or None
-        Time estimate of the job (``toolpath`` and ``build``).
+        Time estimate of the job on the first dialect's machine (motion-aware; ``toolpath`` and ``build``).
     cad : camtube.cad.outputs.CadOutputs or None
         CAD outputs with the verification report (``build`` and ``cad``).
     """
@@ -111,7 +111,7 @@ def outputs(loaded: Loaded, request: Request, progress: Progress = NO_PROGRESS):
     est = cad = None
     if request.what in (TOOLPATH, BUILD):
         from camtube.export.dialects import DIALECTS
-        from camtube.plan.moves import estimate
+        from camtube.plan.motion_time import job_estimate
         from camtube.plan.outputs import toolpath_streams
 
         if request.what == BUILD:
@@ -120,7 +120,7 @@ def outputs(loaded: Loaded, request: Request, progress: Progress = NO_PROGRESS):
             files[f"{job.name}.design.dxf"] = design_dxf(pattern)
         dialects = tuple(request.dialects) if request.dialects else tuple(DIALECTS.values())
         files.update(toolpath_streams(job, dialects, progress))
-        est = estimate(job)
+        est = job_estimate(job, dialects[0])  # motion-aware on the first dialect's machine
     if request.what in (BUILD, CAD):
         from camtube.cad.outputs import cad_outputs
 

@@ -23,6 +23,10 @@ def register(sub) -> None:
         p.add_argument("--dialect", choices=("all",) + tuple(DIALECTS), default="all",
                        help="G-code dialect(s) to write (default all: linuxcnc .ngc rotary X/A/Z, "
                             "grbl .nc flat X/Y/Z)")
+        p.add_argument("--machine", metavar="NAME|FILE",
+                       help="machine profile to write the G-code for (see `camtube machines`; a YAML file of "
+                            "your own): axes, limits, blending, laser I/O, corner strategy. Replaces --dialect; "
+                            "the estimate and the job file follow its limits")
 
     p = sub.add_parser("toolpath", help="plan the laser passes; write toolpath DXF, G-code and job file",
                        description="Plan the multi-pass laser job (drill offsets 0.005 mm, focus + defocus, "
@@ -82,6 +86,13 @@ def _run(args, what: str) -> int:
     check_output_dir(args.output)
     loaded = load_from_args(args)
     dialects = None if getattr(args, "dialect", "all") == "all" else (DIALECTS[args.dialect],)
+    if getattr(args, "machine", None):
+        from camtube.export.dialects import dialect_from_profile
+        from camtube.machine import load_profile
+
+        if args.dialect != "all":
+            raise CamtubeError("--machine and --dialect both choose the G-code; fix: give one of them")
+        dialects = (dialect_from_profile(load_profile(args.machine)),)
     cad = cad_options(args) if what != "toolpath" else None
     request = Request(what=what, dialects=dialects, ordering=getattr(args, "ordering", None),
                       **({"cad": cad} if cad is not None else {}))

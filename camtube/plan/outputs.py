@@ -73,7 +73,9 @@ def toolpath_streams(job, dialects: Sequence[Dialect] = tuple(DIALECTS.values())
         f"{job.name}.toolpath.dxf": surveyed(lambda: iter_toolpath_dxf(job, progress=progress))}
     for d in dialects:
         streams[f"{job.name}{d.suffix}"] = surveyed(lambda d=d: iter_gcode(job, d, progress=progress))
-    streams[f"{job.name}.job.json"] = surveyed(lambda: iter_job_json(job, progress=progress))
+    # the job file records the machine of the first dialect (the rotary stage by default)
+    first = dialects[0] if dialects else None
+    streams[f"{job.name}.job.json"] = surveyed(lambda: iter_job_json(job, progress=progress, dialect=first))
     return streams
 
 

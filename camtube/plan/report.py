@@ -14,6 +14,9 @@ def summary_rows(job, est) -> list[tuple[str, str]]:
             f"focus {format_duration_s(est.focus_s)}"
     if est.lead_s:
         parts += f", lead {format_duration_s(est.lead_s)}"
+    machine = getattr(est, "machine", None)
+    if machine:  # motion-aware total: the parts are at nominal speed
+        parts = f"on machine {machine}, with its accelerations; at nominal speeds {parts}"
     return [
         ("job", job.name),
         ("ordering / repeats", f"{job.ordering} / {job.repeats}"),

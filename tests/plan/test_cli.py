@@ -49,3 +49,19 @@ def test_errors_exit_2(tmp_path, capsys):
     assert main(["toolpath", str(dxf), "--outer-radius", "0.5", "-o", str(tmp_path / "o")]) == 2  # drawn for 0.75
     assert "outer radius" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_machine_profile_chooses_the_gcode_and_is_recorded(tmp_path, capsys):
+    assert main(["toolpath", str(PATTERNS / "tube1.yaml"), "-o", str(tmp_path), "-q",
+                 "--machine", "linuxcnc-surface"]) == 0
+    out = capsys.readouterr().out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["tube1.job.json", "tube1.ngc", "tube1.toolpath.dxf"]
+    d = json.loads((tmp_path / "tube1.job.json").read_text())
+    assert d["machine"]["name"] == "linuxcnc-surface"
+    assert "on machine linuxcnc-surface" in out
+    ngc = (tmp_path / "tube1.ngc").read_text()
+    assert "G64 P0.001" in ngc and " Y" in ngc  # the uniform-dose profile: blending tolerance, surface axis Y
+    assert main(["toolpath", str(PATTERNS / "tube1.yaml"), "-o", str(tmp_path / "x"), "-q",
+                 "--machine", "linuxcnc-surface", "--dialect", "grbl"]) == 2
+    assert "--machine and --dialect" in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
