@@ -69,3 +69,74 @@ def load_from_args(args: argparse.Namespace) -> Loaded:
         for w in loaded.warnings:
             print(f"warning: {w}", file=sys.stderr)
     return loaded
+
+
+def add_cad_options(p: argparse.ArgumentParser) -> None:
+    """The CAD stage's options (shared by ``camtube cad`` and ``camtube build``)."""
+    g = p.add_argument_group("CAD model and verification")
+    g.add_argument("--no-step", action="store_true", help="skip the build123d B-rep and STEP (fast preview)")
+    g.add_argument("--no-pictures", action="store_true", help="skip the PNG pictures")
+    g.add_argument("--kerf", type=float, default=None, metavar="MM",
+                   help="beam kerf for the simulation, mm (default: process.kerf, or 0.02 if that is 0)")
+    g.add_argument("--segments", type=int, default=None, metavar="N",
+                   help="sides of the meshes' polygonal circles (default 256; 128 above 64 cuts)")
+    g.add_argument("--allow-fail", action="store_true",
+                   help="exit 0 even when a verification check fails (default: exit 1)")
+
+
+def cad_options(args: argparse.Namespace):
+    """:class:`camtube.pipeline.CadOptions` from the parsed CAD options (values checked)."""
+    from camtube.pipeline import CadOptions
+
+    if args.kerf is not None and not (0 < args.kerf < 1.0):
+        raise CamtubeError(f"--kerf {args.kerf}: the simulated kerf must be > 0 and < 1 mm; fix: give the beam's "
+                           "kerf width in mm, e.g. --kerf 0.02")
+    if args.segments is not None and not (8 <= args.segments <= 4096):
+        raise CamtubeError(f"--segments {args.segments}: allowed 8..4096; fix: e.g. --segments 256")
+    return CadOptions(step=not args.no_step, pictures=not args.no_pictures, segments=args.segments,
+                      kerf_mm=args.kerf)
+
+
+def check_output_dir(path: str) -> None:
+    """Refuse an output directory that names an existing file."""
+    if os.path.exists(path) and not os.path.isdir(path):
+        raise CamtubeError(f"{path}: is a file, but -o names the output directory; fix: give a directory "
+                           "(new or existing)")
+
+
+def run_outputs(args: argparse.Namespace, what: str) -> int:
+    """``camtube toolpath|build|cad``: load, build the outputs with :mod:`camtube.pipeline`, write them
+    as one set, print the summary, the paths and the verification verdict; the exit status."""
+    from camtube.export.dialects import DIALECTS
+    from camtube.pipeline import Request, run
+    from camtube.plan.report import summary_table
+    from camtube.progress import make_progress
+
+    check_output_dir(args.output)
+    loaded = load_from_args(args)
+    dialects = None if getattr(args, "dialect", "all") == "all" else (DIALECTS[args.dialect],)
+    if getattr(args, "machine", None):
+        from camtube.export.dialects import dialect_from_profile
+        from camtube.machine import load_profile
+
+        if args.dialect != "all":
+            raise CamtubeError("--machine and --dialect both choose the G-code; fix: give one of them")
+        dialects = (dialect_from_profile(load_profile(args.machine)),)
+    cad = cad_options(args) if what != "toolpath" else None
+    request = Request(what=what, dialects=dialects, ordering=getattr(args, "ordering", None),
+                      **({"cad": cad} if cad is not None else {}))
+    with make_progress(quiet=args.quiet) as progress:
+        result = run(loaded, args.output, request, progress,
+                     warn=None if args.quiet else (lambda w: print(f"warning: {w}", file=sys.stderr)))
+    if result.estimate is not None:
+        print(summary_table(result.job, result.estimate))
+    for p in result.paths:
+        print(f"wrote {p}")
+    if result.cad is not None:
+        for line in result.cad.verdict_lines():
+            print(line)
+        if not result.verified:
+            print(f"camtube {args.command}: the job failed its own verification (see the report above): "
+                  "do not cut it; exit status 1", file=sys.stderr)
+            return 0 if args.allow_fail else 1
+    return 0

@@ -84,6 +84,16 @@ class Result:
         return self.cad is None or self.cad.passed
 
 
+def design_extras(pattern) -> str:
+    """What later stages say about a design for ``camtube design``: the model's predicted
+    stroke-angle curve (the design stage itself never calls the model)."""
+    if not pattern.notches:
+        return ""
+    from camtube.model.core.predict import design_summary
+
+    return design_summary(pattern)
+
+
 def plan(loaded: Loaded, ordering: str | None = None, progress: Progress = NO_PROGRESS):
     """The planned job of a loaded pattern."""
     from camtube.plan import plan_job
@@ -111,8 +121,8 @@ def outputs(loaded: Loaded, request: Request, progress: Progress = NO_PROGRESS):
     est = cad = None
     if request.what in (TOOLPATH, BUILD):
         from camtube.export.dialects import DIALECTS
-        from camtube.plan.motion_time import job_estimate
-        from camtube.plan.outputs import toolpath_streams
+        from camtube.export.motion_time import job_estimate
+        from camtube.export.outputs import toolpath_streams
 
         if request.what == BUILD:
             from camtube.export.dxf import design_dxf

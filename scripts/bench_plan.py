@@ -48,7 +48,7 @@ from camtube.design.loader import load_pattern
 from camtube.export.dialects import DIALECTS
 from camtube.export.gcode import iter_gcode
 from camtube.plan import plan_job
-from camtube.plan.outputs import write_streams
+from camtube.export.outputs import write_streams
 job = plan_job(load_pattern(sys.argv[1], sys.argv[4:]))
 ds = [DIALECTS[n] for n in sys.argv[3].split(",")]
 write_streams({job.name + d.suffix: iter_gcode(job, d) for d in ds}, sys.argv[2])

@@ -23,7 +23,7 @@ OUT = ROOT / "toolpaths"
 def preset_texts(name: str) -> dict[str, str]:
     from camtube.design.loader import load_pattern
     from camtube.plan import plan_job
-    from camtube.plan.outputs import toolpath_texts
+    from camtube.export.outputs import toolpath_texts
 
     return toolpath_texts(plan_job(load_pattern(ROOT / "patterns" / f"{name}.yaml")))
 

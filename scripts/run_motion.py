@@ -5,7 +5,7 @@
     python scripts/run_motion.py --table out/motion.jsonl         # print the table of earlier results
 
 For each (machine, preset): plan the preset, write its G-code for the machine and the job file,
-estimate the time from the G-code (``camtube.plan.motion_time``), run it with ``camtube.motion``
+estimate the time from the G-code (``camtube.export.motion_time``), run it with ``camtube.motion``
 and measure the recording against the job. One JSON line per run is appended to ``--out`` as soon
 as it finishes; the markdown table (the one in docs/motion.md) is printed at the end.
 """
@@ -33,8 +33,8 @@ def run_one(machine: str, preset: str, workdir=None) -> dict:
     from camtube.motion.analysis import JobGeometry, analyse
     from camtube.motion.linuxcnc import run_program
     from camtube.plan import plan_job
-    from camtube.plan.motion_time import estimate_program
-    from camtube.plan.outputs import toolpath_streams, write_streams
+    from camtube.export.motion_time import estimate_program
+    from camtube.export.outputs import toolpath_streams, write_streams
 
     profile = load_profile(machine)
     dialect = dialect_from_profile(profile)

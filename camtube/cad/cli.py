@@ -7,7 +7,7 @@ from camtube.cliutil import add_pattern_argument
 
 
 def register(sub) -> None:
-    from camtube.plan.cli import add_cad_options
+    from camtube.cliutil import add_cad_options
 
     p = sub.add_parser(
         "cad", help="write the 3-D model of the cut tube (STEP, STL), its as-cut simulation and a verification report",
@@ -23,6 +23,6 @@ def register(sub) -> None:
 
 
 def cmd_cad(args: argparse.Namespace) -> int:
-    from camtube.plan.cli import _run
+    from camtube.cliutil import run_outputs
 
-    return _run(args, "cad")
+    return run_outputs(args, "cad")

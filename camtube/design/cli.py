@@ -95,14 +95,10 @@ def cmd_design(args: argparse.Namespace) -> int:
 
 
 def _design_extras(pattern) -> str:
-    """Sections other stages add to ``camtube design`` (the predicted stroke-angle curve)."""
-    if not pattern.notches:
-        return ""
-    try:
-        from camtube.model.predict import design_summary
-    except ModuleNotFoundError:
-        return ""
-    return design_summary(pattern)
+    """Sections later stages add to ``camtube design`` (gathered by the orchestration, not by this stage)."""
+    from camtube.pipeline import design_extras
+
+    return design_extras(pattern)
 
 
 def cmd_dxf(args: argparse.Namespace) -> int:

@@ -182,7 +182,7 @@ def merge_seam_polygons(contours, circumference_mm: float, tol_mm: float) -> lis
         Each joined or untouched contour and the indices of the input pieces it is made of.
     """
     import shapely
-    from shapely.geometry import LineString, Polygon
+    from shapely.geometry import Polygon
     from shapely.geometry.polygon import orient
 
     c = circumference_mm

@@ -14,7 +14,7 @@ import math
 import re
 from typing import Sequence
 
-from camtube.design.geometry import DirectionBend, bends_at_stroke, joint_geometry
+from camtube.design.geometry import DirectionBend, bends_at_stroke
 from camtube.design.pattern import Cut, Pattern
 from camtube.errors import Issue
 

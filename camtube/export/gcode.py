@@ -30,7 +30,7 @@ import numpy as np
 from camtube import __version__
 from camtube.export.dialects import LINUXCNC, Dialect
 from camtube.fmt import format_duration_s
-from camtube.plan.moves import CUT, FOCUS, LEAD, RAPID, Moves, estimate, iter_moves, job_moves, time_warning
+from camtube.plan.moves import CUT, FOCUS, LEAD, RAPID, Moves, iter_moves, job_moves, time_warning
 from camtube.plan.packed import no_gc
 from camtube.plan.safety import check_moves
 from camtube.progress import NO_PROGRESS, Progress
@@ -282,7 +282,7 @@ def iter_gcode(job, dialect: Dialect = LINUXCNC, *, progress: Progress = NO_PROG
         text is never yielded (the file layer discards the partial file).
     """
     from camtube.machine.corners import strategy_moves
-    from camtube.plan.motion_time import job_estimate
+    from camtube.export.motion_time import job_estimate
 
     if moves is None and dialect.profile is not None:
         moves = strategy_moves(job, dialect.profile)  # the profile's corner strategy (None: the job's moves)

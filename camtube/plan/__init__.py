@@ -5,7 +5,7 @@
 (``job_moves(job)`` all at once, for small jobs); ``estimate(job)`` -> times;
 ``time_warning(job, estimate)`` -> a warning above ``process.max_time_h``;
 ``camtube.plan.safety.check_job`` -> raises :class:`~camtube.errors.SafetyError`;
-``camtube.plan.outputs.toolpath_streams`` / ``write_toolpaths`` -> the files, streamed.
+``camtube.export.outputs.toolpath_streams`` / ``write_toolpaths`` -> the files, streamed.
 """
 from camtube.plan.job import Job, Pass
 from camtube.plan.moves import Estimate, Moves, estimate, iter_moves, job_moves, time_warning

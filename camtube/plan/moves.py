@@ -191,7 +191,7 @@ class Estimate:
         Laser-off feed moves (LEAD) at their own speed.
     motion_s : float or None
         The motion-aware time for a machine profile (trapezoidal moves with its axis limits
-        and blending, :mod:`camtube.plan.motion_time`); when set it is :attr:`total_s`.
+        and blending, :mod:`camtube.export.motion_time`); when set it is :attr:`total_s`.
     machine : str or None
         Name of the profile ``motion_s`` was computed for.
     """

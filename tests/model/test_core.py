@@ -13,7 +13,6 @@ from camtube.model.core import Effect, FitError, Param, Parameters, builtin_regi
 from camtube.model.core.fit import fit, grid_starts
 from camtube.model.core.predict import model_for_pattern, pattern_values
 from camtube.model.sim.synth import synthesize
-from camtube.model.sim.truth import Hidden, simulate
 from tests.conftest import PATTERNS, ROOT
 
 P2 = load_pattern(PATTERNS / "tube2.yaml")

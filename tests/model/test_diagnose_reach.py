@@ -7,7 +7,6 @@ library lacks, and plain white noise with a known sigma.
 from __future__ import annotations
 
 import importlib.util
-import json
 import math
 import sys
 

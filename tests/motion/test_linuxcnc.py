@@ -19,8 +19,8 @@ from camtube.machine import load_profile
 from camtube.motion import linuxcnc as lc
 from camtube.motion.analysis import JobGeometry, analyse
 from camtube.plan import plan_job
-from camtube.plan.motion_time import estimate_program
-from camtube.plan.outputs import toolpath_streams, write_streams
+from camtube.export.motion_time import estimate_program
+from camtube.export.outputs import toolpath_streams, write_streams
 from tests.conftest import PATTERNS
 
 SHORT = ["notch.count=2", "process.repeats=1", "process.drill_passes=1", "holes=[]"]  # 4 passes, 2 notches

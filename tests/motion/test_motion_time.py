@@ -11,7 +11,7 @@ from camtube.export.dialects import LINUXCNC, dialect_from_profile
 from camtube.export.gcode import gcode
 from camtube.machine import load_profile
 from camtube.plan import plan_job
-from camtube.plan.motion_time import estimate_program, job_estimate, trajectory_time
+from camtube.export.motion_time import estimate_program, job_estimate, trajectory_time
 from tests.conftest import PATTERNS
 
 

@@ -11,7 +11,7 @@ from camtube.export.gcode import gcode
 from camtube.fmt import format_duration_s, hms
 from camtube.plan import estimate, plan_job
 from camtube.plan.moves import time_warning
-from camtube.plan.outputs import write_toolpaths
+from camtube.export.outputs import write_toolpaths
 from camtube.plan.report import summary_table
 from camtube.progress import NO_PROGRESS, Progress, RichProgress, Task, make_progress
 from tests.conftest import PATTERNS
@@ -45,7 +45,7 @@ def test_time_warning_fires_above_max_time_h(job):
     header = text.split("(pass 0:")[0]
     # the header's figure is the motion-aware time on the dialect's machine; paren comments use []
     from camtube.export.dialects import LINUXCNC
-    from camtube.plan.motion_time import job_estimate
+    from camtube.export.motion_time import job_estimate
 
     hms = format_duration_s(job_estimate(short, LINUXCNC).total_s).split("(")[1].rstrip(")")
     assert "WARNING: the estimated laser time" in header and f"[{hms}]" in header

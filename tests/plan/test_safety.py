@@ -15,7 +15,7 @@ from camtube.export.jobfile import job_json
 from camtube.export.toolpath_dxf import toolpath_dxf
 from camtube.plan import job_moves, plan_job
 from camtube.plan.moves import FOCUS, RAPID
-from camtube.plan.outputs import write_toolpaths
+from camtube.export.outputs import write_toolpaths
 from camtube.plan.safety import check_job, check_moves
 from camtube.tol import TOL
 from tests.conftest import PATTERNS

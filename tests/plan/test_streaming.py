@@ -58,7 +58,8 @@ def test_an_unsafe_chunk_is_never_yielded(job):
     cut = int(mv.pass_rows()[290])  # chunks hold whole passes: 0..289, 290..
     chunks = [edited.rows(0, cut), edited.rows(cut, len(mv))]
     it = iter_gcode(job, LINUXCNC, moves=chunks)
-    header, first = next(it), next(it)
+    next(it)  # the header
+    first = next(it)
     assert "pass 0:" in first and "pass 300:" not in first
     with pytest.raises(SafetyError, match="pass 300 "):
         next(it)
@@ -161,7 +162,7 @@ def test_check_job_is_chunked_and_remembered(job):
 def test_survey_checks_and_estimates_once_for_every_writer(job):
     from dataclasses import replace
 
-    from camtube.plan.outputs import survey, toolpath_streams
+    from camtube.export.outputs import survey, toolpath_streams
 
     fresh = replace(job)
     est = survey(fresh)
@@ -177,7 +178,7 @@ def test_writers_stream_in_bounded_chunks_without_pass_objects():
     from camtube.design.contour import rectangle
     from camtube.design.pattern import Process
     from camtube.plan.moves import CHUNK_PASSES
-    from camtube.plan.outputs import toolpath_streams
+    from camtube.export.outputs import toolpath_streams
 
     n = 1000  # 32,000 passes: 8 chunks of passes
     job = plan_job([rectangle(1.5 + i, 0.5, 1.8 + i, 2.5, "notch") for i in range(n)], Process(),

@@ -332,7 +332,6 @@ def _bin_means(x: np.ndarray, r: np.ndarray, sid: np.ndarray, width: float):
 def _periodic(r: np.ndarray, v: dict, sid: np.ndarray, floor: float, excess: float,
               stroke_smooth: np.ndarray) -> list[dict]:
     out = []
-    n = r.size
     # against the motor stroke: a quartic trend per sample removed, >= 3 periods in the span
     x = v["stroke"]
     dx = np.abs(np.diff(x))
