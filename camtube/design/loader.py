@@ -8,7 +8,6 @@ errors are reported together.
 """
 from __future__ import annotations
 
-import difflib
 import math
 import os
 from dataclasses import dataclass
@@ -22,6 +21,7 @@ from camtube.design.generate import notch_row
 from camtube.design.pattern import Pattern, Process, RepeatRule, Rules, Tendon, Tube, hole, notch, sort_cuts
 from camtube.design.schema import SCHEMA, Field
 from camtube.errors import Issue, PatternError
+from camtube.yamltext import closest, line_map
 
 
 @dataclass(frozen=True)
@@ -47,34 +47,9 @@ class Loaded:
     summary: str = ""
 
 
-def _line_map(text: str) -> dict[str, int]:
-    """Dotted key -> 1-based line of its value, from the YAML node tree."""
-    out: dict[str, int] = {}
-    try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.YAMLError:
-        return out
-
-    def walk(node, prefix):
-        if isinstance(node, yaml.MappingNode):
-            for k, v in node.value:
-                key = f"{prefix}.{k.value}" if prefix else str(k.value)
-                out[key] = k.start_mark.line + 1
-                walk(v, key)
-        elif isinstance(node, yaml.SequenceNode):
-            for i, v in enumerate(node.value):
-                key = f"{prefix}[{i}]"
-                out[key] = v.start_mark.line + 1
-                walk(v, key)
-
-    if root is not None:
-        walk(root, "")
-    return out
-
-
 def _did_you_mean(word: str, options: Iterable[str]) -> str:
-    m = difflib.get_close_matches(word, list(options), n=1, cutoff=0.5)
-    return f"did you mean '{m[0]}'?" if m else "remove it"
+    m = closest(word, options)
+    return f"did you mean '{m}'?" if m else "remove it"
 
 
 def parse_override(item: str) -> tuple[str, Any]:
@@ -260,7 +235,7 @@ def read_yaml(path: str | os.PathLike) -> tuple[dict, dict[str, int], str]:
     if not isinstance(raw, dict):
         raise PatternError([Issue("<top>", "a pattern file must be a mapping of sections", None,
                                   "sections " + ", ".join(SCHEMA), "start the file with 'tube:'", file, 1)])
-    return raw, _line_map(text), file
+    return raw, line_map(text), file
 
 
 def _process(proc: dict) -> Process:

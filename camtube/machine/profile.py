@@ -19,7 +19,6 @@ Keys (units in the comments of the shipped files; ``docs/motion.md`` has the tab
 """
 from __future__ import annotations
 
-import difflib
 import math
 import os
 from dataclasses import dataclass
@@ -27,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from camtube.errors import Issue, PatternError
+from camtube.yamltext import closest, line_map
 
 #: Folder of the shipped profiles (``machines/`` at the top of the repository).
 MACHINES_DIR = Path(__file__).resolve().parents[2] / "machines"
@@ -150,31 +150,9 @@ _KEYS = ("description", "dialect", "suffix", "rotary", "axes", "limits", "blendi
 _REQUIRED = ("dialect", "axes", "limits")
 
 
-def _line_map(text: str) -> dict[str, int]:
-    """Dotted key -> 1-based line, from the YAML node tree."""
-    import yaml
-
-    out: dict[str, int] = {}
-    try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.YAMLError:
-        return out
-
-    def walk(node, prefix):
-        if isinstance(node, yaml.MappingNode):
-            for k, v in node.value:
-                key = f"{prefix}.{k.value}" if prefix else str(k.value)
-                out[key] = k.start_mark.line + 1
-                walk(v, key)
-
-    if root is not None:
-        walk(root, "")
-    return out
-
-
 def _hint(word: str, options) -> str:
-    m = difflib.get_close_matches(str(word), list(options), n=1, cutoff=0.5)
-    return f"did you mean '{m[0]}'?" if m else f"remove it (known: {', '.join(options)})"
+    m = closest(word, options)
+    return f"did you mean '{m}'?" if m else f"remove it (known: {', '.join(options)})"
 
 
 class _Checker:
@@ -353,7 +331,7 @@ def read_profile(path: str | os.PathLike) -> MachineProfile:
         raise PatternError([Issue("yaml", f"not valid YAML: {getattr(exc, 'problem', exc)}", None, "YAML mapping",
                                   "fix the syntax at the line shown", file, mark.line + 1 if mark else None)]
                            ) from None
-    return build_profile(raw, Path(path).stem, file, _line_map(text))
+    return build_profile(raw, Path(path).stem, file, line_map(text))
 
 
 def profile_names() -> tuple[str, ...]:
