@@ -48,10 +48,10 @@ from camtube.design.loader import load_pattern
 from camtube.export.dialects import DIALECTS
 from camtube.export.gcode import iter_gcode
 from camtube.plan import plan_job
-from camtube.export.outputs import write_streams
+from camtube.io import write_set
 job = plan_job(load_pattern(sys.argv[1], sys.argv[4:]))
 ds = [DIALECTS[n] for n in sys.argv[3].split(",")]
-write_streams({job.name + d.suffix: iter_gcode(job, d) for d in ds}, sys.argv[2])
+write_set(sys.argv[2], {job.name + d.suffix: iter_gcode(job, d) for d in ds})
 """
 
 

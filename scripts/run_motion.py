@@ -34,7 +34,8 @@ def run_one(machine: str, preset: str, workdir=None) -> dict:
     from camtube.motion.linuxcnc import run_program
     from camtube.plan import plan_job
     from camtube.export.motion_time import estimate_program
-    from camtube.export.outputs import toolpath_streams, write_streams
+    from camtube.export.outputs import toolpath_streams
+    from camtube.io import write_set
 
     profile = load_profile(machine)
     dialect = dialect_from_profile(profile)
@@ -42,7 +43,7 @@ def run_one(machine: str, preset: str, workdir=None) -> dict:
     with tempfile.TemporaryDirectory(prefix="camtube-run-motion-") as tmp:
         streams = toolpath_streams(job, (dialect,))
         keep = {k: v for k, v in streams.items() if k.endswith((dialect.suffix, ".job.json"))}
-        write_streams(keep, tmp)
+        write_set(tmp, keep)
         ngc = Path(tmp) / f"{job.name}{dialect.suffix}"
         est = estimate_program(ngc.read_text(), profile)
         rec = run_program(ngc, profile, timeout_s=4 * est.total_s + 120, workdir=workdir)

@@ -10,8 +10,8 @@ File names in the output directory, for a job called ``NAME``:
 :func:`toolpath_streams` gives every file as a lazy iterator of text chunks: each
 chunk of passes is built, safety-checked and formatted only when the file layer
 pulls it, and then dropped, so a job of 10^6 passes is written in bounded memory.
-Hand the dict to ``camtube.io.write_set`` (or :func:`write_toolpaths`), which
-writes temporary files and publishes them only when every stream has finished
+Hand the dict to ``camtube.io.write_set`` (as :func:`write_toolpaths` does), which
+stages every file and publishes the set only when every stream has finished
 (a SafetyError in any chunk leaves nothing behind).
 """
 from __future__ import annotations
@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Iterable, Iterator, Sequence
 
 from camtube.export.dialects import DIALECTS, Dialect
+from camtube.io import write_set
 from camtube.progress import NO_PROGRESS, Progress
 
 
@@ -84,46 +85,6 @@ def toolpath_texts(job, dialects: Sequence[Dialect] = tuple(DIALECTS.values())) 
     return {name: "".join(chunks) for name, chunks in toolpath_streams(job, dialects).items()}
 
 
-def write_streams(streams: dict[str, str | bytes | Iterable[str]], outdir: str | os.PathLike) -> list[Path]:
-    """Write every stream into ``outdir``; publish all files only when all succeeded.
-
-    Each file is streamed into a temporary file beside its target (text as UTF-8,
-    ``\\n`` line endings unchanged); when every stream is complete the files are
-    renamed into place. On any error (a SafetyError mid-stream, a full disk, Ctrl-C)
-    the temporary files are removed and no target is touched. (``camtube.io.write_set``
-    is the project-wide form of this.)
-    """
-    import tempfile
-
-    from camtube.io import _publish
-
-    out = Path(outdir)
-    out.mkdir(parents=True, exist_ok=True)
-    staged: list[tuple[str, Path]] = []
-    try:
-        for name, data in streams.items():
-            path = out / name
-            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=out)
-            staged.append((tmp, path))
-            with os.fdopen(fd, "wb") as fh:
-                if isinstance(data, (str, bytes)):
-                    data = [data]
-                for chunk in data:
-                    fh.write(chunk.encode("utf-8") if isinstance(chunk, str) else chunk)
-                fh.flush()
-                os.fsync(fh.fileno())
-        for tmp, path in staged:
-            _publish(tmp, path)
-    except BaseException:
-        for tmp, _ in staged:
-            try:
-                os.unlink(tmp)
-            except FileNotFoundError:
-                pass
-        raise
-    return [path for _, path in staged]
-
-
 def write_toolpaths(job, outdir: str | os.PathLike, dialects: Sequence[Dialect] = tuple(DIALECTS.values()),
                     pattern=None, progress: Progress | None = None) -> list[Path]:
     """Check and write the job's toolpath DXF, G-code (each dialect) and job file (+ design DXF if ``pattern``).
@@ -142,7 +103,7 @@ def write_toolpaths(job, outdir: str | os.PathLike, dialects: Sequence[Dialect] 
 
         streams[f"{job.name}.design.dxf"] = design_dxf(pattern)
     streams.update(toolpath_streams(job, dialects, progress))
-    return write_streams(streams, outdir)
+    return write_set(outdir, streams)
 
 
 def _as_progress(progress) -> Progress:

@@ -20,7 +20,8 @@ from camtube.motion import linuxcnc as lc
 from camtube.motion.analysis import JobGeometry, analyse
 from camtube.plan import plan_job
 from camtube.export.motion_time import estimate_program
-from camtube.export.outputs import toolpath_streams, write_streams
+from camtube.export.outputs import toolpath_streams
+from camtube.io import write_set
 from tests.conftest import PATTERNS
 
 SHORT = ["notch.count=2", "process.repeats=1", "process.drill_passes=1", "holes=[]"]  # 4 passes, 2 notches
@@ -39,7 +40,7 @@ def write_short_job(tmp_path, machine: str):
     dialect = dialect_from_profile(profile)
     job = plan_job(load_pattern(PATTERNS / "tube1.yaml", SHORT))
     streams = toolpath_streams(job, (dialect,))
-    write_streams({k: v for k, v in streams.items() if k.endswith((".ngc", ".job.json"))}, tmp_path)
+    write_set(tmp_path, {k: v for k, v in streams.items() if k.endswith((".ngc", ".job.json"))})
     return profile, job, tmp_path / f"{job.name}.ngc", tmp_path / f"{job.name}.job.json"
 
 
