@@ -74,10 +74,10 @@ def design_report(pattern) -> str:
 
 def _closure_by_direction(pattern, geo) -> list[tuple[float, float, int]]:
     """(direction deg, closure angle of its notches rad, notch count) per bending direction."""
-    out: dict[float, list] = {}
-    for n, g in zip(pattern.notches, geo.notches):
-        out.setdefault(round(n.angle_deg % 360.0, 9), []).append(g.closure_angle_rad)
-    return [(a, sum(v), len(v)) for a, v in sorted(out.items())]
+    from camtube.design.geometry import notches_by_direction
+
+    closure = {id(n): g.closure_angle_rad for n, g in zip(pattern.notches, geo.notches)}
+    return [(a, sum(closure[id(n)] for n in ns), len(ns)) for a, ns in notches_by_direction(pattern)]
 
 
 def _table(rows) -> str:

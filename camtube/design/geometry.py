@@ -178,6 +178,22 @@ def beam_depth_mm(outer_radius_mm: float, arc_mm: float) -> float:
     return outer_radius_mm * (1.0 - math.cos(arc_mm / (2.0 * outer_radius_mm)))
 
 
+def tendon_compliance_mm_per_N(length_mm: float, modulus_gpa: float, radius_mm: float) -> float:
+    """Tendon compliance ``C = L0 / (E_t pi r_t^2)`` in mm/N (E_t in GPa = 1e3 N/mm^2)."""
+    return float(length_mm) / (float(modulus_gpa) * 1e3 * math.pi * float(radius_mm) ** 2)
+
+
+def notches_by_direction(pattern: Pattern) -> list[tuple[float, list]]:
+    """``(direction deg in [0, 360), its notches)`` per bending direction, by direction.
+
+    Each direction has its own tendon, which pulls only its own notches.
+    """
+    groups: dict[float, list] = {}
+    for n in pattern.notches:
+        groups.setdefault(round(n.angle_deg % 360.0, 9), []).append(n)
+    return sorted(groups.items())
+
+
 #: Young's modulus (GPa) of tube materials, for the bending stiffness of the backbone.
 #: Polyimide: 2.5 GPa, a typical figure for polyimide tubing (the source paper does not give one).
 MATERIAL_MODULUS_GPA = {"polyimide": 2.5}
@@ -243,12 +259,9 @@ def bends_at_stroke(pattern: Pattern, stroke_mm: float | None = None,
     e = e_gpa * 1e3  # N/mm^2
     stroke = pattern.rules.max_stroke_mm if stroke_mm is None else stroke_mm
     td = pattern.tendon
-    compliance = td.length_mm / (td.modulus_gpa * 1e3 * math.pi * td.radius_mm ** 2)  # mm/N
-    groups: dict[float, list] = {}
-    for n in pattern.notches:
-        groups.setdefault(round(n.angle_deg % 360.0, 9), []).append(n)
+    compliance = tendon_compliance_mm_per_N(td.length_mm, td.modulus_gpa, td.radius_mm)
     out = []
-    for ang, notches in sorted(groups.items()):
+    for ang, notches in notches_by_direction(pattern):
         geos = [joint_geometry(t.outer_radius_mm, t.inner_radius_mm, n.arc_mm, n.width_mm, td.radius_mm)
                 for n in notches]
         arm = geos[0].moment_arm_mm

@@ -24,15 +24,12 @@ from typing import Callable, Iterable, Iterator, Mapping
 
 import numpy as np
 
+from camtube.design.geometry import tendon_compliance_mm_per_N  # noqa: F401  (written once, in design)
+
 #: Unloaded tendon length (mm) when neither the pattern nor the user gives one.
 DEFAULT_L0_MM = 70.0
 #: Tendon Young's modulus (GPa) when neither the pattern nor the user gives one (the paper's fibre).
 DEFAULT_E_T_GPA = 28.0
-
-
-def tendon_compliance_mm_per_N(length_mm: float, modulus_gpa: float, radius_mm: float) -> float:
-    """Tendon compliance ``C = L0 / (E_t pi r_t^2)`` in mm/N (E_t in GPa = 1e3 N/mm^2)."""
-    return float(length_mm) / (float(modulus_gpa) * 1e3 * math.pi * float(radius_mm) ** 2)
 
 
 @dataclass(frozen=True)

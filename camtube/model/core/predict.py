@@ -25,14 +25,14 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from camtube.design.geometry import pattern_geometry
+from camtube.design.geometry import MATERIAL_MODULUS_GPA, notches_by_direction, pattern_geometry
 from camtube.design.pattern import Pattern
 from camtube.model.core.model import Effect, JointModel
 from camtube.model.core.params import tendon_compliance_mm_per_N
 from camtube.model.data.dataset import Dataset
 
 #: Default Young's modulus of polyimide (GPa) for the bending stiffness.
-POLYIMIDE_MODULUS_GPA = 2.5
+POLYIMIDE_MODULUS_GPA = MATERIAL_MODULUS_GPA["polyimide"]
 
 
 def model_for_pattern(pattern: Pattern, effects: Sequence[Effect | str] = (), registry=None) -> JointModel:
@@ -180,13 +180,11 @@ def design_summary(pattern: Pattern, steps: int = 5,
     A pattern that bends several ways (bidirectional, multi-direction) has one tendon per
     direction, each pulling only its own notches: one table per direction.
     """
-    groups: dict[float, list] = {}
-    for n in pattern.notches:
-        groups.setdefault(round(n.angle_deg % 360.0, 9), []).append(n)
+    groups = notches_by_direction(pattern)
     if len(groups) == 1:
         return _direction_summary(pattern, steps, modulus_gpa, "")
     return "".join(_direction_summary(pattern.with_cuts(cuts), steps, modulus_gpa, f", notches at {ang:g} deg")
-                   for ang, cuts in sorted(groups.items()))
+                   for ang, cuts in groups)
 
 
 def _direction_summary(pattern: Pattern, steps: int, modulus_gpa: float, label: str) -> str:
