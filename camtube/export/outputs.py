@@ -96,7 +96,7 @@ def write_toolpaths(job, outdir: str | os.PathLike, dialects: Sequence[Dialect] 
     SafetyError
         The job is unsafe; no file has been written.
     """
-    progress = _as_progress(progress)
+    progress = NO_PROGRESS if progress is None else progress
     streams: dict[str, str | Iterable[str]] = {}
     if pattern is not None:
         from camtube.export.dxf import design_dxf
@@ -104,33 +104,3 @@ def write_toolpaths(job, outdir: str | os.PathLike, dialects: Sequence[Dialect] 
         streams[f"{job.name}.design.dxf"] = design_dxf(pattern)
     streams.update(toolpath_streams(job, dialects, progress))
     return write_set(outdir, streams)
-
-
-def _as_progress(progress) -> Progress:
-    """A Progress object (None -> no-op; a bare ``f(done, total)`` callable is wrapped)."""
-    if progress is None:
-        return NO_PROGRESS
-    if isinstance(progress, Progress):
-        return progress
-    return _CallableProgress(progress)
-
-
-class _CallableProgress(Progress):
-    """Adapter for a ``f(done, total)`` callable (the CLI's earlier interface)."""
-
-    def __init__(self, fn) -> None:
-        self._fn = fn
-
-    def task(self, label: str, total: int):
-        from camtube.progress import Task
-
-        fn = self._fn
-
-        class _T(Task):
-            done = 0
-
-            def advance(self, n: int = 1) -> None:
-                self.done += n
-                fn(min(self.done, total), total)
-
-        return _T()
