@@ -42,6 +42,13 @@ Method
    resolvable, and does not undercut the noise floor (re-estimated from its
    residual) by more than twice the floor's uncertainty (fitting noise);
    otherwise the next candidate is tried.
+   **Replacement.** When a candidate's fit puts a parameter of an effect
+   chosen earlier on a bound, the candidate explains what that effect did
+   (a sharp toe first taken for slack): it is also tried *instead of* it.
+   Such a replacement leads when its held-out error is within
+   ``EQUAL_HELDOUT`` of the best candidate's (it ends with fewer effects); it
+   is accepted only if the chain without the replaced effect still lowers
+   the RMSE at every step (``Diagnosis.replaced`` records it).
 6. **Per-sample parameters.** With several samples, each recommended
    effect's parameters are tried per sample; they are kept when the held-out
    error falls significantly. The output says which samples differ (values
@@ -54,7 +61,13 @@ Method
    (``stop_ratio=None`` turns the rule off: the significance
    tests alone must then stop it), when nothing qualifies, or after
    ``max_effects``.
-8. **Reach the floor or say so.** The chain of accepted effects is
+8. **Offsets the first rest contradicts.** A recommended constant offset
+   (``angle_bias``, ``force_zero``) is checked against the rows at the start
+   of the record where the model holds the joint unloaded: a sensor offset
+   leaves no residual there; one that does is called out in the notes (the
+   joint rests bent once loaded -- joint friction, a permanent set -- or the
+   toe law is wrong at low force).
+9. **Reach the floor or say so.** The chain of accepted effects is
    recommended only when its all-rows RMSE is within :data:`REACH_RATIO`
    (1.15) x the noise floor. Otherwise a structured misfit remains that the
    library does not explain: the effects are listed as ``partial`` (each
@@ -118,6 +131,9 @@ class Candidate:
         Why it is not significant or not trusted (empty if it passes).
     gain_z : float
         Fall of the held-out MSE over its standard error.
+    replaces : tuple[str, ...]
+        Effects chosen earlier that this candidate takes the place of: with it in the model their
+        parameters went to a bound (it explains what they did), so it is also tried without them.
     """
 
     effect: str
@@ -135,6 +151,12 @@ class Candidate:
     gain_z: float = 0.0
     block_mse: np.ndarray | None = None
     per_sample: tuple = ()
+    replaces: tuple = ()
+
+    @property
+    def label(self) -> str:
+        """The effect, and the chosen effects it takes the place of (``toe_shape (replacing slack)``)."""
+        return self.effect + (f" (replacing {', '.join(self.replaces)})" if self.replaces else "")
 
 
 @dataclass(frozen=True, eq=False)
@@ -189,6 +211,10 @@ class Diagnosis:
         The current model, then one step per partial effect (refitted on all rows), as ``waterfall`` would.
     noise_floor_parts_deg : (float, float)
         Statistical and systematic parts of ``noise_floor_se_deg`` (see :func:`noise_floor_parts`).
+    replaced : tuple[tuple[tuple[str, ...], str], ...]
+        Effects chosen earlier and dropped for a later one that explains what they did: ``((old, ...), new)``.
+    chosen_round : dict
+        The round (index into ``rounds``) in which each recommended (or partial) effect was chosen.
     stop_reason : str
     seconds : dict
         Wall time of the parts (not written to JSON: output is deterministic).
@@ -215,6 +241,8 @@ class Diagnosis:
     partial: tuple = ()
     partial_steps: tuple = ()
     noise_floor_parts_deg: tuple = ()
+    replaced: tuple = ()
+    chosen_round: dict = field(default_factory=dict)
 
     @property
     def candidates(self) -> tuple:
@@ -568,6 +596,8 @@ def diagnose(
     recommended: list[str] = []
     rejected: list[tuple[str, str]] = []
     chosen: list[Effect] = []
+    replaced: list[tuple[tuple, str]] = []
+    chosen_round: dict[str, int] = {}
     stop = ""
     while True:
         # the held-out RMSE at full resolution: the all-rows RMSE times the held-out / in-sample ratio of the
@@ -585,16 +615,18 @@ def diagnose(
             break
         ranked = _round(current, search, cur_names, cur, cur_ho, cur_mse, fold, block, pool, floor, fixed,
                         bic_threshold, min_gain, min_excess, z, grid, modulus_range_gpa, cur_ps, strata,
-                        per_sample and len(search.samples) > 1, init)
+                        per_sample and len(search.samples) > 1, init, tuple(chosen))
         ranked_base_ho = cur_ho
         accepted = None
         for c in ranked:
             if not c.significant:
                 continue
             eff = next(e for e in pool if e.name == c.effect)
-            m = current.with_effects(list(current.effects) + [eff])
-            names = cur_names + eff.full_names()
-            ps = cur_ps + list(c.per_sample)
+            gone = {n for e in chosen if e.name in c.replaces for n in e.full_names()}
+            keep = [e for e in chosen if e.name not in c.replaces]
+            m = current.with_effects([e for e in current.effects if e.name not in c.replaces] + [eff])
+            names = tuple(n for n in cur_names if n not in gone) + eff.full_names()
+            ps = [n for n in cur_ps if n.split("@")[0] not in gone] + list(c.per_sample)
             init = {k: v for k, v in c.values.items() if k.split("@")[0] in names}
             r = refit_all_rows(m, data, names, fixed, init, grid, per_sample=ps)
             problems = []
@@ -612,10 +644,24 @@ def diagnose(
                 problems.append(f"its RMSE {r.rmse:.3f} deg undercuts the noise floor {f_c:.3f} +- "
                                 f"{se_c:.3f} deg (statistical {parts_c[0]:.3f}, systematic {parts_c[1]:.3f}; "
                                 "it would fit noise)")
+            inter: list[Step] = []
+            if not problems and c.replaces:
+                # the waterfall without the replaced effects: every step must still lower the RMSE
+                for i in range(1, len(keep) + 1):
+                    mi = model.with_effects(list(model.effects) + keep[:i])
+                    ni = _names_for(mi, fit_params)
+                    psi = [n for n in ps if n.split("@")[0] in ni]
+                    ri = refit_all_rows(mi, data, ni, fixed,
+                                        {k: v for k, v in r.params.items() if k.split("@")[0] in ni}, grid,
+                                        per_sample=psi)
+                    inter.append(_step(ri, psi))
+                seq = [steps[0].rmse_deg] + [x.rmse_deg for x in inter] + [r.rmse]
+                if not all(b < a for a, b in zip(seq, seq[1:])):
+                    problems.append(f"without {', '.join(c.replaces)} a step of the chain does not lower the RMSE")
             if problems:
-                rejected.append((c.effect, "; ".join(problems)))
+                rejected.append((c.label, "; ".join(problems)))
                 continue
-            accepted = (c, eff, m, names, r, {k: v for k, v in init.items() if k in r.fitted}, ps)
+            accepted = (c, eff, m, names, r, {k: v for k, v in init.items() if k in r.fitted}, ps, keep, inter)
             break
         ranked = tuple(_mark_rejected(ranked, rejected))
         rounds.append(ranked)
@@ -624,12 +670,18 @@ def diagnose(
             stop = ("no candidate improves the model significantly and reliably"
                     + (f" (best: {top.effect}: {top.why})" if top is not None and top.why else ""))
             break
-        c, eff, m, names, r, init, ps = accepted
+        c, eff, m, names, r, init, ps, keep, inter = accepted
         floor, floor_se, floor_parts = f_c, se_c, parts_c
         cur_ps = ps
-        rejected = [(e, w) for e, w in rejected if e != eff.name]
+        rejected = [(e, w) for e, w in rejected if e.split(" (replacing")[0] != eff.name]
+        if c.replaces:
+            replaced.append((tuple(c.replaces), eff.name))
+            chosen = keep
+            recommended = [e.name for e in keep]
+            steps = steps[:1] + inter
         recommended.append(eff.name)
         chosen.append(eff)
+        chosen_round[eff.name] = len(rounds) - 1
         current, cur_names, prev_all = m, names, r
         steps.append(_step(r, cur_ps, init))
         cur = _search_fit(current, search, cur_names, c.values, fixed, per_sample=cur_ps)
@@ -650,6 +702,7 @@ def diagnose(
         if final is not None:
             steps.append(final)
         ps_names = list(steps[-1].per_sample)
+    notes += _offset_notes(data, steps[-1], chosen, floor)
     base_ps = steps[0].rmse_per_sample
     fin_ps = steps[-1].rmse_per_sample
     for smp in base_ps:
@@ -678,16 +731,56 @@ def diagnose(
     return Diagnosis(data, model, floor, base_rmse, base_ho, tuple(rounds), tuple(recommended), tuple(steps),
                      tuple(fit_params), stop, fixed, secs, catalog, floor_se, tuple(dict(rejected).items()),
                      tuple(ps_names),
-                     tuple(notes), grid, partial, partial_steps, floor_parts)
+                     tuple(notes), grid, partial, partial_steps, floor_parts, tuple(replaced),
+                     {k: chosen_round[k] for k in recommended or partial if k in chosen_round})
+
+
+def first_rest_rows(data: Dataset, predicted: np.ndarray, tol_deg: float) -> np.ndarray:
+    """Indices of the rows at the start of each sample where the model holds the joint at its first angle
+    (within ``tol_deg``): the joint has not yet been loaded (the first tension goes into slack or a toe)."""
+    out = []
+    for _, sl in data.sample_slices():
+        pr = np.asarray(predicted[sl], float)
+        if pr.size == 0:
+            continue
+        moved = np.flatnonzero(np.abs(pr - pr[0]) > tol_deg)
+        n = int(moved[0]) if moved.size else pr.size
+        out.extend(range(sl.start, sl.start + n))
+    return np.asarray(out, dtype=np.intp)
+
+
+def _offset_notes(data: Dataset, final: Step, chosen: Sequence[Effect], floor: float) -> list[str]:
+    """A constant offset that the record's first rest contradicts is not (only) the sensor's: say so.
+
+    A sensor offset reads the same before the joint was ever loaded as after; an offset fitted because the
+    joint rests bent once it has been loaded (friction in the joint, a permanent set) or because the toe law
+    is wrong at low force does not. The final model's residual on the first-rest rows is then far from zero.
+    """
+    offsets = [e for e in chosen if e.family == "offset"]
+    if not offsets or floor <= 0:
+        return []
+    rows = first_rest_rows(data, final.predicted, 0.05 * floor)
+    if rows.size < 4:
+        return []
+    r = float(np.mean(final.residuals[rows]))
+    se = floor / math.sqrt(rows.size)
+    if abs(r) <= 3.0 * se:
+        return []
+    names = ", ".join(e.name for e in offsets)
+    return [f"{names}: before the joint was first loaded ({rows.size} rows at the start of the record) the "
+            f"final model is off by {r:+.3f} +- {se:.3f} deg, so the offset appears only once the joint has been "
+            "loaded: it is not (only) a sensor offset; expect a joint that rests bent after loading (friction in "
+            "the joint, a permanent set) or a toe law that is wrong at low force; read the sensor with the joint "
+            "unloaded to tell"]
 
 
 def _mark_rejected(ranked, rejected):
     why = dict(rejected)
     for c in ranked:
-        if c.effect in why and c.significant:
+        if c.label in why and c.significant:
             yield Candidate(c.effect, c.effects, c.rmse_deg, c.heldout_rmse_deg, c.delta_bic, c.params,
-                            c.equivalent, c.confounded, False, "all-rows check: " + why[c.effect], c.predicted,
-                            c.values, c.gain_z, c.block_mse, c.per_sample)
+                            c.equivalent, c.confounded, False, "all-rows check: " + why[c.label], c.predicted,
+                            c.values, c.gain_z, c.block_mse, c.per_sample, c.replaces)
         else:
             yield c
 
@@ -716,11 +809,14 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
            fixed: Mapping[str, float], bic_threshold: float, min_gain: float, min_excess: float, z: float,
            grid: int, modulus_range_gpa: tuple[float, float], cur_ps: Sequence[str] = (),
            strata: np.ndarray | None = None, try_per_sample: bool = False,
-           init: Mapping[str, float] | None = None) -> tuple[Candidate, ...]:
+           init: Mapping[str, float] | None = None, swappable: Sequence[Effect] = ()) -> tuple[Candidate, ...]:
     """Every effect of ``pool`` on top of ``current``, ranked by held-out RMSE.
 
     With ``try_per_sample``, the best two effects are also fitted with per-sample parameters; that
-    version replaces the shared one when its held-out error is significantly lower.
+    version replaces the shared one when its held-out error is significantly lower. When a candidate's fit
+    puts a parameter of an effect of ``swappable`` (chosen earlier in this diagnosis) on a bound, the
+    candidate explains what that effect did: it is also tried *instead of* it (stepwise selection with
+    replacement), so an early stand-in (slack for a sharp toe) does not stay in the model.
     """
     fits = []
     for eff in pool:
@@ -740,8 +836,21 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
             dm, se = _gain(mse, mse2, strata)
             if dm > z * se and f2.bic < f.bic - bic_threshold:
                 row[3:7] = [f2, ho2, mse2, tuple(new)]
+    for row in list(fits):
+        eff, m, new, f = row[:4]
+        for old in swappable:
+            gone = set(old.full_names())
+            if not any(n.split("@")[0] in gone for n in f.at_bound):
+                continue
+            m2 = current.with_effects([e for e in current.effects if e.name != old.name] + [eff])
+            names2 = tuple(n for n in cur_names if n not in gone) + tuple(new)
+            ps2 = [n for n in cur_ps if n not in gone]
+            start = {k: v for k, v in f.params.items() if k.split("@")[0] not in gone}
+            f2 = _search_fit(m2, search, names2, start, fixed, grid=grid, grid_names=new, per_sample=ps2)
+            ho2, mse2 = _cv(m2, search, names2, f2.params, fixed, fold, block, per_sample=ps2)
+            fits.append([eff, m2, new, f2, ho2, mse2, (), (old.name,)])
     tried: list[Candidate] = []
-    for eff, m, new, f, ho, mse, eff_ps in fits:
+    for eff, m, new, f, ho, mse, eff_ps, *swap in fits:
         dbic = f.bic - cur.bic
         shown = [n for n in f.fitted if n.split("@")[0] in new] if eff_ps else list(new)
         params = {nm: (f.params[nm], f.stderr.get(nm, math.inf), m.spec(nm).unit) for nm in shown}
@@ -773,12 +882,12 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
         tried.append(Candidate(eff.name, tuple(e.name for e in m.effects), f.rmse, ho, dbic, params,
                                confounded=tuple(conf), significant=not why, why="; ".join(why),
                                predicted=f.predicted, values=dict(f.params), gain_z=gz, block_mse=mse,
-                               per_sample=eff_ps))
-    tried.sort(key=lambda c: (c.heldout_rmse_deg, c.effect))
+                               per_sample=eff_ps, replaces=tuple(swap[0]) if swap else ()))
+    tried.sort(key=lambda c: (c.heldout_rmse_deg, c.effect, c.replaces))
     # equivalences: near-equal held-out error and predictions within half the noise floor
     fam = {e.name: e.family for e in pool}
     out = []
-    useful = [c for c in tried if c.heldout_rmse_deg <= (1.0 - min_gain) * cur_ho]
+    useful = [c for c in tried if c.heldout_rmse_deg <= (1.0 - min_gain) * cur_ho and not c.replaces]
     for c in tried:
         eq = []
         for o in (useful if c in useful else ()):
@@ -792,7 +901,7 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
                 eq.append(o.effect)
         out.append(Candidate(c.effect, c.effects, c.rmse_deg, c.heldout_rmse_deg, c.delta_bic, c.params,
                              tuple(eq), c.confounded, c.significant, c.why, c.predicted, c.values, c.gain_z,
-                             c.block_mse, c.per_sample))
+                             c.block_mse, c.per_sample, c.replaces))
     # among candidates that cannot be told apart from the best, the lowest BIC (the simplest) leads
     if out and out[0].equivalent:
         group = [c for c in out if c is out[0] or c.effect in out[0].equivalent]
@@ -804,6 +913,15 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
             lead = min(simpler, key=lambda c: (len(c.params), c.delta_bic, c.effect))
         out.remove(lead)
         out.insert(0, lead)
+    # parsimony: a significant replacement as good as the leader (within EQUAL_HELDOUT) leads, as it ends
+    # with fewer effects
+    if out and not out[0].replaces:
+        swaps = [c for c in out if c.replaces and c.significant
+                 and c.heldout_rmse_deg <= (1.0 + EQUAL_HELDOUT) * out[0].heldout_rmse_deg]
+        if swaps:
+            lead = min(swaps, key=lambda c: (c.heldout_rmse_deg, c.effect))
+            out.remove(lead)
+            out.insert(0, lead)
     # trusted, significant candidates first (in that order), then the rest
     out.sort(key=lambda c: not c.significant)
     return tuple(out)

@@ -118,6 +118,7 @@ def _candidate_dict(d: Diagnosis, c: Candidate) -> dict:
     e = d.catalog.get(c.effect)
     return {
         "effect": c.effect,
+        "replaces": list(c.replaces),
         "rmse_deg": _num(c.rmse_deg),
         "heldout_rmse_deg": _num(c.heldout_rmse_deg),
         "delta_bic": _num(c.delta_bic),
@@ -145,6 +146,7 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
     out["candidates"] = [_candidate_dict(d, c) for c in d.candidates]
     out["rounds"] = [[_candidate_dict(d, c) for c in r] for r in d.rounds]
     out["recommended"] = list(d.recommended)
+    out["replaced"] = [{"effects": list(old), "by": new} for old, new in d.replaced]
     out["waterfall"] = [{"effects": list(s.effects), "rmse_deg": _num(s.rmse_deg),
                          "per_sample": {k: _num(v) for k, v in s.rmse_per_sample.items()}} for s in d.waterfall]
     out["final"] = {"effects": list(final.effects), "rmse_deg": _num(final.rmse_deg),
@@ -187,13 +189,13 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
     if d.candidates:
         lines.append("")
         lines.append("candidates (each effect added to the current model, ranked by held-out RMSE):")
-        w = max(len(c.effect) for c in d.candidates)
+        w = max(len(c.label) for c in d.candidates)
         lines.append(f"  {'#':>2}  {'effect':<{w}}  {'held-out':>8}  {'RMSE':>7}  {'dBIC':>9}  verdict")
         for k, c in enumerate(d.candidates, 1):
             verdict = "significant" if c.significant else c.why
             if c.equivalent:
                 verdict += f"; cannot be told apart from {', '.join(c.equivalent)}"
-            lines.append(f"  {k:>2}  {c.effect:<{w}}  {c.heldout_rmse_deg:8.3f}  {c.rmse_deg:7.3f}  "
+            lines.append(f"  {k:>2}  {c.label:<{w}}  {c.heldout_rmse_deg:8.3f}  {c.rmse_deg:7.3f}  "
                          f"{c.delta_bic:9.1f}  {verdict}")
     lines.append("")
     if d.recommended:
@@ -213,8 +215,13 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
                     continue
                 lines.append(f"       {full} = {_pm(step.params[full], step.stderr.get(full, math.inf), p.unit)}"
                              f"  ({p.doc})")
-            rnd = d.rounds[k - 1] if k - 1 < len(d.rounds) else ()
-            c = next((c for c in rnd if c.effect == name), None)
+            i = d.chosen_round.get(name, k - 1)
+            rnd = d.rounds[i] if i < len(d.rounds) else ()
+            c = next((c for c in rnd if c.effect == name and c.significant),
+                     next((c for c in rnd if c.effect == name), None))
+            if c is not None and c.replaces:
+                lines.append(f"       replaces {', '.join(c.replaces)} (chosen earlier): with {name} in the model its "
+                             "parameters went to a bound, so it was dropped")
             if c is not None and c.equivalent:
                 lines.append(f"       the data cannot tell it apart from: {', '.join(c.equivalent)}")
             if c is not None and c.confounded:

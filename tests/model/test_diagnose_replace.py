@@ -1,0 +1,57 @@
+"""Stepwise selection with replacement, and the first-rest check of offsets (camtube.model.diagnose.search)."""
+from __future__ import annotations
+
+import numpy as np
+
+from camtube.design.loader import load_pattern
+from camtube.model.core.predict import model_for_pattern, pattern_values
+from camtube.model.data.dataset import Dataset
+from camtube.model.diagnose import diagnose
+from camtube.model.diagnose.search import first_rest_rows
+from camtube.model.report.diagnosis import diagnosis_dict, diagnosis_text
+from camtube.model.sim.truth import Hidden, simulate
+from tests.conftest import PATTERNS
+
+
+def _run(tube: str, hidden: Hidden, seed: int):
+    p = load_pattern(PATTERNS / f"{tube}.yaml")
+    sim = simulate(p, hidden, n_samples=2, n_cycles=50, rate_hz=10.0, seed=seed)
+    return sim, diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
+
+
+def test_an_early_stand_in_is_replaced_by_the_effect_that_explains_it():
+    # a sharp (Fung) toe with a large play: slack leads at first (a sharp knee looks like slack), then the
+    # fitted-shape toe takes the slack's place (the slack's deadband goes to zero with it in the model)
+    sim, d = _run("tube2", Hidden(toe_mm=0.3, toe_form="fung", play_mm=0.116), 9003)
+    chain = d.recommended or d.partial
+    assert d.candidates[0].effect == "slack"
+    assert "slack" not in chain and set(chain) == {"play", "toe_shape"}
+    assert d.replaced == ((("slack",), "toe_shape"),)
+    steps = d.waterfall if d.recommended else d.partial_steps
+    assert all(b.rmse_deg < a.rmse_deg for a, b in zip(steps, steps[1:]))
+    assert [s.effects for s in steps[1:]] == [("play",), ("play", "toe_shape")]
+    assert diagnosis_dict(d)["replaced"] == [{"effects": ["slack"], "by": "toe_shape"}]
+
+
+def test_first_rest_rows_are_the_leading_rows_where_the_model_holds_the_joint():
+    t = np.arange(8) * 0.1
+    data = Dataset(time_s=np.r_[t, t], stroke_mm=np.zeros(16), force_N=np.zeros(16), angle_deg=np.zeros(16),
+                   sample=np.array(["S1"] * 8 + ["S2"] * 8, dtype=object), cycle=np.ones(16, int))
+    pred = np.r_[[0.5, 0.5, 0.5, 1.0, 2.0, 0.5, 0.5, 0.5], [0.0, 0.3, 0.0, 0, 0, 0, 0, 0]]
+    assert first_rest_rows(data, pred, 0.01).tolist() == [0, 1, 2, 8]
+
+
+def test_an_offset_the_first_rest_contradicts_is_called_out():
+    # a Fung toe on the weakest joint: joint friction holds it bent once loaded, and the toe law misses the
+    # lowest forces; the constant offset that soaks this up is not the sensor's, and the output says so
+    _, d = _run("tube1", Hidden(toe_mm=0.372, toe_form="fung"), 9001)
+    assert "angle_bias" in d.recommended
+    assert any("before the joint was first loaded" in n for n in d.sample_notes)
+    assert "not (only) a sensor offset" in diagnosis_text(d)
+
+
+def test_a_true_sensor_offset_gets_no_such_note():
+    _, d = _run("tube2", Hidden(angle_bias_deg=0.8), 42)
+    assert d.recommended[:1] in (("angle_bias",), ("force_zero",))
+    assert abs(d.final.params.get("angle_bias.bias_deg", 0.8) - 0.8) < 0.08
+    assert not any("before the joint was first loaded" in n for n in d.sample_notes)
