@@ -100,6 +100,9 @@ EQUAL_HELDOUT = 0.03
 GRID = 3
 #: A chain of effects is recommended only when its all-rows RMSE is within this multiple of the noise floor.
 REACH_RATIO = 1.15
+#: Candidates (best held-out first) also tried with per-sample parameters in each round: samples that differ
+#: a lot make the shared version of the right effect rank low (two slacks 4x apart), so more than the top two.
+PER_SAMPLE_TRIES = 4
 #: Significant digits of the start values printed with ``--init`` (and used by the diagnosis itself).
 INIT_DIGITS = 6
 
@@ -812,8 +815,8 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
            init: Mapping[str, float] | None = None, swappable: Sequence[Effect] = ()) -> tuple[Candidate, ...]:
     """Every effect of ``pool`` on top of ``current``, ranked by held-out RMSE.
 
-    With ``try_per_sample``, the best two effects are also fitted with per-sample parameters; that
-    version replaces the shared one when its held-out error is significantly lower. When a candidate's fit
+    With ``try_per_sample``, the best :data:`PER_SAMPLE_TRIES` effects are also fitted with per-sample
+    parameters; that version replaces the shared one when its held-out error is significantly lower. When a candidate's fit
     puts a parameter of an effect of ``swappable`` (chosen earlier in this diagnosis) on a bound, the
     candidate explains what that effect did: it is also tried *instead of* it (stepwise selection with
     replacement), so an early stand-in (slack for a sharp toe) does not stay in the model.
@@ -828,7 +831,7 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
         ho, mse = _cv(m, search, cur_names + new, f.params, fixed, fold, block, per_sample=cur_ps)
         fits.append([eff, m, new, f, ho, mse, ()])
     if try_per_sample:
-        for row in sorted([r for r in fits if r[2]], key=lambda r: r[4])[:2]:
+        for row in sorted([r for r in fits if r[2]], key=lambda r: r[4])[:PER_SAMPLE_TRIES]:
             eff, m, new, f, ho, mse, _ = row
             ps = list(cur_ps) + list(new)
             f2 = _search_fit(m, search, cur_names + new, f.params, fixed, per_sample=ps)
