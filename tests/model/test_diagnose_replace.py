@@ -55,3 +55,14 @@ def test_a_true_sensor_offset_gets_no_such_note():
     assert d.recommended[:1] in (("angle_bias",), ("force_zero",))
     assert abs(d.final.params.get("angle_bias.bias_deg", 0.8) - 0.8) < 0.08
     assert not any("before the joint was first loaded" in n for n in d.sample_notes)
+
+
+def test_a_family_member_far_behind_does_not_jump_ahead():
+    # a power toe behind play: the fitted-shape toe is best but untrusted (its shape on the bound: a sharp
+    # knee, like slack); its family member, the quadratic toe, is far behind slack and must not lead
+    _, d = _run("tube2", Hidden(toe_mm=0.436, toe_form="power", play_mm=0.062), 11002)
+    first = d.candidates[0]
+    quad = next(c for c in d.candidates if c.effect == "toe")
+    assert first.significant and first.heldout_rmse_deg < quad.heldout_rmse_deg / 1.03
+    assert "toe" in {c.effect for c in d.candidates if "toe_shape" in c.equivalent}  # still declared a family
+    assert "toe_shape" in d.recommended and "play" in d.recommended and "slack" not in d.recommended

@@ -762,7 +762,7 @@ def _offset_notes(data: Dataset, final: Step, chosen: Sequence[Effect], floor: f
     offsets = [e for e in chosen if e.family == "offset"]
     if not offsets or floor <= 0:
         return []
-    rows = first_rest_rows(data, final.predicted, 0.05 * floor)
+    rows = first_rest_rows(data, final.predicted, 0.5 * floor)
     if rows.size < 4:
         return []
     r = float(np.mean(final.residuals[rows]))
@@ -907,7 +907,12 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
                              c.block_mse, c.per_sample, c.replaces))
     # among candidates that cannot be told apart from the best, the lowest BIC (the simplest) leads
     if out and out[0].equivalent:
-        group = [c for c in out if c is out[0] or c.effect in out[0].equivalent]
+        # ... but a member of the group does not jump ahead of a significant candidate it is clearly worse than
+        # (a family member of an untrusted best candidate: a quadratic toe far behind slack)
+        sig = [c.heldout_rmse_deg for c in out if c.significant]
+        cap = (1.0 + EQUAL_HELDOUT) * min(sig) if sig else math.inf
+        group = [c for c in out if (c is out[0] or c.effect in out[0].equivalent)
+                 and (c.heldout_rmse_deg <= cap or not c.significant)]
         lead = min(group, key=lambda c: (not c.significant, c.delta_bic, c.effect))
         # Occam: an indistinguishable candidate with fewer parameters whose BIC is within the threshold leads
         simpler = [c for c in group if c.significant == lead.significant and len(c.params) < len(lead.params)
