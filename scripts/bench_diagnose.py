@@ -7,7 +7,7 @@ effects, the first candidate (and what it is declared indistinguishable from), t
 RMSE before/after, the estimated and true sensor floors, whether the printed `camtube model fit` command
 reproduces the final RMSE (it is run), per-sample values, and the seconds of the diagnosis.
 
-Run: ``python scripts/bench_diagnose.py [--batch tune|heldout|heldout2|heldout3|heldout4|heldout5|speed|all]``
+Run: ``python scripts/bench_diagnose.py [--batch tune|heldout|heldout2|heldout3|heldout4|heldout5|heldout6|speed|all]``
 
 ``tune``: the sets the method was tuned on. ``heldout``: a batch drawn with fresh seeds and parameters
 after the method was settled (seed 20261122; seen since, while ``toe_shape`` was built). ``heldout2``:
@@ -17,7 +17,8 @@ have (the truth's ``power`` and ``tanh`` toes); looked at since (the posterior-m
 ``heldout4``: drawn after stepwise replacement and the first-rest check were settled (seed 20261125,
 seeds 11000-): sharp toes with play or slack, a hidden sensor offset, per-sample play and slack; looked at
 (its per-sample slack led to trying four candidates per sample). ``heldout5``: drawn after that (seed
-20261126, seeds 13000-).
+20261126, seeds 13000-); looked at (the family-lead rule followed). ``heldout6``: drawn after that (seed
+20261127, seeds 15000-), every truth toe form at random.
 ``speed``: 10,000 and 200,000 rows (targets 5 s and 20 s).
 """
 from __future__ import annotations
@@ -211,6 +212,38 @@ def heldout5_batch(seed: int = 20261126) -> list:
 OFFSETS = ("angle_bias.bias_deg", "force_zero.zero_N")
 
 
+def heldout6_batch(seed: int = 20261127) -> list:
+    """A sixth fresh batch, drawn once the family-lead rule, the first-rest tolerance and the bench's offset and
+    replacement checks were settled (heldout5 had been looked at): new seeds (15000-), new parameters, every
+    truth toe form, combinations with play, slack and viscoelasticity, per-sample effects on every tube."""
+    rng = np.random.default_rng(seed)
+    u = lambda a, b: float(np.round(rng.uniform(a, b), 3))  # noqa: E731
+    tubes = ("tube1", "tube2", "tube3")
+    t = lambda: tubes[int(rng.integers(3))]  # noqa: E731
+    forms = ("exponential", "power", "tanh", "fung")
+    form = lambda: forms[int(rng.integers(4))]  # noqa: E731
+    play, s1, s2 = u(0.03, 0.12), u(0.03, 0.08), u(0.1, 0.2)
+    f1, f2, f3 = form(), form(), form()
+    return [
+        ("control", t(), Hidden(joint_friction_nmm=u(0.02, 0.1)), set(), {}),
+        (f"{f1}-toe", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f1), TOES, {}),
+        (f"{f2}-toe + play", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f2, play_mm=play), TOES | {"play"},
+         {"play.play_mm": play}),
+        (f"{f3}-toe + slack", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f3, slack_mm=s1), TOES | {"slack"}, {}),
+        ("viscoelastic + play", t(), Hidden(visco_ratio=u(0.2, 0.6), visco_tau_s=u(1.0, 4.0), play_mm=play),
+         {"viscoelastic", "play"}, {"play.play_mm": play}),
+        ("slack per sample", t(), [Hidden(slack_mm=s1), Hidden(slack_mm=s2)], {"slack"},
+         {"slack.deadband_mm@1": s1, "slack.deadband_mm@2": s2}),
+        ("play on S2 only", t(), [Hidden(), Hidden(play_mm=play)], {"play"},
+         {"play.play_mm@1": 0.0, "play.play_mm@2": play}),
+        ("sensor offset", t(), Hidden(angle_bias_deg=(b := u(-1.0, 1.0))), {"angle_bias", "force_zero"},
+         {"angle_bias.bias_deg": b}),
+        ("cycle creep", t(), Hidden(cycle_creep_mm=u(0.03, 0.1), cycle_creep_n=u(3, 8)), {"creep", "viscoelastic"},
+         {}),
+        ("control", t(), Hidden(), set(), {}),
+    ]
+
+
 def _offset_shifts(p, data, d, name: str, value: float) -> tuple:
     """(fitted, true) angle shift in deg of a hidden offset ``name = value`` found as the other offset."""
     other = next((o for o in OFFSETS if o in d.final.params), None)
@@ -352,13 +385,14 @@ def speed() -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--batch", default="tune", choices=("tune", "heldout", "heldout2", "heldout3", "heldout4", "heldout5", "speed", "all"))
+    ap.add_argument("--batch", default="tune", choices=("tune", "heldout", "heldout2", "heldout3", "heldout4", "heldout5", "heldout6", "speed", "all"))
     args = ap.parse_args()
     if args.batch in ("speed", "all", "tune"):
         speed()
     for batch, sets, seed0 in (("tune", TUNE, 100), ("heldout", heldout_batch, 5000),
                                ("heldout2", heldout2_batch, 7000), ("heldout3", heldout3_batch, 9000),
-                               ("heldout4", heldout4_batch, 11000), ("heldout5", heldout5_batch, 13000)):
+                               ("heldout4", heldout4_batch, 11000), ("heldout5", heldout5_batch, 13000),
+                               ("heldout6", heldout6_batch, 15000)):
         if args.batch not in (batch, "all"):
             continue
         sets = sets if not callable(sets) else sets()
