@@ -31,6 +31,9 @@ def test_an_early_stand_in_is_replaced_by_the_effect_that_explains_it():
     assert all(b.rmse_deg < a.rmse_deg for a, b in zip(steps, steps[1:]))
     assert [s.effects for s in steps[1:]] == [("play",), ("play", "toe_shape")]
     assert diagnosis_dict(d)["replaced"] == [{"effects": ["slack"], "by": "toe_shape"}]
+    assert "replaced: slack (chosen in an earlier round) by toe_shape" in diagnosis_text(d)
+    assert "toe_shape (replacing slack)" in diagnosis_text(d) or any(
+        c.label == "toe_shape (replacing slack)" for rnd in d.rounds for c in rnd)
 
 
 def test_first_rest_rows_are_the_leading_rows_where_the_model_holds_the_joint():

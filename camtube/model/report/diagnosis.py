@@ -219,9 +219,6 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
             rnd = d.rounds[i] if i < len(d.rounds) else ()
             c = next((c for c in rnd if c.effect == name and c.significant),
                      next((c for c in rnd if c.effect == name), None))
-            if c is not None and c.replaces:
-                lines.append(f"       replaces {', '.join(c.replaces)} (chosen earlier): with {name} in the model its "
-                             "parameters went to a bound, so it was dropped")
             if c is not None and c.equivalent:
                 lines.append(f"       the data cannot tell it apart from: {', '.join(c.equivalent)}")
             if c is not None and c.confounded:
@@ -247,6 +244,10 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
     else:
         lines.append("recommended: nothing")
     lines += partial_lines(d)
+    for old, new in d.replaced:
+        lines.append(f"replaced: {', '.join(old)} (chosen in an earlier round) by {new}: with {new} in the model "
+                     f"the parameters of {', '.join(old)} went to a bound (it explains what they did), so "
+                     f"{'they were' if len(old) > 1 else 'it was'} dropped")
     for note in d.sample_notes:
         lines.append(f"note: {note}")
     for name, why in d.rejected:
@@ -340,7 +341,7 @@ def ranking_png(d: Diagnosis) -> bytes:
     y = np.arange(len(cands))[::-1]
     ax.barh(y, [c.heldout_rmse_deg for c in cands],
             color=["tab:green" if c.significant else "0.6" for c in cands])
-    ax.set_yticks(y, [c.effect for c in cands])
+    ax.set_yticks(y, [c.label for c in cands])
     ax.axvline(d.base_heldout_rmse_deg, color="tab:red", lw=1, label="current model")
     ax.axvline(d.noise_floor_deg, color="black", ls="--", lw=1, label="noise floor")
     ax.set_xlabel("held-out RMSE (deg); green: significant")
@@ -382,7 +383,7 @@ def report_files(d: Diagnosis, command: str = "", title: str = "camtube diagnosi
         note = "significant" if c.significant else c.why
         if c.equivalent:
             note += f"; cannot be told apart from {', '.join(c.equivalent)}"
-        rows.append(f"<tr><td>{k}</td><td>{esc(c.effect)}</td><td>{c.heldout_rmse_deg:.3f}</td>"
+        rows.append(f"<tr><td>{k}</td><td>{esc(c.label)}</td><td>{c.heldout_rmse_deg:.3f}</td>"
                     f"<td>{c.rmse_deg:.3f}</td><td>{c.delta_bic:.1f}</td><td>{esc(params)}</td>"
                     f"<td>{esc(note)}</td></tr>")
     page = f"""<!DOCTYPE html>
