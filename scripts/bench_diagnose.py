@@ -7,7 +7,7 @@ effects, the first candidate (and what it is declared indistinguishable from), t
 RMSE before/after, the estimated and true sensor floors, whether the printed `camtube model fit` command
 reproduces the final RMSE (it is run), per-sample values, and the seconds of the diagnosis.
 
-Run: ``python scripts/bench_diagnose.py [--batch tune|heldout|heldout2|heldout3|heldout4|heldout5|heldout6|speed|all]``
+Run: ``python scripts/bench_diagnose.py [--batch tune|heldout|heldout2|heldout3|heldout4|heldout5|heldout6|speed|controls|variants|all]``
 
 ``tune``: the sets the method was tuned on. ``heldout``: a batch drawn with fresh seeds and parameters
 after the method was settled (seed 20261122; seen since, while ``toe_shape`` was built). ``heldout2``:
@@ -383,12 +383,51 @@ def speed() -> None:
               + ", ".join(f"{k} {v:.2f} s" for k, v in d.seconds.items()))
 
 
+def controls() -> None:
+    """Controls with the stop rule off: every tube, two seeds, joint friction 0, 0.05 and 0.1 N mm."""
+    for tube in ("tube1", "tube2", "tube3"):
+        p = load_pattern(ROOT / "patterns" / f"{tube}.yaml")
+        for seed in (301, 302):
+            for fr in (0.0, 0.05, 0.1):
+                sim = simulate(p, Hidden(joint_friction_nmm=fr), n_samples=2, n_cycles=50, rate_hz=10.0, seed=seed)
+                d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p), stop_ratio=None)
+                print(f"control {tube} seed {seed} friction {fr:g} N mm, stop rule off: recommended "
+                      f"{list(d.recommended) or 'nothing'}, partial {list(d.partial) or 'nothing'}; "
+                      f"RMSE / true floor {d.final.rmse_deg / sim.sensor_floor_deg:.2f}")
+
+
+def variants() -> None:
+    """Record shapes the batches do not have: one or three samples, 20 cycles, 25 Hz, a faster stroke (tube 2)."""
+    cases = [("control", Hidden()), ("play 0.05", Hidden(play_mm=0.05)),
+             ("exp toe 0.3", Hidden(toe_mm=0.3, toe_form="exponential")), ("slack 0.08", Hidden(slack_mm=0.08)),
+             ("viscoelastic 0.3 / 2 s", Hidden(visco_ratio=0.3, visco_tau_s=2.0))]
+    shapes = [dict(n_samples=1, n_cycles=50, rate_hz=10.0), dict(n_samples=3, n_cycles=20, rate_hz=10.0),
+              dict(n_samples=2, n_cycles=20, rate_hz=25.0), dict(n_samples=2, n_cycles=30, rate_hz=10.0, speed_mm_s=1.0)]
+    p = load_pattern(ROOT / "patterns" / "tube2.yaml")
+    for shape in shapes:
+        for name, h in cases:
+            sim = simulate(p, h, seed=777, **shape)
+            d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
+            first = d.candidates[0] if d.candidates else None
+            lead = f"{first.effect} (= {', '.join(first.equivalent)})" if first and first.equivalent else (
+                first.effect if first else "-")
+            prm = ", ".join(f"{k} {v:.4g}" for k, v in d.final.params.items() if "." in k)
+            print(f"{shape} {name}: first {lead}; recommended {list(d.recommended) or 'nothing'} "
+                  f"({d.final.rmse_deg / sim.sensor_floor_deg:.2f}x the true floor) {prm}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--batch", default="tune", choices=("tune", "heldout", "heldout2", "heldout3", "heldout4", "heldout5", "heldout6", "speed", "all"))
+    ap.add_argument("--batch", default="tune",
+                    choices=("tune", "heldout", "heldout2", "heldout3", "heldout4", "heldout5", "heldout6", "speed",
+                             "controls", "variants", "all"))
     args = ap.parse_args()
     if args.batch in ("speed", "all", "tune"):
         speed()
+    if args.batch in ("controls", "all"):
+        controls()
+    if args.batch in ("variants", "all"):
+        variants()
     for batch, sets, seed0 in (("tune", TUNE, 100), ("heldout", heldout_batch, 5000),
                                ("heldout2", heldout2_batch, 7000), ("heldout3", heldout3_batch, 9000),
                                ("heldout4", heldout4_batch, 11000), ("heldout5", heldout5_batch, 13000),
