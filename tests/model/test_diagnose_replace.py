@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from camtube.design.loader import load_pattern
 from camtube.model.core.predict import model_for_pattern, pattern_values
@@ -69,3 +70,15 @@ def test_a_family_member_far_behind_does_not_jump_ahead():
     assert first.significant and first.heldout_rmse_deg < quad.heldout_rmse_deg / 1.03
     assert "toe" in {c.effect for c in d.candidates if "toe_shape" in c.equivalent}  # still declared a family
     assert "toe_shape" in d.recommended and "play" in d.recommended and "slack" not in d.recommended
+
+
+def test_the_values_printed_under_each_effect_are_the_whole_chain_s():
+    # play's own step (before the toe replaced the slack) puts 0.18 mm of lost motion; the chain has 0.06 mm
+    import re
+
+    _, d = _run("tube2", Hidden(toe_mm=0.436, toe_form="power", play_mm=0.062), 11002)
+    chain = d.waterfall[len(d.recommended)]
+    step = d.waterfall[d.recommended.index("play") + 1]
+    assert abs(step.params["play.play_mm"] / chain.params["play.play_mm"] - 1) > 0.5  # the case this is about
+    shown = float(re.search(r"play\.play_mm = ([0-9.e+-]+) \+-", diagnosis_text(d)).group(1))
+    assert shown == pytest.approx(chain.params["play.play_mm"], rel=1e-3)

@@ -201,19 +201,22 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
     if d.recommended:
         lines.append("recommended, in order:")
         prev = base
+        # the values are those of the whole chain (what the command below gives before any per-sample step):
+        # a step's own refit can differ a lot (play alone takes up a toe's slack)
+        chain = d.waterfall[len(d.recommended)]
         for k, name in enumerate(d.recommended, 1):
             e = d.catalog[name]
             step = d.waterfall[k]
             lines.append(f"  {k}. {name}: {e.signature}: {e.meaning}.")
             for p in e.params:
                 full = f"{name}.{p.name}"
-                if full in step.per_sample:
+                if full in chain.per_sample:
                     lines.append(f"       {full}, per sample ({p.doc}):")
-                    for smp in step.rmse_per_sample:
+                    for smp in chain.rmse_per_sample:
                         key = f"{full}@{smp}"
-                        lines.append(f"         {key} = {_pm(step.params[key], step.stderr.get(key, math.inf), p.unit)}")
+                        lines.append(f"         {key} = {_pm(chain.params[key], chain.stderr.get(key, math.inf), p.unit)}")
                     continue
-                lines.append(f"       {full} = {_pm(step.params[full], step.stderr.get(full, math.inf), p.unit)}"
+                lines.append(f"       {full} = {_pm(chain.params[full], chain.stderr.get(full, math.inf), p.unit)}"
                              f"  ({p.doc})")
             i = d.chosen_round.get(name, k - 1)
             rnd = d.rounds[i] if i < len(d.rounds) else ()
