@@ -81,7 +81,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -597,7 +597,7 @@ def diagnose(
     prev_all = base_full
     rounds: list[tuple[Candidate, ...]] = []
     recommended: list[str] = []
-    rejected: list[tuple[str, str]] = []
+    rejected: list[tuple[Candidate, str]] = []  # (candidate, why it failed the all-rows check)
     chosen: list[Effect] = []
     replaced: list[tuple[tuple, str]] = []
     chosen_round: dict[str, int] = {}
@@ -662,7 +662,7 @@ def diagnose(
                 if not all(b < a for a, b in zip(seq, seq[1:])):
                     problems.append(f"without {', '.join(c.replaces)} a step of the chain does not lower the RMSE")
             if problems:
-                rejected.append((c.label, "; ".join(problems)))
+                rejected.append((c, "; ".join(problems)))
                 continue
             accepted = (c, eff, m, names, r, {k: v for k, v in init.items() if k in r.fitted}, ps, keep, inter)
             break
@@ -676,7 +676,7 @@ def diagnose(
         c, eff, m, names, r, init, ps, keep, inter = accepted
         floor, floor_se, floor_parts = f_c, se_c, parts_c
         cur_ps = ps
-        rejected = [(e, w) for e, w in rejected if e.split(" (replacing")[0] != eff.name]
+        rejected = [(rc, w) for rc, w in rejected if rc.effect != eff.name]
         if c.replaces:
             replaced.append((tuple(c.replaces), eff.name))
             chosen = keep
@@ -732,7 +732,7 @@ def diagnose(
         recommended, steps, ps_names = [], steps[:1], []
         notes = [f"partial model: {n}" for n in notes]
     return Diagnosis(data, model, floor, base_rmse, base_ho, tuple(rounds), tuple(recommended), tuple(steps),
-                     tuple(fit_params), stop, fixed, secs, catalog, floor_se, tuple(dict(rejected).items()),
+                     tuple(fit_params), stop, fixed, secs, catalog, floor_se, tuple({rc.label: w for rc, w in rejected}.items()),
                      tuple(ps_names),
                      tuple(notes), grid, partial, partial_steps, floor_parts, tuple(replaced),
                      {k: chosen_round[k] for k in recommended or partial if k in chosen_round})
@@ -778,12 +778,10 @@ def _offset_notes(data: Dataset, final: Step, chosen: Sequence[Effect], floor: f
 
 
 def _mark_rejected(ranked, rejected):
-    why = dict(rejected)
+    why = {rc.label: w for rc, w in rejected}
     for c in ranked:
         if c.label in why and c.significant:
-            yield Candidate(c.effect, c.effects, c.rmse_deg, c.heldout_rmse_deg, c.delta_bic, c.params,
-                            c.equivalent, c.confounded, False, "all-rows check: " + why[c.label], c.predicted,
-                            c.values, c.gain_z, c.block_mse, c.per_sample, c.replaces)
+            yield replace(c, significant=False, why="all-rows check: " + why[c.label])
         else:
             yield c
 
@@ -902,9 +900,7 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
                      or float(np.sqrt(np.mean((o.predicted - c.predicted) ** 2))) <= 0.5 * floor)
             if same_fam or close:
                 eq.append(o.effect)
-        out.append(Candidate(c.effect, c.effects, c.rmse_deg, c.heldout_rmse_deg, c.delta_bic, c.params,
-                             tuple(eq), c.confounded, c.significant, c.why, c.predicted, c.values, c.gain_z,
-                             c.block_mse, c.per_sample, c.replaces))
+        out.append(replace(c, equivalent=tuple(eq)))
     # among candidates that cannot be told apart from the best, the lowest BIC (the simplest) leads
     if out and out[0].equivalent:
         # ... but a member of the group does not jump ahead of a significant candidate it is clearly worse than
