@@ -78,12 +78,16 @@ TUNE = [
 ]
 
 
+def _drawers(seed: int):
+    """``(rng, u, t)`` of a batch: ``u(a, b)`` a uniform value rounded to 3 decimals, ``t()`` a tube at random."""
+    rng = np.random.default_rng(seed)
+    tubes = ("tube1", "tube2", "tube3")
+    return (rng, lambda a, b: float(np.round(rng.uniform(a, b), 3)), lambda: tubes[int(rng.integers(3))])
+
+
 def heldout_batch(seed: int = 20261122) -> list:
     """Fresh sets: new seeds, parameters drawn at random (drawn once the method was settled)."""
-    rng = np.random.default_rng(seed)
-    u = lambda a, b: float(np.round(rng.uniform(a, b), 3))  # noqa: E731
-    tubes = ("tube1", "tube2", "tube3")
-    t = lambda: tubes[int(rng.integers(3))]  # noqa: E731
+    _, u, t = _drawers(seed)
     play, toe, s1, s2 = u(0.03, 0.12), u(0.15, 0.45), u(0.02, 0.06), u(0.08, 0.15)
     ratio, tau, cc = u(0.2, 0.6), u(1.0, 4.0), u(0.03, 0.1)
     return [
@@ -104,10 +108,7 @@ def heldout_batch(seed: int = 20261122) -> list:
 def heldout2_batch(seed: int = 20261123) -> list:
     """A second fresh batch, drawn once ``toe_shape`` was settled: new seeds (7000-), new parameters, and toe
     forms the library does not have (the truth's ``power`` and ``tanh`` toes)."""
-    rng = np.random.default_rng(seed)
-    u = lambda a, b: float(np.round(rng.uniform(a, b), 3))  # noqa: E731
-    tubes = ("tube1", "tube2", "tube3")
-    t = lambda: tubes[int(rng.integers(3))]  # noqa: E731
+    _, u, t = _drawers(seed)
     play, s1 = u(0.03, 0.12), u(0.04, 0.15)
     return [
         ("control", t(), Hidden(joint_friction_nmm=u(0.02, 0.1)), set(), {}),
@@ -130,10 +131,7 @@ def heldout3_batch(seed: int = 20261124) -> list:
     """A third fresh batch, drawn once the posterior-mean toe law was settled (heldout2 had been looked at):
     new seeds (9000-), new parameters, Fung's exponential toe (a form no camtube code had seen) and the
     other truth toes with new values."""
-    rng = np.random.default_rng(seed)
-    u = lambda a, b: float(np.round(rng.uniform(a, b), 3))  # noqa: E731
-    tubes = ("tube1", "tube2", "tube3")
-    t = lambda: tubes[int(rng.integers(3))]  # noqa: E731
+    _, u, t = _drawers(seed)
     play, s1 = u(0.03, 0.12), u(0.04, 0.15)
     return [
         ("control", t(), Hidden(joint_friction_nmm=u(0.02, 0.1)), set(), {}),
@@ -155,10 +153,7 @@ def heldout4_batch(seed: int = 20261125) -> list:
     """A fourth fresh batch, drawn once stepwise replacement and the first-rest check of offsets were settled
     (heldout3 had been looked at): new seeds (11000-), new parameters, the truth's Fung, power and tanh toes
     combined with play and slack, a hidden sensor offset, and per-sample play on tube 3."""
-    rng = np.random.default_rng(seed)
-    u = lambda a, b: float(np.round(rng.uniform(a, b), 3))  # noqa: E731
-    tubes = ("tube1", "tube2", "tube3")
-    t = lambda: tubes[int(rng.integers(3))]  # noqa: E731
+    _, u, t = _drawers(seed)
     play, s1, s2, bias = u(0.03, 0.12), u(0.03, 0.08), u(0.09, 0.18), u(0.3, 1.2)
     return [
         ("control", t(), Hidden(joint_friction_nmm=u(0.02, 0.1)), set(), {}),
@@ -184,10 +179,7 @@ def heldout5_batch(seed: int = 20261126) -> list:
     """A fifth fresh batch, drawn once per-sample versions of the best four candidates were settled (heldout4
     showed a per-sample slack ranked too low to be tried per sample): new seeds (13000-), new parameters, a
     hidden load-cell zero offset, sharp toes with slack or play, samples whose play differs."""
-    rng = np.random.default_rng(seed)
-    u = lambda a, b: float(np.round(rng.uniform(a, b), 3))  # noqa: E731
-    tubes = ("tube1", "tube2", "tube3")
-    t = lambda: tubes[int(rng.integers(3))]  # noqa: E731
+    _, u, t = _drawers(seed)
     p1, p2, s1, s2, z = u(0.02, 0.05), u(0.07, 0.14), u(0.03, 0.08), u(0.1, 0.2), u(0.01, 0.04)
     return [
         ("control", t(), Hidden(joint_friction_nmm=u(0.02, 0.1)), set(), {}),
@@ -208,18 +200,11 @@ def heldout5_batch(seed: int = 20261126) -> list:
     ]
 
 
-#: The two sensor offsets: a constant angle shift each (the output declares them indistinguishable).
-OFFSETS = ("angle_bias.bias_deg", "force_zero.zero_N")
-
-
 def heldout6_batch(seed: int = 20261127) -> list:
     """A sixth fresh batch, drawn once the family-lead rule, the first-rest tolerance and the bench's offset and
     replacement checks were settled (heldout5 had been looked at): new seeds (15000-), new parameters, every
     truth toe form, combinations with play, slack and viscoelasticity, per-sample effects on every tube."""
-    rng = np.random.default_rng(seed)
-    u = lambda a, b: float(np.round(rng.uniform(a, b), 3))  # noqa: E731
-    tubes = ("tube1", "tube2", "tube3")
-    t = lambda: tubes[int(rng.integers(3))]  # noqa: E731
+    rng, u, t = _drawers(seed)
     forms = ("exponential", "power", "tanh", "fung")
     form = lambda: forms[int(rng.integers(4))]  # noqa: E731
     play, s1, s2 = u(0.03, 0.12), u(0.03, 0.08), u(0.1, 0.2)
@@ -244,17 +229,21 @@ def heldout6_batch(seed: int = 20261127) -> list:
     ]
 
 
+#: The two sensor offsets: a constant angle shift each (the output declares them indistinguishable).
+OFFSETS = ("angle_bias.bias_deg", "force_zero.zero_N")
+
+
 def _offset_shifts(p, data, d, name: str, value: float) -> tuple:
     """(fitted, true) angle shift in deg of a hidden offset ``name = value`` found as the other offset."""
     other = next((o for o in OFFSETS if o in d.final.params), None)
     if other is None:
         return (None, value)
-    fitted = {k: v for k, v in d.final.params.items()}
+    fitted = dict(d.final.params)
     model = model_for_pattern(p, list(d.final.effects))
     got = float(np.median(model.predict(data, fitted) - model.predict(data, {**fitted, other: 0.0})))
     if name == "angle_bias.bias_deg":
         return (got, value)
-    base = {k: v for k, v in fitted.items() if k.split(".")[0] not in ("angle_bias", "force_zero")}
+    base = {k: v for k, v in fitted.items() if k not in OFFSETS}
     zm = model_for_pattern(p, ["force_zero"])
     true = float(np.median(zm.predict(data, {**base, name: value}) - zm.predict(data, {**base, name: 0.0})))
     return (got, true)
