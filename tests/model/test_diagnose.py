@@ -222,7 +222,9 @@ def test_fit_warns_when_a_history_effect_is_fitted_on_the_default_selection(tmp_
     assert "warning: play" in out and "--branch both" in out
 
 
-def test_diagnose_init_start_values_reach_a_multimodal_user_effect():
+def _wobble_data(start_period_mm: float):
+    """A user's periodic stroke error (true period 0.7 mm, amplitude 0.03 mm) on tube 2 data with 0.25 deg noise,
+    declared with the start value ``start_period_mm``: ``(pattern, data, registry with the effect)``."""
     from camtube.model.core import Effect, Param
     from camtube.model.core.registry import builtin_registry
     from camtube.model.sim.synth import synthesize
@@ -231,13 +233,18 @@ def test_diagnose_init_start_values_reach_a_multimodal_user_effect():
         return s + p["amp_mm"] * np.sin(2 * np.pi * s / p["period_mm"])
 
     wob = Effect(name="wobble", stage="stroke", apply=apply,
-                 params=(Param("amp_mm", "mm", 0.0, 0.1, 0.01), Param("period_mm", "mm", 0.1, 2.0, 0.3)))
+                 params=(Param("amp_mm", "mm", 0.0, 0.1, 0.01),
+                         Param("period_mm", "mm", 0.1, 2.0, start_period_mm)))
     p = load_pattern(PATTERNS / "tube2.yaml")
     d = synthesize(p, 2, 4, seed=4, slack_mm=0.0)
     m = model_for_pattern(p, [wob])
     truth = {**m.initial_values(d, pattern_values(p)), "wobble.amp_mm": 0.03, "wobble.period_mm": 0.7}
     d = d.with_angle(m.predict(d, truth) + np.random.default_rng(0).normal(0, 0.25, len(d)))
-    reg = builtin_registry().with_effects([wob])
+    return p, d, builtin_registry().with_effects([wob])
+
+
+def test_diagnose_init_start_values_reach_a_multimodal_user_effect():
+    p, d, reg = _wobble_data(0.3)
     stuck = diagnose(model_for_pattern(p), d, ("E_t",), pattern_values(p), registry=reg, candidates=["wobble"],
                      grid=0)
     got = diagnose(model_for_pattern(p), d, ("E_t",), pattern_values(p), registry=reg, candidates=["wobble"],
@@ -250,21 +257,7 @@ def test_diagnose_init_start_values_reach_a_multimodal_user_effect():
 
 def test_user_effect_is_multi_started_over_its_declared_range():
     """A period starting at 0.5 mm finds a true 0.7 mm with the default starts (no --init): the scan of the range."""
-    from camtube.model.core import Effect, Param
-    from camtube.model.core.registry import builtin_registry
-    from camtube.model.sim.synth import synthesize
-
-    def apply(ctx, s, p):
-        return s + p["amp_mm"] * np.sin(2 * np.pi * s / p["period_mm"])
-
-    wob = Effect(name="wobble", stage="stroke", apply=apply,
-                 params=(Param("amp_mm", "mm", 0.0, 0.1, 0.01), Param("period_mm", "mm", 0.1, 2.0, 0.5)))
-    p = load_pattern(PATTERNS / "tube2.yaml")
-    d = synthesize(p, 2, 4, seed=4, slack_mm=0.0)
-    m = model_for_pattern(p, [wob])
-    truth = {**m.initial_values(d, pattern_values(p)), "wobble.amp_mm": 0.03, "wobble.period_mm": 0.7}
-    d = d.with_angle(m.predict(d, truth) + np.random.default_rng(0).normal(0, 0.25, len(d)))
-    reg = builtin_registry().with_effects([wob])
+    p, d, reg = _wobble_data(0.5)
     stuck = diagnose(model_for_pattern(p), d, ("E_t",), pattern_values(p), registry=reg, candidates=["wobble"],
                      grid=0)
     got = diagnose(model_for_pattern(p), d, ("E_t",), pattern_values(p), registry=reg, candidates=["wobble"])
