@@ -625,11 +625,11 @@ def diagnose(
             if not c.significant:
                 continue
             eff = next(e for e in pool if e.name == c.effect)
-            gone = {n for e in chosen if e.name in c.replaces for n in e.full_names()}
             keep = [e for e in chosen if e.name not in c.replaces]
-            m = current.with_effects([e for e in current.effects if e.name not in c.replaces] + [eff])
-            names = tuple(n for n in cur_names if n not in gone) + eff.full_names()
-            ps = [n for n in cur_ps if n.split("@")[0] not in gone] + list(c.per_sample)
+            m, names, ps = _without(current, cur_names, cur_ps, [e for e in chosen if e.name in c.replaces])
+            m = m.with_effects(list(m.effects) + [eff])
+            names += eff.full_names()
+            ps += list(c.per_sample)
             init = {k: v for k, v in c.values.items() if k.split("@")[0] in names}
             r = refit_all_rows(m, data, names, fixed, init, grid, per_sample=ps)
             problems = []
@@ -738,6 +738,15 @@ def diagnose(
                      {k: chosen_round[k] for k in recommended or partial if k in chosen_round})
 
 
+def _without(model: JointModel, names: Sequence[str], per_sample: Sequence[str],
+             effects: Sequence[Effect]) -> tuple[JointModel, tuple, list]:
+    """``model``, its fitted ``names`` and its ``per_sample`` names with ``effects`` (and their parameters) removed."""
+    drop = {e.name for e in effects}
+    gone = {n for e in effects for n in e.full_names()}
+    return (model.with_effects([e for e in model.effects if e.name not in drop]),
+            tuple(n for n in names if n not in gone), [n for n in per_sample if n.split("@")[0] not in gone])
+
+
 def first_rest_rows(data: Dataset, predicted: np.ndarray, tol_deg: float) -> np.ndarray:
     """Indices of the rows at the start of each sample where the model holds the joint at its first angle
     (within ``tol_deg``): the joint has not yet been loaded (the first tension goes into slack or a toe)."""
@@ -843,9 +852,9 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
             gone = set(old.full_names())
             if not any(n.split("@")[0] in gone for n in f.at_bound):
                 continue
-            m2 = current.with_effects([e for e in current.effects if e.name != old.name] + [eff])
-            names2 = tuple(n for n in cur_names if n not in gone) + tuple(new)
-            ps2 = [n for n in cur_ps if n not in gone]
+            m2, names2, ps2 = _without(current, cur_names, cur_ps, [old])
+            m2 = m2.with_effects(list(m2.effects) + [eff])
+            names2 += tuple(new)
             start = {k: v for k, v in f.params.items() if k.split("@")[0] not in gone}
             f2 = _search_fit(m2, search, names2, start, fixed, grid=grid, grid_names=new, per_sample=ps2)
             ho2, mse2 = _cv(m2, search, names2, f2.params, fixed, fold, block, per_sample=ps2)
