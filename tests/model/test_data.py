@@ -77,6 +77,31 @@ def test_bad_csv_names_file_and_line(tmp_path, lines, line, words):
         assert w in msg, msg
 
 
+@pytest.mark.parametrize("header, words", [
+    # the same quantity in another unit: renaming would change the numbers silently, so the fix says convert
+    (HEADER.replace("angle_deg", "angle_rad"), ["convert 'angle_rad' from rad to deg", "'angle_deg'"]),
+    (HEADER.replace("force_N", "force_mN"), ["convert 'force_mN' from mN to N"]),
+    (HEADER.replace("stroke_mm", "Stroke (mm)"), ["rename 'Stroke (mm)' -> 'stroke_mm'"]),
+])
+def test_missing_column_fix_converts_other_units_and_renames_near_names(header, words):
+    with pytest.raises(DataError) as err:
+        parse_csv(_csv([header] + GOOD[1:]), source="m.csv")
+    msg = str(err.value)
+    for w in words:
+        assert w in msg, msg
+    assert "rename 'angle_rad'" not in msg and "rename 'force_mN'" not in msg, msg
+
+
+@pytest.mark.parametrize("sep, name", [(";", "';'"), ("\t", "tabs")])
+def test_spreadsheet_separators_are_named(sep, name):
+    # a spreadsheet's export with a decimal comma separates its columns with ';' (or tabs)
+    text = _csv([r.replace(",", sep).replace(".", ",") for r in GOOD])
+    with pytest.raises(DataError) as err:
+        parse_csv(text, source="m.csv")
+    msg = str(err.value)
+    assert f"separated by {name}" in msg and "m.csv:1:" in msg, msg
+
+
 def test_time_backwards_is_checked_per_sample_only():
     # sample B starts at t = 0 again after A: allowed
     d = parse_csv(_csv(GOOD + ["B,1,0.0,0.0,0.0,0.0", "B,1,0.1,0.1,0.1,0.5"]))

@@ -47,6 +47,15 @@ def _to_float(col: tuple, name: str, lines: np.ndarray, source: str, finite: boo
     return arr
 
 
+def _check_separator(header: list[str], source: str, line: int) -> None:
+    """A header of one cell holding ';' or tabs: a spreadsheet's export (often with decimal commas)."""
+    if len(header) != 1:
+        return
+    for sep, name in ((";", "';'"), ("\t", "tabs")):
+        if sep in header[0]:
+            raise _err(source, line, f"the columns are separated by {name}, not commas",
+                       "save the file as comma-separated values with a decimal point (not a decimal comma)")
+
 def parse_csv(text: str, source: str = "<csv>") -> Dataset:
     """Parse measurement CSV text into a :class:`Dataset` (see the module docstring).
 
@@ -75,6 +84,7 @@ def parse_csv(text: str, source: str = "<csv>") -> Dataset:
             if header is None:
                 header = [c.strip() for c in rec]
                 header_line = ln
+                _check_separator(header, source, ln)
                 continue
             if len(rec) != len(header):
                 raise _err(source, ln, f"{len(rec)} cells but the header (line {header_line}) has "
@@ -93,12 +103,19 @@ def parse_csv(text: str, source: str = "<csv>") -> Dataset:
     if missing:
         hints = []
         for c in missing:
+            quantity, unit = c.rsplit("_", 1) if "_" in c else (c, "")
+            other = [h for h in header if "_" in h and h.rsplit("_", 1)[0].lower() == quantity.lower()
+                     and h.rsplit("_", 1)[1] != unit]
+            if other and unit:
+                # the same quantity in another unit: renaming would silently change the numbers
+                hints.append(f"convert {other[0]!r} from {other[0].rsplit('_', 1)[1]} to {unit} and name it {c!r}")
+                continue
             m = difflib.get_close_matches(c, header, n=1, cutoff=0.5)
             if m:
-                hints.append(f"{m[0]!r} -> {c!r}")
+                hints.append(f"rename {m[0]!r} -> {c!r}")
         raise _err(source, header_line,
                    f"missing column(s) {', '.join(missing)} (found: {', '.join(header)})",
-                   ("rename " + ", ".join(hints)) if hints else f"the header must contain {', '.join(COLUMNS)}")
+                   "; ".join(hints) if hints else f"the header must contain {', '.join(COLUMNS)}")
     if not rows:
         raise _err(source, header_line, "no data rows after the header")
 
