@@ -272,7 +272,8 @@ def run_set(name, tube, hidden, want, truth, seed, n_cycles=50, rate_hz=10.0, ch
                                                        if d.per_sample else "") or "nothing"
            + (f" (partial: {', '.join(d.partial)}, {d.partial_steps[-1].rmse_deg / sim.sensor_floor_deg:.2f}x)"
               if d.partial else ""),
-           "rmse_before": d.waterfall[0].rmse_deg, "rmse_after": d.final.rmse_deg,
+           "baseline": ", ".join(d.baseline) or "-",
+           "rmse_before": d.given.rmse_deg, "rmse_after": d.final.rmse_deg,
            "floor": d.noise_floor_deg, "sensor_floor": sim.sensor_floor_deg, "seconds": secs,
            "notes": list(d.sample_notes), "params": {}}
     for k, v in truth.items():
@@ -283,8 +284,10 @@ def run_set(name, tube, hidden, want, truth, seed, n_cycles=50, rate_hz=10.0, ch
             continue
         row["params"][k] = (got, v)
     # acceptance checks
+    # each recommended step, and each baseline effect where it joined the chain
     steps = d.waterfall
-    row["steps_lower"] = all(b.rmse_deg < a.rmse_deg for a, b in zip(steps, steps[1:]))
+    row["steps_lower"] = (all(b.rmse_deg < a.rmse_deg for a, b in zip(steps, steps[1:]))
+                          and all(after < before for _, before, after in d.baseline_gain.values()))
     # the first candidate is hidden, or declared indistinguishable from a hidden effect, or was replaced later
     # by a hidden effect (the output says `replaces slack`: the later effect explains what it did)
     by = {new for olds, new in d.replaced if first and first.effect in olds}
@@ -294,7 +297,7 @@ def run_set(name, tube, hidden, want, truth, seed, n_cycles=50, rate_hz=10.0, ch
     row["not_more"] = len(d.recommended) <= n_hidden(hidden)
     row["ratio"] = d.final.rmse_deg / sim.sensor_floor_deg
     row["controls_ok"] = bool(want) or not d.recommended
-    base_ps, fin_ps = steps[0].rmse_per_sample, d.final.rmse_per_sample
+    base_ps, fin_ps = d.given.rmse_per_sample, d.final.rmse_per_sample
     row["no_sample_worse"] = all(fin_ps[s] <= 1.02 * base_ps[s] for s in base_ps) or any(
         "ends worse" in n for n in d.sample_notes)
     if check_command and d.recommended:
@@ -320,14 +323,15 @@ def run_set(name, tube, hidden, want, truth, seed, n_cycles=50, rate_hz=10.0, ch
 
 
 def table(rows: list[dict]) -> str:
-    lines = ["| set | hidden | first | recommended | RMSE before | RMSE after | floor (est / true) | after / true floor "
-             "| command RMSE | params (fitted vs true) | s |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| set | hidden | first | recommended | baseline | RMSE before | RMSE after | floor (est / true) "
+             "| after / true floor | command RMSE | params (fitted vs true) | s |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         prm = "; ".join(f"{k} {g:.3g} vs {v:.3g}" if g is not None else f"{k} - vs {v:.3g}"
                         for k, (g, v) in r["params"].items())
         cmd = f"{r['command_rmse']:.3f}" if "command_rmse" in r else "-"
-        lines.append(f"| {r['set']} | {r['hidden']} | {r['first']} | {r['recommended']} | {r['rmse_before']:.3f} | "
+        lines.append(f"| {r['set']} | {r['hidden']} | {r['first']} | {r['recommended']} | {r['baseline']} | "
+                     f"{r['rmse_before']:.3f} | "
                      f"{r['rmse_after']:.3f} | {r['floor']:.3f} / {r['sensor_floor']:.3f} | {r['ratio']:.2f} | {cmd} | "
                      f"{prm or '-'} | {r['seconds']:.1f} |")
     return "\n".join(lines)

@@ -52,6 +52,9 @@ def register(model_sub) -> None:
                    help="do not test per-sample parameters of the recommended effects")
     d.add_argument("--init", action="append", default=[], metavar="NAME=VALUE",
                    help="also start a candidate's parameter at VALUE (e.g. a period), repeatable")
+    d.add_argument("--no-baseline", dest="baseline", action="store_false",
+                   help="do not take the joint's rest angle (friction in the joint) into the baseline when the "
+                        "data show it; it is then an ordinary candidate")
     d.add_argument("--json", metavar="OUT.json", help="write the diagnosis as JSON")
     d.add_argument("--report", metavar="DIR", help="write an HTML report with PNG plots into DIR")
     d.set_defaults(func=cmd_diagnose)
@@ -102,7 +105,8 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     d = diagnose(model, rows, split_names(args.fit_params), fixed, candidates=cands,
                  max_rows=args.max_rows, max_effects=args.max_effects, registry=reg,
                  stop_ratio=1.15 if args.stop_rule else None, modulus_range_gpa=(lo, hi),
-                 per_sample=args.per_sample, init=parse_assignments(args.init, "--init"))
+                 per_sample=args.per_sample, init=parse_assignments(args.init, "--init"),
+                 baseline=None if args.baseline else ())
     prefix = fit_command_prefix(args)
     title = f"{pattern.name}: {args.data} ({len(rows)} rows, cycles {args.cycles}, both directions, deadband kept)"
     print(diagnosis_text(d, prefix, title))

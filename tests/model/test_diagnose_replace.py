@@ -14,16 +14,18 @@ from camtube.model.sim.truth import Hidden, simulate
 from tests.conftest import PATTERNS
 
 
-def _run(tube: str, hidden: Hidden, seed: int):
+def _run(tube: str, hidden: Hidden, seed: int, **kw):
     p = load_pattern(PATTERNS / f"{tube}.yaml")
     sim = simulate(p, hidden, n_samples=2, n_cycles=50, rate_hz=10.0, seed=seed)
-    return sim, diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
+    return sim, diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p), **kw)
 
 
 def test_an_early_stand_in_is_replaced_by_the_effect_that_explains_it():
     # a sharp (Fung) toe with a large play: slack leads at first (a sharp knee looks like slack), then the
-    # fitted-shape toe takes the slack's place (the slack's deadband goes to zero with it in the model)
-    sim, d = _run("tube2", Hidden(toe_mm=0.3, toe_form="fung", play_mm=0.116), 9003)
+    # fitted-shape toe takes the slack's place (the slack's deadband goes to zero with it in the model).
+    # Without the baseline: with the joint's rest angle in it, slack + play already reach the floor here
+    # (slack is declared indistinguishable from toe_shape), so no later round would run.
+    sim, d = _run("tube2", Hidden(toe_mm=0.3, toe_form="fung", play_mm=0.116), 9003, baseline=())
     chain = d.recommended or d.partial
     assert d.candidates[0].effect == "slack"
     assert "slack" not in chain and set(chain) == {"play", "toe_shape"}
@@ -46,12 +48,42 @@ def test_first_rest_rows_are_the_leading_rows_where_the_model_holds_the_joint():
 
 
 def test_an_offset_the_first_rest_contradicts_is_called_out():
-    # a Fung toe on the weakest joint: joint friction holds it bent once loaded, and the toe law misses the
-    # lowest forces; the constant offset that soaks this up is not the sensor's, and the output says so
-    _, d = _run("tube1", Hidden(toe_mm=0.372, toe_form="fung"), 9001)
+    # a Fung toe on the weakest joint: joint friction holds it bent once loaded. Without the joint's rest
+    # angle in the baseline a constant offset soaks this up; it is not the sensor's, and the output says so
+    _, d = _run("tube1", Hidden(toe_mm=0.372, toe_form="fung"), 9001, baseline=())
     assert "angle_bias" in d.recommended
     assert any("before the joint was first loaded" in n for n in d.sample_notes)
     assert "not (only) a sensor offset" in diagnosis_text(d)
+
+
+def test_the_joint_s_rest_angle_joins_the_baseline_instead_of_a_sensor_offset():
+    # the same set with the default baseline: the rest angle joins once the toe is in the model, and the toe
+    # alone is recommended (no offset, no note); its value is near the truth's friction / stiffness angle
+    sim, d = _run("tube1", Hidden(toe_mm=0.372, toe_form="fung"), 9001)
+    assert d.recommended == ("toe_shape",) and d.baseline == ("rest_angle",)
+    chain, before, after = d.baseline_gain["rest_angle"]
+    assert chain == ("toe_shape",) and after < 0.9 * before
+    assert d.final.rmse_deg <= 1.15 * d.noise_floor_deg
+    # friction moment 0.05 N mm (the truth's default) over the bending stiffness of each sample
+    rest_true_deg = float(np.degrees(0.05 / np.mean(sim.params["K_nmm_per_rad"])))
+    assert abs(d.final.params["rest_angle.rest_deg"] - rest_true_deg) < 0.3 * rest_true_deg
+    assert not any("before the joint was first loaded" in n for n in d.sample_notes)
+    text = diagnosis_text(d, "camtube model fit x.csv")
+    assert "baseline: rest_angle joins the model" in text and "--effects toe_shape,rest_angle" in text
+    js = diagnosis_dict(d, "camtube model fit x.csv")
+    assert js["given"]["effects"] == [] and js["baseline"][0]["effect"] == "rest_angle"
+    assert js["baseline"][0]["joined_chain"] == ["toe_shape"]
+
+
+def test_before_stopping_a_stand_in_is_swapped_for_the_effect_it_stands_in_for():
+    # a power toe behind play: slack leads and, with play and the joint's rest angle, reaches the stop ratio
+    # (1.12 x); the swap round tries the first round's best candidates in its place: toe_shape is
+    # significantly better, and replaces it
+    _, d = _run("tube2", Hidden(toe_mm=0.436, toe_form="power", play_mm=0.062), 11002)
+    assert d.candidates[0].effect == "slack"
+    assert set(d.recommended) == {"play", "toe_shape"} and d.replaced == ((("slack",), "toe_shape"),)
+    assert all(b.rmse_deg < a.rmse_deg for a, b in zip(d.waterfall, d.waterfall[1:]))
+    assert d.final.rmse_deg <= 1.15 * d.noise_floor_deg
 
 
 def test_a_true_sensor_offset_gets_no_such_note():

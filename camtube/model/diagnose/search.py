@@ -98,11 +98,16 @@ CORR_LIMIT = 0.99
 EQUAL_HELDOUT = 0.03
 #: Grid values per new parameter in the multi-start fits (also ``--starts`` of the printed command).
 GRID = 3
+#: Effects every real joint may show, which the diagnosis takes into its baseline (tried before every round)
+#: instead of recommending them as missing physics: friction in the joint holds the unloaded joint bent.
+BASELINE = ("rest_angle",)
 #: A chain of effects is recommended only when its all-rows RMSE is within this multiple of the noise floor.
 REACH_RATIO = 1.15
 #: Candidates (best held-out first) also tried with per-sample parameters in each round: samples that differ
 #: a lot make the shared version of the right effect rank low (two slacks 4x apart), so more than the top two.
 PER_SAMPLE_TRIES = 4
+#: Before stopping, this many of the first round's best candidates are tried in place of each chosen effect.
+SWAP_TRIES = 3
 #: Significant digits of the start values printed with ``--init`` (and used by the diagnosis itself).
 INIT_DIGITS = 6
 
@@ -197,7 +202,7 @@ class Diagnosis:
     rejected : tuple[tuple[str, str], ...]
         Candidates that passed the search but failed the all-rows check: (effect, reason).
     waterfall : tuple[Step, ...]
-        The current model, then one step per recommended effect (the last is what the command reproduces).
+        The current model (with the baseline effects that joined), then one step per recommended effect (the last is what the command reproduces).
     fit_params : tuple[str, ...]
         Parameters fitted besides the effects' own.
     per_sample : tuple[str, ...]
@@ -218,6 +223,13 @@ class Diagnosis:
         Effects chosen earlier and dropped for a later one that explains what they did: ``((old, ...), new)``.
     chosen_round : dict
         The round (index into ``rounds``) in which each recommended (or partial) effect was chosen.
+    given : Step
+        The model as given, refitted on all rows (``waterfall[0]`` unless a baseline effect joined).
+    baseline : tuple[str, ...]
+        Baseline effects (:data:`BASELINE`) that joined the model: ``waterfall`` starts from the model with them.
+    baseline_gain : dict
+        ``{effect: (chain, rmse_before_deg, rmse_after_deg)}``: the all-rows RMSE of the chain of effects
+        chosen when the baseline effect joined, without and with it.
     stop_reason : str
     seconds : dict
         Wall time of the parts (not written to JSON: output is deterministic).
@@ -246,6 +258,9 @@ class Diagnosis:
     noise_floor_parts_deg: tuple = ()
     replaced: tuple = ()
     chosen_round: dict = field(default_factory=dict)
+    given: Step | None = None
+    baseline: tuple = ()
+    baseline_gain: dict = field(default_factory=dict)
 
     @property
     def candidates(self) -> tuple:
@@ -522,6 +537,7 @@ def diagnose(
     modulus_range_gpa: tuple[float, float] = (1.0, 300.0),
     per_sample: bool = True,
     init: Mapping[str, float] | None = None,
+    baseline: Sequence[str | Effect] | None = None,
 ) -> Diagnosis:
     """Find the effects missing from ``model`` (see the module docstring).
 
@@ -560,6 +576,11 @@ def diagnose(
     init : dict, optional
         Extra start values ``{full name: value}`` for candidates' parameters (``--init``): each candidate
         is also fitted from them (useful for multimodal parameters such as a period).
+    baseline : sequence, optional
+        Effects (or names in ``registry``) taken into the baseline, not recommended, when the data show them
+        (default :data:`BASELINE`; ``()``: none, they are then ordinary candidates). Before every round
+        each is tried on top of the current chain; it joins when it is significant and trusted and the
+        chain rebuilt with it from the start still lowers the RMSE at every step.
 
     Returns
     -------
@@ -573,7 +594,11 @@ def diagnose(
     else:
         pool = [reg.get_effect(c) if isinstance(c, str) else c for c in candidates]
     have = {e.name for e in model.effects}
-    pool = [e for e in pool if e.name not in have]
+    names_b = BASELINE if baseline is None else baseline
+    pending = [reg.get_effect(b) if isinstance(b, str) else b for b in names_b
+               if not isinstance(b, str) or b in reg]
+    pending = [e for e in pending if e.name not in have]
+    pool = [e for e in pool if e.name not in have and e.name not in {b.name for b in pending}]
     check_fittable(data)
 
     full_names = _names_for(model, fit_params)
@@ -594,6 +619,9 @@ def diagnose(
     cur_ho, cur_mse = _cv(current, search, cur_names, cur.params, fixed, fold, block)
     base_rmse, base_ho = cur.rmse, cur_ho
     steps = [_step(base_full)]
+    given = steps[0]
+    baseline_added: list[str] = []
+    baseline_gain: dict[str, tuple] = {}
     prev_all = base_full
     rounds: list[tuple[Candidate, ...]] = []
     recommended: list[str] = []
@@ -601,30 +629,56 @@ def diagnose(
     chosen: list[Effect] = []
     replaced: list[tuple[tuple, str]] = []
     chosen_round: dict[str, int] = {}
+    swaps_tried = False
+    first_useful: list[Effect] = []
     stop = ""
     while True:
+        for eff in list(pending):
+            got = _baseline_try(eff, model, current, search, data, cur_names, cur, cur_ho, cur_mse, fold, block,
+                                floor, fixed, bic_threshold, min_gain, min_excess, z, grid, modulus_range_gpa,
+                                cur_ps, strata, prev_all, chosen, fit_params)
+            if got is None:
+                continue
+            baseline_gain[eff.name] = (tuple(e.name for e in chosen), prev_all.rmse, got[3].rmse)
+            model, current, cur_names, prev_all, steps, cb = got
+            cur = _search_fit(current, search, cur_names, cb.values, fixed, per_sample=cur_ps)
+            cur_ho, cur_mse = cb.heldout_rmse_deg, cb.block_mse
+            baseline_added.append(eff.name)
+            pending.remove(eff)
         # the held-out RMSE at full resolution: the all-rows RMSE times the held-out / in-sample ratio of the
         # search rows (thinned rows see a coarser history and a shorter force average than all rows do)
         ho_full = prev_all.rmse * cur_ho / cur.rmse if cur.rmse > 0 else cur_ho
+        swaps_only = False
         if stop_ratio is not None and ho_full <= stop_ratio * floor:
             stop = (f"the held-out RMSE {ho_full:.3f} deg (all rows) is within {stop_ratio:g} x the noise floor "
                     f"{floor:.3f} deg: nothing left to explain")
-            break
+            # before stopping, one round of swaps: an effect chosen early may stand in for a later one (slack
+            # for a sharp toe behind play) and reach the stop ratio with it; a candidate that explains what it
+            # did (its parameters go to a bound) and is significantly better in its place replaces it
+            if not chosen or swaps_tried:
+                break
+            swaps_only = swaps_tried = True
         if len(recommended) >= max_effects:
             stop = f"stopped after {max_effects} effects"
             break
         if not pool:
             stop = "no candidate effects left"
             break
-        ranked = _round(current, search, cur_names, cur, cur_ho, cur_mse, fold, block, pool, floor, fixed,
+        # the swap round tries every effect that helped the model as given (one that explained little on top
+        # of the stand-in, as a sharp toe on top of slack, may explain more in its place)
+        tried_pool = ([e for e in first_useful if e.name not in {x.name for x in chosen}][:SWAP_TRIES]
+                      if swaps_only else pool)
+        ranked = _round(current, search, cur_names, cur, cur_ho, cur_mse, fold, block, tried_pool, floor, fixed,
                         bic_threshold, min_gain, min_excess, z, grid, modulus_range_gpa, cur_ps, strata,
-                        per_sample and len(search.samples) > 1, init, tuple(chosen))
+                        per_sample and len(search.samples) > 1 and not swaps_only, init, tuple(chosen),
+                        swap_all=swaps_only)
         ranked_base_ho = cur_ho
         accepted = None
+        n_rejected = len(rejected)
         for c in ranked:
-            if not c.significant:
+            if not c.significant or (swaps_only and not c.replaces):
                 continue
-            eff = next(e for e in pool if e.name == c.effect)
+            eff = next(e for e in tried_pool if e.name == c.effect)
             keep = [e for e in chosen if e.name not in c.replaces]
             m, names, ps = _without(current, cur_names, cur_ps, [e for e in chosen if e.name in c.replaces])
             m = m.with_effects(list(m.effects) + [eff])
@@ -666,6 +720,9 @@ def diagnose(
                 continue
             accepted = (c, eff, m, names, r, {k: v for k, v in init.items() if k in r.fitted}, ps, keep, inter)
             break
+        if swaps_only and accepted is None:
+            del rejected[n_rejected:]  # no swap: the diagnosis stops as it would have, its output unchanged
+            break
         ranked = tuple(_mark_rejected(ranked, rejected))
         rounds.append(ranked)
         if accepted is None:
@@ -674,6 +731,7 @@ def diagnose(
                     + (f" (best: {top.effect}: {top.why})" if top is not None and top.why else ""))
             break
         c, eff, m, names, r, init, ps, keep, inter = accepted
+        swaps_tried = False
         floor, floor_se, floor_parts = f_c, se_c, parts_c
         cur_ps = ps
         rejected = [(rc, w) for rc, w in rejected if rc.effect != eff.name]
@@ -692,6 +750,10 @@ def diagnose(
         # the next round tries only the effects that helped in this one (held-out RMSE down by min_gain):
         # one that explained nothing on the simpler model is not retried (speed; see the module docstring)
         useful = {x.effect for x in ranked if x.heldout_rmse_deg <= (1.0 - min_gain) * ranked_base_ho}
+        if len(rounds) == 1:
+            # the swap round's candidates: the best SWAP_TRIES of the first round that helped
+            order = [x.effect for x in sorted(ranked, key=lambda x: x.heldout_rmse_deg) if not x.replaces]
+            first_useful = sorted([e for e in pool if e.name in useful], key=lambda e: order.index(e.name))
         pool = [e for e in pool if e.name != eff.name and e.name in useful]
     clock["search"] = time.perf_counter()
 
@@ -706,7 +768,7 @@ def diagnose(
             steps.append(final)
         ps_names = list(steps[-1].per_sample)
     notes += _offset_notes(data, steps[-1], chosen, floor)
-    base_ps = steps[0].rmse_per_sample
+    base_ps = given.rmse_per_sample
     fin_ps = steps[-1].rmse_per_sample
     for smp in base_ps:
         if fin_ps.get(smp, 0.0) > 1.02 * base_ps[smp]:
@@ -735,7 +797,8 @@ def diagnose(
                      tuple(fit_params), stop, fixed, secs, catalog, floor_se, tuple({rc.label: w for rc, w in rejected}.items()),
                      tuple(ps_names),
                      tuple(notes), grid, partial, partial_steps, floor_parts, tuple(replaced),
-                     {k: chosen_round[k] for k in recommended or partial if k in chosen_round})
+                     {k: chosen_round[k] for k in recommended or partial if k in chosen_round},
+                     given, tuple(baseline_added), baseline_gain)
 
 
 def _without(model: JointModel, names: Sequence[str], per_sample: Sequence[str],
@@ -745,6 +808,46 @@ def _without(model: JointModel, names: Sequence[str], per_sample: Sequence[str],
     gone = {n for e in effects for n in e.full_names()}
     return (model.with_effects([e for e in model.effects if e.name not in drop]),
             tuple(n for n in names if n not in gone), [n for n in per_sample if n.split("@")[0] not in gone])
+
+
+def _baseline_try(eff: Effect, model: JointModel, current: JointModel, search: Dataset, data: Dataset,
+                  cur_names: tuple, cur: FitResult, cur_ho: float, cur_mse: np.ndarray, fold: np.ndarray,
+                  block: np.ndarray, floor: float, fixed: Mapping[str, float], bic_threshold: float, min_gain: float,
+                  min_excess: float, z: float, grid: int, modulus_range_gpa: tuple[float, float], cur_ps: list,
+                  strata, prev_all: FitResult, chosen: Sequence[Effect], fit_params: Sequence[str]):
+    """The baseline effect ``eff`` on top of the current chain, if it joins: ``(model, current, names, fit on all
+    rows, waterfall, candidate)`` with ``eff`` in the model from the start; None when it does not.
+
+    It joins when it passes a round's tests (significant on held-out cycles, lower BIC, parameters trusted),
+    its refit on all rows lowers the RMSE with every parameter off its bounds, and the chain rebuilt with it
+    from the start (model + eff, + each chosen effect in turn) lowers the RMSE at every step.
+    """
+    ranked = _round(current, search, cur_names, cur, cur_ho, cur_mse, fold, block, [eff], floor, fixed,
+                    bic_threshold, min_gain, min_excess, z, grid, modulus_range_gpa, cur_ps, strata)
+    c = next((c for c in ranked if not c.replaces), None)
+    if c is None or not c.significant:
+        return None
+    chain = current.with_effects(list(current.effects) + [eff])
+    names = cur_names + tuple(eff.full_names())
+    init = {k: v for k, v in c.values.items() if k.split("@")[0] in names}
+    r = refit_all_rows(chain, data, names, fixed, init, grid, per_sample=cur_ps)
+    if not r.rmse < prev_all.rmse or _resolution_problems(chain, list(r.fitted), r.params, r.stderr, r.at_bound,
+                                                          data, modulus_range_gpa):
+        return None
+    start = model.with_effects(list(model.effects) + [eff])
+    steps = []
+    for i in range(len(chosen)):
+        mi = start.with_effects(list(start.effects) + list(chosen[:i]))
+        ni = _names_for(mi, fit_params)
+        psi = [n for n in cur_ps if n.split("@")[0] in ni]
+        ri = refit_all_rows(mi, data, ni, fixed, {k: v for k, v in r.params.items() if k.split("@")[0] in ni},
+                            grid, per_sample=psi)
+        steps.append(_step(ri, psi))
+    steps.append(_step(r, cur_ps, {k: v for k, v in init.items() if k in r.fitted}))
+    seq = [st.rmse_deg for st in steps]
+    if not all(b < a for a, b in zip(seq, seq[1:])):
+        return None
+    return start, chain, names, r, steps, c
 
 
 def first_rest_rows(data: Dataset, predicted: np.ndarray, tol_deg: float) -> np.ndarray:
@@ -819,17 +922,32 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
            fixed: Mapping[str, float], bic_threshold: float, min_gain: float, min_excess: float, z: float,
            grid: int, modulus_range_gpa: tuple[float, float], cur_ps: Sequence[str] = (),
            strata: np.ndarray | None = None, try_per_sample: bool = False,
-           init: Mapping[str, float] | None = None, swappable: Sequence[Effect] = ()) -> tuple[Candidate, ...]:
+           init: Mapping[str, float] | None = None, swappable: Sequence[Effect] = (),
+           swap_all: bool = False) -> tuple[Candidate, ...]:
     """Every effect of ``pool`` on top of ``current``, ranked by held-out RMSE.
 
     With ``try_per_sample``, the best :data:`PER_SAMPLE_TRIES` effects are also fitted with per-sample
     parameters; that version replaces the shared one when its held-out error is significantly lower. When a candidate's fit
     puts a parameter of an effect of ``swappable`` (chosen earlier in this diagnosis) on a bound, the
     candidate explains what that effect did: it is also tried *instead of* it (stepwise selection with
-    replacement), so an early stand-in (slack for a sharp toe) does not stay in the model.
+    replacement), so an early stand-in (slack for a sharp toe) does not stay in the model. With ``swap_all``
+    each candidate is tried only instead of each effect of ``swappable`` (not on top of them).
     """
     fits = []
-    for eff in pool:
+    for eff in (pool if swap_all else ()):
+        # instead of each effect of swappable only (the stop ratio is reached: nothing is to be added)
+        new = eff.full_names()
+        for old in swappable:
+            gone = set(old.full_names())
+            m2, names2, ps2 = _without(current, cur_names, cur_ps, [old])
+            m2 = m2.with_effects(list(m2.effects) + [eff])
+            names2 += tuple(new)
+            start = m2.initial_values(search, base={k: v for k, v in cur.params.items()
+                                                     if k.split("@")[0] not in gone})
+            f2 = _search_fit(m2, search, names2, start, fixed, grid=grid, grid_names=new, per_sample=ps2)
+            ho2, mse2 = _cv(m2, search, names2, f2.params, fixed, fold, block, per_sample=ps2)
+            fits.append([eff, m2, new, f2, ho2, mse2, (), (old.name,)])
+    for eff in (() if swap_all else pool):
         m = current.with_effects(list(current.effects) + [eff])
         new = eff.full_names()
         start = m.initial_values(search, base=cur.params)
@@ -846,7 +964,7 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
             dm, se = _gain(mse, mse2, strata)
             if dm > z * se and f2.bic < f.bic - bic_threshold:
                 row[3:7] = [f2, ho2, mse2, tuple(new)]
-    for row in list(fits):
+    for row in ([] if swap_all else list(fits)):
         eff, m, new, f = row[:4]
         for old in swappable:
             gone = set(old.full_names())

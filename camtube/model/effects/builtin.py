@@ -21,6 +21,7 @@ kerf           kinematics  notch arc widened by the kerf: phi, hence the arm, ch
 flat_walls     kinematics  flat (planar) instead of radial notch walls: other arm (none)
 chords         kinematics  tendon as straight chords across the notches (none)
 hardstop       kinematics  notches close: the joint stops bending (stop_deg)
+rest_angle     kinematics  joint friction: once loaded, the unloaded joint rests bent (rest_deg)
 angle_bias     angle       tracker offset (bias_deg)
 force_zero     force       load-cell zero offset (zero_N)
 =============  ==========  =====================================================
@@ -523,6 +524,34 @@ HARDSTOP = Effect(
 )
 
 
+def _rest_angle(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
+    rest = math.radians(max(p["rest_deg"], 0.0))
+    out = np.asarray(theta, float).copy()
+    for _, sl in ctx.data.sample_slices():
+        a = out[sl]
+        # the joint starts straight; once it has been bent past its rest angle it never comes back below it
+        loaded = np.flatnonzero(a > rest)
+        if loaded.size:
+            a[loaded[0]:] = np.maximum(a[loaded[0]:], rest)
+            out[sl] = a
+    return out
+
+
+REST_ANGLE = Effect(
+    name="rest_angle", stage="kinematics",
+    params=(Param("rest_deg", "deg", 0.0, 20.0, 0.3,
+                  "angle at which the unloaded joint stays bent (friction moment / bending stiffness)",
+                  starts=(0.2, 1.0)),),
+    apply=_rest_angle,
+    family="rest",
+    meaning="friction in the joint (or a permanent set): once loaded, the joint's spring returns it only until "
+            "its moment equals the friction, so the unloaded joint rests bent at rest_deg while the tendon "
+            "goes slack",
+    signature="after the first load, a positive residual where the tendon is slack or barely pulled (at rest "
+              "and at the start of each pull); none before the first load",
+)
+
+
 # ----------------------------------------------------------------------------- measurement stages
 
 def _bias(ctx: Context, angle: np.ndarray, p: dict) -> np.ndarray:
@@ -554,6 +583,6 @@ FORCE_ZERO = Effect(
 
 #: The built-in effects, in their documented order.
 BUILTIN_EFFECTS = (SLACK, PLAY, CREEP, FRICTION, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
-                   HARDSTOP, ANGLE_BIAS, FORCE_ZERO)
+                   HARDSTOP, REST_ANGLE, ANGLE_BIAS, FORCE_ZERO)
 #: Built-in effect names in that order.
 BUILTINS = tuple(e.name for e in BUILTIN_EFFECTS)

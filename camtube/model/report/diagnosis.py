@@ -9,7 +9,9 @@ report directory with an index is complete).
 
     {"schema", "noise_floor_deg", "noise_floor_se_deg",
      "noise_floor_se_parts_deg": {"statistical", "systematic"},
-     "base": {"effects", "rmse_deg", "heldout_rmse_deg", "per_sample", "params"},
+     "base": {"effects", "rmse_deg", "heldout_rmse_deg", "per_sample", "params"},   # with the baseline
+     "given": {"effects", "rmse_deg", "per_sample"},          # the model as given (before the baseline)
+     "baseline": [{"effect", "meaning", "joined_chain", "rmse_before_deg", "rmse_deg", "params"}],  # rest_angle
      "candidates": [{"effect", "rmse_deg", "heldout_rmse_deg", "delta_bic", "params": {name: {value, stderr, unit}},
                      "equivalent", "confounded", "significant", "why", "meaning", "signature"}],
      "rounds": [[candidate, ...], ...],        # candidates of each greedy round (first = "candidates")
@@ -143,6 +145,17 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
                    "per_sample": {k: _num(v) for k, v in base.rmse_per_sample.items()},
                    "params": {k: {"value": _num(v), "stderr": _num(base.stderr[k]) if k in base.stderr else None,
                                   "unit": base.units.get(k, "")} for k, v in base.params.items()}}
+    given = d.given or base
+    out["given"] = {"effects": list(given.effects), "rmse_deg": _num(given.rmse_deg),
+                    "per_sample": {k: _num(v) for k, v in given.rmse_per_sample.items()}}
+    out["baseline"] = [{"effect": name, "meaning": d.catalog[name].meaning if name in d.catalog else "",
+                        "joined_chain": list(d.baseline_gain.get(name, ((), 0, 0))[0]),
+                        "rmse_before_deg": _num(d.baseline_gain.get(name, ((), math.nan, 0))[1]),
+                        "rmse_deg": _num(d.baseline_gain.get(name, ((), 0, math.nan))[2]),
+                        "params": {k: {"value": _num(v), "stderr": _num(final.stderr.get(k, math.inf)),
+                                       "unit": final.units.get(k, "")}
+                                   for k, v in final.params.items() if k.split("@")[0].startswith(name + ".")}}
+                       for name in d.baseline]
     out["candidates"] = [_candidate_dict(d, c) for c in d.candidates]
     out["rounds"] = [[_candidate_dict(d, c) for c in r] for r in d.rounds]
     out["recommended"] = list(d.recommended)
@@ -166,6 +179,27 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
     return out
 
 
+def baseline_lines(d: Diagnosis) -> list[str]:
+    """The baseline effects that joined the model: what they mean, their values (the final chain's), the RMSE."""
+    if not d.baseline or d.given is None:
+        return []
+    base = d.waterfall[0]
+    out: list[str] = []
+    for name in d.baseline:
+        e = d.catalog.get(name)
+        vals = "; ".join(f"{name}.{p.name} = "
+                         f"{_pm(d.final.params[f'{name}.{p.name}'], d.final.stderr.get(f'{name}.{p.name}', math.inf), p.unit)}"
+                         for p in (e.params if e else ()) if f"{name}.{p.name}" in d.final.params)
+        out.append(f"baseline: {name} joins the model, as a property of this joint rather than missing physics: "
+                   f"{e.meaning if e else name}; {vals}")
+        chain, before, after = d.baseline_gain.get(name, ((), d.given.rmse_deg, base.rmse_deg))
+        on = f"the model with {', '.join(chain)}" if chain else "the current model"
+        out.append(f"  it lowers the RMSE of {on} from {before:.3f} to {after:.3f} deg")
+    out.append("  the recommended steps below start from the model with it, and the command includes it "
+               "(--no-baseline: try it as an ordinary candidate instead)")
+    return out
+
+
 def diagnosis_json(d: Diagnosis, command: str = "", meta: dict | None = None) -> str:
     """:func:`diagnosis_dict` as indented JSON with a final newline (deterministic)."""
     return json.dumps(diagnosis_dict(d, command, meta), indent=2, allow_nan=False) + "\n"
@@ -176,12 +210,14 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
     floor = d.noise_floor_deg
     base = d.waterfall[0]
     lines = [title] if title else []
-    cur = ", ".join(base.effects) or "none"
+    given = d.given or base
+    cur = ", ".join(given.effects) or "none"
     parts = d.noise_floor_parts_deg
     lines.append(f"noise floor (white noise in the residual): {floor:.3f} +- {d.noise_floor_se_deg:.3f} deg"
                  + (f" (statistical {parts[0]:.3f}, systematic {parts[1]:.3f})" if len(parts) == 2 else ""))
-    lines.append(f"current model (effects: {cur}): RMSE {base.rmse_deg:.3f} deg = "
-                 f"{_times(base.rmse_deg, floor)} the noise floor; held-out {d.base_heldout_rmse_deg:.3f} deg")
+    lines.append(f"current model (effects: {cur}): RMSE {given.rmse_deg:.3f} deg = "
+                 f"{_times(given.rmse_deg, floor)} the noise floor; held-out {d.base_heldout_rmse_deg:.3f} deg")
+    lines += baseline_lines(d)
     where = describe(residual_atlas(d.data, base.residuals), floor)
     if where:
         lines.append("where it fails:")
@@ -286,7 +322,8 @@ def model_png(d: Diagnosis, max_samples: int = 4) -> bytes:
     for ax, (smp, s) in zip(axes, sl):
         st = d.data.stroke_mm[s]
         ax.plot(st, d.data.angle_deg[s], ".", ms=1.5, color="0.6", label="measured", rasterized=True)
-        ax.plot(st, base.predicted[s], "-", lw=0.7, color="tab:red", label="current model")
+        ax.plot(st, base.predicted[s], "-", lw=0.7, color="tab:red",
+                label="current model" + (f" + {', '.join(d.baseline)} (baseline)" if d.baseline else ""))
         if final is not base:
             ax.plot(st, final.predicted[s], "-", lw=0.7, color="black",
                     label="+ " + ", ".join(d.recommended))
@@ -364,7 +401,8 @@ def waterfall_png(d: Diagnosis) -> bytes:
     x = np.arange(len(groups))
     for k, s in enumerate(steps):
         vals = [s.rmse_deg] + [s.rmse_per_sample[g] for g in samples]
-        label = ("current model" if k == 0 else "+ " + d.recommended[k - 1] if k <= len(d.recommended)
+        label = (("current model" + (f" + {', '.join(d.baseline)}" if d.baseline else "")) if k == 0
+                 else "+ " + d.recommended[k - 1] if k <= len(d.recommended)
                  else "per-sample " + ", ".join(d.per_sample))
         ax.bar(x + (k - (len(steps) - 1) / 2) * width, vals, width, label=label)
     ax.axhline(d.noise_floor_deg, color="black", ls="--", lw=1, label="noise floor")
