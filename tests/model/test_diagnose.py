@@ -153,6 +153,33 @@ def test_cli_json_report_and_fit_command(tmp_path, capsys):
     assert math.isclose(fitted["params"]["play.play_mm"]["value"], 0.06, rel_tol=0.1)
 
 
+def test_cli_baseline_rest_angle_is_printed_reproduced_and_can_be_turned_off(tmp_path, capsys):
+    # a control paused at zero stroke: the joint's friction holds it bent there; the rest angle joins the
+    # baseline, the printed command (with it) reproduces the final RMSE, --no-baseline makes it a candidate
+    p = load_pattern(PATTERNS / "tube1.yaml")
+    sim = simulate(p, Hidden(), n_samples=2, n_cycles=12, seed=8, dwell_s=2.0)
+    csv = tmp_path / "d.csv"
+    csv.write_text(format_csv(sim.data))
+    pat = str(PATTERNS / "tube1.yaml")
+    out = tmp_path / "d.json"
+    assert main(["model", "diagnose", str(csv), "--pattern", pat, "-q", "--json", str(out)]) == 0
+    text = capsys.readouterr().out
+    js = json.loads(out.read_text())
+    assert js["recommended"] == [] and [b["effect"] for b in js["baseline"]] == ["rest_angle"]
+    assert js["given"]["rmse_deg"] > js["final"]["rmse_deg"]
+    assert "baseline: rest_angle joins the model" in text and "recommended: nothing" in text
+    assert "--effects rest_angle" in js["command"] and js["command"] in text
+    fit_json = tmp_path / "fit.json"
+    assert main(js["command"].split()[1:] + ["-q", "--json", str(fit_json)]) == 0
+    fitted = json.loads(fit_json.read_text())
+    assert fitted["rmse_deg"] == pytest.approx(js["final"]["rmse_deg"], rel=1e-3)
+    off = tmp_path / "off.json"
+    assert main(["model", "diagnose", str(csv), "--pattern", pat, "-q", "--json", str(off), "--no-baseline"]) == 0
+    js_off = json.loads(off.read_text())
+    assert js_off["baseline"] == [] and (js_off["recommended"] or [c["effect"] for c in js_off["partial"]])[0] \
+        == "rest_angle"
+
+
 # ----------------------------------------------------------------------------- trust (issue 11)
 
 def test_cycle_blocks_test_every_cycle_and_cycle_one_in_both_folds():

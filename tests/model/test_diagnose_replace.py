@@ -1,4 +1,5 @@
-"""Stepwise selection with replacement, and the first-rest check of offsets (camtube.model.diagnose.search)."""
+"""Stepwise selection with replacement and swaps, the joint's rest angle in the baseline, and the first-rest
+check of offsets (camtube.model.diagnose.search)."""
 from __future__ import annotations
 
 import numpy as np
@@ -114,3 +115,16 @@ def test_the_values_printed_under_each_effect_are_the_whole_chain_s():
     assert abs(step.params["play.play_mm"] / chain.params["play.play_mm"] - 1) > 0.5  # the case this is about
     shown = float(re.search(r"play\.play_mm = ([0-9.e+-]+) \+-", diagnosis_text(d)).group(1))
     assert shown == pytest.approx(chain.params["play.play_mm"], rel=1e-3)
+
+
+def test_a_control_that_rests_at_zero_stroke_gets_nothing_but_its_rest_angle():
+    # a joint without missing physics, paused 2 s at zero stroke every cycle: friction holds it bent there
+    # (0.6 deg on tube 1). The rest angle joins the baseline, nothing is recommended; without the baseline it
+    # is an ordinary candidate, and the one the data ask for
+    p = load_pattern(PATTERNS / "tube1.yaml")
+    sim = simulate(p, Hidden(), n_samples=2, n_cycles=30, rate_hz=10.0, seed=4242, dwell_s=2.0)
+    d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
+    assert d.recommended == () and d.partial == () and d.baseline == ("rest_angle",)
+    assert d.given.rmse_deg > 1.2 * sim.sensor_floor_deg and d.final.rmse_deg < 1.05 * sim.sensor_floor_deg
+    off = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p), baseline=())
+    assert off.baseline == () and (off.recommended or off.partial)[:1] == ("rest_angle",)

@@ -147,3 +147,25 @@ def test_offsets_and_hardstop(tube1):
     assert get_effect("angle_bias").family == get_effect("force_zero").family
     h = model_for_pattern(tube1, ["hardstop"]).predict(data, vals | {"hardstop.stop_deg": 5.0})
     assert h.max() == pytest.approx(5.0) and np.all(h <= base + 1e-12)
+
+
+def test_rest_angle_holds_the_joint_bent_once_loaded_and_not_before(tube1):
+    # two samples, each: rest at zero stroke, a pull, release to zero stroke, a second pull
+    up = np.linspace(0, 1.0, 11)
+    one = np.r_[np.zeros(3), up, up[::-1], up]
+    data = _data(np.r_[one, one], samples=["S1"] * one.size + ["S2"] * one.size)
+    vals = pattern_values(tube1)
+    base = model_for_pattern(tube1).predict(data, vals)
+    got = model_for_pattern(tube1, ["rest_angle"]).predict(data, vals | {"rest_angle.rest_deg": 2.0})
+    for sl in (slice(0, one.size), slice(one.size, 2 * one.size)):
+        b, g = base[sl], got[sl]
+        first = int(np.flatnonzero(b > 2.0)[0])
+        # before the first load the joint is straight, as the base model says
+        np.testing.assert_allclose(g[:first], b[:first])
+        # afterwards it never comes below the rest angle, and above it the base model is unchanged
+        np.testing.assert_allclose(g[first:], np.maximum(b[first:], 2.0))
+        assert g[-len(up) - 1] == pytest.approx(2.0) and b[-len(up) - 1] == pytest.approx(0.0)
+    # its place in the chain: the rest is the joint's, the sensor's offset comes on top of it
+    both = model_for_pattern(tube1, ["angle_bias", "rest_angle"]).predict(
+        data, vals | {"rest_angle.rest_deg": 2.0, "angle_bias.bias_deg": -0.5})
+    np.testing.assert_allclose(both, got - 0.5)

@@ -282,6 +282,10 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
             lines.append(f"  {cmd}")
     else:
         lines.append("recommended: nothing")
+        cmd = add_command(d, command) if d.baseline else ""
+        if cmd:
+            lines.append("the model with its baseline:")
+            lines.append(f"  {cmd}")
     lines += partial_lines(d)
     for old, new in d.replaced:
         lines.append(f"replaced: {', '.join(old)} (chosen in an earlier round) by {new}: with {new} in the model "
