@@ -339,14 +339,16 @@ def _toe_table(shape: float, x_min: float) -> tuple[np.ndarray, np.ndarray]:
     return hit
 
 
-def toe_elongation(ctx: Context, elong: np.ndarray, extra: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
-    """Add a toe law's elongation ``extra(force_N) -> mm`` (beyond the linear law) to ``elong`` (n,).
+_TOE_FORCES: "weakref.WeakKeyDictionary[Dataset, tuple]" = weakref.WeakKeyDictionary()
 
-    The law is evaluated at :func:`local_force_N`; near zero force, where it is steep, it is averaged
-    over the tension's posterior given the averaged force (a normal of the remaining noise's size,
-    :func:`local_force_sd_N`, truncated at zero: a tendon cannot push), by :data:`TOE_NODES` quantile
-    nodes. Where the elongation would exceed the stroke the tendon is slack and the joint straight.
-    """
+
+def _toe_forces(ctx: Context) -> tuple[np.ndarray, np.ndarray]:
+    """``(forces, low)``: the averaged force of every row (clipped at zero), then :data:`TOE_NODES` quantile
+    nodes of the tension's posterior for each row of ``low`` (the rows near zero force). Cached per Dataset and
+    force array: they depend on the data only, and a fit evaluates the law many times."""
+    hit = _TOE_FORCES.get(ctx.data)
+    if hit is not None and hit[0] is ctx.force_N:
+        return hit[1], hit[2]
     fa = local_force_N(ctx)
     f = np.maximum(fa, 0.0)
     sd = local_force_sd_N(ctx.data)
@@ -359,6 +361,19 @@ def toe_elongation(ctx: Context, elong: np.ndarray, extra: Callable[[np.ndarray]
         u = (np.arange(TOE_NODES) + 0.5) / TOE_NODES
         fq = mu[:, None] + s[:, None] * ndtri(np.minimum(p0 + u[None, :] * (1.0 - p0), 1.0 - 1e-12))
         f = np.concatenate([f, np.maximum(fq, 0.0).ravel()])
+    _TOE_FORCES[ctx.data] = (ctx.force_N, f, low)
+    return f, low
+
+
+def toe_elongation(ctx: Context, elong: np.ndarray, extra: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    """Add a toe law's elongation ``extra(force_N) -> mm`` (beyond the linear law) to ``elong`` (n,).
+
+    The law is evaluated at :func:`local_force_N`; near zero force, where it is steep, it is averaged
+    over the tension's posterior given the averaged force (a normal of the remaining noise's size,
+    :func:`local_force_sd_N`, truncated at zero: a tendon cannot push), by :data:`TOE_NODES` quantile
+    nodes. Where the elongation would exceed the stroke the tendon is slack and the joint straight.
+    """
+    f, low = _toe_forces(ctx)
     toe = extra(f)
     n = elong.size
     if low.size:
