@@ -7,7 +7,7 @@ effects, the first candidate (and what it is declared indistinguishable from), t
 RMSE before/after, the estimated and true sensor floors, whether the printed `camtube model fit` command
 reproduces the final RMSE (it is run), per-sample values, and the seconds of the diagnosis.
 
-Run: ``python scripts/bench_diagnose.py [--batch tune|heldout|heldout2|heldout3|heldout4|heldout5|heldout6|speed|controls|variants|all]``
+Run: ``python scripts/bench_diagnose.py [--batch tune|heldout|heldout2|...|heldout7|speed|controls|variants|all]``
 
 ``tune``: the sets the method was tuned on. ``heldout``: a batch drawn with fresh seeds and parameters
 after the method was settled (seed 20261122; seen since, while ``toe_shape`` was built). ``heldout2``:
@@ -18,7 +18,9 @@ have (the truth's ``power`` and ``tanh`` toes); looked at since (the posterior-m
 seeds 11000-): sharp toes with play or slack, a hidden sensor offset, per-sample play and slack; looked at
 (its per-sample slack led to trying four candidates per sample). ``heldout5``: drawn after that (seed
 20261126, seeds 13000-); looked at (the family-lead rule followed). ``heldout6``: drawn after that (seed
-20261127, seeds 15000-), every truth toe form at random.
+20261127, seeds 15000-), every truth toe form at random; looked at once the joint's rest angle joined the
+baseline. ``heldout7``: drawn after that (seed 20261128, seeds 17000-), with record shapes drawn per set
+(sine or triangular stroke, a pause at zero stroke, 0.5-2x the sensor noise, joint friction 0.02-0.12 N mm).
 ``speed``: 10,000 and 200,000 rows (targets 5 s and 20 s).
 """
 from __future__ import annotations
@@ -229,6 +231,54 @@ def heldout6_batch(seed: int = 20261127) -> list:
     ]
 
 
+def heldout7_batch(seed: int = 20261128) -> list:
+    """A seventh fresh batch, drawn once the joint's rest angle in the baseline and the swap round were settled
+    (every earlier batch had been looked at): new seeds (17000-), new parameters, and record shapes the
+    earlier batches lack, drawn at random per set: a sine or triangular stroke, a pause at zero stroke of 0-3 s,
+    sensor noise 0.5-2x the usual, joint friction 0.02-0.12 N mm."""
+    rng, u, t = _drawers(seed)
+    forms = ("exponential", "power", "tanh", "fung", "quadratic")
+    form = lambda: forms[int(rng.integers(len(forms)))]  # noqa: E731
+
+    def record() -> dict:
+        k = u(0.5, 2.0)
+        return {"stroke_shape": ("triangle", "sine")[int(rng.integers(2))],
+                "dwell_s": (0.0, u(0.5, 3.0))[int(rng.integers(2))],
+                "noise_angle_deg": round(0.25 * k, 3), "noise_force_N": round(0.005 * k, 4)}
+
+    def fr() -> float:
+        return u(0.02, 0.12)
+
+    play, p2, s1, s2 = u(0.03, 0.12), u(0.02, 0.05), u(0.03, 0.08), u(0.1, 0.2)
+    f1, f2, f3 = form(), form(), form()
+    return [
+        ("control", t(), Hidden(joint_friction_nmm=fr()), set(), {}, record()),
+        (f"{f1}-toe", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f1, joint_friction_nmm=fr()), TOES, {}, record()),
+        (f"{f2}-toe + play", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f2, play_mm=play, joint_friction_nmm=fr()),
+         TOES | {"play"}, {"play.play_mm": play}, record()),
+        (f"{f3}-toe + slack", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f3, slack_mm=s1, joint_friction_nmm=fr()),
+         TOES | {"slack"}, {}, record()),
+        ("viscoelastic", t(), Hidden(visco_ratio=(r := u(0.2, 0.6)), visco_tau_s=(tau := u(1.0, 4.0)),
+                                     joint_friction_nmm=fr()),
+         {"viscoelastic"}, {"viscoelastic.ratio": r, "viscoelastic.tau_s": tau}, record()),
+        ("slack per sample", t(), [Hidden(slack_mm=s1, joint_friction_nmm=(f := fr())),
+                                   Hidden(slack_mm=s2, joint_friction_nmm=f)], {"slack"},
+         {"slack.deadband_mm@1": s1, "slack.deadband_mm@2": s2}, record()),
+        ("play per sample", t(), [Hidden(play_mm=p2, joint_friction_nmm=(f := fr())),
+                                  Hidden(play_mm=play + 0.03, joint_friction_nmm=f)], {"play"},
+         {"play.play_mm@1": p2, "play.play_mm@2": play + 0.03}, record()),
+        ("sensor offset", t(), Hidden(angle_bias_deg=(b := u(-1.2, 1.2)), joint_friction_nmm=fr()),
+         {"angle_bias", "force_zero"}, {"angle_bias.bias_deg": b}, record()),
+        ("load-cell zero", t(), Hidden(force_zero_N=(z := u(0.01, 0.04)), joint_friction_nmm=fr()),
+         {"angle_bias", "force_zero"}, {"force_zero.zero_N": z}, record()),
+        ("cycle creep", t(), Hidden(cycle_creep_mm=u(0.03, 0.1), cycle_creep_n=u(3, 8), joint_friction_nmm=fr()),
+         {"creep", "viscoelastic"}, {}, record()),
+        ("slack", t(), Hidden(slack_mm=(sl := u(0.04, 0.15)), joint_friction_nmm=fr()), {"slack"},
+         {"slack.deadband_mm": sl}, record()),
+        ("control", t(), Hidden(joint_friction_nmm=fr()), set(), {}, record()),
+    ]
+
+
 #: The two sensor offsets: a constant angle shift each (the output declares them indistinguishable).
 OFFSETS = ("angle_bias.bias_deg", "force_zero.zero_N")
 
@@ -257,14 +307,17 @@ def _param(d, name: str):
     return got
 
 
-def run_set(name, tube, hidden, want, truth, seed, n_cycles=50, rate_hz=10.0, check_command=True) -> dict:
+def run_set(name, tube, hidden, want, truth, record=None, *, seed, n_cycles=50, rate_hz=10.0,
+            check_command=True) -> dict:
+    """Simulate one set (``record``: extra :func:`simulate` options: dwell, stroke shape, noise) and diagnose it."""
     p = load_pattern(ROOT / "patterns" / f"{tube}.yaml")
-    sim = simulate(p, hidden, n_samples=2, n_cycles=n_cycles, rate_hz=rate_hz, seed=seed)
+    sim = simulate(p, hidden, n_samples=2, n_cycles=n_cycles, rate_hz=rate_hz, seed=seed, **(record or {}))
     t0 = time.perf_counter()
     d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
     secs = time.perf_counter() - t0
     first = d.candidates[0] if d.candidates else None
-    row = {"set": f"{name} ({tube})", "hidden": ", ".join(sorted(want)) or "-", "rows": len(sim.data),
+    shape = ", ".join(f"{k} {v}" for k, v in (record or {}).items())
+    row = {"set": f"{name} ({tube}{'; ' + shape if shape else ''})", "hidden": ", ".join(sorted(want)) or "-", "rows": len(sim.data),
            "n_hidden": n_hidden(hidden),
            "first": (first.effect + (f" (= {', '.join(first.equivalent)})" if first.equivalent else ""))
            if first else "-",
@@ -364,15 +417,17 @@ def verdicts(rows: list[dict]) -> str:
 
 def speed() -> None:
     p = load_pattern(ROOT / "patterns" / "tube2.yaml")
-    for cycles, rate in ((50, 10.0), (250, 40.0)):
-        sim = simulate(p, Hidden(play_mm=0.06, toe_mm=0.3, toe_form="exponential"), n_samples=2, n_cycles=cycles,
-                       rate_hz=rate, seed=1)
+    for cycles, rate, dwell, h in ((50, 10.0, 0.0, Hidden(play_mm=0.06, toe_mm=0.3, toe_form="exponential")),
+                                   (250, 40.0, 0.0, Hidden(play_mm=0.06, toe_mm=0.3, toe_form="exponential")),
+                                   (42, 10.0, 2.0, Hidden(play_mm=0.06, toe_mm=0.2, toe_form="tanh"))):
+        sim = simulate(p, h, n_samples=2, n_cycles=cycles, rate_hz=rate, seed=1, dwell_s=dwell)
         t0 = time.perf_counter()
         d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
         secs = time.perf_counter() - t0
         n = len(sim.data)
         target = SPEED_TARGETS_S[min(SPEED_TARGETS_S, key=lambda k: abs(k - n))]
-        print(f"speed: {n} rows, recommended {list(d.recommended)}: {secs:.2f} s (target {target:g} s); "
+        print(f"speed: {n} rows{f', {dwell:g} s pause at zero stroke' if dwell else ''}, recommended "
+              f"{list(d.recommended)}: {secs:.2f} s (target {target:g} s); "
               + ", ".join(f"{k} {v:.2f} s" for k, v in d.seconds.items()))
 
 
@@ -390,14 +445,19 @@ def controls() -> None:
 
 
 def variants() -> None:
-    """Record shapes the batches do not have: one or three samples, 20 cycles, 25 Hz, a faster stroke (tube 2)."""
+    """Record shapes the batches do not have (tube 2): one or three samples, 20 cycles, 25 Hz, a faster stroke;
+    and (tubes 2 and 1) a sine stroke, a 2 s pause at zero stroke, sensor noise 0.4x and 2x the usual."""
     cases = [("control", Hidden()), ("play 0.05", Hidden(play_mm=0.05)),
              ("exp toe 0.3", Hidden(toe_mm=0.3, toe_form="exponential")), ("slack 0.08", Hidden(slack_mm=0.08)),
              ("viscoelastic 0.3 / 2 s", Hidden(visco_ratio=0.3, visco_tau_s=2.0))]
     shapes = [dict(n_samples=1, n_cycles=50, rate_hz=10.0), dict(n_samples=3, n_cycles=20, rate_hz=10.0),
-              dict(n_samples=2, n_cycles=20, rate_hz=25.0), dict(n_samples=2, n_cycles=30, rate_hz=10.0, speed_mm_s=1.0)]
-    p = load_pattern(ROOT / "patterns" / "tube2.yaml")
-    for shape in shapes:
+              dict(n_samples=2, n_cycles=20, rate_hz=25.0), dict(n_samples=2, n_cycles=30, rate_hz=10.0, speed_mm_s=1.0),
+              dict(n_samples=2, n_cycles=40, rate_hz=10.0, stroke_shape="sine"),
+              dict(n_samples=2, n_cycles=40, rate_hz=10.0, dwell_s=2.0),
+              dict(n_samples=2, n_cycles=40, rate_hz=10.0, noise_angle_deg=0.1, noise_force_N=0.002),
+              dict(n_samples=2, n_cycles=40, rate_hz=10.0, noise_angle_deg=0.5, noise_force_N=0.01)]
+    for tube, shape in [("tube2", s) for s in shapes] + [("tube1", s) for s in shapes[4:]]:
+        p = load_pattern(ROOT / "patterns" / f"{tube}.yaml")
         for name, h in cases:
             sim = simulate(p, h, seed=777, **shape)
             d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
@@ -405,15 +465,15 @@ def variants() -> None:
             lead = f"{first.effect} (= {', '.join(first.equivalent)})" if first and first.equivalent else (
                 first.effect if first else "-")
             prm = ", ".join(f"{k} {v:.4g}" for k, v in d.final.params.items() if "." in k)
-            print(f"{shape} {name}: first {lead}; recommended {list(d.recommended) or 'nothing'} "
+            print(f"{tube} {shape} {name}: first {lead}; recommended {list(d.recommended) or 'nothing'} "
                   f"({d.final.rmse_deg / sim.sensor_floor_deg:.2f}x the true floor) {prm}")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--batch", default="tune",
-                    choices=("tune", "heldout", "heldout2", "heldout3", "heldout4", "heldout5", "heldout6", "speed",
-                             "controls", "variants", "all"))
+                    choices=("tune", "heldout", "heldout2", "heldout3", "heldout4", "heldout5", "heldout6", "heldout7",
+                             "speed", "controls", "variants", "all"))
     args = ap.parse_args()
     if args.batch in ("speed", "all", "tune"):
         speed()
@@ -424,7 +484,7 @@ def main() -> None:
     for batch, sets, seed0 in (("tune", TUNE, 100), ("heldout", heldout_batch, 5000),
                                ("heldout2", heldout2_batch, 7000), ("heldout3", heldout3_batch, 9000),
                                ("heldout4", heldout4_batch, 11000), ("heldout5", heldout5_batch, 13000),
-                               ("heldout6", heldout6_batch, 15000)):
+                               ("heldout6", heldout6_batch, 15000), ("heldout7", heldout7_batch, 17000)):
         if args.batch not in (batch, "all"):
             continue
         sets = sets if not callable(sets) else sets()

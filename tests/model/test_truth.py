@@ -111,3 +111,22 @@ def test_harder_forms_exponential_toe_cycle_creep_per_sample_effects_and_frictio
     s1 = two.data.sample == "1"
     assert np.max(np.abs(two.angle_true_deg[~s1] - base.angle_true_deg)) < 1e-9
     assert np.max(np.abs(two.angle_true_deg[s1] - base.angle_true_deg)) > 0.5
+
+
+def test_sine_stroke_and_dwell(tube2):
+    # a raised cosine over the triangle's ramp time, then the pause at zero stroke; the friction holds the
+    # joint bent during the pause once it has been loaded (the unloaded tendon goes slack)
+    smax, speed, rate, dwell = 2.5, 0.5, 10.0, 2.0
+    sim = simulate(tube2, Hidden(), n_samples=1, n_cycles=3, stroke_shape="sine", dwell_s=dwell, rate_hz=rate,
+                   speed_mm_s=speed, noise_angle_deg=0.0, noise_force_N=0.0)
+    t, x = np.asarray(sim.data.time_s), np.asarray(sim.data.stroke_mm)
+    period = 2 * smax / speed + dwell
+    ph = (t % period) / (2 * smax / speed)
+    moving = ph < 1.0
+    np.testing.assert_allclose(x[moving], 0.5 * smax * (1 - np.cos(2 * np.pi * ph[moving])), atol=1e-12)
+    assert np.all(x[~moving] == 0.0) and x.max() == pytest.approx(smax)
+    paused = ~moving & (np.asarray(sim.data.cycle) > 1)
+    k = sim.params["K_nmm_per_rad"][0]
+    assert np.allclose(sim.angle_true_deg[paused], math.degrees(0.05 / k), rtol=0.05)
+    with pytest.raises(ValueError, match="stroke_shape"):
+        simulate(tube2, Hidden(), n_cycles=1, stroke_shape="square")

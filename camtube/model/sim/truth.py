@@ -239,6 +239,7 @@ def simulate(
     dwell_s: float = 0.0,
     stiffness_nmm_per_rad: float | None = None,
     stiffness_spread: float = 0.1,
+    stroke_shape: str = "triangle",
 ) -> Simulation:
     """Simulate a measurement of ``pattern`` with the ``hidden`` physics.
 
@@ -262,6 +263,9 @@ def simulate(
         Joint bending stiffness K (default: E_pi I / (n h) with E_pi = 2.5 GPa).
     stiffness_spread : float
         Relative spread of K between samples.
+    stroke_shape : str
+        ``triangle`` (ramps at ``speed_mm_s``) or ``sine`` (a raised cosine 0 -> max -> 0 over the same
+        time: slow near the turning points, fastest mid-stroke, as a crank or a smoothed motion profile).
 
     Returns
     -------
@@ -277,6 +281,12 @@ def simulate(
     k0 = joint_stiffness_nmm_per_rad(pattern) if stiffness_nmm_per_rad is None else stiffness_nmm_per_rad
     smax = pattern.rules.max_stroke_mm if max_stroke_mm is None else max_stroke_mm
     time, stroke, cycle = triangle_stroke(smax, speed_mm_s, rate_hz, n_cycles, dwell_s)
+    if stroke_shape == "sine":
+        ramp_s = smax / speed_mm_s
+        phase = np.minimum((time % (2.0 * ramp_s + dwell_s)) / (2.0 * ramp_s), 1.0)
+        stroke = 0.5 * smax * (1.0 - np.cos(2.0 * np.pi * phase))
+    elif stroke_shape != "triangle":
+        raise ValueError(f"stroke_shape must be 'triangle' or 'sine', not {stroke_shape!r}")
     m = stroke.size
     parts: dict[str, list] = {k: [] for k in ("sample", "angle", "force", "true", "tension")}
     ks = []
