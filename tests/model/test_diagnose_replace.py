@@ -128,3 +128,20 @@ def test_a_control_that_rests_at_zero_stroke_gets_nothing_but_its_rest_angle():
     assert d.given.rmse_deg > 1.2 * sim.sensor_floor_deg and d.final.rmse_deg < 1.05 * sim.sensor_floor_deg
     off = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p), baseline=())
     assert off.baseline == () and (off.recommended or off.partial)[:1] == ("rest_angle",)
+
+
+def test_swaps_as_good_as_the_chain_are_declared_indistinguishable():
+    from camtube.model.diagnose.search import Candidate, _declare_alternatives, _swap_alternatives
+
+    def cand(effect, ho, replaces=(), significant=True, equivalent=()):
+        return Candidate(effect, (), ho, ho, -20.0, {}, equivalent=equivalent, significant=significant,
+                         replaces=replaces)
+
+    # the chain's held-out RMSE is 0.300 deg: a swap within 3 % is an alternative, one 5 % worse is not
+    final_round = (cand("angle_bias", 0.305, ("slack",)), cand("toe", 0.315, ("slack",)), cand("kerf", 0.29))
+    alts = _swap_alternatives(final_round, 0.300)
+    assert alts == {"slack": ["angle_bias"]}
+    rounds = [(cand("slack", 0.4, equivalent=("creep",)), cand("toe", 0.5)), (cand("play", 0.3),)]
+    out = _declare_alternatives(rounds, {"slack": 0, "play": 1}, alts)
+    assert out[0][0].equivalent == ("creep", "angle_bias") and out[0][1].equivalent == ()
+    assert out[1] == rounds[1]

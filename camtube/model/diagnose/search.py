@@ -631,6 +631,7 @@ def diagnose(
     chosen_round: dict[str, int] = {}
     swaps_tried = False
     first_useful: list[Effect] = []
+    notes_late: list[str] = []
     stop = ""
     while True:
         for eff in list(pending):
@@ -721,7 +722,14 @@ def diagnose(
             accepted = (c, eff, m, names, r, {k: v for k, v in init.items() if k in r.fitted}, ps, keep, inter)
             break
         if swaps_only and accepted is None:
-            del rejected[n_rejected:]  # no swap: the diagnosis stops as it would have, its output unchanged
+            del rejected[n_rejected:]  # no swap: the diagnosis stops as it would have
+            # ... but a swap as good as the chain (held-out within EQUAL_HELDOUT) is an alternative the data
+            # cannot rule out: declared indistinguishable from the effect it would replace
+            alts = _swap_alternatives(ranked, cur_ho)
+            rounds = _declare_alternatives(rounds, chosen_round, alts)
+            for old, found in alts.items():
+                notes_late.append(f"{', '.join(found)} in place of {old} explain the data as well (held-out RMSE "
+                                  f"within {100 * EQUAL_HELDOUT:g} %): the data cannot tell them apart from {old}")
             break
         ranked = tuple(_mark_rejected(ranked, rejected))
         rounds.append(ranked)
@@ -768,6 +776,7 @@ def diagnose(
             steps.append(final)
         ps_names = list(steps[-1].per_sample)
     notes += _offset_notes(data, steps[-1], chosen, floor)
+    notes += notes_late
     base_ps = given.rmse_per_sample
     fin_ps = steps[-1].rmse_per_sample
     for smp in base_ps:
@@ -848,6 +857,30 @@ def _baseline_try(eff: Effect, model: JointModel, current: JointModel, search: D
     if not all(b < a for a, b in zip(seq, seq[1:])):
         return None
     return start, chain, names, r, steps, c
+
+
+def _swap_alternatives(ranked, cur_ho: float) -> dict[str, list[str]]:
+    """``{chosen effect: [effect, ...]}``: swaps of the final round whose held-out RMSE is within
+    :data:`EQUAL_HELDOUT` of the chain's (alternatives the data cannot rule out)."""
+    out: dict[str, list[str]] = {}
+    for c in ranked:
+        if c.replaces and c.heldout_rmse_deg <= (1.0 + EQUAL_HELDOUT) * cur_ho:
+            out.setdefault(c.replaces[0], []).append(c.effect)
+    return out
+
+
+def _declare_alternatives(rounds: list, chosen_round: Mapping[str, int], alts: Mapping[str, list]) -> list:
+    """``rounds`` with the alternatives ``alts`` added to the ``equivalent`` of each chosen effect's candidate."""
+    out = []
+    for i, rnd in enumerate(rounds):
+        row = []
+        for c in rnd:
+            more = [n for n in alts.get(c.effect, ()) if n not in c.equivalent and n != c.effect]
+            if more and chosen_round.get(c.effect) == i and c.significant:
+                c = replace(c, equivalent=tuple(c.equivalent) + tuple(more))
+            row.append(c)
+        out.append(tuple(row))
+    return out
 
 
 def first_rest_rows(data: Dataset, predicted: np.ndarray, tol_deg: float) -> np.ndarray:
