@@ -20,7 +20,9 @@ seeds 11000-): sharp toes with play or slack, a hidden sensor offset, per-sample
 20261126, seeds 13000-); looked at (the family-lead rule followed). ``heldout6``: drawn after that (seed
 20261127, seeds 15000-), every truth toe form at random; looked at once the joint's rest angle joined the
 baseline. ``heldout7``: drawn after that (seed 20261128, seeds 17000-), with record shapes drawn per set
-(sine or triangular stroke, a pause at zero stroke, 0.5-2x the sensor noise, joint friction 0.02-0.12 N mm).
+(sine or triangular stroke, a pause at zero stroke, 0.5-2x the sensor noise, joint friction 0.02-0.12 N mm);
+run once, then the final round's alternatives were declared. ``heldout8``: drawn after that (seed 20261129,
+seeds 19000-), the same record shapes, and a ratcheting (force-driven) creep.
 ``speed``: 10,000 and 200,000 rows (targets 5 s and 20 s).
 """
 from __future__ import annotations
@@ -279,6 +281,53 @@ def heldout7_batch(seed: int = 20261128) -> list:
     ]
 
 
+def heldout8_batch(seed: int = 20261129) -> list:
+    """An eighth fresh batch, drawn once the final round's alternatives were declared (heldout7 had been run
+    once): new seeds (19000-), new parameters, record shapes drawn per set as in heldout7, and a ratcheting
+    (force-driven) creep, a form the library's time-driven creep does not share."""
+    rng, u, t = _drawers(seed)
+    forms = ("exponential", "power", "tanh", "fung", "quadratic")
+    form = lambda: forms[int(rng.integers(len(forms)))]  # noqa: E731
+
+    def record() -> dict:
+        k = u(0.5, 2.0)
+        return {"stroke_shape": ("triangle", "sine")[int(rng.integers(2))],
+                "dwell_s": (0.0, u(0.5, 3.0))[int(rng.integers(2))],
+                "noise_angle_deg": round(0.25 * k, 3), "noise_force_N": round(0.005 * k, 4)}
+
+    def fr() -> float:
+        return u(0.02, 0.12)
+
+    play, s1, s2 = u(0.03, 0.12), u(0.03, 0.08), u(0.1, 0.2)
+    f1, f2, f3 = form(), form(), form()
+    return [
+        ("control", t(), Hidden(joint_friction_nmm=fr()), set(), {}, record()),
+        (f"{f1}-toe", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f1, joint_friction_nmm=fr()), TOES, {}, record()),
+        (f"{f2}-toe", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f2, joint_friction_nmm=fr()), TOES, {}, record()),
+        (f"{f3}-toe + play", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f3, play_mm=play, joint_friction_nmm=fr()),
+         TOES | {"play"}, {"play.play_mm": play}, record()),
+        ("play + slack", t(), Hidden(play_mm=play, slack_mm=s2, joint_friction_nmm=fr()), {"play", "slack"},
+         {"play.play_mm": play, "slack.deadband_mm": s2}, record()),
+        ("viscoelastic + play", t(), Hidden(visco_ratio=u(0.2, 0.6), visco_tau_s=u(1.0, 4.0), play_mm=play,
+                                            joint_friction_nmm=fr()),
+         {"viscoelastic", "play"}, {"play.play_mm": play}, record()),
+        ("slack per sample", t(), [Hidden(slack_mm=s1, joint_friction_nmm=(f := fr())),
+                                   Hidden(slack_mm=s2, joint_friction_nmm=f)], {"slack"},
+         {"slack.deadband_mm@1": s1, "slack.deadband_mm@2": s2}, record()),
+        ("play on S1 only", t(), [Hidden(play_mm=play, joint_friction_nmm=(f := fr())),
+                                  Hidden(joint_friction_nmm=f)], {"play"},
+         {"play.play_mm@1": play, "play.play_mm@2": 0.0}, record()),
+        ("sensor offset", t(), Hidden(angle_bias_deg=(b := u(-1.2, 1.2)), joint_friction_nmm=fr()),
+         {"angle_bias", "force_zero"}, {"angle_bias.bias_deg": b}, record()),
+        ("cycle creep", t(), Hidden(cycle_creep_mm=u(0.03, 0.1), cycle_creep_n=u(3, 8), joint_friction_nmm=fr()),
+         {"creep", "viscoelastic"}, {}, record()),
+        ("ratcheting creep", t(), Hidden(creep_mm_per_N=u(0.05, 0.2), creep_tau_s=u(20.0, 90.0),
+                                         joint_friction_nmm=fr()),
+         {"creep", "viscoelastic"}, {}, record()),
+        ("control", t(), Hidden(joint_friction_nmm=fr()), set(), {}, record()),
+    ]
+
+
 #: The two sensor offsets: a constant angle shift each (the output declares them indistinguishable).
 OFFSETS = ("angle_bias.bias_deg", "force_zero.zero_N")
 
@@ -473,7 +522,7 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--batch", default="tune",
                     choices=("tune", "heldout", "heldout2", "heldout3", "heldout4", "heldout5", "heldout6", "heldout7",
-                             "speed", "controls", "variants", "all"))
+                             "heldout8", "speed", "controls", "variants", "all"))
     args = ap.parse_args()
     if args.batch in ("speed", "all", "tune"):
         speed()
@@ -484,7 +533,8 @@ def main() -> None:
     for batch, sets, seed0 in (("tune", TUNE, 100), ("heldout", heldout_batch, 5000),
                                ("heldout2", heldout2_batch, 7000), ("heldout3", heldout3_batch, 9000),
                                ("heldout4", heldout4_batch, 11000), ("heldout5", heldout5_batch, 13000),
-                               ("heldout6", heldout6_batch, 15000), ("heldout7", heldout7_batch, 17000)):
+                               ("heldout6", heldout6_batch, 15000), ("heldout7", heldout7_batch, 17000),
+                               ("heldout8", heldout8_batch, 19000)):
         if args.batch not in (batch, "all"):
             continue
         sets = sets if not callable(sets) else sets()
