@@ -230,6 +230,9 @@ class Diagnosis:
     baseline_gain : dict
         ``{effect: (chain, rmse_before_deg, rmse_after_deg)}``: the all-rows RMSE of the chain of effects
         chosen when the baseline effect joined, without and with it.
+    dropped : tuple[str, ...]
+        Effects chosen in an earlier round and dropped before stopping: the chain without them was not
+        significantly worse on held-out cycles (a later effect explains what they did).
     stop_reason : str
     seconds : dict
         Wall time of the parts (not written to JSON: output is deterministic).
@@ -261,6 +264,7 @@ class Diagnosis:
     given: Step | None = None
     baseline: tuple = ()
     baseline_gain: dict = field(default_factory=dict)
+    dropped: tuple = ()
 
     @property
     def candidates(self) -> tuple:
@@ -630,6 +634,9 @@ def diagnose(
     replaced: list[tuple[tuple, str]] = []
     chosen_round: dict[str, int] = {}
     swaps_tried = False
+    full_retry = False
+    dropped: list[str] = []
+    all_pool = list(pool)
     first_useful: list[Effect] = []
     notes_late: list[str] = []
     stop = ""
@@ -665,6 +672,19 @@ def diagnose(
         if not pool:
             stop = "no candidate effects left"
             break
+        if swaps_only and len(chosen) > 1:
+            # ... and first, each chosen effect is tried away: one that a later effect made redundant (tendon-sheath
+            # friction standing in for play until play came in) goes when the chain without it is not
+            # significantly worse on held-out cycles
+            got = _drop_try(model, current, search, data, cur_names, cur, cur_mse, fold, block, fixed,
+                            bic_threshold, z, grid, modulus_range_gpa, cur_ps, strata, chosen, fit_params)
+            if got is not None:
+                old, current, cur_names, cur_ps, prev_all, steps, cur, cur_ho, cur_mse = got
+                dropped.append(old.name)
+                chosen = [e for e in chosen if e.name != old.name]
+                recommended = [e.name for e in chosen]
+                swaps_tried = False
+                continue
         # the swap round tries every effect that helped the model as given (one that explained little on top
         # of the stand-in, as a sharp toe on top of slack, may explain more in its place)
         tried_pool = ([e for e in first_useful if e.name not in {x.name for x in chosen}][:SWAP_TRIES]
@@ -733,6 +753,16 @@ def diagnose(
             break
         ranked = tuple(_mark_rejected(ranked, rejected))
         rounds.append(ranked)
+        if accepted is None and not full_retry:
+            # the pool was narrowed to the effects that helped the round before (speed); one that explained
+            # nothing while a bigger effect dominated (play under a viscoelastic tendon) may be what is left:
+            # before giving up, the round is run again with every effect not yet chosen
+            again = [e for e in all_pool if e.name not in {x.name for x in chosen} | {x.name for x in pool}]
+            full_retry = True
+            if again:
+                rounds.pop()
+                pool = pool + again
+                continue
         if accepted is None:
             top = ranked[0] if ranked else None
             stop = ("no candidate improves the model significantly and reliably"
@@ -807,7 +837,7 @@ def diagnose(
                      tuple(ps_names),
                      tuple(notes), grid, partial, partial_steps, floor_parts, tuple(replaced),
                      {k: chosen_round[k] for k in recommended or partial if k in chosen_round},
-                     given, tuple(baseline_added), baseline_gain)
+                     given, tuple(baseline_added), baseline_gain, tuple(dropped))
 
 
 def _without(model: JointModel, names: Sequence[str], per_sample: Sequence[str],
@@ -857,6 +887,45 @@ def _baseline_try(eff: Effect, model: JointModel, current: JointModel, search: D
     if not all(b < a for a, b in zip(seq, seq[1:])):
         return None
     return start, chain, names, r, steps, c
+
+
+def _drop_try(model: JointModel, current: JointModel, search: Dataset, data: Dataset, cur_names: tuple,
+              cur: FitResult, cur_mse: np.ndarray, fold: np.ndarray, block: np.ndarray, fixed: Mapping[str, float],
+              bic_threshold: float, z: float, grid: int, modulus_range_gpa: tuple[float, float], cur_ps: list,
+              strata, chosen: Sequence[Effect], fit_params: Sequence[str]):
+    """The chosen effect whose removal costs least, if the chain is not significantly better with it (held-out
+    gain within ``z`` standard errors, BIC within ``bic_threshold``) and the chain without it passes the all-rows
+    checks with every step lowering the RMSE: ``(effect, model, names, per-sample names, fit on all rows,
+    waterfall, search fit, held-out RMSE, block MSE)``; None when every effect is needed."""
+    tries = []
+    for old in chosen:
+        gone = set(old.full_names())
+        m, names, ps = _without(current, cur_names, cur_ps, [old])
+        start = {k: v for k, v in cur.params.items() if k.split("@")[0] not in gone}
+        f = _search_fit(m, search, names, start, fixed, per_sample=ps)
+        ho, mse = _cv(m, search, names, f.params, fixed, fold, block, per_sample=ps)
+        dm, se = _gain(mse, cur_mse, strata)  # what keeping the effect gains
+        if dm > z * se or f.bic - cur.bic >= bic_threshold:
+            continue
+        tries.append((ho, old, m, names, ps, f, mse))
+    for ho, old, m, names, ps, f, mse in sorted(tries, key=lambda t: (t[0], t[1].name)):
+        init = {k: v for k, v in f.params.items() if k in names or k.split("@")[0] in names}
+        r = refit_all_rows(m, data, names, fixed, init, grid, per_sample=ps)
+        if _resolution_problems(m, list(r.fitted), r.params, r.stderr, r.at_bound, data, modulus_range_gpa):
+            continue
+        keep = [e for e in chosen if e.name != old.name]
+        steps = []
+        for i in range(len(keep)):
+            mi = model.with_effects(list(model.effects) + keep[:i])
+            ni = _names_for(mi, fit_params)
+            psi = [n for n in ps if n.split("@")[0] in ni]
+            ri = refit_all_rows(mi, data, ni, fixed, {k: v for k, v in r.params.items() if k.split("@")[0] in ni},
+                                grid, per_sample=psi)
+            steps.append(_step(ri, psi))
+        steps.append(_step(r, ps, {k: v for k, v in init.items() if k in r.fitted}))
+        if all(b.rmse_deg < a.rmse_deg for a, b in zip(steps, steps[1:])):
+            return old, m, names, ps, r, steps, f, ho, mse
+    return None
 
 
 def _swap_alternatives(ranked, cur_ho: float) -> dict[str, list[str]]:

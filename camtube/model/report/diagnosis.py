@@ -16,6 +16,7 @@ report directory with an index is complete).
                      "equivalent", "confounded", "significant", "why", "meaning", "signature"}],
      "rounds": [[candidate, ...], ...],        # candidates of each greedy round (first = "candidates")
      "recommended": [effect, ...],             # in order; only a chain within 1.15 x the noise floor
+     "replaced": [{"effects", "by"}], "dropped": [effect, ...],   # stepwise: swapped or dropped before the end
      "partial": [{"effect", "rmse_before_deg", "rmse_deg", "floor_ratio", "params"}],  # lower it, not a fix
      "waterfall": [{"effects", "rmse_deg", "per_sample"}],
      "final": {"effects", "rmse_deg", "params"}, "stop_reason", "command",
@@ -160,6 +161,7 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
     out["rounds"] = [[_candidate_dict(d, c) for c in r] for r in d.rounds]
     out["recommended"] = list(d.recommended)
     out["replaced"] = [{"effects": list(old), "by": new} for old, new in d.replaced]
+    out["dropped"] = list(d.dropped)
     out["waterfall"] = [{"effects": list(s.effects), "rmse_deg": _num(s.rmse_deg),
                          "per_sample": {k: _num(v) for k, v in s.rmse_per_sample.items()}} for s in d.waterfall]
     out["final"] = {"effects": list(final.effects), "rmse_deg": _num(final.rmse_deg),
@@ -291,6 +293,9 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
         lines.append(f"replaced: {', '.join(old)} (chosen in an earlier round) by {new}: with {new} in the model "
                      f"the parameters of {', '.join(old)} went to a bound (it explains what they did), so "
                      f"{'they were' if len(old) > 1 else 'it was'} dropped")
+    for name in d.dropped:
+        lines.append(f"dropped: {name} (chosen in an earlier round): without it the held-out error is not "
+                     "significantly worse, so a later effect explains what it did")
     for note in d.sample_notes:
         lines.append(f"note: {note}")
     for name, why in d.rejected:
