@@ -22,7 +22,8 @@ seeds 11000-): sharp toes with play or slack, a hidden sensor offset, per-sample
 baseline. ``heldout7``: drawn after that (seed 20261128, seeds 17000-), with record shapes drawn per set
 (sine or triangular stroke, a pause at zero stroke, 0.5-2x the sensor noise, joint friction 0.02-0.12 N mm);
 run once, then the final round's alternatives were declared. ``heldout8``: drawn after that (seed 20261129,
-seeds 19000-), the same record shapes, and a ratcheting (force-driven) creep.
+seeds 19000-), the same record shapes, and a ratcheting (force-driven) creep; looked at (the full retry and
+the dropping of redundant effects followed). ``heldout9``: drawn after that (seed 20261130, seeds 21000-).
 ``speed``: 10,000 and 200,000 rows (targets 5 s and 20 s).
 """
 from __future__ import annotations
@@ -328,6 +329,54 @@ def heldout8_batch(seed: int = 20261129) -> list:
     ]
 
 
+def heldout9_batch(seed: int = 20261130) -> list:
+    """A ninth fresh batch, drawn once the full retry and the dropping of redundant effects were settled
+    (heldout8 had been looked at: its viscoelastic + play set led to both): new seeds (21000-), new parameters,
+    record shapes drawn per set as in heldout7."""
+    rng, u, t = _drawers(seed)
+    forms = ("exponential", "power", "tanh", "fung", "quadratic")
+    form = lambda: forms[int(rng.integers(len(forms)))]  # noqa: E731
+
+    def record() -> dict:
+        k = u(0.5, 2.0)
+        return {"stroke_shape": ("triangle", "sine")[int(rng.integers(2))],
+                "dwell_s": (0.0, u(0.5, 3.0))[int(rng.integers(2))],
+                "noise_angle_deg": round(0.25 * k, 3), "noise_force_N": round(0.005 * k, 4)}
+
+    def fr() -> float:
+        return u(0.02, 0.12)
+
+    play, p2, s1, s2 = u(0.03, 0.12), u(0.02, 0.05), u(0.03, 0.08), u(0.1, 0.2)
+    f1, f2, f3 = form(), form(), form()
+    return [
+        ("control", t(), Hidden(joint_friction_nmm=fr()), set(), {}, record()),
+        (f"{f1}-toe", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f1, joint_friction_nmm=fr()), TOES, {}, record()),
+        (f"{f2}-toe + play", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f2, play_mm=play, joint_friction_nmm=fr()),
+         TOES | {"play"}, {"play.play_mm": play}, record()),
+        (f"{f3}-toe + slack", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f3, slack_mm=s1, joint_friction_nmm=fr()),
+         TOES | {"slack"}, {}, record()),
+        ("viscoelastic + play", t(), Hidden(visco_ratio=u(0.2, 0.6), visco_tau_s=u(1.0, 4.0), play_mm=play,
+                                            joint_friction_nmm=fr()),
+         {"viscoelastic", "play"}, {"play.play_mm": play}, record()),
+        ("viscoelastic", t(), Hidden(visco_ratio=(r := u(0.2, 0.6)), visco_tau_s=(tau := u(1.0, 4.0)),
+                                     joint_friction_nmm=fr()),
+         {"viscoelastic"}, {"viscoelastic.ratio": r, "viscoelastic.tau_s": tau}, record()),
+        ("slack per sample", t(), [Hidden(slack_mm=s1, joint_friction_nmm=(f := fr())),
+                                   Hidden(slack_mm=s2, joint_friction_nmm=f)], {"slack"},
+         {"slack.deadband_mm@1": s1, "slack.deadband_mm@2": s2}, record()),
+        ("play per sample", t(), [Hidden(play_mm=p2, joint_friction_nmm=(f := fr())),
+                                  Hidden(play_mm=play + 0.03, joint_friction_nmm=f)], {"play"},
+         {"play.play_mm@1": p2, "play.play_mm@2": play + 0.03}, record()),
+        ("sensor offset", t(), Hidden(angle_bias_deg=(b := u(-1.2, 1.2)), joint_friction_nmm=fr()),
+         {"angle_bias", "force_zero"}, {"angle_bias.bias_deg": b}, record()),
+        ("cycle creep", t(), Hidden(cycle_creep_mm=u(0.03, 0.1), cycle_creep_n=u(3, 8), joint_friction_nmm=fr()),
+         {"creep", "viscoelastic"}, {}, record()),
+        ("play + slack", t(), Hidden(play_mm=play, slack_mm=s2, joint_friction_nmm=fr()), {"play", "slack"},
+         {"play.play_mm": play, "slack.deadband_mm": s2}, record()),
+        ("control", t(), Hidden(joint_friction_nmm=fr()), set(), {}, record()),
+    ]
+
+
 #: The two sensor offsets: a constant angle shift each (the output declares them indistinguishable).
 OFFSETS = ("angle_bias.bias_deg", "force_zero.zero_N")
 
@@ -522,7 +571,7 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--batch", default="tune",
                     choices=("tune", "heldout", "heldout2", "heldout3", "heldout4", "heldout5", "heldout6", "heldout7",
-                             "heldout8", "speed", "controls", "variants", "all"))
+                             "heldout8", "heldout9", "speed", "controls", "variants", "all"))
     args = ap.parse_args()
     if args.batch in ("speed", "all", "tune"):
         speed()
@@ -534,7 +583,7 @@ def main() -> None:
                                ("heldout2", heldout2_batch, 7000), ("heldout3", heldout3_batch, 9000),
                                ("heldout4", heldout4_batch, 11000), ("heldout5", heldout5_batch, 13000),
                                ("heldout6", heldout6_batch, 15000), ("heldout7", heldout7_batch, 17000),
-                               ("heldout8", heldout8_batch, 19000)):
+                               ("heldout8", heldout8_batch, 19000), ("heldout9", heldout9_batch, 21000)):
         if args.batch not in (batch, "all"):
             continue
         sets = sets if not callable(sets) else sets()

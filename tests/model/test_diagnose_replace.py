@@ -29,11 +29,13 @@ def test_an_early_stand_in_is_replaced_by_the_effect_that_explains_it():
     sim, d = _run("tube2", Hidden(toe_mm=0.3, toe_form="fung", play_mm=0.116), 9003, baseline=())
     chain = d.recommended or d.partial
     assert d.candidates[0].effect == "slack"
-    assert "slack" not in chain and set(chain) == {"play", "toe_shape"}
+    # (without the baseline an offset then stands in for the joint's rest angle: see the first-rest test below)
+    assert "slack" not in chain and {"play", "toe_shape"} <= set(chain) and set(chain) <= {"play", "toe_shape",
+                                                                                         "angle_bias", "force_zero"}
     assert d.replaced == ((("slack",), "toe_shape"),)
     steps = d.waterfall if d.recommended else d.partial_steps
     assert all(b.rmse_deg < a.rmse_deg for a, b in zip(steps, steps[1:]))
-    assert [s.effects for s in steps[1:]] == [("play",), ("play", "toe_shape")]
+    assert [s.effects for s in steps[1:3]] == [("play",), ("play", "toe_shape")]
     assert diagnosis_dict(d)["replaced"] == [{"effects": ["slack"], "by": "toe_shape"}]
     assert "replaced: slack (chosen in an earlier round) by toe_shape" in diagnosis_text(d)
     assert "toe_shape (replacing slack)" in diagnosis_text(d) or any(
