@@ -13,6 +13,7 @@ import numpy as np
 # speed: the direction of motion is derived data, cached per Dataset object (fits evaluate the model
 # hundreds of times on the same rows); see scripts/bench_diagnose.py
 _DIRECTION: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_SLICES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True, eq=False)
@@ -57,16 +58,20 @@ class Dataset:
         return [str(self.sample[i]) for i in sorted(idx)]
 
     def sample_slices(self) -> list[tuple[str, slice]]:
-        """``(sample, slice)`` of each sample's contiguous rows, in order."""
+        """``(sample, slice)`` of each sample's contiguous rows, in order (computed once per Dataset; a new list
+        each call)."""
+        hit = _SLICES.get(self)
+        if hit is not None:
+            return list(hit)
         out = []
         n = len(self)
-        if n == 0:
-            return out
-        change = np.flatnonzero(self.sample[1:] != self.sample[:-1]) + 1
-        starts = np.concatenate(([0], change))
-        ends = np.concatenate((change, [n]))
-        for s, e in zip(starts, ends):
-            out.append((str(self.sample[s]), slice(int(s), int(e))))
+        if n:
+            change = np.flatnonzero(self.sample[1:] != self.sample[:-1]) + 1
+            starts = np.concatenate(([0], change))
+            ends = np.concatenate((change, [n]))
+            for s, e in zip(starts, ends):
+                out.append((str(self.sample[s]), slice(int(s), int(e))))
+        _SLICES[self] = tuple(out)
         return out
 
     @property

@@ -635,6 +635,8 @@ def diagnose(
     chosen_round: dict[str, int] = {}
     swaps_tried = False
     full_retry = False
+    retry_prev: tuple = ()
+    retry_pool: list[Effect] = []
     dropped: list[str] = []
     all_pool = list(pool)
     first_useful: list[Effect] = []
@@ -688,18 +690,24 @@ def diagnose(
         # the swap round tries every effect that helped the model as given (one that explained little on top
         # of the stand-in, as a sharp toe on top of slack, may explain more in its place)
         tried_pool = ([e for e in first_useful if e.name not in {x.name for x in chosen}][:SWAP_TRIES]
-                      if swaps_only else pool)
+                      if swaps_only else retry_pool or pool)
         ranked = _round(current, search, cur_names, cur, cur_ho, cur_mse, fold, block, tried_pool, floor, fixed,
                         bic_threshold, min_gain, min_excess, z, grid, modulus_range_gpa, cur_ps, strata,
                         per_sample and len(search.samples) > 1 and not swaps_only, init, tuple(chosen),
                         swap_all=swaps_only)
+        if retry_pool and not swaps_only:
+            ranked = tuple(sorted(tuple(retry_prev) + tuple(ranked),
+                                  key=lambda c: (not c.significant, c.heldout_rmse_deg, c.effect, c.replaces)))
+            retry_prev, retry_pool = (), []
         ranked_base_ho = cur_ho
         accepted = None
         n_rejected = len(rejected)
         for c in ranked:
             if not c.significant or (swaps_only and not c.replaces):
                 continue
-            eff = next(e for e in tried_pool if e.name == c.effect)
+            eff = next((e for e in tried_pool if e.name == c.effect), None)
+            if eff is None:  # a candidate of the narrowed round, already tried (merged into the full retry)
+                continue
             keep = [e for e in chosen if e.name not in c.replaces]
             m, names, ps = _without(current, cur_names, cur_ps, [e for e in chosen if e.name in c.replaces])
             m = m.with_effects(list(m.effects) + [eff])
@@ -760,7 +768,8 @@ def diagnose(
             again = [e for e in all_pool if e.name not in {x.name for x in chosen} | {x.name for x in pool}]
             full_retry = True
             if again:
-                rounds.pop()
+                # only the effects left out are fitted; the round is recorded with both
+                retry_prev, retry_pool = rounds.pop(), again
                 pool = pool + again
                 continue
         if accepted is None:
