@@ -90,7 +90,7 @@ def run(sets, samples: int = 2, cycles: int = 50) -> list[dict]:
         u = ureport.of_diagnosis(d)
         t1 = time.perf_counter()
         row = {"effect": effect, "params": params, "seed": seed, "truth": gen.TRUTH_VARIABLE.get(effect, "-"),
-               "sensor_floor": truth.sensor_floor_deg, "base_rmse": d.waterfall[0].rmse_deg,
+               "sensor_floor": truth.sensor_floor_deg, "base_rmse": d.given.rmse_deg,
                "rec": list(d.recommended), "rmse_rec": d.final.rmse_deg, "floor_est": d.noise_floor_deg,
                "partial": list(d.partial), "rmse_partial": d.partial_steps[-1].rmse_deg if d.partial else None,
                "follows": (u or {}).get("follows", []), "lead": (u or {}).get("leading", "") if u else None,
