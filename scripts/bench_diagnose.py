@@ -23,7 +23,9 @@ baseline. ``heldout7``: drawn after that (seed 20261128, seeds 17000-), with rec
 (sine or triangular stroke, a pause at zero stroke, 0.5-2x the sensor noise, joint friction 0.02-0.12 N mm);
 run once, then the final round's alternatives were declared. ``heldout8``: drawn after that (seed 20261129,
 seeds 19000-), the same record shapes, and a ratcheting (force-driven) creep; looked at (the full retry and
-the dropping of redundant effects followed). ``heldout9``: drawn after that (seed 20261130, seeds 21000-).
+the dropping of redundant effects followed). ``heldout9``: drawn after that (seed 20261130, seeds 21000-);
+run once, then looked at (dropping by the all-rows BIC followed). ``heldout10``: its composition drawn again
+after that (seed 20261201, seeds 23000-).
 ``speed``: 10,000 and 200,000 rows (targets 5 s and 20 s).
 """
 from __future__ import annotations
@@ -234,23 +236,33 @@ def heldout6_batch(seed: int = 20261127) -> list:
     ]
 
 
-def heldout7_batch(seed: int = 20261128) -> list:
-    """A seventh fresh batch, drawn once the joint's rest angle in the baseline and the swap round were settled
-    (every earlier batch had been looked at): new seeds (17000-), new parameters, and record shapes the
-    earlier batches lack, drawn at random per set: a sine or triangular stroke, a pause at zero stroke of 0-3 s,
-    sensor noise 0.5-2x the usual, joint friction 0.02-0.12 N mm."""
-    rng, u, t = _drawers(seed)
-    forms = ("exponential", "power", "tanh", "fung", "quadratic")
-    form = lambda: forms[int(rng.integers(len(forms)))]  # noqa: E731
-
+def _shapes(rng, u):
+    """``(record, fr)`` of a batch with record shapes: ``record()`` draws a sine or triangular stroke, a pause at
+    zero stroke of 0 or 0.5-3 s and 0.5-2x the sensor noise; ``fr()`` a joint friction of 0.02-0.12 N mm."""
     def record() -> dict:
         k = u(0.5, 2.0)
         return {"stroke_shape": ("triangle", "sine")[int(rng.integers(2))],
                 "dwell_s": (0.0, u(0.5, 3.0))[int(rng.integers(2))],
                 "noise_angle_deg": round(0.25 * k, 3), "noise_force_N": round(0.005 * k, 4)}
 
-    def fr() -> float:
-        return u(0.02, 0.12)
+    return record, lambda: u(0.02, 0.12)
+
+
+def _forms(rng):
+    """A function drawing one of the truth's five toe forms."""
+    forms = ("exponential", "power", "tanh", "fung", "quadratic")
+    return lambda: forms[int(rng.integers(len(forms)))]
+
+
+def heldout7_batch(seed: int = 20261128) -> list:
+    """A seventh fresh batch, drawn once the joint's rest angle in the baseline and the swap round were settled
+    (every earlier batch had been looked at): new seeds (17000-), new parameters, and record shapes the
+    earlier batches lack, drawn at random per set: a sine or triangular stroke, a pause at zero stroke of 0-3 s,
+    sensor noise 0.5-2x the usual, joint friction 0.02-0.12 N mm."""
+    rng, u, t = _drawers(seed)
+    form = _forms(rng)
+
+    record, fr = _shapes(rng, u)
 
     play, p2, s1, s2 = u(0.03, 0.12), u(0.02, 0.05), u(0.03, 0.08), u(0.1, 0.2)
     f1, f2, f3 = form(), form(), form()
@@ -287,17 +299,9 @@ def heldout8_batch(seed: int = 20261129) -> list:
     once): new seeds (19000-), new parameters, record shapes drawn per set as in heldout7, and a ratcheting
     (force-driven) creep, a form the library's time-driven creep does not share."""
     rng, u, t = _drawers(seed)
-    forms = ("exponential", "power", "tanh", "fung", "quadratic")
-    form = lambda: forms[int(rng.integers(len(forms)))]  # noqa: E731
+    form = _forms(rng)
 
-    def record() -> dict:
-        k = u(0.5, 2.0)
-        return {"stroke_shape": ("triangle", "sine")[int(rng.integers(2))],
-                "dwell_s": (0.0, u(0.5, 3.0))[int(rng.integers(2))],
-                "noise_angle_deg": round(0.25 * k, 3), "noise_force_N": round(0.005 * k, 4)}
-
-    def fr() -> float:
-        return u(0.02, 0.12)
+    record, fr = _shapes(rng, u)
 
     play, s1, s2 = u(0.03, 0.12), u(0.03, 0.08), u(0.1, 0.2)
     f1, f2, f3 = form(), form(), form()
@@ -332,19 +336,12 @@ def heldout8_batch(seed: int = 20261129) -> list:
 def heldout9_batch(seed: int = 20261130) -> list:
     """A ninth fresh batch, drawn once the full retry and the dropping of redundant effects were settled
     (heldout8 had been looked at: its viscoelastic + play set led to both): new seeds (21000-), new parameters,
-    record shapes drawn per set as in heldout7."""
+    record shapes drawn per set as in heldout7. Looked at since: its viscoelastic + play set led to dropping
+    by the all-rows BIC."""
     rng, u, t = _drawers(seed)
-    forms = ("exponential", "power", "tanh", "fung", "quadratic")
-    form = lambda: forms[int(rng.integers(len(forms)))]  # noqa: E731
+    form = _forms(rng)
 
-    def record() -> dict:
-        k = u(0.5, 2.0)
-        return {"stroke_shape": ("triangle", "sine")[int(rng.integers(2))],
-                "dwell_s": (0.0, u(0.5, 3.0))[int(rng.integers(2))],
-                "noise_angle_deg": round(0.25 * k, 3), "noise_force_N": round(0.005 * k, 4)}
-
-    def fr() -> float:
-        return u(0.02, 0.12)
+    record, fr = _shapes(rng, u)
 
     play, p2, s1, s2 = u(0.03, 0.12), u(0.02, 0.05), u(0.03, 0.08), u(0.1, 0.2)
     f1, f2, f3 = form(), form(), form()
@@ -375,6 +372,12 @@ def heldout9_batch(seed: int = 20261130) -> list:
          {"play.play_mm": play, "slack.deadband_mm": s2}, record()),
         ("control", t(), Hidden(joint_friction_nmm=fr()), set(), {}, record()),
     ]
+
+
+def heldout10_batch(seed: int = 20261201) -> list:
+    """A tenth fresh batch, drawn once dropping by the all-rows BIC was settled: the ninth batch's composition
+    with new seeds (23000-), new parameters and record shapes."""
+    return heldout9_batch(seed)
 
 
 #: The two sensor offsets: a constant angle shift each (the output declares them indistinguishable).
@@ -571,7 +574,7 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--batch", default="tune",
                     choices=("tune", "heldout", "heldout2", "heldout3", "heldout4", "heldout5", "heldout6", "heldout7",
-                             "heldout8", "heldout9", "speed", "controls", "variants", "all"))
+                             "heldout8", "heldout9", "heldout10", "speed", "controls", "variants", "all"))
     args = ap.parse_args()
     if args.batch in ("speed", "all", "tune"):
         speed()
@@ -583,7 +586,8 @@ def main() -> None:
                                ("heldout2", heldout2_batch, 7000), ("heldout3", heldout3_batch, 9000),
                                ("heldout4", heldout4_batch, 11000), ("heldout5", heldout5_batch, 13000),
                                ("heldout6", heldout6_batch, 15000), ("heldout7", heldout7_batch, 17000),
-                               ("heldout8", heldout8_batch, 19000), ("heldout9", heldout9_batch, 21000)):
+                               ("heldout8", heldout8_batch, 19000), ("heldout9", heldout9_batch, 21000),
+                               ("heldout10", heldout10_batch, 23000)):
         if args.batch not in (batch, "all"):
             continue
         sets = sets if not callable(sets) else sets()
