@@ -149,17 +149,24 @@ def test_swaps_as_good_as_the_chain_are_declared_indistinguishable():
     assert out[1] == rounds[1]
 
 
-def test_a_stand_in_made_redundant_by_a_later_effect_is_dropped():
-    # a viscoelastic tendon with play on tube 1, noisy, pausing at zero stroke: play explains nothing while the
-    # viscoelastic loop dominates, so it left the narrowed pool; tendon-sheath friction stood in for it. The
-    # full retry finds play, and before stopping the friction is dropped (not significantly needed any more)
-    p = load_pattern(PATTERNS / "tube1.yaml")
-    sim = simulate(p, Hidden(visco_ratio=0.522, visco_tau_s=3.854, play_mm=0.05, joint_friction_nmm=0.105),
-                   n_samples=2, n_cycles=50, rate_hz=10.0, seed=19005, dwell_s=0.73, noise_angle_deg=0.415,
-                   noise_force_N=0.0083)
+@pytest.mark.parametrize("tube, hidden, seed, dwell_s, noise_deg", [
+    # tube 1: play explains nothing while the viscoelastic loop dominates, so it left the narrowed pool;
+    # tendon-sheath friction stood in for it. The full retry finds play, and the friction goes before stopping
+    # (the chain is not significantly worse without it on held-out cycles)
+    ("tube1", Hidden(visco_ratio=0.522, visco_tau_s=3.854, play_mm=0.05, joint_friction_nmm=0.105), 19005, 0.73,
+     0.415),
+    # tube 2: friction is chosen before play; on the thinned search rows (a coarser history for the play
+    # operator) it still helps, on all rows it does not (all-rows BIC), so it goes
+    ("tube2", Hidden(visco_ratio=0.486, visco_tau_s=3.549, play_mm=0.089, joint_friction_nmm=0.073), 21004, 1.417,
+     0.428),
+])
+def test_a_stand_in_made_redundant_by_a_later_effect_is_dropped(tube, hidden, seed, dwell_s, noise_deg):
+    p = load_pattern(PATTERNS / f"{tube}.yaml")
+    sim = simulate(p, hidden, n_samples=2, n_cycles=50, rate_hz=10.0, seed=seed, dwell_s=dwell_s,
+                   noise_angle_deg=noise_deg, noise_force_N=noise_deg / 50.0)
     d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
     assert set(d.recommended) == {"viscoelastic", "play"}
-    assert abs(d.final.params["play.play_mm"] - 0.05) < 0.005
+    assert abs(d.final.params["play.play_mm"] / hidden.play_mm - 1.0) < 0.1
     assert d.dropped == ("friction",) and "dropped: friction" in diagnosis_text(d)
     assert diagnosis_dict(d)["dropped"] == ["friction"]
     assert all(b.rmse_deg < a.rmse_deg for a, b in zip(d.waterfall, d.waterfall[1:]))
