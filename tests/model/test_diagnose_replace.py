@@ -170,3 +170,16 @@ def test_a_stand_in_made_redundant_by_a_later_effect_is_dropped(tube, hidden, se
     assert d.dropped == ("friction",) and "dropped: friction" in diagnosis_text(d)
     assert diagnosis_dict(d)["dropped"] == ["friction"]
     assert all(b.rmse_deg < a.rmse_deg for a, b in zip(d.waterfall, d.waterfall[1:]))
+
+
+def test_time_constants_are_judged_against_the_measured_sampling_not_the_thinned_search_rows():
+    # a viscoelastic tendon with a 1.29 s retardation on tube 3, sampled at 10 Hz: the candidate search thins
+    # the rows to one in five, whose 0.5 s interval once made 1.29 s "shorter than three sample intervals"
+    # and left the effect out (a partial chain of four stand-ins at 8.3x the floor)
+    p = load_pattern(PATTERNS / "tube3.yaml")
+    sim = simulate(p, Hidden(visco_ratio=0.206, visco_tau_s=1.293, joint_friction_nmm=0.04), n_samples=2,
+                   n_cycles=50, rate_hz=10.0, seed=23005, stroke_shape="sine", noise_angle_deg=0.174,
+                   noise_force_N=0.0035)
+    d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
+    assert d.recommended == ("viscoelastic",)
+    assert abs(d.final.params["viscoelastic.tau_s"] / 1.293 - 1.0) < 0.1

@@ -80,6 +80,7 @@ others are ratios of errors or multiples of standard errors.
 from __future__ import annotations
 
 import math
+import weakref
 import time
 from dataclasses import dataclass, field, replace
 from typing import Mapping, Sequence
@@ -478,15 +479,28 @@ def _names_for(model: JointModel, fit_params: Sequence[str]) -> tuple:
     return tuple(dict.fromkeys(out))
 
 
+_SCALES: "weakref.WeakKeyDictionary[Dataset, tuple]" = weakref.WeakKeyDictionary()
+
+
+def _resolution_scales(data: Dataset) -> tuple[float, float, float]:
+    """``(sample interval s, record length s, stroke span mm)`` of ``data``, cached per Dataset."""
+    hit = _SCALES.get(data)
+    if hit is None:
+        t = np.asarray(data.time_s, float)
+        dts = [np.median(np.diff(t[sl])) for _, sl in data.sample_slices() if sl.stop - sl.start > 2]
+        dt = float(np.median(dts)) if dts else 0.0
+        record = max((float(np.ptp(t[sl])) for _, sl in data.sample_slices()), default=0.0)
+        span = float(np.ptp(np.asarray(data.stroke_mm, float))) if len(data) else 0.0
+        hit = _SCALES[data] = (dt, record, span)
+    return hit
+
+
 def _resolution_problems(model: JointModel, names: Sequence[str], values: Mapping[str, float],
                          stderr: Mapping[str, float], at_bound: Sequence[str], data: Dataset,
                          modulus_range_gpa: tuple[float, float]) -> list[str]:
-    """Why the fitted ``names`` cannot be trusted: on a bound, infinite stderr, not resolvable by the data."""
-    t = np.asarray(data.time_s, float)
-    dts = [np.median(np.diff(t[sl])) for _, sl in data.sample_slices() if sl.stop - sl.start > 2]
-    dt = float(np.median(dts)) if dts else 0.0
-    record = max((float(np.ptp(t[sl])) for _, sl in data.sample_slices()), default=0.0)
-    span = float(np.ptp(np.asarray(data.stroke_mm, float))) if len(data) else 0.0
+    """Why the fitted ``names`` cannot be trusted: on a bound, infinite stderr, not resolvable by ``data`` (all
+    the rows measured: the search's thinned rows have a longer interval but resolve the same time constants)."""
+    dt, record, span = _resolution_scales(data)
     out = []
     free_base = {nm.split("@")[0] for nm in names if nm not in at_bound and math.isfinite(stderr.get(nm, math.inf))}
     for nm in names:
@@ -695,7 +709,7 @@ def diagnose(
         ranked = _round(current, search, cur_names, cur, cur_ho, cur_mse, fold, block, tried_pool, floor, fixed,
                         bic_threshold, min_gain, min_excess, z, grid, modulus_range_gpa, cur_ps, strata,
                         per_sample and len(search.samples) > 1 and not swaps_only, init, tuple(chosen),
-                        swap_all=swaps_only)
+                        swap_all=swaps_only, measured=data)
         if retry_pool and not swaps_only:
             ranked = tuple(sorted(tuple(retry_prev) + tuple(ranked),
                                   key=lambda c: (not c.significant, c.heldout_rmse_deg, c.effect, c.replaces)))
@@ -872,7 +886,7 @@ def _baseline_try(eff: Effect, model: JointModel, current: JointModel, search: D
     from the start (model + eff, + each chosen effect in turn) lowers the RMSE at every step.
     """
     ranked = _round(current, search, cur_names, cur, cur_ho, cur_mse, fold, block, [eff], floor, fixed,
-                    bic_threshold, min_gain, min_excess, z, grid, modulus_range_gpa, cur_ps, strata)
+                    bic_threshold, min_gain, min_excess, z, grid, modulus_range_gpa, cur_ps, strata, measured=data)
     c = next((c for c in ranked if not c.replaces), None)
     if c is None or not c.significant:
         return None
@@ -1038,7 +1052,7 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
            grid: int, modulus_range_gpa: tuple[float, float], cur_ps: Sequence[str] = (),
            strata: np.ndarray | None = None, try_per_sample: bool = False,
            init: Mapping[str, float] | None = None, swappable: Sequence[Effect] = (),
-           swap_all: bool = False) -> tuple[Candidate, ...]:
+           swap_all: bool = False, measured: Dataset | None = None) -> tuple[Candidate, ...]:
     """Every effect of ``pool`` on top of ``current``, ranked by held-out RMSE.
 
     With ``try_per_sample``, the best :data:`PER_SAMPLE_TRIES` effects are also fitted with per-sample
@@ -1120,7 +1134,7 @@ def _round(current: JointModel, search: Dataset, cur_names: tuple, cur: FitResul
         if gain >= min_gain and not gz > z:
             why.append(f"the held-out gain is {gz:.1f} standard errors, not more than {z:g} (within the noise)")
         if new and not why:
-            why += _resolution_problems(m, list(f.fitted), f.params, f.stderr, f.at_bound, search,
+            why += _resolution_problems(m, list(f.fitted), f.params, f.stderr, f.at_bound, measured or search,
                                         modulus_range_gpa)
         tried.append(Candidate(eff.name, tuple(e.name for e in m.effects), f.rmse, ho, dbic, params,
                                confounded=tuple(conf), significant=not why, why="; ".join(why),
