@@ -682,9 +682,12 @@ def diagnose(
             if not chosen or swaps_tried:
                 break
             swaps_only = swaps_tried = True
-        if len(recommended) >= max_effects:
+        if not swaps_only and len(recommended) >= max_effects:
             stop = f"stopped after {max_effects} effects"
-            break
+            # the same swaps and drops before this stop: a full chain may hold stand-ins
+            if swaps_tried:
+                break
+            swaps_only = swaps_tried = True
         if not pool:
             stop = "no candidate effects left"
             break
