@@ -257,25 +257,33 @@ def _forms(rng):
     return lambda: forms[int(rng.integers(len(forms)))]
 
 
-def heldout7_batch(seed: int = 20261128) -> list:
-    """A seventh fresh batch, drawn once the joint's rest angle in the baseline and the swap round were settled
-    (every earlier batch had been looked at): new seeds (17000-), new parameters, and record shapes the
-    earlier batches lack, drawn at random per set: a sine or triangular stroke, a pause at zero stroke of 0-3 s,
-    sensor noise 0.5-2x the usual, joint friction 0.02-0.12 N mm."""
-    rng, u, t = _drawers(seed)
+def _toe_opening(rng, u, t, record, fr) -> tuple:
+    """The values and first four sets the seventh and ninth batches share: ``(play, p2, s1, s2, sets)``, sets
+    being a control and three toes of random form (alone, with play, with slack), each with its record shape."""
     form = _forms(rng)
-
-    record, fr = _shapes(rng, u)
-
     play, p2, s1, s2 = u(0.03, 0.12), u(0.02, 0.05), u(0.03, 0.08), u(0.1, 0.2)
     f1, f2, f3 = form(), form(), form()
-    return [
+    sets = [
         ("control", t(), Hidden(joint_friction_nmm=fr()), set(), {}, record()),
         (f"{f1}-toe", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f1, joint_friction_nmm=fr()), TOES, {}, record()),
         (f"{f2}-toe + play", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f2, play_mm=play, joint_friction_nmm=fr()),
          TOES | {"play"}, {"play.play_mm": play}, record()),
         (f"{f3}-toe + slack", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f3, slack_mm=s1, joint_friction_nmm=fr()),
          TOES | {"slack"}, {}, record()),
+    ]
+    return play, p2, s1, s2, sets
+
+
+def heldout7_batch(seed: int = 20261128) -> list:
+    """A seventh fresh batch, drawn once the joint's rest angle in the baseline and the swap round were settled
+    (every earlier batch had been looked at): new seeds (17000-), new parameters, and record shapes the
+    earlier batches lack, drawn at random per set: a sine or triangular stroke, a pause at zero stroke of 0-3 s,
+    sensor noise 0.5-2x the usual, joint friction 0.02-0.12 N mm."""
+    rng, u, t = _drawers(seed)
+    record, fr = _shapes(rng, u)
+    play, p2, s1, s2, toe_sets = _toe_opening(rng, u, t, record, fr)
+    return [
+        *toe_sets,
         ("viscoelastic", t(), Hidden(visco_ratio=(r := u(0.2, 0.6)), visco_tau_s=(tau := u(1.0, 4.0)),
                                      joint_friction_nmm=fr()),
          {"viscoelastic"}, {"viscoelastic.ratio": r, "viscoelastic.tau_s": tau}, record()),
@@ -303,9 +311,7 @@ def heldout8_batch(seed: int = 20261129) -> list:
     (force-driven) creep, a form the library's time-driven creep does not share."""
     rng, u, t = _drawers(seed)
     form = _forms(rng)
-
     record, fr = _shapes(rng, u)
-
     play, s1, s2 = u(0.03, 0.12), u(0.03, 0.08), u(0.1, 0.2)
     f1, f2, f3 = form(), form(), form()
     return [
@@ -342,19 +348,10 @@ def heldout9_batch(seed: int = 20261130) -> list:
     record shapes drawn per set as in heldout7. Looked at since: its viscoelastic + play set led to dropping
     by the all-rows BIC."""
     rng, u, t = _drawers(seed)
-    form = _forms(rng)
-
     record, fr = _shapes(rng, u)
-
-    play, p2, s1, s2 = u(0.03, 0.12), u(0.02, 0.05), u(0.03, 0.08), u(0.1, 0.2)
-    f1, f2, f3 = form(), form(), form()
+    play, p2, s1, s2, toe_sets = _toe_opening(rng, u, t, record, fr)
     return [
-        ("control", t(), Hidden(joint_friction_nmm=fr()), set(), {}, record()),
-        (f"{f1}-toe", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f1, joint_friction_nmm=fr()), TOES, {}, record()),
-        (f"{f2}-toe + play", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f2, play_mm=play, joint_friction_nmm=fr()),
-         TOES | {"play"}, {"play.play_mm": play}, record()),
-        (f"{f3}-toe + slack", t(), Hidden(toe_mm=u(0.15, 0.5), toe_form=f3, slack_mm=s1, joint_friction_nmm=fr()),
-         TOES | {"slack"}, {}, record()),
+        *toe_sets,
         ("viscoelastic + play", t(), Hidden(visco_ratio=u(0.2, 0.6), visco_tau_s=u(1.0, 4.0), play_mm=play,
                                             joint_friction_nmm=fr()),
          {"viscoelastic", "play"}, {"play.play_mm": play}, record()),

@@ -751,16 +751,9 @@ def diagnose(
             inter: list[Step] = []
             if not problems and c.replaces:
                 # the waterfall without the replaced effects: every step must still lower the RMSE
-                for i in range(1, len(keep) + 1):
-                    mi = model.with_effects(list(model.effects) + keep[:i])
-                    ni = _names_for(mi, fit_params)
-                    psi = [n for n in ps if n.split("@")[0] in ni]
-                    ri = refit_all_rows(mi, data, ni, fixed,
-                                        {k: v for k, v in r.params.items() if k.split("@")[0] in ni}, grid,
-                                        per_sample=psi)
-                    inter.append(_step(ri, psi))
-                seq = [steps[0].rmse_deg] + [x.rmse_deg for x in inter] + [r.rmse]
-                if not all(b < a for a, b in zip(seq, seq[1:])):
+                inter = _chain_steps(model, keep, range(1, len(keep) + 1), data, fit_params, fixed, r.params, grid,
+                                     ps)
+                if not _each_lower([steps[0].rmse_deg] + [x.rmse_deg for x in inter] + [r.rmse]):
                     problems.append(f"without {', '.join(c.replaces)} a step of the chain does not lower the RMSE")
             if problems:
                 rejected.append((c, "; ".join(problems)))
@@ -876,6 +869,27 @@ def _without(model: JointModel, names: Sequence[str], per_sample: Sequence[str],
             tuple(n for n in names if n not in gone), [n for n in per_sample if n.split("@")[0] not in gone])
 
 
+def _chain_steps(start: JointModel, effects: Sequence[Effect], counts, data: Dataset, fit_params: Sequence[str],
+                 fixed: Mapping[str, float], values: Mapping[str, float], grid: int,
+                 per_sample: Sequence[str]) -> list[Step]:
+    """Waterfall steps of ``start`` plus ``effects[:i]`` for each ``i`` of ``counts``, each refitted on all rows
+    from ``values`` (per-sample names kept where the step has the parameter)."""
+    out = []
+    for i in counts:
+        mi = start.with_effects(list(start.effects) + list(effects[:i]))
+        ni = _names_for(mi, fit_params)
+        psi = [n for n in per_sample if n.split("@")[0] in ni]
+        ri = refit_all_rows(mi, data, ni, fixed, {k: v for k, v in values.items() if k.split("@")[0] in ni}, grid,
+                            per_sample=psi)
+        out.append(_step(ri, psi))
+    return out
+
+
+def _each_lower(rmse_deg: Sequence[float]) -> bool:
+    """Every value below the one before it (every step of a waterfall lowers the RMSE)."""
+    return all(b < a for a, b in zip(rmse_deg, rmse_deg[1:]))
+
+
 def _baseline_try(eff: Effect, model: JointModel, current: JointModel, search: Dataset, data: Dataset,
                   cur_names: tuple, cur: FitResult, cur_ho: float, cur_mse: np.ndarray, fold: np.ndarray,
                   block: np.ndarray, floor: float, fixed: Mapping[str, float], bic_threshold: float, min_gain: float,
@@ -901,17 +915,9 @@ def _baseline_try(eff: Effect, model: JointModel, current: JointModel, search: D
                                                           data, modulus_range_gpa):
         return None
     start = model.with_effects(list(model.effects) + [eff])
-    steps = []
-    for i in range(len(chosen)):
-        mi = start.with_effects(list(start.effects) + list(chosen[:i]))
-        ni = _names_for(mi, fit_params)
-        psi = [n for n in cur_ps if n.split("@")[0] in ni]
-        ri = refit_all_rows(mi, data, ni, fixed, {k: v for k, v in r.params.items() if k.split("@")[0] in ni},
-                            grid, per_sample=psi)
-        steps.append(_step(ri, psi))
+    steps = _chain_steps(start, chosen, range(len(chosen)), data, fit_params, fixed, r.params, grid, cur_ps)
     steps.append(_step(r, cur_ps, {k: v for k, v in init.items() if k in r.fitted}))
-    seq = [st.rmse_deg for st in steps]
-    if not all(b < a for a, b in zip(seq, seq[1:])):
+    if not _each_lower([st.rmse_deg for st in steps]):
         return None
     return start, chain, names, r, steps, c
 
@@ -944,16 +950,9 @@ def _drop_try(model: JointModel, current: JointModel, search: Dataset, data: Dat
         if _resolution_problems(m, list(r.fitted), r.params, r.stderr, r.at_bound, data, modulus_range_gpa):
             continue
         keep = [e for e in chosen if e.name != old.name]
-        steps = []
-        for i in range(len(keep)):
-            mi = model.with_effects(list(model.effects) + keep[:i])
-            ni = _names_for(mi, fit_params)
-            psi = [n for n in ps if n.split("@")[0] in ni]
-            ri = refit_all_rows(mi, data, ni, fixed, {k: v for k, v in r.params.items() if k.split("@")[0] in ni},
-                                grid, per_sample=psi)
-            steps.append(_step(ri, psi))
+        steps = _chain_steps(model, keep, range(len(keep)), data, fit_params, fixed, r.params, grid, ps)
         steps.append(_step(r, ps, {k: v for k, v in init.items() if k in r.fitted}))
-        if all(b.rmse_deg < a.rmse_deg for a, b in zip(steps, steps[1:])):
+        if _each_lower([st.rmse_deg for st in steps]):
             return old, m, names, ps, r, steps, f, ho, mse
     return None
 
