@@ -657,7 +657,8 @@ def diagnose(
     notes_late: list[str] = []
     stop = ""
     while True:
-        for eff in list(pending):
+        # (not again before a full retry: the chain is the one the last try saw)
+        for eff in ([] if retry_pool else list(pending)):
             got = _baseline_try(eff, model, current, search, data, cur_names, cur, cur_ho, cur_mse, fold, block,
                                 floor, fixed, bic_threshold, min_gain, min_excess, z, grid, modulus_range_gpa,
                                 cur_ps, strata, prev_all, chosen, fit_params)
