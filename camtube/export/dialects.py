@@ -79,14 +79,27 @@ class Dialect:
     spindle_per_watt: float = 0.0
     profile: object = field(default=None, compare=False, repr=False)
 
+    @property
+    def uses_speed(self) -> bool:
+        """True when a settings line depends on the pass's scan speed (the pulses per mm)."""
+        return any("pulses_per_mm" in x for x in self.settings)
+
     def comment_line(self, text: str) -> str:
         """``text`` as a comment line (parentheses removed from paren comments)."""
         if self.comment == "paren":
             return "(" + text.replace("(", "[").replace(")", "]") + ")"
         return "; " + text
 
-    def fields(self, power_w: float, frequency_khz: float) -> dict:
-        return {"power_w": power_w, "frequency_khz": frequency_khz, "spindle": power_w * self.spindle_per_watt}
+    def fields(self, power_w: float, frequency_khz: float, speed_mm_s: float = 0.0,
+               outer_radius_mm: float = 0.0) -> dict:
+        """Values of the format fields of ``laser_on`` and ``settings`` for one pass's settings.
+
+        ``pulses_per_mm`` = pulses per mm of path at the scan speed (1/mm, the dose of a
+        distance-gated laser), ``outer_radius_mm`` the tube's (mm).
+        """
+        ppmm = 1000.0 * frequency_khz / speed_mm_s if speed_mm_s > 0 else 0.0
+        return {"power_w": power_w, "frequency_khz": frequency_khz, "spindle": power_w * self.spindle_per_watt,
+                "pulses_per_mm": ppmm, "outer_radius_mm": outer_radius_mm}
 
 
 def blending_line(profile) -> str | None:
@@ -113,7 +126,9 @@ def dialect_from_profile(profile) -> Dialect:
     if profile.dialect == "linuxcnc":
         g = profile.gate_output
         settings = tuple(line for out, line in ((profile.power_output, "M68 E{} Q{{power_w:.3f}}"),
-                                                (profile.frequency_output, "M68 E{} Q{{frequency_khz:.3f}}"))
+                                                (profile.frequency_output, "M68 E{} Q{{frequency_khz:.3f}}"),
+                                                (profile.dose_output, "M68 E{} Q{{pulses_per_mm:.6f}}"),
+                                                (profile.radius_output, "M68 E{} Q{{outer_radius_mm:.6f}}"))
                          if out is not None for line in [line.format(out)])
         pre = ("G21 G90 G17 G40 G49 G80",) + ((blend,) if blend else ()) + (f"M65 P{g}", "G93", f"G0 {az}0")
         return Dialect(preamble=pre, postamble=(f"M65 P{g}", "G94", "M2"), laser_on=f"M62 P{g}",

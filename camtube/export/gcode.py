@@ -150,11 +150,11 @@ class _Emitter:
         lead, tail = ("(", ")") if d.comment == "paren" else ("; ", "")
         self.comment = (lead + "pass {}: cut {} {}, repeat {}, focus {} at {:g} mm, drill {} offset {:.4f} mm"
                         + tail).format
-        self.gates: dict[tuple[float, float], tuple[str, str]] = {}
-        self.prev_key: tuple[float, float] | None = None
+        self.gates: dict[tuple[float, float, float], tuple[str, str]] = {}
+        self.prev_key: tuple[float, float, float] | None = None
         self.blocks: dict[tuple[int, float], tuple[str, str, bool, bool]] = {}
 
-    def _gate_on(self, key: tuple[float, float]) -> tuple[str, str]:
+    def _gate_on(self, key: tuple[float, float, float]) -> tuple[str, str]:
         """(settings lines where they change, the gate-on line).
 
         The settings (``M68`` on LinuxCNC) are not motion-synchronised: the controller stops to
@@ -164,10 +164,13 @@ class _Emitter:
         d = self.d
         g = self.gates.get(key)
         if g is None:
-            fields = d.fields(*key)
+            fields = d.fields(*key, self.job.outer_radius_mm)
             g = self.gates[key] = ("".join(x.format(**fields) + "\n" for x in d.settings),
                                    d.laser_on.format(**fields))
-        out = (g[0] if key != self.prev_key else ""), g[1]
+        # power and frequency (and the dose, for a distance-gated laser) are written where they change
+        same = self.prev_key is not None and (key == self.prev_key or (key[:2] == self.prev_key[:2]
+                                                                       and not self.d.uses_speed))
+        out = ("" if same else g[0]), g[1]
         self.prev_key = key
         return out
 
@@ -241,7 +244,7 @@ class _Emitter:
                 blk = self._rows(X, Y, Z, F, K, L, i, r1)
             before, after, opened, reopened = blk
             if opened:
-                settings, gate_on = self._gate_on((pw, fq))
+                settings, gate_on = self._gate_on((pw, fq, speed))
                 text.append(settings + before + gate_on)
                 text.append(after.replace(_REOPEN, gate_on) if reopened else after)
             elif before:

@@ -12,6 +12,10 @@ Figures (:class:`MotionReport`):
 - run time (first to last cycle with motion) against the estimate and the lower bound;
 - beam-on path length against the job's cut length;
 - share of the beam-on path run within +-5 % of the scan speed;
+- dose: share of the beam-on path that gets within +-5 % of the nominal pulses per mm
+  (``1000 frequency_khz / scan_speed``): from the recorded pulse rate of a distance-gated
+  profile (the rate commanded at sample ``k`` is in force from ``k`` to ``k + 1``), or, for a
+  time-gated one, the set frequency over the recorded speed;
 - farthest beam-on position outside the design cut regions (the tube is periodic in y);
 - largest distance from a drawn corner (every vertex of every pass path, matched by
   focus level) to the beam-on path at that focus.
@@ -55,6 +59,7 @@ class JobGeometry:
     corners: np.ndarray
     estimate_s: float
     lower_bound_s: float
+    frequency_khz: float = math.nan
 
     @classmethod
     def from_job(cls, job, estimate_s: float = math.nan) -> "JobGeometry":
@@ -64,7 +69,8 @@ class JobGeometry:
                                   for p in job.passes]) if job.passes else np.zeros((0, 3))
         return cls(job.name, float(job.outer_radius_mm), float(job.process.scan_speed_mm_s),
                    float(job.cut_length_mm), tuple(np.asarray(c.points, float) for c in job.design), corners,
-                   float(estimate_s), float(job.cut_length_mm / job.process.scan_speed_mm_s))
+                   float(estimate_s), float(job.cut_length_mm / job.process.scan_speed_mm_s),
+                   float(job.process.frequency_khz))
 
     @classmethod
     def from_job_file(cls, path: str | os.PathLike) -> "JobGeometry":
@@ -107,6 +113,9 @@ class MotionReport:
     corners: int
     samples: int
     wall_s: float
+    dose_share: float = math.nan
+    nominal_pulses_per_mm: float = math.nan
+    distance_gated: bool = False
 
     @property
     def estimate_error(self) -> float:
@@ -132,6 +141,10 @@ class MotionReport:
             ("within +-5 % of scan speed", f"{100 * self.speed_share:.2f}", f"% of the beam-on path (scan "
                                                                             f"{self.scan_speed_mm_s:g} mm/s, median "
                                                                             f"{self.median_speed_mm_s:.2f})"),
+            ("dose within +-5 %", f"{100 * self.dose_share:.2f}", f"% of the beam-on path (nominal "
+                                                                 f"{self.nominal_pulses_per_mm:.1f} pulses/mm, "
+                                                                 + ("distance-gated rate recorded)" if self.distance_gated
+                                                                    else "time-gated: set frequency / speed)")),
             ("beam on outside cut regions", f"{1000 * self.max_outside_mm:.3f}", "um at most"),
             ("drawn corner missed by", f"{1000 * self.max_corner_miss_mm:.3f}", f"um at most ({self.corners} "
                                                                                 "corners)"),
@@ -254,6 +267,15 @@ def analyse(rec, geom: JobGeometry, profile, estimate_s: float | None = None) ->
         outside = _outside_mm(pts[:, 0], pts[:, 1], geom.regions, big)
         miss = _corner_miss_mm(geom.corners, a, b, z[ia], big)
     est = geom.estimate_s if estimate_s is None else float(estimate_s)
+    nominal = 1000.0 * geom.frequency_khz / v
+    rate = getattr(rec, "rate_khz", None)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if rate is not None:  # pulses fired over each beam-on interval per mm moved
+            ppmm = 1000.0 * rate[:-1][on] * dt[on] / lo
+        else:  # time gating: the set frequency, whatever the speed
+            ppmm = 1000.0 * geom.frequency_khz / speed
+    good = np.abs(ppmm / nominal - 1.0) <= SPEED_BAND
+    dose_share = float(lo[good].sum() / length) if length > 0 else 0.0
     return MotionReport(geom.name, profile.name, rec.run_time_s, est, geom.lower_bound_s, float(dt[on].sum()),
                         length, geom.cut_length_mm, v, share, median, outside, miss, len(geom.corners), len(rec),
-                        rec.wall_s)
+                        rec.wall_s, dose_share, nominal, rate is not None)
