@@ -58,6 +58,10 @@ class Dialect:
         ``(text)`` or ``; text``.
     spindle_per_watt : float
         S value per watt for ``{spindle}``.
+    blend_on, blend_off : str | None
+        ``blend`` corner strategy: the lines written before the first beam-on move of a pass
+        (``G64 P<tol>``) and before its last (``G61``, so the machine stops where the gate closes);
+        None otherwise.
     profile : MachineProfile | None
         The machine profile the dialect was built from (limits, blending, corner strategy).
     """
@@ -78,6 +82,8 @@ class Dialect:
     comment: Literal["paren", "semicolon"] = "paren"
     spindle_per_watt: float = 0.0
     profile: object = field(default=None, compare=False, repr=False)
+    blend_on: str | None = None
+    blend_off: str | None = None
 
     @property
     def uses_speed(self) -> bool:
@@ -103,8 +109,12 @@ class Dialect:
 
 
 def blending_line(profile) -> str | None:
-    """The G-code line that sets ``profile.blending`` (None: leave the controller's own)."""
-    if profile.blending == "exact_stop":
+    """The G-code line that sets ``profile.blending`` (None: leave the controller's own).
+
+    Under the ``blend`` corner strategy the program starts in exact stop; the emitter switches to
+    the tolerance for the beam-on moves of each pass (:attr:`Dialect.blend_on`).
+    """
+    if profile.blending == "exact_stop" or profile.corner_strategy == "blend":
         return "G61"
     if profile.blending == "controller":
         return None
@@ -131,8 +141,10 @@ def dialect_from_profile(profile) -> Dialect:
                                                 (profile.radius_output, "M68 E{} Q{{outer_radius_mm:.6f}}"))
                          if out is not None for line in [line.format(out)])
         pre = ("G21 G90 G17 G40 G49 G80",) + ((blend,) if blend else ()) + (f"M65 P{g}", "G93", f"G0 {az}0")
+        blend = (f"G64 P{profile.blending:g}", "G61") if profile.corner_strategy == "blend" else (None, None)
         return Dialect(preamble=pre, postamble=(f"M65 P{g}", "G94", "M2"), laser_on=f"M62 P{g}",
-                       laser_off=f"M63 P{g}", settings=settings, feed_mode="inverse_time", **common)
+                       laser_off=f"M63 P{g}", settings=settings, feed_mode="inverse_time", blend_on=blend[0],
+                       blend_off=blend[1], **common)
     pre = ("G21 G90 G17 G94",) + ((blend,) if blend else ()) + ("M5", f"G0 {az}0")
     return Dialect(preamble=pre, postamble=("M5", "M2"), laser_on=f"{profile.spindle} S{{spindle:.0f}}",
                    laser_off="M5", feed_mode="units_per_minute", spindle_per_watt=profile.s_per_watt, **common)

@@ -186,6 +186,7 @@ class _Emitter:
         parts: list[str] = []
         before = None
         state = False
+        blend_on, blend_off = d.blend_on, d.blend_off
         for i in range(lo, hi):
             on = L[i]
             if on != state:
@@ -194,6 +195,11 @@ class _Emitter:
                 else:
                     parts.append((_REOPEN if on else d.laser_off) + "\n")
                 state = on
+                last = on and (i + 1 == hi or not L[i + 1])
+                if on and blend_on is not None and not last:
+                    parts.append(blend_on + "\n")  # the beam-on run is one blended path ...
+            if on and blend_off is not None and (i + 1 == hi or not L[i + 1]):
+                parts.append(blend_off + "\n")  # ... that ends at rest, where the gate closes
             k = K[i]
             if k == RAPID:
                 parts.append(self.rapid(X[i], Y[i]) + "\n")

@@ -105,7 +105,85 @@ def move_limits(d: np.ndarray, letters, profile, requested_v: np.ndarray):
     return L, vmax, alim
 
 
-def trajectory_time(d: np.ndarray, letters, profile, requested_v: np.ndarray, joined: np.ndarray) -> MotionEstimate:
+#: LinuxCNC 2.9's blend arcs (``tp.h``, ``blendmath.c``): the share of the acceleration a blend arc
+#: uses tangentially, and normally (sqrt(1 - 0.5^2)); the share of a line a blend may consume.
+BLEND_ACC_RATIO_TANGENTIAL = 0.5
+BLEND_ACC_RATIO_NORMAL = math.sqrt(1.0 - BLEND_ACC_RATIO_TANGENTIAL ** 2)
+BLEND_DIST_FRACTION = 0.5
+BLEND_TOL_FRACTION = 0.25
+TP_MIN_SEGMENT_CYCLES = 1.02
+
+
+def _blend_arcs(L, vmax, a, req, u, blend, tol_mm, a_plane, sample_s=0.0):
+    """Lines joined by LinuxCNC's tangent blend arcs: (L, vmax, a, joined) of lines and arcs in turn.
+
+    Follows LinuxCNC 2.9's line-line blend (``blendInit3FromLineLine``, ``blendComputeParameters``):
+    at a junction turning by ``phi`` (half-angle ``theta = (pi - phi) / 2``) within tolerance ``T``
+    (the G64 P value, at most a quarter of either line), the arc may reach ``d_geom = min(L1, L2,
+    cos(theta) T / (1 - sin(theta)))`` along each line (L1: what is left of the first line, at most
+    half of it; L2: half the second); its speed is ``v_plan = min(sqrt(a_n tan(theta) d_geom),
+    requested)`` with ``a_n = 0.866 a``; its radius ``R = max(v_plan^2 / a_n, R_blend)``; it
+    trims ``R / tan(theta)`` off both lines and runs at ``v_plan`` with half the acceleration.
+
+    Parameters
+    ----------
+    L, vmax, a, req : (m,) float
+        Length (mm), velocity limit, acceleration limit and requested velocity of each line.
+    u : (m, 3) float
+        Unit direction of each line (XYZ).
+    blend : (m,) bool
+        ``blend[i]``: the junction after line ``i`` is blended (G64 active when it was queued).
+    tol_mm : float
+        The blending tolerance (G64 P).
+    a_plane : float
+        Acceleration bound in the plane of the lines (mm/s^2).
+    sample_s : float
+        LinuxCNC runs a line in no less than ``TP_MIN_SEGMENT_CYCLES`` servo cycles: its speed is
+        at most its length over this (s); 0: no such limit.
+    """
+    m = len(L)
+    trim_start = np.zeros(m)
+    out_L, out_v, out_a, out_j = [], [], [], []
+    Ll, vl, al, rl = L.tolist(), vmax.tolist(), a.tolist(), req.tolist()
+    dots = np.einsum("ij,ij->i", u[:-1], u[1:]).tolist() if m > 1 else []
+    a_n = a_plane * BLEND_ACC_RATIO_NORMAL
+    a_par = 0.5 * a_plane
+    for i in range(m):
+        arc = None
+        trim_end = 0.0
+        if i < m - 1 and blend[i]:
+            phi = math.acos(max(-1.0, min(1.0, dots[i])))
+            if phi > 1e-9:
+                theta = 0.5 * (math.pi - phi)
+                T = min(tol_mm, BLEND_TOL_FRACTION * Ll[i], BLEND_TOL_FRACTION * Ll[i + 1])
+                L1 = min(Ll[i] - trim_start[i], BLEND_DIST_FRACTION * Ll[i])
+                L2 = BLEND_DIST_FRACTION * Ll[i + 1]
+                d_tol = math.cos(theta) * T / (1.0 - math.sin(theta))
+                d_geom = min(L1, L2, d_tol)
+                R_geom = math.tan(theta) * d_geom
+                v_plan = min(math.sqrt(a_n * R_geom), max(rl[i], rl[i + 1]))
+                v_tri = math.sqrt(2.0 * a_par * d_geom)
+                s_blend = min(v_tri, v_plan) / a_par * v_plan
+                R_plan = max(v_plan * v_plan / a_n, min(s_blend / phi, R_geom))
+                trim_end = R_plan / math.tan(theta)
+                trim_start[i + 1] = trim_end
+                arc = (R_plan * phi, v_plan)
+        out_L.append(max(Ll[i] - trim_start[i] - trim_end, 0.0))
+        out_v.append(min(vl[i], Ll[i] / sample_s) if sample_s > 0 else vl[i])
+        out_a.append(al[i])
+        out_j.append(bool(blend[i]) if i < m - 1 else False)
+        if arc is not None:
+            out_L.append(arc[0])
+            out_v.append(arc[1])
+            out_a.append(a_plane * BLEND_ACC_RATIO_TANGENTIAL)
+            out_j.append(True)
+    Lo = np.array(out_L)
+    keep = Lo > 1e-9  # a line the blends on both sides used up entirely is gone
+    return Lo[keep], np.array(out_v)[keep], np.array(out_a)[keep], np.array(out_j, dtype=bool)[keep]
+
+
+def trajectory_time(d: np.ndarray, letters, profile, requested_v: np.ndarray, joined: np.ndarray,
+                    blend: np.ndarray | None = None) -> MotionEstimate:
     """Time of a sequence of straight moves.
 
     Parameters
@@ -118,6 +196,9 @@ def trajectory_time(d: np.ndarray, letters, profile, requested_v: np.ndarray, jo
         Requested path velocity (``inf`` for rapids).
     joined : (m,) bool
         ``joined[i]``: move ``i`` runs into move ``i + 1`` without stopping (the last is ignored).
+    blend : (m,) bool, optional
+        ``blend[i]``: the junction after move ``i`` is a LinuxCNC blend arc within the profile's
+        tolerance (:func:`_blend_arcs`; pure-XYZ moves only); ``joined`` is then ignored there.
     """
     m = len(d)
     if m == 0:
@@ -125,6 +206,14 @@ def trajectory_time(d: np.ndarray, letters, profile, requested_v: np.ndarray, jo
     L, vmax, a = move_limits(d, letters, profile, requested_v)
     keep = L > 1e-12
     L, vmax, a, joined = L[keep], vmax[keep], a[keep], joined[keep].copy()
+    if blend is not None and blend[keep].any():
+        lin = np.array([c in _LINEAR for c in letters])
+        dk = d[keep][:, lin]
+        u = dk / L[:, None]
+        plane = min(profile.axis(c).max_acceleration for c in letters[:2])
+        req = np.minimum(np.asarray(requested_v, float)[keep], vmax)
+        L, vmax, a, joined = _blend_arcs(L, vmax, a, req, u, blend[keep] | joined, float(profile.blending), plane,
+                                         TP_MIN_SEGMENT_CYCLES * profile.servo_period_s)
     m = len(L)
     if m == 0:
         return MotionEstimate(0.0, 0, 0)
@@ -177,7 +266,12 @@ def estimate_machine_moves(mm, profile) -> MotionEstimate:
     joined = _joined(d, letters, profile)
     # every pass starts from rest (a pass boundary is a chunk boundary: the estimate does not depend on chunking)
     joined[:-1] &= n.pass_index[1:] == n.pass_index[:-1]
-    return trajectory_time(d, letters, profile, req, joined)
+    blend = None
+    if profile.corner_strategy == "blend":  # the emitter blends beam-on runs and stops where the gate switches
+        blend = np.zeros(len(d), bool)
+        blend[:-1] = n.laser[:-1] & n.laser[1:] & (n.pass_index[1:] == n.pass_index[:-1])
+        joined &= blend
+    return trajectory_time(d, letters, profile, req, joined, blend)
 
 
 def _joined(d, letters, profile) -> np.ndarray:
@@ -256,8 +350,14 @@ def estimate_program(text: str, profile) -> MotionEstimate:
     inv = np.array(rows_inv)
     req = np.where(inv, _requested_velocity(d, letters, f, is_feed, "inverse_time"),
                    _requested_velocity(d, letters, f, is_feed, "per_minute"))
-    joined = _collinear_cartesian(d, letters) & ~np.array(rows_stop)
-    return trajectory_time(d, letters, profile, req, joined)
+    stop = np.array(rows_stop)
+    joined = _collinear_cartesian(d, letters) & ~stop
+    blend = None
+    if profile.corner_strategy == "blend":  # every junction queued under G64 is a blend arc
+        blend = ~stop
+        blend[-1] = False
+        joined &= blend
+    return trajectory_time(d, letters, profile, req, joined, blend)
 
 
 # ---------------------------------------------------------------- jobs

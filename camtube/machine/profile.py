@@ -12,7 +12,7 @@ Keys (units in the comments of the shipped files; ``docs/motion.md`` has the tab
 ``axes`` (axial, circumferential, focus letters), ``limits.<LETTER>.max_velocity``
 (mm/s or deg/s) and ``.max_acceleration`` (mm/s^2 or deg/s^2), ``blending``
 (``exact_stop``, a path tolerance in mm, or ``controller``), ``corner_strategy``
-(``overtravel`` | ``none``), ``servo_period_s``, ``laser`` (``gate_output``,
+(``overtravel`` | ``none`` | ``blend``), ``servo_period_s``, ``laser`` (``gate_output``,
 ``power_output``, ``frequency_output``, ``gating`` (``time`` | ``distance``),
 ``dose_output``, ``radius_output`` for LinuxCNC; ``spindle`` M3/M4 and
 ``s_per_watt`` for GRBL), ``rotary_range_deg``, ``wrap``, ``comment``
@@ -42,7 +42,7 @@ from camtube.yamltext import closest, line_map
 MACHINES_DIR = Path(__file__).resolve().parents[2] / "machines"
 DEFAULT_MACHINE = "linuxcnc-rotary"
 DIALECT_KINDS = ("linuxcnc", "grbl")
-CORNER_STRATEGIES = ("overtravel", "none")
+CORNER_STRATEGIES = ("overtravel", "none", "blend")
 GATINGS = ("time", "distance")
 COMMENT_STYLES = ("paren", "semicolon")
 
@@ -85,10 +85,14 @@ class MachineProfile:
     blending : str | float
         ``"exact_stop"`` (G61), a path tolerance in mm (G64 P..), or
         ``"controller"`` (nothing written; the controller's own junction handling).
-    corner_strategy : {"overtravel", "none"}
+    corner_strategy : {"overtravel", "none", "blend"}
         ``overtravel``: every cut edge is run at the scan speed from a beam-off
         lead-in to a beam-off lead-out along its own line (uniform dose, see
-        :mod:`camtube.machine.corners`); ``none``: edges run back to back.
+        :mod:`camtube.machine.corners`); ``none``: edges run back to back;
+        ``blend``: the beam-on moves of a pass are one path, blended within the
+        tolerance ``blending`` (``G64 P``: LinuxCNC joins them with tangent arcs at
+        the speed their curvature allows), and the machine stops exactly (``G61``)
+        wherever the gate switches, so the gate never switches in a blend.
     servo_period_s : float
         Controller servo period (s): the motion-synchronised gate switches on this clock.
     gate_output, power_output, frequency_output : int | None
@@ -292,6 +296,10 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
     if corner == "overtravel" and dialect != "linuxcnc":
         ck.add("corner_strategy", "overtravel needs motion-synchronised gating (dialect linuxcnc)", corner,
                "none for grbl", "write corner_strategy: none")
+    if corner == "blend" and (dialect != "linuxcnc" or isinstance(blending, str) or rotary):
+        ck.add("corner_strategy", "blend needs a LinuxCNC profile with a path tolerance (blending: 0.001) on linear "
+               "axes (LinuxCNC blends moves with rotary motion parabolically, at half the acceleration)", corner,
+               "none | overtravel", "write corner_strategy: none, or drive the rotary axis in surface mm (Y)")
     servo = ck.number(m.get("servo_period_s", 0.001), "servo_period_s")
     laser = m.get("laser", {}) or {}
     if not isinstance(laser, dict):

@@ -73,8 +73,10 @@ def simplify_closed(points, tol_mm: float = TOL.path, inside_mm: float = 0.0) ->
             rel = q - a
             cross = sgn * (d[0] * rel[:, 1] - d[1] * rel[:, 0]) / L  # > 0: the vertex lies inside the chord
             t = (rel @ d) / L2
-            viol = np.where(cross > 0, cross / left, -cross / tol_mm)
-            viol = np.where((t < 0) | (t > 1), np.inf, viol)
+            # distance to the chord as a segment (beyond an end: to that end), by side
+            tc = np.clip(t, 0.0, 1.0)
+            dist = np.hypot(rel[:, 0] - tc * d[0], rel[:, 1] - tc * d[1])
+            viol = np.where(cross > 0, dist / left, dist / tol_mm)
             m = int(np.argmax(viol))
             if viol[m] <= 1.0:
                 continue
