@@ -151,10 +151,15 @@ def run(loaded: Loaded, outdir: str | os.PathLike, request: Request, progress: P
 
     files, job, est, cad = outputs(loaded, request, progress)
     if warn is not None and est is not None:
+        from camtube.export.motion_time import slow_job_warning
         from camtube.plan.moves import time_warning
 
-        w = time_warning(job, est)
-        if w:
-            warn(w)
+        from camtube.export.dialects import DIALECTS
+
+        first = request.dialects[0] if request.dialects else next(iter(DIALECTS.values()))
+        profile = getattr(first, "profile", None)  # the machine the estimate is for
+        for w in (time_warning(job, est), slow_job_warning(job, est, profile)):
+            if w:
+                warn(w)
     paths = write_set(Path(outdir), files)
     return Result(paths, job, est, cad)

@@ -128,9 +128,11 @@ def _header(job, dialect: Dialect, est) -> list[str]:
           f"{format_duration_s(est.total_s)}" + (f" on machine {est.machine}" if est.machine else "")
           + f", lower bound {format_duration_s(est.lower_bound_s)}, ratio {est.ratio:.4f}"),
     ]
-    warning = time_warning(job, est)
-    if warning:
-        lines.append(c("WARNING: " + warning))
+    from camtube.export.motion_time import slow_job_warning
+
+    for warning in (time_warning(job, est), slow_job_warning(job, est, dialect.profile, short=True)):
+        if warning:
+            lines.append(c("WARNING: " + warning))
     return lines
 
 

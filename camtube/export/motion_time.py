@@ -402,3 +402,62 @@ def job_estimate(job, dialect, moves=None):
     if moves is None and profile is not None:
         return job.cached(f"_motion_estimate:{profile.source or profile.name}", make)
     return make()
+
+
+# ---------------------------------------------------------------- warnings
+def slow_job_warning(job, est, profile, short: bool = False) -> str | None:
+    """A warning when the estimate exceeds the lower bound by more than ``profile.warn_time_factor``, naming the cause.
+
+    The time above the lower bound (cut length / scan speed) is split into its causes:
+
+    - **segments**: the estimate above the time-optimal bound (:mod:`camtube.machine.bound`): stops
+      and slow-downs the machine makes where the path is smooth (a flattened curve cut as
+      separate moves under exact stop, or blends slower than its curvature allows);
+    - **corners**: the time-optimal bound's path time above the lower bound: braking into the
+      true corners and round the curves at the profile's accelerations (the machine cannot do
+      better; only higher limits or gentler curves can);
+    - **leads**: beam-off lead-ins and lead-outs of an over-travel profile;
+    - **rapids**: rapid and focus moves.
+
+    ``short``: one line of at most ~200 characters for a G-code comment (LinuxCNC's interpreter
+    refuses lines over 255). Returns None when the estimate is within the factor (or no profile).
+    """
+    from camtube.fmt import format_duration_s
+    from camtube.machine.bound import time_optimal
+
+    if profile is None or not est.lower_bound_s > 0:
+        return None
+    factor = profile.warn_time_factor
+    if not est.total_s > factor * est.lower_bound_s:
+        return None
+    opt = time_optimal(job, profile)
+    leads = est.lead_s
+    parts = {
+        "segments": max(est.total_s - opt.total_s - leads, 0.0),
+        "corners": max(opt.path_s - est.lower_bound_s, 0.0),
+        "leads": leads,
+        "rapids": opt.free_s,
+    }
+    what = {
+        "segments": "stops and slow-downs where the path is smooth",
+        "corners": f"braking at {opt.stops} true corners and pass ends and round curves at the profile's accelerations",
+        "leads": "beam-off lead-ins and lead-outs",
+        "rapids": "rapid and focus moves",
+    }
+    fix = {
+        "segments": "a profile that cuts each pass as one blended path (--machine linuxcnc-path) or joins its moves",
+        "corners": "higher accelerations in the machine profile, or larger corner and curve radii in the design",
+        "leads": "distance gating (laser.gating: distance), which keeps the dose uniform without over-travel",
+        "rapids": "fewer, nearer cuts",
+    }
+    order = sorted(parts, key=lambda k: -parts[k])
+    shown = [k for k in order if parts[k] > 0.005 * est.total_s]
+    if short:
+        return (f"estimate {est.total_s / est.lower_bound_s:.2f} x the lower bound (machine.warn_time_factor "
+                f"{factor:g}); above it: " + ", ".join(f"{k} {parts[k]:.1f} s" for k in shown)
+                + f"; time-optimal {opt.total_s:.1f} s")
+    causes = ", ".join(f"{k} {parts[k]:.1f} s ({what[k]})" for k in shown)
+    return (f"the estimated laser time {format_duration_s(est.total_s)} on machine {profile.name} is "
+            f"{est.total_s / est.lower_bound_s:.2f} x the lower bound {format_duration_s(est.lower_bound_s)} "
+            f"(machine.warn_time_factor = {factor:g}); above the bound: {causes}; the time-optimal motion that stops "
+            f"at every true corner takes {format_duration_s(opt.total_s)}; to go faster: {fix[order[0]]}")

@@ -22,6 +22,7 @@ surface limits ``radians(limit) r_o``. Times in s.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -79,8 +80,36 @@ def _corner_flags(px, py, corners: np.ndarray, reach: np.ndarray) -> np.ndarray:
     return dist <= reach
 
 
+@dataclass(frozen=True)
+class OptimalTime:
+    """The time-optimal bound of a job on a machine, in parts (s).
+
+    Attributes
+    ----------
+    path_s : float
+        Along the passes' paths (stops at true corners and pass ends, curvature-limited).
+    free_s : float
+        Rapid and focus moves, each from rest to rest.
+    stops : int
+        Stops along the paths (true corners and pass ends).
+    """
+
+    path_s: float
+    free_s: float
+    stops: int
+
+    @property
+    def total_s(self) -> float:
+        return self.path_s + self.free_s
+
+
 def time_optimal_s(job, profile, corner_deg: float = TOL.corner_deg) -> float:
-    """The time-optimal bound (s) of ``job`` on ``profile`` (module docstring).
+    """The time-optimal bound (s) of ``job`` on ``profile`` (module docstring; :func:`time_optimal`)."""
+    return time_optimal(job, profile, corner_deg).total_s
+
+
+def time_optimal(job, profile, corner_deg: float = TOL.corner_deg) -> OptimalTime:
+    """The time-optimal bound of ``job`` on ``profile`` (module docstring), in parts.
 
     Parameters
     ----------
@@ -92,7 +121,8 @@ def time_optimal_s(job, profile, corner_deg: float = TOL.corner_deg) -> float:
     vlim, alim = surface_limits(profile, job.outer_radius_mm)
     corners = design_corners(job, corner_deg)
     offsets = job.packed.pass_offset
-    total = 0.0
+    path_s = free_s = 0.0
+    stops = 0
     cos_corner = math.cos(math.radians(corner_deg))
     for mv in iter_moves(job):
         x0, y0, z0 = mv.starts()
@@ -104,7 +134,7 @@ def time_optimal_s(job, profile, corner_deg: float = TOL.corner_deg) -> float:
         free = (mv.kind == RAPID) | (mv.kind == FOCUS)
         vmax = _along(vlim, u)
         a = _along(alim, u)
-        total += float(_trapezoids(L[free & ok], 0.0, 0.0, vmax[free & ok], a[free & ok]).sum())
+        free_s += float(_trapezoids(L[free & ok], 0.0, 0.0, vmax[free & ok], a[free & ok]).sum())
         path = ((mv.kind == CUT) | (mv.kind == LEAD)) & ok
         idx = np.flatnonzero(path)
         if len(idx) == 0:
@@ -142,5 +172,6 @@ def time_optimal_s(job, profile, corner_deg: float = TOL.corner_deg) -> float:
             prev = vj[i]
         v1 = np.array(vj)
         v0 = np.concatenate(([0.0], v1[:-1]))
-        total += float(_trapezoids(L[idx], v0, v1, vcap, a[idx]).sum())
-    return total
+        path_s += float(_trapezoids(L[idx], v0, v1, vcap, a[idx]).sum())
+        stops += int(np.count_nonzero(~smooth))
+    return OptimalTime(path_s, free_s, stops)

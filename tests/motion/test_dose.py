@@ -151,3 +151,33 @@ def test_a_curved_drawing_runs_as_one_path_per_pass(tmp_path):
     assert r.dose_share >= 0.99 and abs(r.length_error) < 0.001
     assert r.max_outside_mm <= 0.001 and r.max_corner_miss_mm <= 0.002
     assert r.run_time_s < 1.15 * time_optimal_s(job, profile)
+
+
+# ---------------------------------------------------------------- warnings that name the cause
+def test_a_slow_job_is_warned_about_with_its_cause():
+    from camtube.export.motion_time import slow_job_warning
+
+    job = curved_job("elliptical")
+    rotary, path = load_profile("linuxcnc-rotary"), load_profile("linuxcnc-path")
+    est = job_estimate(job, dialect_from_profile(rotary))
+    assert est.total_s > rotary.warn_time_factor * est.lower_bound_s
+    w = slow_job_warning(job, est, rotary)
+    assert w.startswith("the estimated laser time") and "machine.warn_time_factor = 3" in w
+    causes = w.split("above the bound: ")[1]
+    assert causes.startswith("segments") and "corners" in causes and "--machine linuxcnc-path" in w
+    header = [ln for ln in gcode(job, dialect_from_profile(rotary)).splitlines()[:8] if ln.startswith("(WARNING")]
+    assert len(header) == 1 and len(header[0]) < 256  # LinuxCNC's interpreter refuses longer lines
+    assert "x the lower bound" in header[0] and "segments" in header[0] and "time-optimal" in header[0]
+    # the same drawing as blended paths: within the factor, no warning
+    assert slow_job_warning(job, job_estimate(job, dialect_from_profile(path)), path) is None
+    tube = plan_job(load_pattern(PATTERNS / "tube1.yaml"))
+    assert slow_job_warning(tube, job_estimate(tube, LINUXCNC), rotary) is None
+
+
+def test_the_warning_is_heard_before_writing(tmp_path, capsys):
+    from camtube.cli import main
+
+    dxf = ROOT / "examples" / "curved" / "elliptical.dxf"
+    assert main(["toolpath", str(dxf), "--outer-radius", "0.8", "-o", str(tmp_path)]) == 0
+    err = capsys.readouterr().err
+    assert "x the lower bound" in err and "segments" in err
