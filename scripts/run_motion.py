@@ -5,7 +5,7 @@
     python scripts/run_motion.py --table out/motion.jsonl         # print the table of earlier results
 
 For each (machine, preset): plan the preset, write its G-code for the machine and the job file,
-estimate the time from the G-code (``camtube.export.motion_time``), run it with ``camtube.motion``
+estimate the time from the G-code (``camtube.machine.motion_time``), run it with ``camtube.motion``
 and measure the recording against the job. One JSON line per run is appended to ``--out`` as soon
 as it finishes; the markdown table (the one in docs/motion.md) is printed at the end.
 """
@@ -48,7 +48,7 @@ def run_one(machine: str, preset: str, workdir=None, overrides=()) -> dict:
     from camtube.machine.bound import time_optimal_s
     from camtube.motion.analysis import JobGeometry, analyse
     from camtube.motion.linuxcnc import run_program
-    from camtube.export.motion_time import estimate_program
+    from camtube.machine.motion_time import estimate_program
     from camtube.export.outputs import toolpath_streams
     from camtube.io import write_set
 

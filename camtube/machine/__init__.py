@@ -2,7 +2,7 @@
 
 :func:`load_profile` reads a shipped profile by name or any profile file;
 :class:`MachineProfile` is the frozen value the planner, the emitter, the time
-estimate (:mod:`camtube.export.motion_time`) and the motion runner
+estimate (:mod:`camtube.machine.motion_time`) and the motion runner
 (:mod:`camtube.motion`) take.
 """
 from __future__ import annotations

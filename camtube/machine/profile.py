@@ -159,6 +159,11 @@ class MachineProfile:
         return self.blending == "exact_stop"
 
     @property
+    def feed_mode(self) -> str:
+        """``inverse_time`` (G93: F = 1 / minutes of each move) for LinuxCNC, ``units_per_minute`` (G94) for GRBL."""
+        return "inverse_time" if self.dialect == "linuxcnc" else "units_per_minute"
+
+    @property
     def uniform_dose(self) -> bool:
         """True when the pulses per millimetre stay at their nominal value however the stage moves
         (distance gating), or every beam-on move runs at the scan speed (over-travel)."""

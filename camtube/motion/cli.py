@@ -43,7 +43,7 @@ def cmd_motion(args: argparse.Namespace) -> int:
     from camtube.machine import load_profile
     from camtube.motion.analysis import JobGeometry, analyse
     from camtube.motion.linuxcnc import run_program, unavailable_reason
-    from camtube.export.motion_time import estimate_program
+    from camtube.machine.motion_time import estimate_program
 
     why = unavailable_reason()
     if why:

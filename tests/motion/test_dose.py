@@ -16,7 +16,7 @@ from camtube.design.source import DrawingOptions, load_source
 from camtube.errors import PatternError
 from camtube.export.dialects import LINUXCNC, dialect_from_profile
 from camtube.export.gcode import gcode
-from camtube.export.motion_time import estimate_program, job_estimate
+from camtube.machine.motion_time import estimate_program, job_estimate
 from camtube.io import write_set
 from camtube.machine import load_profile
 from camtube.machine.bound import time_optimal_s
@@ -155,7 +155,7 @@ def test_a_curved_drawing_runs_as_one_path_per_pass(tmp_path):
 
 # ---------------------------------------------------------------- warnings that name the cause
 def test_a_slow_job_is_warned_about_with_its_cause():
-    from camtube.export.motion_time import slow_job_warning
+    from camtube.machine.motion_time import slow_job_warning
 
     job = curved_job("elliptical")
     rotary, path = load_profile("linuxcnc-rotary"), load_profile("linuxcnc-path")
