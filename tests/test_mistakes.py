@@ -174,3 +174,21 @@ def test_a_real_import_error_is_not_taken_for_an_interrupt(monkeypatch, tmp_path
     monkeypatch.setattr(camtube.pipeline, "run", broken)
     with pytest.raises(ImportError):
         main(["build", TUBE1, "-o", str(tmp_path / "o"), "-q"])
+
+
+@pytest.mark.parametrize("content,words", [(b"\x00\x01binary\xff" * 50, ("bad.py:", "fix: give a Python source file")),
+                                           (b"def x(:\n", ("bad.py:1:", "fix: correct the Python at that line"))])
+def test_an_effect_file_that_is_not_python(tmp_path, content, words):
+    data = tmp_path / "d.csv"
+    assert camtube("model", "synth", "--pattern", str(PATTERNS / "tube2.yaml"), "-o", str(data)).returncode == 0
+    bad = tmp_path / "bad.py"
+    bad.write_bytes(content)
+    r = camtube("model", "fit", str(data), "--pattern", str(PATTERNS / "tube2.yaml"), "--effect-file", str(bad))
+    assert_refused(r, *words)
+    assert ":None" not in r.stderr
+
+
+def test_a_binary_measurement_file(tmp_path):
+    bad = tmp_path / "d.csv"
+    bad.write_bytes(bytes(range(128, 256)) * 8)
+    assert_refused(camtube("model", "fit", str(bad), "--pattern", TUBE1), str(bad), "not a UTF-8 text file")
