@@ -114,6 +114,12 @@ def _publish(tmp: str, path: Path) -> None:
     os.replace(tmp, path)
 
 
+def _not_empty(path: str | os.PathLike, what: str) -> None:
+    """Refuse an empty path (``-o ''`` would otherwise mean the working directory)."""
+    if not str(path).strip():
+        raise OutputError(repr(str(path)), "the path is empty", f"give the output {what}'s name")
+
+
 def _check_file_target(path: Path) -> None:
     if path.is_dir():
         raise OutputError(path, "it is a directory", "name a file (e.g. add the file name to the path)")
@@ -167,6 +173,7 @@ def write_atomic(path: str | os.PathLike, data: Payload) -> Path:
     OutputError
         The file cannot be written (read-only location, a directory of that name, ...).
     """
+    _not_empty(path, "file")
     path = Path(path)
     with _staged(path, f".{path.name}.", ".tmp") as (fd, _tmp):
         with os.fdopen(fd, "wb") as fh:
@@ -275,6 +282,7 @@ def check_writable_dir(outdir: str | os.PathLike) -> None:
     OutputError
         The location is read-only, not a folder, or cannot hold new entries.
     """
+    _not_empty(outdir, "directory")
     out = Path(outdir).absolute()
     probe_in = out if out.is_dir() else out.parent
     while not probe_in.exists() and probe_in != probe_in.parent:
@@ -311,6 +319,7 @@ def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload]) -> list[P
         ``outdir`` cannot be created or written (it names a file, the location is
         read-only, ...); nothing of the new set is visible then.
     """
+    _not_empty(outdir, "directory")
     out = Path(outdir)
     if out.exists() and not out.is_dir():
         raise OutputError(out, "a file of that name exists", "name a directory (new or existing), not a file")

@@ -192,3 +192,30 @@ def test_a_binary_measurement_file(tmp_path):
     bad = tmp_path / "d.csv"
     bad.write_bytes(bytes(range(128, 256)) * 8)
     assert_refused(camtube("model", "fit", str(bad), "--pattern", TUBE1), str(bad), "not a UTF-8 text file")
+
+
+@pytest.mark.parametrize("section,value", [("tube", "3"), ("notch", "[1,2]"), ("process", "fast")])
+def test_a_section_that_is_not_a_mapping_is_one_line_not_one_per_missing_key(section, value):
+    assert_refused(camtube("design", TUBE1, "--set", f"{section}={value}"), f"{section}: expected a mapping")
+
+
+def test_a_tendon_thicker_than_the_lumen():
+    assert_refused(camtube("design", TUBE1, "--set", "tendon.radius=0.5"), "tendon.radius", "inner_radius = 0.45")
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["build", TUBE1], ("required: -o/--output", "camtube build --help")),
+    (["toolpath", TUBE1, "-o", "x", "--ordering", "fastest"], ("invalid choice: 'fastest'",)),
+    (["model", "fit", "x.csv"], ("--pattern", "camtube model fit --help")),
+    (["nosuch"], ("invalid choice: 'nosuch'",)),
+])
+def test_command_line_mistakes_are_one_line_too(tmp_path, argv, words):
+    assert_refused(camtube(*argv, cwd=tmp_path), *words)
+    assert listing(tmp_path) == []
+
+
+@pytest.mark.parametrize("cmd", [["toolpath", TUBE1, "-o", ""], ["dxf", TUBE1, "-o", ""], ["build", TUBE1, "-o", " "]])
+def test_an_empty_output_path_is_refused_not_taken_for_the_working_directory(tmp_path, cmd):
+    r = camtube(*cmd, cwd=tmp_path)
+    assert r.returncode == 2 and "Traceback" not in r.stderr and "fix:" in r.stderr
+    assert listing(tmp_path) == []

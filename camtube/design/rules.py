@@ -202,6 +202,10 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
         err("tube.inner_radius", "inner radius must be smaller than the outer radius",
             ri, f"< tube.outer_radius = {ro:g} mm", "check r_i and r_o (radii, not diameters)")
         return errors, warnings  # everything below depends on a valid section
+    rt = pattern.tendon.radius_mm
+    if not rt < ri:
+        err("tendon.radius", "the tendon is thicker than the tube's lumen (it runs inside the tube)", rt,
+            f"< tube.inner_radius = {ri:g} mm", "check r_t (a radius, not a diameter) and r_i")
 
     seen_keys: set[str] = set()
     for cut, origin in zip(pattern.cuts, origins):
