@@ -65,21 +65,21 @@ class PublishedInterrupt(KeyboardInterrupt):
 def _uninterrupted():
     """Hold Ctrl-C (SIGINT) back while the body runs; one that came meanwhile is raised at the end.
 
-    Only in the main thread of a platform with ``pthread_sigmask``; elsewhere the body runs as is.
+    The Python-level handler is swapped for one that only notes the signal (whichever thread the
+    operating system delivered it to, Python runs handlers in the main thread), then put back and
+    called. Only in the main thread, where handlers can be set; elsewhere the body runs as is.
     """
-    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    noted: list[tuple[int, object]] = []
+    old = signal.signal(signal.SIGINT, lambda signum, frame: noted.append((signum, frame)))
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
-        _pending_handlers_run_here()
-
-
-def _pending_handlers_run_here() -> None:
-    """A Python call: a signal unblocked just before raises its ``KeyboardInterrupt`` at this point."""
+        signal.signal(signal.SIGINT, old)
+        if noted and callable(old):
+            old(*noted[0])  # the default handler raises KeyboardInterrupt here
 
 
 class OutputError(CamtubeError, OSError):
