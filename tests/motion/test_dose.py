@@ -175,7 +175,7 @@ def test_a_slow_job_is_warned_about_with_its_cause():
 
 
 def test_the_warning_is_heard_before_writing(tmp_path, capsys):
-    from camtube.cli import main
+    from camtube.commands import main
 
     dxf = ROOT / "examples" / "curved" / "elliptical.dxf"
     assert main(["toolpath", str(dxf), "--outer-radius", "0.8", "-o", str(tmp_path)]) == 0
