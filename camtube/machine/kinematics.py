@@ -99,3 +99,55 @@ def machine_moves(job, machine, moves: Moves | None = None) -> MachineMoves:
             feed[feedrow] = per[feedrow] / minutes[feedrow]
     feed = np.round(feed, dialect.feed_decimals)
     return MachineMoves(mv, ax, ay, az, feed, dialect, ro, (s_ax, s_ay, s_az))
+
+
+#: Largest rounding error of a printed feed, relative to the feed (the dose follows the speed).
+FEED_ROUNDING = 0.01
+
+
+def check_feeds(job, machine) -> None:
+    """Refuse a job whose feeds the machine's G-code cannot carry (before anything is written).
+
+    The smallest feed of a job is that of its longest cut move: in G93 (inverse time)
+    ``F = 60 v / L`` per minute, in G94 ``F = 60 v`` mm/min. Printed with
+    ``profile.feed_decimals`` it is off by up to half a unit of the last decimal; when that is
+    more than :data:`FEED_ROUNDING` of the feed (a feed that rounds to zero is the extreme), the
+    machine would run the job at another speed than planned, and the estimate could fall below
+    the lower bound: the job is meaningless.
+
+    Raises
+    ------
+    PatternError
+        One issue naming ``process.scan_speed_mm_s``, the feed, and the slowest speed that works.
+    """
+    from camtube.errors import Issue, PatternError
+
+    profile = getattr(machine, "profile", machine)
+    pk = job.packed
+    if pk.n_pass == 0:
+        return
+    v = float(np.min(pk.pass_speed))
+    v_edge = pk.vertices
+    nxt = np.arange(1, len(v_edge) + 1)
+    last = pk.geom_offset[1:] - 1
+    nxt[last] = pk.geom_offset[:-1]
+    seg = np.hypot(*(v_edge[nxt] - v_edge).T)
+    seg[last[~pk.geom_closed]] = 0.0
+    L = float(seg.max()) if len(seg) else 0.0
+    if not L > 0:
+        return
+    half = 0.5 * 10.0 ** -profile.feed_decimals
+    inverse = profile.feed_mode == "inverse_time"
+    f = 60.0 * v / L if inverse else 60.0 * v
+    if half <= FEED_ROUNDING * f:
+        return
+    f_min = half / FEED_ROUNDING
+    v_min = f_min * L / 60.0 if inverse else f_min / 60.0
+    unit = "/min (G93, inverse time)" if inverse else "mm/min (G94)"
+    printed = f"F{round(f, profile.feed_decimals):.{profile.feed_decimals}f}"
+    raise PatternError([Issue(
+        "process.scan_speed_mm_s",
+        f"too slow for machine {profile.name}: the longest cut move ({L:.4g} mm) would get F = {f:.3g} {unit}, "
+        f"written {printed} with {profile.feed_decimals} decimals (off by more than {100 * FEED_ROUNDING:g} %); "
+        "the job would be meaningless", f"{v:g} mm/s", f">= {v_min:.3g} mm/s on this machine",
+        f"set process.scan_speed_mm_s to at least {v_min:.3g}")])

@@ -22,6 +22,7 @@ import contextlib
 import json
 import math
 import os
+import re
 import shutil
 import subprocess
 import tempfile
@@ -245,6 +246,52 @@ def dose_hal(profile) -> list[str]:
         "setp scale.1.gain 0.001", "net laser-rate-khz scale.1.out",
     ]
     return hal
+
+
+_AXIS_WORD = re.compile(r"(?<![A-Z])([XYZABCUVW])\s*[-+]?(?:\d+\.?\d*|\.\d+)")
+_HEADER_MACHINE = re.compile(r"on machine ([\w.-]+)")
+
+
+def check_program(path: str | os.PathLike, profile) -> str:
+    """The text of a program ``profile`` can run, or :class:`MotionRunError` with one line saying why not.
+
+    Read before LinuxCNC starts (a wrong file used to cost a 12 s timeout or a traceback):
+    refuses binary data, a YAML file (a pattern or profile given by mistake), a program with no
+    G0/G1 moves, and one that moves axes the profile does not have (a flat-bed GRBL ``.nc``, or a
+    program written for another machine: the message names the machine its header gives).
+    """
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise MotionRunError(f"{path}: cannot read the program: {exc.strerror}") from None
+    fix = "give the .ngc that `camtube toolpath` wrote for a LinuxCNC machine"
+    bad = raw.find(b"\x00")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        bad = exc.start if bad < 0 else min(bad, exc.start)
+    if bad >= 0:
+        raise MotionRunError(f"{path}: not a G-code program (binary data at byte {bad}); {fix}")
+    lines = [ln.split(";", 1)[0] for ln in text.splitlines()]
+    body = [re.sub(r"\(.*?\)", "", ln).strip().upper() for ln in lines]
+    moves = [ln for ln in body if re.match(r"^(N\d+\s*)?G0?[01](?!\d)", ln)]
+    if path.suffix.lower() in (".yaml", ".yml") or (not moves and any(re.match(r"^[a-z_]+:", ln) for ln in lines)):
+        raise MotionRunError(f"{path}: a YAML file, not a G-code program; run `camtube toolpath {path.name} -o DIR` "
+                             f"and give DIR/NAME.ngc")
+    if not moves:
+        raise MotionRunError(f"{path}: no G0/G1 moves: not a G-code program camtube wrote; {fix}")
+    used = sorted({m for ln in moves for m in _AXIS_WORD.findall(ln)})
+    foreign = [a for a in used if a not in profile.axes]
+    if foreign:
+        m = _HEADER_MACHINE.search(text[:2000])
+        whose = (f"it was written for machine {m.group(1)}: give --machine {m.group(1)}" if m and m.group(1) !=
+                 profile.name else f"give --machine NAME for the machine it was written for (`camtube machines`)")
+        if "M5" in body and "G93" not in body:  # a GRBL flat-bed program (G94, spindle-gated)
+            whose = "a flat-bed GRBL program (.nc) cannot run on LinuxCNC's motion controller; " + fix
+        raise MotionRunError(f"{path}: moves axis {', '.join(foreign)}, which machine {profile.name} does not have "
+                             f"(axes {' '.join(profile.axes)}); {whose}")
+    return text
 
 
 def split_program(text: str, max_moves: int = PIECE_MOVES) -> list[str]:
