@@ -74,6 +74,7 @@ def cmd_machines(args: argparse.Namespace) -> int:
         blend = p.blending if isinstance(p.blending, str) else f"G64 P{p.blending:g}"
         mark = " (default)" if name == DEFAULT_MACHINE else ""
         print(f"{name}{mark}: {p.dialect} {p.suffix}, axes {''.join(p.axes)}, max vel/acc {lim}, "
-              f"blending {blend}, corners {p.corner_strategy}")
+              f"blending {blend}, corners {p.corner_strategy}"
+              + (f", laser gated by {p.gating}" if p.dialect == "linuxcnc" else ""))
         print(f"    {p.description}")
     return 0
