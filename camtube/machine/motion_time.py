@@ -117,9 +117,11 @@ BLEND_ACC_RATIO_NORMAL = math.sqrt(1.0 - BLEND_ACC_RATIO_TANGENTIAL ** 2)
 BLEND_DIST_FRACTION = 0.5
 BLEND_TOL_FRACTION = 0.25
 TP_MIN_SEGMENT_CYCLES = 1.02
+#: [TRAJ] ARC_BLEND_GAP_CYCLES, LinuxCNC's default: a line left shorter than this many cycles is consumed.
+ARC_BLEND_GAP_CYCLES = 4
 
 
-def _blend_arcs(L, vmax, a, req, u, blend, tol_mm, a_plane, sample_s=0.0):
+def _blend_arcs(L, vmax, a, req, u, blend, tol_mm, a_plane, sample_s=0.0, gap_s=0.0):
     """Lines joined by LinuxCNC's tangent blend arcs: (L, vmax, a, joined) of lines and arcs in turn.
 
     Follows LinuxCNC 2.9's line-line blend (``blendInit3FromLineLine``, ``blendComputeParameters``):
@@ -145,6 +147,10 @@ def _blend_arcs(L, vmax, a, req, u, blend, tol_mm, a_plane, sample_s=0.0):
     sample_s : float
         LinuxCNC runs a line in no less than ``TP_MIN_SEGMENT_CYCLES`` servo cycles: its speed is
         at most its length over this (s); 0: no such limit.
+    gap_s : float
+        ``ARC_BLEND_GAP_CYCLES`` servo cycles (s): what is left of a line between two blends, if it
+        would take less than this at the next arc's speed, is consumed into that arc (its speed
+        and half the acceleration).
     """
     m = len(L)
     trim_start = np.zeros(m)
@@ -173,9 +179,15 @@ def _blend_arcs(L, vmax, a, req, u, blend, tol_mm, a_plane, sample_s=0.0):
                 trim_end = R_plan / math.tan(theta)
                 trim_start[i + 1] = trim_end
                 arc = (R_plan * phi, v_plan)
-        out_L.append(max(Ll[i] - trim_start[i] - trim_end, 0.0))
-        out_v.append(min(vl[i], Ll[i] / sample_s) if sample_s > 0 else vl[i])
-        out_a.append(al[i])
+        left = max(Ll[i] - trim_start[i] - trim_end, 0.0)
+        v_i, a_i = (min(vl[i], Ll[i] / sample_s) if sample_s > 0 else vl[i]), al[i]
+        if arc is not None and trim_start[i] > 0 and left < gap_s * arc[1]:
+            # blendCheckConsume: a line between two blends shorter than ARC_BLEND_GAP_CYCLES cycles at the
+            # arc's speed is consumed into the arc: it runs at the arc's speed and tangential acceleration
+            v_i, a_i = min(v_i, arc[1]), a_plane * BLEND_ACC_RATIO_TANGENTIAL
+        out_L.append(left)
+        out_v.append(v_i)
+        out_a.append(a_i)
         out_j.append(bool(blend[i]) if i < m - 1 else False)
         if arc is not None:
             out_L.append(arc[0])
@@ -218,7 +230,8 @@ def trajectory_time(d: np.ndarray, letters, profile, requested_v: np.ndarray, jo
         plane = min(profile.axis(c).max_acceleration for c in letters[:2])
         req = np.minimum(np.asarray(requested_v, float)[keep], vmax)
         L, vmax, a, joined = _blend_arcs(L, vmax, a, req, u, blend[keep] | joined, float(profile.blending), plane,
-                                         TP_MIN_SEGMENT_CYCLES * profile.servo_period_s)
+                                         TP_MIN_SEGMENT_CYCLES * profile.servo_period_s,
+                                         ARC_BLEND_GAP_CYCLES * profile.servo_period_s)
     m = len(L)
     if m == 0:
         return MotionEstimate(0.0, 0, 0)
