@@ -74,8 +74,8 @@ def run_one(machine: str, preset: str, workdir=None, overrides=()) -> dict:
 def table(rows: list[dict]) -> str:
     head = ("| machine | job | LinuxCNC run s | estimate s (error) | lower bound s | run / lower bound | "
             "time-optimal s | run / time-optimal | beam-on path vs cut length | dose within +-5 % | "
-            "within +-5 % of scan speed | beam on outside regions um | corner missed by um |")
-    out = [head, "|" + "---|" * 13]
+            "within +-5 % of scan speed | beam on outside regions um | corner missed by um | path followed within um |")
+    out = [head, "|" + "---|" * 14]
     for r in rows:
         opt = r.get("optimal_s", float("nan"))
         dose = r.get("dose_share", float("nan"))
@@ -84,7 +84,7 @@ def table(rows: list[dict]) -> str:
                    f"{r['run_time_s'] / r['lower_bound_s']:.3f} | {opt:.2f} | {r['run_time_s'] / opt:.3f} | "
                    f"{100 * r['length_error']:+.3f} % | {100 * dose:.2f} % | "
                    f"{100 * r['speed_share']:.2f} % | {1000 * r['max_outside_mm']:.3f} | "
-                   f"{1000 * r['max_corner_miss_mm']:.3f} |")
+                   f"{1000 * r['max_corner_miss_mm']:.3f} | {1000 * r.get('max_path_dev_mm', float('nan')):.3f} |")
     return "\n".join(out)
 
 
@@ -129,7 +129,8 @@ def main() -> int:
                   f"lower bound {r['lower_bound_s']:.2f} s, time-optimal {r['optimal_s']:.2f} s, "
                   f"length {100 * r['length_error']:+.3f} %, dose {100 * r['dose_share']:.2f} %, "
                   f"speed share {100 * r['speed_share']:.2f} %, "
-                  f"outside {1000 * r['max_outside_mm']:.3f} um, corner {1000 * r['max_corner_miss_mm']:.3f} um "
+                  f"outside {1000 * r['max_outside_mm']:.3f} um, corner {1000 * r['max_corner_miss_mm']:.3f} um, "
+                  f"path {1000 * r['max_path_dev_mm']:.3f} um "
                   f"({time.time() - t0:.0f} s)", flush=True)
     print(table(rows))
     return 0

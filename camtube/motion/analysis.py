@@ -60,6 +60,7 @@ class JobGeometry:
     estimate_s: float
     lower_bound_s: float
     frequency_khz: float = math.nan
+    paths: tuple = ()
 
     @classmethod
     def from_job(cls, job, estimate_s: float = math.nan) -> "JobGeometry":
@@ -67,10 +68,13 @@ class JobGeometry:
         corners = np.concatenate([np.column_stack([np.asarray(p.contour.points, float),
                                                    np.full(len(p.contour.points), p.focus_offset_mm)])
                                   for p in job.passes]) if job.passes else np.zeros((0, 3))
+        pk = job.packed
+        seen = sorted({(int(g), float(z)) for g, z in zip(pk.pass_geom.tolist(), pk.pass_z.tolist())})
+        paths = tuple((np.asarray(pk.path_points(g), float), bool(pk.geom_closed[g]), z) for g, z in seen)
         return cls(job.name, float(job.outer_radius_mm), float(job.process.scan_speed_mm_s),
                    float(job.cut_length_mm), tuple(np.asarray(c.points, float) for c in job.design), corners,
                    float(estimate_s), float(job.cut_length_mm / job.process.scan_speed_mm_s),
-                   float(job.process.frequency_khz))
+                   float(job.process.frequency_khz), paths)
 
     @classmethod
     def from_job_file(cls, path: str | os.PathLike) -> "JobGeometry":
@@ -116,6 +120,7 @@ class MotionReport:
     dose_share: float = math.nan
     nominal_pulses_per_mm: float = math.nan
     distance_gated: bool = False
+    max_path_dev_mm: float = math.nan
 
     @property
     def estimate_error(self) -> float:
@@ -146,6 +151,8 @@ class MotionReport:
                                                                  + ("distance-gated rate recorded)" if self.distance_gated
                                                                     else "time-gated: set frequency / speed)")),
             ("beam on outside cut regions", f"{1000 * self.max_outside_mm:.3f}", "um at most"),
+            ("path followed within", f"{1000 * self.max_path_dev_mm:.3f}", "um at most (beam-on samples from the "
+                                                                          "pass's commanded path)"),
             ("drawn corner missed by", f"{1000 * self.max_corner_miss_mm:.3f}", f"um at most ({self.corners} "
                                                                                 "corners)"),
         ]
@@ -223,6 +230,35 @@ def _corner_miss_mm(corners: np.ndarray, a: np.ndarray, b: np.ndarray, fz: np.nd
     return worst
 
 
+def _path_dev_mm(paths, pts: np.ndarray, fz: np.ndarray, circ: float) -> float:
+    """Largest distance from beam-on points to the commanded pass paths at their focus (periodic in y)."""
+    import shapely
+
+    if len(pts) == 0 or not paths:
+        return math.nan
+    worst = 0.0
+    periodic = math.isfinite(circ)
+    for f in np.unique(np.round(fz, 6)):
+        segs = []
+        for pp, closed, z in paths:
+            if abs(z - f) > 1e-6:
+                continue
+            ring = np.vstack([pp, pp[:1]]) if closed else pp
+            for dy in ((-circ, 0.0, circ) if periodic else (0.0,)):
+                shifted = ring - [0.0, (np.floor(ring[:, 1].min() / circ) * circ if periodic else 0.0) - dy]
+                segs.extend(shapely.linestrings(np.stack([shifted[:-1], shifted[1:]], axis=1)))
+        if not segs:
+            return math.inf
+        tree = shapely.STRtree(segs)
+        q = pts[np.abs(fz - f) < 1e-4]
+        if periodic:
+            q = np.column_stack([q[:, 0], np.mod(q[:, 1], circ)])
+        q = np.unique(np.round(q, 9), axis=0)
+        _, dist = tree.query_nearest(shapely.points(q), return_distance=True, all_matches=False)
+        worst = max(worst, float(np.max(dist)))
+    return worst
+
+
 def analyse(rec, geom: JobGeometry, profile, estimate_s: float | None = None) -> MotionReport:
     """Measure a :class:`~camtube.motion.linuxcnc.Recording` against the job it ran.
 
@@ -266,6 +302,8 @@ def analyse(rec, geom: JobGeometry, profile, estimate_s: float | None = None) ->
         pts = np.unique(np.concatenate([a, b]), axis=0)
         outside = _outside_mm(pts[:, 0], pts[:, 1], geom.regions, big)
         miss = _corner_miss_mm(geom.corners, a, b, z[ia], big)
+    zz = np.concatenate([z[ia], z[ia]])
+    path_dev = _path_dev_mm(geom.paths, np.concatenate([a, b]), zz, circ if profile.rotary else math.inf)
     est = geom.estimate_s if estimate_s is None else float(estimate_s)
     nominal = 1000.0 * geom.frequency_khz / v
     rate = getattr(rec, "rate_khz", None)
@@ -278,4 +316,4 @@ def analyse(rec, geom: JobGeometry, profile, estimate_s: float | None = None) ->
     dose_share = float(lo[good].sum() / length) if length > 0 else 0.0
     return MotionReport(geom.name, profile.name, rec.run_time_s, est, geom.lower_bound_s, float(dt[on].sum()),
                         length, geom.cut_length_mm, v, share, median, outside, miss, len(geom.corners), len(rec),
-                        rec.wall_s, dose_share, nominal, rate is not None)
+                        rec.wall_s, dose_share, nominal, rate is not None, path_dev)

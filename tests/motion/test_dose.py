@@ -23,6 +23,7 @@ from camtube.machine.bound import time_optimal_s
 from camtube.motion import linuxcnc as lc
 from camtube.motion.analysis import JobGeometry, analyse
 from camtube.plan import plan_job
+from camtube.tol import TOL
 from camtube.export.outputs import toolpath_streams
 from tests.conftest import PATTERNS, ROOT
 from tests.motion.test_linuxcnc import SHORT, require_linuxcnc
@@ -151,6 +152,7 @@ def test_a_curved_drawing_runs_as_one_path_per_pass(tmp_path):
     assert r.dose_share >= 0.99 and abs(r.length_error) < 0.001
     assert r.max_outside_mm <= 0.001 and r.max_corner_miss_mm <= 0.002
     assert r.run_time_s < 1.15 * time_optimal_s(job, profile)
+    assert r.max_path_dev_mm <= TOL.path  # every curve followed within the path tolerance
 
 
 # ---------------------------------------------------------------- warnings that name the cause
