@@ -71,6 +71,21 @@ def run_one(machine: str, preset: str, workdir=None, overrides=()) -> dict:
     return d
 
 
+def rescore(r: dict) -> dict:
+    """A result with its estimate (from the program written again) and time-optimal bound recomputed."""
+    from camtube.export.dialects import dialect_from_profile
+    from camtube.export.gcode import gcode
+    from camtube.machine import load_profile
+    from camtube.machine.bound import time_optimal_s
+    from camtube.machine.motion_time import estimate_program
+
+    name, *overrides = r["preset"].split()
+    profile = load_profile(r["machine"])
+    job = load_job(name, tuple(overrides))
+    est = estimate_program(gcode(job, dialect_from_profile(profile)), profile).total_s
+    return dict(r, estimate_s=est, estimate_error=est / r["run_time_s"] - 1.0, optimal_s=time_optimal_s(job, profile))
+
+
 def table(rows: list[dict]) -> str:
     head = ("| machine | job | LinuxCNC run s | estimate s (error) | lower bound s | run / lower bound | "
             "time-optimal s | run / time-optimal | beam-on path vs cut length | dose within +-5 % | "
@@ -98,10 +113,16 @@ def main() -> int:
                     help="override a pattern key for every job, e.g. process.repeats=1 (a short run)")
     ap.add_argument("--out", default="motion-results.jsonl", help="JSON lines file the results are appended to")
     ap.add_argument("--table", metavar="JSONL", help="only print the table of a results file")
+    ap.add_argument("--rescore", action="store_true",
+                    help="with --table: recompute each run's estimate and time-optimal bound with this code "
+                         "(the program is written again: the same moves as the one that ran)")
     args = ap.parse_args()
     if args.table:
         rows = [json.loads(x) for x in Path(args.table).read_text().splitlines() if x.strip()]
-        print(table([r for r in rows if "error" not in r]))
+        rows = [r for r in rows if "error" not in r]
+        if args.rescore:
+            rows = [rescore(r) for r in rows]
+        print(table(rows))
         return 0
     from camtube.motion.linuxcnc import MotionRunError, unavailable_reason
 
