@@ -220,10 +220,11 @@ def load_bench_map(path: str | Path | None, overrides: list[str] = ()) -> BenchM
         import yaml
 
         from camtube.model.ingest.ndi import read_text
+        from camtube.yamltext import StrictLoader
 
         source = str(path)
         try:
-            doc = yaml.safe_load(read_text(path, "bench map")) or {}
+            doc = yaml.load(read_text(path, "bench map"), Loader=StrictLoader) or {}
         except yaml.YAMLError as exc:
             mark = getattr(exc, "problem_mark", None)
             where = f"{path}:{mark.line + 1}" if mark else str(path)
