@@ -120,7 +120,7 @@ def dropouts_png(ing: Ingested) -> bytes:
         for k in np.flatnonzero(d > 1.5 * float(np.median(d))):
             ax.plot([t[k], t[k + 1]], [y, y], lw=6, color="C1")
     ax.set_yticks(range(len(lanes)), lanes)
-    ax.set_ylim(-0.7, len(lanes) - 0.3)
+    ax.set_ylim(-0.7, len(lanes) + 0.9)
     ax.set_xlabel("tracker clock (s from its first frame); orange: gaps in a log")
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7, loc="upper right", ncol=2)
