@@ -204,7 +204,8 @@ def bench_map_from_dict(doc: dict, source: str = "<bench map>", overrides: list[
         vals = {}
         for name, value in body.items():
             if name not in names:
-                hint = difflib.get_close_matches(name, list(names), n=1)
+                hint = (difflib.get_close_matches(name, list(names), n=1, cutoff=0.5)
+                        or [k for k in names if k.startswith(name) or name.startswith(k)])
                 raise _map_err(source, f"{sec}.{name}", "unknown key",
                                f"did you mean {hint[0]!r}?" if hint else f"known keys: {', '.join(names)}")
             vals[name] = _coerce(sec, name, value, names[name], source)
