@@ -182,7 +182,7 @@ def ingest(tracker: TrackerLog, daq: Series, motor: Series, bench: BenchMap, sam
     if sign < 0:
         what = "N_per_V" if bench.daq.force_unit == "V" else "force_unit"
         raise DataError(f"{daq.source}: column {daq.column!r} falls as the stroke rises (the load cell reads "
-                        f"compression); fix: negate the calibration (--map daq.{what}=-{bench.daq.N_per_V:g})"
+                        f"compression); fix: negate the calibration (--map daq.{what}={-bench.daq.N_per_V:g})"
                         if what == "N_per_V" else
                         f"{daq.source}: column {daq.column!r} falls as the stroke rises; fix: log the tension as positive")
 

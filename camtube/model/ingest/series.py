@@ -67,7 +67,7 @@ class DaqMap:
     force_unit : str
         ``V`` (converted with ``N_per_V``) or ``N``.
     N_per_V : float
-        Load cell calibration, N per V.
+        Load cell calibration, N per V (negative for a load cell that reads tension as a falling voltage).
     offset_V : float or "rest"
         Output at zero force (V, or N for ``force_unit: N``); ``rest``: the median over the first ``rest_s``.
     trigger : str
@@ -139,7 +139,7 @@ _ALLOWED = {
     ("daq", "time_unit"): tuple(TIME_UNITS), ("motor", "time_unit"): tuple(TIME_UNITS),
     ("daq", "force_unit"): ("V", "N"), ("motor", "stroke_unit"): ("counts", "rev", "mm"),
 }
-_POSITIVE = {("daq", "N_per_V"), ("motor", "counts_per_rev"), ("motor", "gear_ratio"), ("motor", "lead_mm_per_rev")}
+_POSITIVE = {("motor", "counts_per_rev"), ("motor", "gear_ratio"), ("motor", "lead_mm_per_rev")}
 
 
 def _map_err(source: str, key: str, msg: str, fix: str) -> DataError:
@@ -163,7 +163,8 @@ def _coerce(section: str, name: str, value, default, source: str):
             v = float(value)
         except (TypeError, ValueError):
             raise _map_err(source, key, f"{value!r} is not a number", f"give a number (default {default:g})") from None
-        if not np.isfinite(v) or ((section, name) in _POSITIVE and v <= 0) or (v < 0 and name in ("rate_hz", "rest_s")):
+        if (not np.isfinite(v) or ((section, name) in _POSITIVE and v <= 0) or (v < 0 and name in ("rate_hz", "rest_s"))
+                or (name == "N_per_V" and v == 0)):
             raise _map_err(source, key, f"{value!r} is out of range", "give a positive number")
         return v
     v = "" if value is None else str(value).strip()
