@@ -170,3 +170,20 @@ def test_tracker_in_metres_is_named_and_fixed_by_the_map(tmp_path, capsys):
     assert main(_argv(tmp_path, tracker=path)) == 2
     assert "look like metres; fix: --map tracker.unit=m" in capsys.readouterr().err
     assert main(_argv(tmp_path, "--map", "tracker.unit=m", tracker=path)) == 0
+
+
+def test_a_shared_trigger_aligns_the_daq_to_the_motor():
+    logs = simulate_bench(load_pattern(PATTERNS / "tube2.yaml"), BenchSetup(seed=5, n_cycles=8, trigger=True,
+                                                                            motor_rate_hz=1000.0))
+    bm = bench_map_from_dict(yaml.safe_load(logs.bench_map_yaml))
+    assert bm.daq.trigger == bm.motor.trigger == "sync"
+    trk = parse_ndi(logs.tracker_csv, "tracker.csv")
+    daq = parse_series(logs.daq_csv, "daq.csv", bm.daq.time, bm.daq.time_unit, bm.daq.force, bm.daq.trigger)
+    mot = parse_series(logs.motor_csv, "motor.csv", bm.motor.time, bm.motor.time_unit, bm.motor.stroke, bm.motor.trigger)
+    ing = ingest(trk, daq, mot, bm)
+    c = ing.clocks["daq"]
+    assert c.method == "trigger+xcorr"
+    epoch = logs.truth_frame_time_s[0]
+    t = daq.time_s
+    bound = 3 * np.hypot(c.offset_err_s, c.drift_err_ppm * 1e-6 * (t - c.t_mid_s)) + 0.0005
+    assert np.all(np.abs(c.to_ref(t) - (logs.to_ref("daq", t) - epoch)) <= np.minimum(bound, 0.002))

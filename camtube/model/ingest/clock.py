@@ -10,7 +10,9 @@ recording, not to an extrapolated clock zero).
 
 **From a shared trigger** (:func:`align_trigger`): the rising edges of a trigger line recorded by both
 instruments, each edge timed by linear interpolation between samples, matched in order; a straight-line fit
-of one clock's edge times against the other's gives offset and drift, with standard errors from the scatter.
+of one clock's edge times against the other's gives offset and drift, with standard errors from the scatter
+plus the edges' timing resolution (a sample interval / sqrt(12) per log: a trigger logged at 100 Hz is good to
+a few ms, not better).
 
 **From the shared motion** (:func:`align_xcorr`): the tracker's bend angle, the load cell's force and the
 motor's stroke all follow the same actuation. A coarse lag is the peak of the full cross-correlation of both
@@ -123,7 +125,10 @@ def align_trigger(name: str, t: np.ndarray, trig: np.ndarray, ref_t: np.ndarray,
                         "bench map to align from the motion")
     t_mid = 0.5 * (t[0] + t[-1])
     c, d, sc, sd = _line_fit(ea, eb - ea, t_mid)
-    return ClockFit(name, "trigger", c, d * 1e6, t_mid, sc, sd * 1e6, 1, ea, eb - ea)
+    # an edge is timed only to within its sample interval; when the pulses keep one phase against the
+    # sampling that error does not average out, so it is added to the fit's scatter
+    quant = float(np.hypot(np.median(np.diff(t)), np.median(np.diff(ref_t)))) / np.sqrt(12.0)
+    return ClockFit(name, "trigger", c, d * 1e6, t_mid, float(np.hypot(sc, quant)), sd * 1e6, 1, ea, eb - ea)
 
 
 def _fill(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

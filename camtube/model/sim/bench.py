@@ -61,6 +61,7 @@ class BenchSetup:
     counts_per_rev: int = 512
     gear_ratio: float = 64.0
     lead_mm_per_rev: float = 0.5
+    trigger: bool = False
     mount_deg: float = 25.0
     wobble_deg: float = 2.0
     seed: int = 0
@@ -214,16 +215,31 @@ def simulate_bench(pattern: Pattern, setup: BenchSetup = BenchSetup(), modulus_g
     keep = ~((tau_d >= g0) & (tau_d < g0 + s.daq_gap_s))
     kept_tau = tau_d[keep]
     gap_true = (float(kept_tau[kept_tau < g0].max()), float(kept_tau[kept_tau >= g0 + s.daq_gap_s].min()))
-    daq_csv = "time_ms,load_V\n" + "".join(f"{a * 1e3:.3f},{v:.6f}\n" for a, v in zip(t_d[keep], volts[keep]))
+    pulses = np.arange(1.0, duration, 13.7137)                     # a shared TTL line: 50 ms pulses, true times
+
+    def ttl(tau_i):
+        k = np.searchsorted(pulses, tau_i, side="right") - 1
+        return np.where((k >= 0) & (tau_i - pulses[np.clip(k, 0, None)] < 0.05), 5.0, 0.0)
+
+    if s.trigger:
+        daq_csv = "time_ms,load_V,sync\n" + "".join(f"{a * 1e3:.3f},{v:.6f},{g:.0f}\n" for a, v, g in
+                                                    zip(t_d[keep], volts[keep], ttl(tau_d)[keep]))
+    else:
+        daq_csv = "time_ms,load_V\n" + "".join(f"{a * 1e3:.3f},{v:.6f}\n" for a, v in zip(t_d[keep], volts[keep]))
     t_m, tau_m = clock(s.motor_start_s, s.motor_drift_ppm, s.motor_rate_hz, "motor")
     st_m, _, _, _ = truth_at(tau_m)
     counts = np.round(st_m / s.lead_mm_per_rev * s.gear_ratio * s.counts_per_rev).astype(np.int64)
-    motor_csv = "t_us,enc_counts\n" + "".join(f"{int(round(a * 1e6))},{v}\n" for a, v in zip(t_m, counts))
+    if s.trigger:
+        motor_csv = "t_us,enc_counts,sync\n" + "".join(f"{int(round(a * 1e6))},{v},{g:.0f}\n" for a, v, g in
+                                                      zip(t_m, counts, ttl(tau_m)))
+    else:
+        motor_csv = "t_us,enc_counts\n" + "".join(f"{int(round(a * 1e6))},{v}\n" for a, v in zip(t_m, counts))
+    trig = ", trigger: sync" if s.trigger else ""
     bench_map = (
         "tracker: {base: \"0A\", tip: \"0B\", unit: mm, rest_s: 3.0}\n"
-        f"daq: {{time: time_ms, time_unit: ms, force: load_V, force_unit: V, N_per_V: {s.N_per_V}, offset_V: rest}}\n"
+        f"daq: {{time: time_ms, time_unit: ms, force: load_V, force_unit: V, N_per_V: {s.N_per_V}, offset_V: rest{trig}}}\n"
         f"motor: {{time: t_us, time_unit: us, stroke: enc_counts, stroke_unit: counts, counts_per_rev: {s.counts_per_rev},"
-        f" gear_ratio: {s.gear_ratio:g}, lead_mm_per_rev: {s.lead_mm_per_rev}, sign: 1}}\n")
+        f" gear_ratio: {s.gear_ratio:g}, lead_mm_per_rev: {s.lead_mm_per_rev}, sign: 1{trig}}}\n")
     return BenchLogs(tracker_csv, daq_csv, motor_csv, bench_map, truth, t_trk,
                      {"daq": (s.daq_start_s, s.daq_drift_ppm, 1e-3), "motor": (s.motor_start_s, s.motor_drift_ppm, 1e-6)},
                      flagged, int(absent.sum()), gap_true)
