@@ -18,10 +18,13 @@ a few ms, not better).
 motor's stroke all follow the same actuation. A coarse lag is the peak of the full cross-correlation of both
 signals on a 20 ms grid (``scipy.signal.correlate``); then, in windows along the recording, the lag that
 best explains the tracker's own samples (no interpolation of the noisy signal) by a piecewise-linear
-function of the instrument's signal interpolated at those instants (straight line plus hinges at six
-quantiles: a static nonlinearity such as the slack deadband between stroke and angle does not bias the lag
-the way a straight-line correlation would), on a 1 ms grid refined by a parabola through the minimum. A straight-line fit of the window lags against time gives offset and drift; their standard
-errors come from the fit's residual scatter. A periodic motion is ambiguous by whole periods: the recording's
+function of the instrument's signal interpolated at those instants (straight line plus hinges doubling from
+the bottom of its range, from 0.5 % or five times its noise, to 32 %, then at 50, 70 and 90 %: a static
+nonlinearity such as the slack deadband between stroke and angle does not bias the lag the way a
+straight-line correlation would), on a 1 ms grid refined by a parabola through the minimum's +-5 ms. A log sampled much faster than the
+tracker is first averaged over a centred window of one tracker frame (no lag, less noise). A straight-line fit of the window lags against time gives offset and drift: weighted by each window's
+standard error (from the curvature of the residual sum of squares at its minimum), scaled up when the windows
+scatter more than that. A periodic motion is ambiguous by whole periods: the recording's
 rests at its start and end break the tie, and ``max_lag_s`` bounds the search.
 """
 from __future__ import annotations
@@ -213,8 +216,9 @@ def align_xcorr(name: str, ref_t: np.ndarray, ref_y: np.ndarray, t: np.ndarray, 
     half = 3 * 0.02
     deltas = np.arange(-half, half + step_s / 2, step_s)
     sd_all = float(np.std(ry))
-    knots = np.quantile(y, np.linspace(0.1, 0.9, 6))
-    wt, wl = [], []
+    y = _smooth_to(t, y, float(np.median(np.diff(rt))))
+    knots = _knots(y)
+    wt, wl, ws = [], [], []
     for a, b in zip(edges[:-1], edges[1:]):
         m = (rt >= a) & (rt < b)
         if m.sum() < 20 or np.std(ry[m]) < 0.05 * sd_all:
@@ -228,18 +232,73 @@ def align_xcorr(name: str, ref_t: np.ndarray, ref_y: np.ndarray, t: np.ndarray, 
             r = yr - basis @ coef
             sse[j] = r @ r
         j = int(np.argmin(sse))
-        frac = 0.0
-        if 0 < j < deltas.size - 1:
-            y0, y1, y2 = sse[j - 1], sse[j], sse[j + 1]
-            den2 = y0 - 2 * y1 + y2
-            frac = 0.5 * (y0 - y2) / den2 if den2 > 0 else 0.0
+        frac, se = 0.0, float("nan")
+        near = slice(max(j - 5, 0), min(j + 6, deltas.size))
+        if near.stop - near.start >= 5 and 0 < j < deltas.size - 1:
+            # a parabola through the minimum's neighbourhood (+-5 ms): robust to a jagged SSE curve
+            cf = np.polyfit(deltas[near] - deltas[j], sse[near], 2)
+            if cf[0] > 0:
+                frac = float(np.clip(-cf[1] / (2 * cf[0]), -5 * step_s, 5 * step_s)) / step_s
+                # var(lag) = 2 s^2 / SSE'' with s^2 the residual variance at the minimum
+                s2 = float(sse[j]) / max(yr.size - knots.size - 2, 1)
+                se = float(np.sqrt(2.0 * s2 / (2.0 * cf[0])))
+        if not np.isfinite(se):
+            continue                       # the minimum is at the edge of the search: no estimate here
         lag = lag0 + deltas[j] + frac * step_s
         wt.append(0.5 * (a + b) - lag)
         wl.append(lag)
+        ws.append(se)
     if not wt:
         raise DataError(f"no stretch of the recording where the tracker and the {name} log both show motion; fix: "
                         "check that both logs belong to the same run (or add a trigger column)")
     wt_a, wl_a = np.asarray(wt), np.asarray(wl)
     t_mid = 0.5 * (t[0] + t[-1])
-    c, d, sc, sd = _line_fit(wt_a, wl_a, t_mid)
+    c, d, sc, sd = _weighted_line(wt_a, wl_a, np.asarray(ws), t_mid)
     return ClockFit(name, "xcorr", c, d * 1e6, t_mid, sc, sd * 1e6, sign, wt_a, wl_a)
+
+
+def _smooth_to(t: np.ndarray, y: np.ndarray, dt_ref: float) -> np.ndarray:
+    """``y`` averaged over a centred window as long as the reference's frame interval (no lag), when the
+    log samples much faster than the reference: its noise then no longer makes the fit jagged in the lag."""
+    dt = float(np.median(np.diff(t)))
+    k = int(round(dt_ref / dt))
+    if k < 3:
+        return y
+    k += 1 - k % 2
+    pad = np.pad(y, k // 2, mode="edge")
+    return np.convolve(pad, np.ones(k) / k, mode="valid")
+
+
+def _knots(y: np.ndarray) -> np.ndarray:
+    """Hinge positions for the piecewise-linear map: doubling from the bottom of ``y``'s range (from 0.5 %,
+    or from 5 noise standard deviations when the signal is noisier) to 32 %, then 50, 70 and 90 %."""
+    lo, hi = np.quantile(y, [0.001, 0.999])
+    span = float(hi - lo) or 1.0
+    noise = float(np.std(np.diff(y, 2)) / np.sqrt(6.0)) if y.size > 3 else 0.0
+    first = max(0.005, 5.0 * noise / span)
+    steps = [f for f in first * 2.0 ** np.arange(12) if f < 0.32]
+    return lo + span * np.array(steps + [0.32, 0.5, 0.7, 0.9])
+
+
+def _weighted_line(x: np.ndarray, y: np.ndarray, se: np.ndarray, x_mid: float) -> tuple[float, float, float, float]:
+    """Offset and drift from window lags with standard errors: ``y = c + d (x - x_mid)``.
+
+    Weighted least squares; the errors are scaled up by the scatter when it exceeds what the windows'
+    own errors say (reduced chi-square > 1). With fewer than three windows the drift is taken as 0 and
+    the offset is the weighted mean. Returns (c, d, se_c, se_d); se_d is NaN with fewer than three windows.
+    """
+    w = 1.0 / se ** 2
+    xm = x - x_mid
+    mean = float(np.sum(w * y) / np.sum(w))
+    chi0 = float(np.sum(w * (y - mean) ** 2) / (y.size - 1)) if y.size > 1 else 1.0
+    se_mean = float(np.sqrt(1.0 / np.sum(w) * max(1.0, chi0)))
+    if y.size < 3:
+        return mean, 0.0, se_mean, float("nan")
+    a = np.column_stack([np.ones_like(xm), xm])
+    aw = a * w[:, None]
+    cov = np.linalg.inv(a.T @ aw)
+    coef = cov @ (aw.T @ y)
+    r = y - a @ coef
+    chi = float(np.sum(w * r * r) / (y.size - 2))
+    cov = cov * max(1.0, chi)
+    return float(coef[0]), float(coef[1]), float(np.sqrt(cov[0, 0])), float(np.sqrt(cov[1, 1]))
