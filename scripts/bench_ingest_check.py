@@ -18,10 +18,14 @@ from camtube.design.loader import load_pattern
 from camtube.model.ingest.ndi import parse_ndi
 from camtube.model.ingest.merge import ingest
 from camtube.model.ingest.series import bench_map_from_dict, parse_series
-from camtube.model.sim.bench import BenchSetup, simulate_bench
+from camtube.model.sim.bench import BenchSetup, random_setups, simulate_bench
 
 TUNED = [("tube2", BenchSetup(seed=s)) for s in (0, 1, 2)]
-HELD_OUT = [
+
+
+#: Seen while the clock alignment was tuned (the first run of the windowed lag search failed two of
+#: them at the recording's ends); kept as a second tuning set, not as held-out evidence.
+SEEN = [
     ("tube1", BenchSetup(seed=101, tracker_rate_hz=40.0, daq_rate_hz=1000.0, motor_rate_hz=50.0, daq_start_s=-2.7,
                          motor_start_s=-0.2, daq_drift_ppm=-80.0, motor_drift_ppm=60.0, noise_rot_deg=0.15)),
     ("tube3", BenchSetup(seed=202, n_cycles=8, tracker_rate_hz=40.0, daq_rate_hz=250.0, motor_rate_hz=200.0,
@@ -91,7 +95,7 @@ def _states(logs):
 
 def main(argv: list[str]) -> int:
     fit = "--fit" in argv
-    for title, cases in (("tuned", TUNED), ("held-out", HELD_OUT)):
+    for title, cases in (("tuned", TUNED), ("seen during tuning", SEEN), ("held-out (random_setups(6, 2311))", random_setups(6, 2311))):
         print(f"== {title}")
         for name, setup in cases:
             r = run(name, setup, fit)

@@ -243,3 +243,24 @@ def simulate_bench(pattern: Pattern, setup: BenchSetup = BenchSetup(), modulus_g
     return BenchLogs(tracker_csv, daq_csv, motor_csv, bench_map, truth, t_trk,
                      {"daq": (s.daq_start_s, s.daq_drift_ppm, 1e-3), "motor": (s.motor_start_s, s.motor_drift_ppm, 1e-6)},
                      flagged, int(absent.sum()), gap_true)
+
+
+def random_setups(n: int = 6, seed: int = 2311) -> list[tuple[str, BenchSetup]]:
+    """``n`` recordings drawn at random, not picked: (preset name, setup) with the joint, cycles, speed,
+    slack, rates, clock offsets and drifts, noise and dropouts drawn from ``seed``.
+
+    ``random_setups(6, 2311)`` is the held-out set of docs/bench.md, drawn once the method was final.
+    """
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(n):
+        out.append((str(rng.choice(["tube1", "tube2", "tube3"])), BenchSetup(
+            seed=int(rng.integers(10_000, 99_999)), n_cycles=int(rng.integers(5, 21)),
+            speed_mm_s=float(rng.choice([0.5, 1.0])), slack_mm=float(rng.uniform(0.0, 0.1)),
+            tracker_rate_hz=float(rng.choice([40.0, 40.0, 60.0])), daq_rate_hz=float(rng.choice([200.0, 500.0, 1000.0])),
+            motor_rate_hz=float(rng.choice([50.0, 100.0, 200.0])), daq_start_s=float(rng.uniform(-3.0, 0.0)),
+            motor_start_s=float(rng.uniform(-3.0, 0.0)), daq_drift_ppm=float(rng.uniform(-100, 100)),
+            motor_drift_ppm=float(rng.uniform(-100, 100)), noise_rot_deg=float(rng.uniform(0.0, 0.2)),
+            noise_force_N=float(rng.uniform(0.002, 0.01)), n_bursts=int(rng.integers(0, 12)),
+            n_absent=int(rng.integers(1, 8)), flip_fraction=float(rng.uniform(0, 0.5)))))
+    return out
