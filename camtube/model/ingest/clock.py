@@ -22,7 +22,8 @@ function of the instrument's signal interpolated at those instants (straight lin
 the bottom of its range, from 0.5 % or five times its noise, to 32 %, then at 50, 70 and 90 %: a static
 nonlinearity such as the slack deadband between stroke and angle does not bias the lag the way a
 straight-line correlation would), on a 1 ms grid refined by a parabola through the minimum's +-5 ms. A log sampled much faster than the
-tracker is first averaged over a centred window of one tracker frame (no lag, less noise). A straight-line fit of the window lags against time gives offset and drift: weighted by each window's
+tracker is first averaged over a centred window of one tracker frame (no lag, less noise). Reference samples that fall in a gap of the log
+(or within the lag search of one) are left out rather than compared with a bridged signal. A straight-line fit of the window lags against time gives offset and drift: weighted by each window's
 standard error (from the curvature of the residual sum of squares at its minimum), scaled up when the windows
 scatter more than that. A periodic motion is ambiguous by whole periods: the recording's
 rests at its start and end break the tie, and ``max_lag_s`` bounds the search.
@@ -210,12 +211,20 @@ def align_xcorr(name: str, ref_t: np.ndarray, ref_y: np.ndarray, t: np.ndarray, 
         raise DataError(f"the {name} log and the tracker export do not overlap in time after alignment; fix: "
                         "give logs of the same run")
     span = hi - lo
+    half = 3 * 0.02
     w = window_s or float(np.clip(span / 8.0, 10.0, 60.0))
     nw = max(int(span // w), 1)
     edges = lo + span * np.arange(nw + 1) / nw
-    half = 3 * 0.02
     deltas = np.arange(-half, half + step_s / 2, step_s)
     sd_all = float(np.std(ry))
+    dti = np.diff(t)
+    gap = np.flatnonzero(dti > 1.5 * np.median(dti))
+    if gap.size:                # reference samples that would see the log bridged across a gap are left out
+        at = rt - lag0
+        hole = np.zeros(rt.size, bool)
+        for k in gap:
+            hole |= (at > t[k] - 2 * half) & (at < t[k + 1] + 2 * half)
+        rt, ry = rt[~hole], ry[~hole]
     y = _smooth_to(t, y, float(np.median(np.diff(rt))))
     knots = _knots(y)
     wt, wl, ws = [], [], []
