@@ -8,7 +8,6 @@ drawn at random by :func:`~camtube.model.sim.bench.random_setups` once the metho
 from __future__ import annotations
 
 import csv
-import shutil
 
 import numpy as np
 import pytest

@@ -3,7 +3,6 @@ pieces that work on what they read (bend angle from poses, clocks, cycles), each
 from __future__ import annotations
 
 import csv
-from pathlib import Path
 
 import numpy as np
 import pytest

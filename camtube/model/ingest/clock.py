@@ -158,7 +158,6 @@ def coarse_lag(ref_t: np.ndarray, ref_y: np.ndarray, t: np.ndarray, y: np.ndarra
     from scipy.signal import correlate, correlation_lags
 
     rt, ry = _fill(ref_t, ref_y)
-    t0 = min(rt[0], t[0])
     n_r = int((rt[-1] - rt[0]) / dt) + 1
     n_i = int((t[-1] - t[0]) / dt) + 1
     a = _uniform(rt, ry, rt[0], dt, n_r)
@@ -167,7 +166,6 @@ def coarse_lag(ref_t: np.ndarray, ref_y: np.ndarray, t: np.ndarray, y: np.ndarra
     b = np.nan_to_num((b - np.nanmean(b)) / (np.nanstd(b) or 1.0))
     c = correlate(a, b, mode="full", method="fft")
     lags = correlation_lags(a.size, b.size, mode="full") * dt + (rt[0] - t[0])
-    del t0
     if max_lag_s is not None:
         keep = np.abs(lags) <= max_lag_s
         c, lags = c[keep], lags[keep]

@@ -15,7 +15,7 @@ import numpy as np
 
 from camtube.errors import DataError
 from camtube.model.data.dataset import Dataset
-from camtube.model.ingest.clock import ClockFit, align_trigger, align_xcorr
+from camtube.model.ingest.clock import align_trigger, align_xcorr
 from camtube.model.ingest.cycles import cycle_numbers, cycle_starts
 from camtube.model.ingest.ndi import TrackerLog
 from camtube.model.ingest.poses import BendAngle, bend_angle
