@@ -91,7 +91,10 @@ def register(sub) -> None:
                     "from a shared trigger or the shared motion), put stroke (mm) and force (N) on the tracker's "
                     "frames without bridging gaps, number the cycles, and write sample, cycle, time_s, stroke_mm, "
                     "force_N, angle_deg (deg). See docs/bench.md.")
-    i.add_argument("--tracker", required=True, metavar="TRACKER.csv", help="NDI Track CSV export (positions mm)")
+    src = i.add_mutually_exclusive_group(required=True)
+    src.add_argument("--tracker", metavar="TRACKER.csv", help="NDI Track CSV export (positions mm)")
+    src.add_argument("--angle-log", metavar="ANGLE.csv",
+                     help="instead of a tracker: a log of the joint angle (deg, or rad with --map angle.unit=rad)")
     i.add_argument("--daq", required=True, metavar="DAQ.csv", help="load cell log: a time column and a force column")
     i.add_argument("--motor", required=True, metavar="MOTOR.csv", help="motor log: a time column and a position column")
     i.add_argument("--bench", metavar="BENCH.yaml", help="bench map: tools, columns, units, calibrations (docs/bench.md)")
@@ -209,13 +212,15 @@ def cmd_ingest(args: argparse.Namespace) -> int:
 
         raise DataError(f"--report {args.report}: a file of that name exists; fix: name a directory")
     bench = load_bench_map(args.bench, args.map_overrides)
-    ing = ingest_files(args.tracker, args.daq, args.motor, bench, args.sample, max_lag_s=args.max_lag)
+    first = args.tracker or args.angle_log
+    ing = ingest_files(first, args.daq, args.motor, bench, args.sample, max_lag_s=args.max_lag,
+                       angle_log=args.angle_log is not None)
     text = format_csv(ing.data)
     files = None
     if args.report:
         from camtube.model.ingest.report import report_files
 
-        files = report_files(ing, f"ingest of {Path(args.tracker).name}")
+        files = report_files(ing, f"ingest of {Path(first).name}")
     from camtube.model.ingest.report import summary_lines
 
     for line in summary_lines(ing):

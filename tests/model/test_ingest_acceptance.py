@@ -188,3 +188,21 @@ def test_a_shared_trigger_aligns_the_daq_to_the_motor():
     t = daq.time_s
     bound = 3 * np.hypot(c.offset_err_s, c.drift_err_ppm * 1e-6 * (t - c.t_mid_s)) + 0.0005
     assert np.all(np.abs(c.to_ref(t) - (logs.to_ref("daq", t) - epoch)) <= np.minimum(bound, 0.002))
+
+
+def test_an_angle_log_in_radians_is_refused_until_the_map_says_so(tmp_path, capsys):
+    rows = list(csv.DictReader(open(BENCH / "truth.csv", newline="")))
+    path = tmp_path / "encoder.csv"
+    path.write_text("t,theta\n" + "".join(f"{r['time_s']},{np.radians(float(r['angle_deg'])):.7f}\n" for r in rows))
+    argv = ["model", "ingest", "--angle-log", str(path), "--daq", str(BENCH / "daq.csv"), "--motor",
+            str(BENCH / "motor.csv"), "--bench", str(BENCH / "bench.yaml"), "-o", str(tmp_path / "d.csv"),
+            "--map", "angle.time=t", "--map", "angle.angle=theta"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "column 'theta' peaks at 0.5" in err and "fix: --map angle.unit=rad" in err
+    assert not (tmp_path / "d.csv").exists()
+    assert main(argv + ["--map", "angle.unit=rad"]) == 0
+    out = list(csv.DictReader(open(tmp_path / "d.csv", newline="")))
+    truth_peak = max(float(r["angle_deg"]) for r in rows)
+    assert max(float(r["angle_deg"]) for r in out) == pytest.approx(truth_peak, abs=1e-4)
+    assert {int(r["cycle"]) for r in out} == {1, 2, 3}

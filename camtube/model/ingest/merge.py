@@ -81,6 +81,48 @@ def _pick_tools(log: TrackerLog, bm: BenchMap):
     return tip, base
 
 
+def _angle_from_poses(tracker: TrackerLog, bench: BenchMap):
+    tip, base = _pick_tools(tracker, bench)
+    tm = bench.tracker
+    ok_pos = tip.position_mm[tip.valid]
+    if tm.unit == "mm" and ok_pos.size and 0 < float(np.nanmax(np.abs(ok_pos))) < 2.0:
+        raise DataError(f"{tracker.source}: columns Tx, Ty, Tz of {tip.label!r} stay below "
+                        f"{float(np.nanmax(np.abs(ok_pos))):.3g}: the positions look like metres; "
+                        "fix: --map tracker.unit=m (NDI Track writes mm)")
+    t0 = float(tip.time_s[0])
+    try:
+        bend = bend_angle(tip.time_s - t0, tip.quat_wxyz, tip.valid, None if base is None else base.quat_wxyz,
+                          None if base is None else base.valid, rest_s=tm.rest_s)
+    except ValueError:
+        raise DataError(f"{tracker.source}: no frame in which the tip{' and the base' if base else ''} coil is "
+                        "tracked (state OK); fix: check the tool names (tracker.tip, tracker.base)") from None
+    flagged: dict = {}
+    for role, tool in (("tip", tip), ("base", base)):
+        if tool is None:
+            continue
+        for st in tool.state[~tool.valid]:
+            flagged[(role, str(st))] = flagged.get((role, str(st)), 0) + 1
+    return bend, t0, flagged, tip, base
+
+
+def _angle_from_log(log: Series, bench: BenchMap):
+    """A joint angle logged directly (an encoder on the joint, a camera): deg, or rad when the map says so."""
+    unit = bench.angle.unit
+    v = log.value
+    peak = float(np.nanmax(np.abs(v))) if v.size else 0.0
+    if unit == "" and 0 < peak < 3.2:
+        raise DataError(f"{log.source}: column {log.column!r} peaks at {peak:.3g}: an angle in radians? "
+                        "fix: --map angle.unit=rad (or --map angle.unit=deg if the bend really stays below 3.2 deg)")
+    ang = np.degrees(v) if unit == "rad" else np.asarray(v, float)
+    t0 = float(log.time_s[0])
+    t = log.time_s - t0
+    valid = np.isfinite(ang)
+    if abs(np.nanmax(ang)) < abs(np.nanmin(ang)):
+        ang = -ang
+    bend = BendAngle(t, ang, np.full(t.size, np.nan), np.full(3, np.nan), valid, 0)
+    return bend, t0, {}, None, None
+
+
 def _gap_mask(t: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
     """For times ``at``: (outside the recording, inside a gap) masks, and the number of gaps in ``t``."""
     dt = np.diff(t)
@@ -105,14 +147,14 @@ def _check_duration(name: str, s: Series, unit: str, key: str, tracker_span: flo
                         f"(--map {name}.time_unit={best})")
 
 
-def ingest(tracker: TrackerLog, daq: Series, motor: Series, bench: BenchMap, sample: str = "1", *,
+def ingest(tracker: TrackerLog | Series, daq: Series, motor: Series, bench: BenchMap, sample: str = "1", *,
            max_lag_s: float | None = None) -> Ingested:
     """Merge the three logs into measurement rows (see the module docstring).
 
     Parameters
     ----------
-    tracker : TrackerLog
-        The NDI export.
+    tracker : TrackerLog or Series
+        The NDI export, or a log of the joint angle itself (read with the map's ``angle`` section).
     daq, motor : Series
         The load cell's and the motor's logs as read (uncalibrated columns).
     bench : BenchMap
@@ -128,27 +170,11 @@ def ingest(tracker: TrackerLog, daq: Series, motor: Series, bench: BenchMap, sam
         A unit or sign that cannot be right (one line naming the file, the column and the fix), logs that
         do not overlap, no frame with both coils tracked.
     """
-    tip, base = _pick_tools(tracker, bench)
-    tm = bench.tracker
-    ok_pos = tip.position_mm[tip.valid]
-    if tm.unit == "mm" and ok_pos.size and float(np.nanmax(np.abs(ok_pos))) < 2.0 and float(np.nanmax(np.abs(ok_pos))) > 0:
-        raise DataError(f"{tracker.source}: columns Tx, Ty, Tz of {tip.label!r} stay below "
-                        f"{float(np.nanmax(np.abs(ok_pos))):.3g}: the positions look like metres; "
-                        "fix: --map tracker.unit=m (NDI Track writes mm)")
-    t0 = float(tip.time_s[0])
-    t_trk = tip.time_s - t0
-    try:
-        bend = bend_angle(t_trk, tip.quat_wxyz, tip.valid, None if base is None else base.quat_wxyz,
-                          None if base is None else base.valid, rest_s=tm.rest_s)
-    except ValueError:
-        raise DataError(f"{tracker.source}: no frame in which the tip{' and the base' if base else ''} coil is "
-                        "tracked (state OK); fix: check the tool names (tracker.tip, tracker.base)") from None
-    flagged: dict = {}
-    for role, tool in (("tip", tip), ("base", base)):
-        if tool is None:
-            continue
-        for st in tool.state[~tool.valid]:
-            flagged[(role, str(st))] = flagged.get((role, str(st)), 0) + 1
+    if isinstance(tracker, Series):
+        bend, t0, flagged, tip, base = _angle_from_log(tracker, bench)
+    else:
+        bend, t0, flagged, tip, base = _angle_from_poses(tracker, bench)
+    t_trk = bend.time_s
     dtt = np.diff(t_trk)
     med = float(np.median(dtt))
     absent = int(np.sum(np.maximum(np.round(dtt / med) - 1, 0)[dtt > 1.5 * med]))
@@ -162,7 +188,7 @@ def ingest(tracker: TrackerLog, daq: Series, motor: Series, bench: BenchMap, sam
         raise DataError(f"{motor.source}: column {motor.column!r} gives a stroke that runs negative "
                         f"({stroke.max():.3g} to {stroke.min():.3g} mm); fix: --map motor.sign=-1 (the position counts "
                         "down as the tendon is pulled)")
-    force = force_N(daq, bench.daq, tm.rest_s)
+    force = force_N(daq, bench.daq, bench.tracker.rest_s)
 
     # ---- clocks: the motor and the DAQ onto the tracker
     ang = bend.angle_deg
@@ -210,18 +236,19 @@ def ingest(tracker: TrackerLog, daq: Series, motor: Series, bench: BenchMap, sam
     data = Dataset(np.full(tk.size, sample, dtype=object), cyc.astype(np.int64), tk - tk[0], s_row, f_row,
                    bend.angle_deg[keep], {"out_of_plane_deg": bend.out_of_plane_deg[keep]})
     traces = {"motor_t": m_t, "motor_stroke": stroke, "daq_t": d_t, "daq_force": force,
-              "tip_state": tip.state, "base_state": None if base is None else base.state, "row_t": tk,
-              "t0_s": t0}
+              "tip_state": None if tip is None else tip.state, "base_state": None if base is None else base.state,
+              "row_t": tk, "t0_s": t0}
     return Ingested(data, bend, {"motor": c_motor, "daq": c_daq}, flagged, absent, dropped,
                     {"tracker": int(np.sum(dtt > 1.5 * med)), "daq": n_gap_d, "motor": n_gap_m}, traces,
                     {"tracker": tracker.source, "daq": daq.source, "motor": motor.source})
 
 
 def ingest_files(tracker_path, daq_path, motor_path, bench: BenchMap, sample: str | None = None, *,
-                 max_lag_s: float | None = None) -> Ingested:
+                 max_lag_s: float | None = None, angle_log: bool = False) -> Ingested:
     """Read the three logs named by the bench map's columns and :func:`ingest` them.
 
-    ``sample`` defaults to the tracker file's name without its suffix.
+    ``sample`` defaults to the tracker file's name without its suffix. With ``angle_log`` the first file is
+    a time-series log of the joint angle (the map's ``angle`` section), not an NDI export.
     """
     from pathlib import Path
 
@@ -229,7 +256,11 @@ def ingest_files(tracker_path, daq_path, motor_path, bench: BenchMap, sample: st
     from camtube.model.ingest.series import load_series
 
     tm = bench.tracker
-    log = load_ndi(tracker_path, unit=tm.unit, rate_hz=tm.rate_hz or None)
+    if angle_log:
+        a = bench.angle
+        log = load_series(tracker_path, a.time, a.time_unit, a.angle, role="angle")
+    else:
+        log = load_ndi(tracker_path, unit=tm.unit, rate_hz=tm.rate_hz or None)
     d = bench.daq
     daq = load_series(daq_path, d.time, d.time_unit, d.force, d.trigger, role="daq")
     m = bench.motor

@@ -140,8 +140,9 @@ def summary_lines(ing: Ingested) -> list[str]:
     out.append(f"tracker dropouts: {ing.dropouts} frames (flagged: {fl}; absent from the export: {ing.absent_frames})")
     out.append("frames without a row: " + ", ".join(f"{k} {v}" for k, v in ing.dropped.items()))
     out.append(f"gaps: " + ", ".join(f"{k} {v}" for k, v in ing.gaps.items()))
-    out.append(f"out-of-plane rotation: RMS {ing.bend.out_of_plane_rms_deg:.3f} deg, "
-               f"max {np.nanmax(ing.bend.out_of_plane_deg):.3f} deg")
+    oop = ing.bend.out_of_plane_deg[ing.bend.valid]
+    if np.isfinite(oop).any():
+        out.append(f"out-of-plane rotation: RMS {ing.bend.out_of_plane_rms_deg:.3f} deg, max {np.nanmax(oop):.3f} deg")
     return out
 
 

@@ -9,6 +9,7 @@ optional trigger column shared with another instrument::
     daq:      {time: t_ms, time_unit: ms, force: load_V, force_unit: V, N_per_V: 2.2, offset_V: rest, trigger: sync}
     motor:    {time: t_us, time_unit: us, stroke: counts, stroke_unit: counts, counts_per_rev: 512,
                gear_ratio: 64, lead_mm_per_rev: 0.5, sign: 1, trigger: sync}
+    angle:    {time: t, time_unit: s, angle: theta, unit: rad}     # only for --angle-log (no tracker)
 
 :func:`load_bench_map` reads such a YAML file; ``--map KEY=VALUE`` pairs (``daq.N_per_V=2.2``) override it.
 Unknown keys are errors with a "did you mean" hint.
@@ -126,17 +127,39 @@ class MotorMap:
 
 
 @dataclass(frozen=True)
+class AngleMap:
+    """How to read a log of the joint angle itself (instead of a tracker export).
+
+    Attributes
+    ----------
+    time, time_unit : str
+        Time column and its unit.
+    angle : str
+        The angle column.
+    unit : str
+        ``deg`` or ``rad``; left empty, the angle is read in deg and refused if it looks like radians.
+    """
+
+    time: str = "time_s"
+    time_unit: str = "s"
+    angle: str = "angle_deg"
+    unit: str = ""
+
+
+@dataclass(frozen=True)
 class BenchMap:
-    """The three instruments' maps (see the module docstring)."""
+    """The instruments' maps (see the module docstring)."""
 
     tracker: TrackerMap = field(default_factory=TrackerMap)
     daq: DaqMap = field(default_factory=DaqMap)
     motor: MotorMap = field(default_factory=MotorMap)
+    angle: AngleMap = field(default_factory=AngleMap)
 
 
 _ALLOWED = {
     ("tracker", "unit"): ("mm", "m"),
     ("daq", "time_unit"): tuple(TIME_UNITS), ("motor", "time_unit"): tuple(TIME_UNITS),
+    ("angle", "time_unit"): tuple(TIME_UNITS), ("angle", "unit"): ("", "deg", "rad"),
     ("daq", "force_unit"): ("V", "N"), ("motor", "stroke_unit"): ("counts", "rev", "mm"),
 }
 _POSITIVE = {("motor", "counts_per_rev"), ("motor", "gear_ratio"), ("motor", "lead_mm_per_rev")}
@@ -197,9 +220,9 @@ def bench_map_from_dict(doc: dict, source: str = "<bench map>", overrides: list[
     sections = {}
     for sec, body in doc.items():
         if not hasattr(base, sec):
-            hint = difflib.get_close_matches(sec, ["tracker", "daq", "motor"], n=1)
+            hint = difflib.get_close_matches(sec, ["tracker", "daq", "motor", "angle"], n=1)
             raise _map_err(source, sec, "unknown section", f"did you mean {hint[0]!r}?" if hint
-                           else "use tracker, daq and motor")
+                           else "use tracker, daq, motor and angle")
         default = getattr(base, sec)
         names = {f.name: getattr(default, f.name) for f in fields(default)}
         vals = {}
@@ -302,7 +325,7 @@ def parse_series(text: str, source: str, time: str, time_unit: str, value: str, 
     idx = {}
     for what, col in wanted:
         if col not in header:
-            key = {"time": f"{role}.time", "value": f"{role}.{'force' if role == 'daq' else 'stroke'}",
+            key = {"time": f"{role}.time", "value": f"{role}.{ {'daq': 'force', 'angle': 'angle'}.get(role, 'stroke')}",
                    "trigger": f"{role}.trigger"}[what]
             hint = difflib.get_close_matches(col, header, n=1, cutoff=0.4)
             fix = f"set {key}: {hint[0]} in the bench map" if hint else f"set {key} to one of: {', '.join(header)}"
