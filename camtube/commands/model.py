@@ -124,7 +124,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from camtube.commands.common import load_from_args
     from camtube.io import write_atomic
     from camtube.model.core.build import (
-        build_registry, fit_param_names, history_warning, parse_assignments, parse_fix, split_names,
+        build_registry, fitted_and_held, history_warning, parse_assignments, split_names,
     )
     from camtube.model.core.fit import FitError, fit
     from camtube.model.core.predict import model_for_pattern, pattern_values
@@ -139,10 +139,10 @@ def cmd_fit(args: argparse.Namespace) -> int:
     raw = load_csv(args.data)
     rows = prepare(raw, args.cycles, args.branch, args.deadband, args.deadband_threshold)
     check_fittable(rows, f"{args.data} (cycles {args.cycles}, {args.branch} branch)")
+    names, held = fitted_and_held(model, args.fit_params, args.fix)
     fixed = pattern_values(pattern)
-    fixed.update(parse_fix(args.fix))
+    fixed.update(held)
     init = parse_assignments(args.init, "--init")
-    names = fit_param_names(model, args.fit_params)
     params = model.make_params(rows, names, fixed, initial=init, per_sample=split_names(args.per_sample))
     warn = history_warning(model, args.branch, min((len(set(rows.cycle[sl].tolist()))
                                                     for _, sl in rows.sample_slices()), default=0),
