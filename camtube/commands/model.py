@@ -201,16 +201,20 @@ def cmd_synth(args: argparse.Namespace) -> int:
 def cmd_ingest(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from camtube.io import write_atomic, write_set
+    from camtube.commands.common import check_output_dir
+    from camtube.io import check_writable_dir, write_atomic, write_set
     from camtube.model.data.csvfile import format_csv
     from camtube.model.ingest.merge import ingest_files
     from camtube.model.ingest.series import load_bench_map
 
     check_suffix(args.output, (".csv",), "-o/--output")
-    if args.report and Path(args.report).exists() and not Path(args.report).is_dir():
+    if Path(args.output).is_dir():
         from camtube.errors import DataError
 
-        raise DataError(f"--report {args.report}: a file of that name exists; fix: name a directory")
+        raise DataError(f"-o {args.output}: is a directory; fix: name the measurement CSV to write")
+    check_writable_dir(Path(args.output).absolute().parent)
+    if args.report:
+        check_output_dir(args.report)
     bench = load_bench_map(args.bench, args.map_overrides)
     first = args.tracker or args.angle_log
     ing = ingest_files(first, args.daq, args.motor, bench, args.sample, max_lag_s=args.max_lag,

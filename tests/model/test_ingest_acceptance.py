@@ -206,3 +206,10 @@ def test_an_angle_log_in_radians_is_refused_until_the_map_says_so(tmp_path, caps
     truth_peak = max(float(r["angle_deg"]) for r in rows)
     assert max(float(r["angle_deg"]) for r in out) == pytest.approx(truth_peak, abs=1e-4)
     assert {int(r["cycle"]) for r in out} == {1, 2, 3}
+
+
+def test_a_report_path_that_is_a_file_is_refused_before_any_work(tmp_path, capsys):
+    (tmp_path / "rep").write_text("x")
+    assert main(_argv(tmp_path, "--report", str(tmp_path / "rep"))) == 2
+    assert "is a file" in capsys.readouterr().err
+    assert not (tmp_path / "d.csv").exists()
