@@ -224,3 +224,15 @@ def test_cycles_from_a_stroke_with_rests_and_dwells():
     assert starts == pytest.approx(3.0 + 6.0 * np.arange(1, 9), abs=0.011)
     cyc = cycle_numbers(t, starts)
     assert cyc[0] == 1 and cyc[-1] == 9 and np.all(np.diff(cyc) >= 0)
+
+
+def test_the_capi_sample_layout_of_one_tool_reads_too_and_a_longer_row_is_refused():
+    head = "#Tools,ToolInfo,Frame#,PortHandle,Face#,TransformStatus,Q0,Qx,Qy,Qz,Tx,Ty,Tz,Error,Markers,State,Tx,Ty,Tz\n"
+    text = (head + "1,610029 s/n:3B1F0A01,100,Port:10,0,OK,1,0,0,0,1,2,3,0.1,0,,,,\n"
+            "1,610029 s/n:3B1F0A01,101,Port:10,0,Missing,,,,,,,,,0,,,,\n")
+    log = parse_ndi(text, "capi.csv", rate_hz=40.0)
+    (tool,) = log.tools
+    assert list(tool.state) == ["OK", "Missing"] and list(tool.valid) == [True, False]
+    assert tool.time_s[1] == pytest.approx(1 / 40.0)
+    with pytest.raises(DataError, match=r"capi.csv:3: 24 cells but the header \(line 1\) has 19"):
+        parse_ndi(text.rstrip("\n") + ",1,2,3,4,5\n", "capi.csv", rate_hz=40.0)

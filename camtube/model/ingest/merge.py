@@ -138,7 +138,7 @@ def _gap_mask(t: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray, in
 def _check_duration(name: str, s: Series, unit: str, key: str, tracker_span: float) -> None:
     span = float(s.time_s[-1] - s.time_s[0])
     ratio = span / tracker_span if tracker_span > 0 else 1.0
-    if not 0.2 <= ratio <= 5.0:
+    if not 0.05 <= ratio <= 20.0:
         units = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "min": 60.0}
         cur = units[unit]
         best = min(units, key=lambda u: abs(np.log(span / cur * units[u] / tracker_span)))

@@ -158,8 +158,9 @@ def _norm(name: str) -> str:
 
 
 def _group_starts(header: list[str]) -> list[int]:
-    starts = [i for i, h in enumerate(header) if _norm(h).startswith("port") or _norm(h) in ("toolinfo", "tool")]
-    return starts
+    names = [_norm(h) for h in header]
+    return [i for i, h in enumerate(names)
+            if (h.startswith("port") and h != "porthandle") or h in ("toolinfo", "tool")]
 
 
 def _cell_float(cell: str) -> float:
@@ -235,6 +236,11 @@ def parse_ndi(text: str, source: str = "<ndi>", *, unit: str = "mm", rate_hz: fl
 
     n = len(rows)
     width = len(header)
+    longer = [k for k, r in enumerate(rows) if len(r) > width and any(c.strip() for c in r[width:])]
+    if longer:
+        k = longer[0]
+        raise _err(source, lines[k], f"{len(rows[k])} cells but the header (line {hline}) has {width}",
+                   "export with one column group per tool in the header (NDI Track's CSV export does)")
     tools = []
     for s, fields in groups:
         label_cells = [r[s].strip() if s < len(r) else "" for r in rows]
