@@ -236,3 +236,13 @@ def test_the_capi_sample_layout_of_one_tool_reads_too_and_a_longer_row_is_refuse
     assert tool.time_s[1] == pytest.approx(1 / 40.0)
     with pytest.raises(DataError, match=r"capi.csv:3: 24 cells but the header \(line 1\) has 19"):
         parse_ndi(text.rstrip("\n") + ",1,2,3,4,5\n", "capi.csv", rate_hz=40.0)
+
+
+def test_a_motion_that_cannot_fix_the_offset_is_refused():
+    t_ref = np.arange(0, 100, 1 / 40.0)
+    t_inst = np.arange(-60, 160, 1 / 100.0)            # covers the tracker's recording at every period shift
+    wave = lambda t: np.abs(((t / 10.0) % 1.0) - 0.5)
+    with pytest.raises(DataError, match="the motion does not fix the motor log's clock.*fix: --max-lag S"):
+        align_xcorr("motor", t_ref, wave(t_ref), t_inst, wave(t_inst + 0.3))
+    c = align_xcorr("motor", t_ref, wave(t_ref), t_inst, wave(t_inst + 0.3), max_lag_s=4.0)
+    assert c.to_ref(np.array([50.0]))[0] == pytest.approx(50.3, abs=0.002)

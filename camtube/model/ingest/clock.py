@@ -57,6 +57,9 @@ class ClockFit:
         Sign of the correlation between the instrument's signal and the reference (+1 expected).
     window_t_s, window_lag_s : (k,) float
         Per-window lags (instrument clock, s) the fit was made from, for the report.
+    runner_up, runner_up_lag_s : float
+        The best other local maximum of the coarse cross-correlation, as a fraction of the chosen one's,
+        and its offset (s). Close to 1 means the motion barely fixes the offset.
     """
 
     name: str
@@ -69,6 +72,8 @@ class ClockFit:
     sign: int = 1
     window_t_s: np.ndarray = field(default_factory=lambda: np.zeros(0))
     window_lag_s: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    runner_up: float = float("nan")
+    runner_up_lag_s: float = float("nan")
 
     def to_ref(self, t: np.ndarray) -> np.ndarray:
         """(n,) reference-clock times of the instrument's times ``t`` (s)."""
@@ -148,8 +153,9 @@ def _uniform(t: np.ndarray, y: np.ndarray, t0: float, dt: float, n: int) -> np.n
 
 
 def coarse_lag(ref_t: np.ndarray, ref_y: np.ndarray, t: np.ndarray, y: np.ndarray, dt: float = 0.02,
-               max_lag_s: float | None = None) -> tuple[float, int, float]:
-    """Coarse lag (s, ``t_ref = t + lag``), correlation sign and peak height from the full cross-correlation.
+               max_lag_s: float | None = None) -> tuple[float, int, float, float]:
+    """Coarse lag (s, ``t_ref = t + lag``), correlation sign, and the best other local maximum of the
+    cross-correlation: its score as a fraction of the peak's, and its lag (s).
 
     Both signals are put on a ``dt`` grid (the reference's gaps bridged linearly), their means removed, and
     correlated over every overlap; outside a recording a signal counts as zero (so a shift by a whole period
@@ -170,7 +176,16 @@ def coarse_lag(ref_t: np.ndarray, ref_y: np.ndarray, t: np.ndarray, y: np.ndarra
         keep = np.abs(lags) <= max_lag_s
         c, lags = c[keep], lags[keep]
     k = int(np.argmax(np.abs(c)))
-    return float(lags[k]), (1 if c[k] >= 0 else -1), float(abs(c[k]) / min(a.size, b.size))
+    sign = 1 if c[k] >= 0 else -1
+    # the best other local maximum (a periodic motion scores again one period off)
+    from scipy.signal import find_peaks
+
+    peaks, _ = find_peaks(sign * c)
+    peaks = peaks[peaks != k]
+    if not peaks.size or c[k] == 0:
+        return float(lags[k]), sign, 0.0, float("nan")
+    j = int(peaks[np.argmax(sign * c[peaks])])
+    return float(lags[k]), sign, float(sign * c[j] / (sign * c[k])), float(lags[j])
 
 
 def align_xcorr(name: str, ref_t: np.ndarray, ref_y: np.ndarray, t: np.ndarray, y: np.ndarray, *,
@@ -201,7 +216,12 @@ def align_xcorr(name: str, ref_t: np.ndarray, ref_y: np.ndarray, t: np.ndarray, 
     ref_y = np.asarray(ref_y, float)
     t = np.asarray(t, float)
     y = np.asarray(y, float)
-    lag0, sign, _ = coarse_lag(ref_t, ref_y, t, y, max_lag_s=max_lag_s)
+    lag0, sign, runner_up, alt = coarse_lag(ref_t, ref_y, t, y, max_lag_s=max_lag_s)
+    if runner_up > 0.995:
+        raise DataError(f"the motion does not fix the {name} log's clock: offsets of {lag0:.2f} s and {alt:.2f} s "
+                        f"fit the tracker within {100 * (1 - runner_up):.1f} % of each other; fix: --max-lag S (the "
+                        "largest offset the clocks can have), a rest at the start and end of the recording, or a "
+                        "trigger column")
     ok = np.isfinite(ref_y)
     rt, ry = ref_t[ok], ref_y[ok]
     lo, hi = max(rt[0], t[0] + lag0), min(rt[-1], t[-1] + lag0)
@@ -261,7 +281,7 @@ def align_xcorr(name: str, ref_t: np.ndarray, ref_y: np.ndarray, t: np.ndarray, 
     wt_a, wl_a = np.asarray(wt), np.asarray(wl)
     t_mid = 0.5 * (t[0] + t[-1])
     c, d, sc, sd = _weighted_line(wt_a, wl_a, np.asarray(ws), t_mid)
-    return ClockFit(name, "xcorr", c, d * 1e6, t_mid, sc, sd * 1e6, sign, wt_a, wl_a)
+    return ClockFit(name, "xcorr", c, d * 1e6, t_mid, sc, sd * 1e6, sign, wt_a, wl_a, runner_up, alt)
 
 
 def _smooth_to(t: np.ndarray, y: np.ndarray, dt_ref: float) -> np.ndarray:

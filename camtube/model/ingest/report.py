@@ -134,8 +134,11 @@ def summary_lines(ing: Ingested) -> list[str]:
            f"stroke {d.stroke_mm.min():.3f} to {d.stroke_mm.max():.3f} mm, force {d.force_N.min():.3f} to "
            f"{d.force_N.max():.3f} N, angle {np.nanmin(d.angle_deg):.2f} to {np.nanmax(d.angle_deg):.2f} deg)"]
     for name, c in ing.clocks.items():
-        out.append(f"{name} clock ({c.method}): offset {c.offset_s:+.4f} s +- {c.offset_err_s * 1e3:.2f} ms, "
-                   f"drift {c.drift_ppm:+.1f} +- {c.drift_err_ppm:.1f} ppm (at {name} time {c.t_mid_s:.1f} s)")
+        line = (f"{name} clock ({c.method}): offset {c.offset_s:+.4f} s +- {c.offset_err_s * 1e3:.2f} ms, "
+                f"drift {c.drift_ppm:+.1f} +- {c.drift_err_ppm:.1f} ppm (at {name} time {c.t_mid_s:.1f} s)")
+        if np.isfinite(c.runner_up):
+            line += f"; next best offset {c.runner_up_lag_s:+.2f} s scores {100 * c.runner_up:.0f} %"
+        out.append(line)
     fl = ", ".join(f"{r} {s}: {n}" for (r, s), n in sorted(ing.flagged.items())) or "none"
     out.append(f"tracker dropouts: {ing.dropouts} frames (flagged: {fl}; absent from the export: {ing.absent_frames})")
     out.append("frames without a row: " + ", ".join(f"{k} {v}" for k, v in ing.dropped.items()))
