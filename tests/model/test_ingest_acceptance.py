@@ -213,3 +213,12 @@ def test_a_report_path_that_is_a_file_is_refused_before_any_work(tmp_path, capsy
     assert main(_argv(tmp_path, "--report", str(tmp_path / "rep"))) == 2
     assert "is a file" in capsys.readouterr().err
     assert not (tmp_path / "d.csv").exists()
+
+
+def test_one_coil_is_taken_against_its_own_rest(tmp_path):
+    # the simulated bench wobbles by 2 deg under the base coil: with the tip coil alone that stays in the angle
+    assert main(_argv(tmp_path, "--map", "tracker.base=")) == 0
+    rows = list(csv.DictReader(open(tmp_path / "d.csv", newline="")))
+    truth = list(csv.DictReader(open(BENCH / "truth.csv", newline="")))
+    peak = max(float(r["angle_deg"]) for r in rows)
+    assert peak == pytest.approx(max(float(r["angle_deg"]) for r in truth), abs=3.0)
