@@ -18,7 +18,7 @@ from camtube.design.loader import load_pattern
 from camtube.model.ingest.ndi import parse_ndi
 from camtube.model.ingest.merge import ingest
 from camtube.model.ingest.series import bench_map_from_dict, parse_series
-from camtube.model.sim.bench import BenchSetup, random_setups, simulate_bench
+from camtube.model.sim.rawlogs import BenchSetup, random_setups, simulate_bench
 
 TUNED = [("tube2", BenchSetup(seed=s)) for s in (0, 1, 2)]
 

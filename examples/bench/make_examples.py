@@ -1,5 +1,5 @@
 """Write the example bench logs of docs/bench.md: a short recording of a tube-2 joint made by
-:func:`camtube.model.sim.bench.simulate_bench` (three cycles, two coils, dropouts, a DAQ gap).
+:func:`camtube.model.sim.rawlogs.simulate_bench` (three cycles, two coils, dropouts, a DAQ gap).
 
     python examples/bench/make_examples.py
 """
@@ -9,7 +9,7 @@ from pathlib import Path
 
 from camtube.design.loader import load_pattern
 from camtube.model.data.csvfile import format_csv
-from camtube.model.sim.bench import BenchSetup, simulate_bench
+from camtube.model.sim.rawlogs import BenchSetup, simulate_bench
 
 HERE = Path(__file__).resolve().parent
 SETUP = BenchSetup(seed=7, n_cycles=3, daq_rate_hz=200.0, motor_rate_hz=50.0, n_bursts=3, n_absent=2)

@@ -1,9 +1,9 @@
-"""``camtube model ingest`` against raw logs simulated from a known truth (:mod:`camtube.model.sim.bench`),
+"""``camtube model ingest`` against raw logs simulated from a known truth (:mod:`camtube.model.sim.rawlogs`),
 and the command's output and errors.
 
 Three sets of recordings, all held to the same acceptance lines of issue 23: the seeds the method was
 tuned on; a set seen while it was tuned (other joints, rates, offsets, drifts, noise); and a held-out set
-drawn at random by :func:`~camtube.model.sim.bench.random_setups` once the method was final.
+drawn at random by :func:`~camtube.model.sim.rawlogs.random_setups` once the method was final.
 """
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ from camtube.design.loader import load_pattern
 from camtube.model.ingest.merge import ingest
 from camtube.model.ingest.ndi import parse_ndi
 from camtube.model.ingest.series import bench_map_from_dict, parse_series
-from camtube.model.sim.bench import BenchSetup, random_setups, simulate_bench
+from camtube.model.sim.rawlogs import BenchSetup, random_setups, simulate_bench
 from tests.conftest import PATTERNS, ROOT
 
 BENCH = ROOT / "examples" / "bench"
