@@ -103,6 +103,12 @@ class OptimalTime:
         return self.path_s + self.free_s
 
 
+def true_corner_flags(points, corners: np.ndarray, offset_mm: float = 0.0) -> np.ndarray:
+    """(k,) bool: the vertices of a pass path (moved ``offset_mm`` inward) that are true corners of the drawing."""
+    p = np.asarray(points, float).reshape(-1, 2)
+    return _corner_flags(p[:, 0], p[:, 1], corners, math.sqrt(2.0) * offset_mm + TOL.path + TOL.safety)
+
+
 def time_optimal_s(job, profile, corner_deg: float = TOL.corner_deg) -> float:
     """The time-optimal bound (s) of ``job`` on ``profile`` (module docstring; :func:`time_optimal`)."""
     return time_optimal(job, profile, corner_deg).total_s

@@ -17,8 +17,11 @@ Figures (:class:`MotionReport`):
   profile (the rate commanded at sample ``k`` is in force from ``k`` to ``k + 1``), or, for a
   time-gated one, the set frequency over the recorded speed;
 - farthest beam-on position outside the design cut regions (the tube is periodic in y);
-- largest distance from a drawn corner (every vertex of every pass path, matched by
-  focus level) to the beam-on path at that focus.
+- largest distance from a drawn corner (every vertex of a pass path that is a true corner of the
+  drawing, :func:`camtube.machine.bound.design_corners`: every vertex of a rectangle, none of a
+  slot or an ellipse; matched by focus level) to the beam-on path at that focus;
+- largest distance of the beam-on path from the pass's commanded path (curves followed within
+  the path tolerance).
 """
 from __future__ import annotations
 
@@ -46,7 +49,10 @@ class JobGeometry:
     regions : list of (k, 2) float
         Design cut regions (unwrapped unrolled frame, mm).
     corners : (c, 3) float
-        Every vertex of every pass path: x, y (mm), focus offset into the material (mm).
+        The vertices of the pass paths that are true corners of the drawing: x, y (mm), focus
+        offset into the material (mm).
+    paths : tuple of ((k, 2) float, bool, float)
+        Every distinct pass path (vertices, closed, focus offset mm).
     estimate_s, lower_bound_s : float
         The job's time estimate and lower bound (s), NaN if unknown.
     """
@@ -65,9 +71,15 @@ class JobGeometry:
     @classmethod
     def from_job(cls, job, estimate_s: float = math.nan) -> "JobGeometry":
         """From a planned :class:`~camtube.plan.job.Job`."""
-        corners = np.concatenate([np.column_stack([np.asarray(p.contour.points, float),
-                                                   np.full(len(p.contour.points), p.focus_offset_mm)])
-                                  for p in job.passes]) if job.passes else np.zeros((0, 3))
+        from camtube.machine.bound import design_corners, true_corner_flags
+
+        drawn = design_corners(job)
+        rows = []
+        for p in job.passes:
+            pts = np.asarray(p.contour.points, float)
+            keep = true_corner_flags(pts, drawn, p.offset_mm)
+            rows.append(np.column_stack([pts[keep], np.full(int(keep.sum()), p.focus_offset_mm)]))
+        corners = np.concatenate(rows) if rows else np.zeros((0, 3))
         pk = job.packed
         seen = sorted({(int(g), float(z)) for g, z in zip(pk.pass_geom.tolist(), pk.pass_z.tolist())})
         paths = tuple((np.asarray(pk.path_points(g), float), bool(pk.geom_closed[g]), z) for g, z in seen)
