@@ -36,11 +36,13 @@ class Tolerances:
         Drawing import: the tube outline's height may differ from 2 pi r_o by
         this much (1 um) before the radius is called a mismatch.
     path : float
-        Path tolerance of a pass (1 um, a tenth of a femtosecond kerf of >= 10 um):
-        a tangent-continuous run of a closed pass path (a flattened arc, spline,
-        fillet or ellipse) is cut as chords that lie within this of the drawn path,
-        and only on its inside (:func:`camtube.plan.paths.simplify_closed`); the
-        machine's blending tolerance (``G64 P``) is the same figure.
+        Chord tolerance of a pass (1 um): a tangent-continuous run of a closed pass
+        path (a flattened arc, spline, fillet or ellipse) is cut as chords that lie
+        within this of the drawn path, and only on its inside
+        (:func:`camtube.plan.paths.simplify_closed`). A machine that blends the
+        chords adds its blending tolerance (``G64 P0.001`` on ``linuxcnc-path``):
+        the beam stays within 2 um of the drawing, a tenth of a 20 um kerf
+        (``MachineProfile.path_tolerance_mm``).
     corner_deg : float
         A vertex where the path turns by more than this (deg) is a true corner:
         the time-optimal bound stops there (:mod:`camtube.machine.bound`); below it

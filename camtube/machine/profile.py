@@ -159,6 +159,16 @@ class MachineProfile:
         return self.blending == "exact_stop"
 
     @property
+    def path_tolerance_mm(self) -> float:
+        """How far the beam may stray from a drawn curve (mm): the chords' ``TOL.path`` (1 um, all on the
+        inside) plus, where a pass is blended (``corner_strategy: blend``), the blending tolerance (``G64 P``):
+        2 um for ``linuxcnc-path``, a tenth of a 20 um femtosecond kerf."""
+        from camtube.tol import TOL
+
+        extra = float(self.blending) if self.corner_strategy == "blend" else 0.0
+        return TOL.path + extra
+
+    @property
     def feed_mode(self) -> str:
         """``inverse_time`` (G93: F = 1 / minutes of each move) for LinuxCNC, ``units_per_minute`` (G94) for GRBL."""
         return "inverse_time" if self.dialect == "linuxcnc" else "units_per_minute"

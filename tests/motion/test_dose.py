@@ -152,7 +152,8 @@ def test_a_curved_drawing_runs_as_one_path_per_pass(tmp_path):
     assert r.dose_share >= 0.99 and abs(r.length_error) < 0.001
     assert r.max_outside_mm <= 0.001 and r.max_corner_miss_mm <= 0.002
     assert r.run_time_s < 1.15 * time_optimal_s(job, profile)
-    assert r.max_path_dev_mm <= TOL.path  # every curve followed within the path tolerance
+    # every curve followed within the blending tolerance of its chords, which lie within TOL.path of the drawing
+    assert r.max_path_dev_mm <= profile.path_tolerance_mm - TOL.path + 1e-4 and profile.path_tolerance_mm <= 0.002
 
 
 # ---------------------------------------------------------------- warnings that name the cause
