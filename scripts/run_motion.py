@@ -89,7 +89,8 @@ def rescore(r: dict) -> dict:
 def table(rows: list[dict]) -> str:
     head = ("| machine | job | LinuxCNC run s | estimate s (error) | lower bound s | run / lower bound | "
             "time-optimal s | run / time-optimal | beam-on path vs cut length | dose within +-5 % | "
-            "within +-5 % of scan speed | beam on outside regions um | corner missed by um | path followed within um |")
+            "within +-5 % of scan speed | beam on outside regions um | corner missed by um | own pass: path / "
+            "vertices um |")
     out = [head, "|" + "---|" * 14]
     for r in rows:
         opt = r.get("optimal_s", float("nan"))
@@ -99,7 +100,8 @@ def table(rows: list[dict]) -> str:
                    f"{r['run_time_s'] / r['lower_bound_s']:.3f} | {opt:.2f} | {r['run_time_s'] / opt:.3f} | "
                    f"{100 * r['length_error']:+.3f} % | {100 * dose:.2f} % | "
                    f"{100 * r['speed_share']:.2f} % | {1000 * r['max_outside_mm']:.3f} | "
-                   f"{1000 * r['max_corner_miss_mm']:.3f} | {1000 * r.get('max_path_dev_mm', float('nan')):.3f} |")
+                   f"{1000 * r['max_corner_miss_mm']:.3f} | {1000 * r.get('max_path_dev_mm', float('nan')):.3f} / "
+                   f"{1000 * r.get('max_vertex_miss_mm', float('nan')):.3f} |")
     return "\n".join(out)
 
 
@@ -119,7 +121,8 @@ def main() -> int:
     args = ap.parse_args()
     if args.table:
         rows = [json.loads(x) for x in Path(args.table).read_text().splitlines() if x.strip()]
-        rows = [r for r in rows if "error" not in r]
+        last = {(r["machine"], r["preset"]): r for r in rows if "error" not in r}  # a rerun replaces a run
+        rows = list(last.values())
         if args.rescore:
             rows = [rescore(r) for r in rows]
         print(table(rows))
@@ -151,7 +154,7 @@ def main() -> int:
                   f"length {100 * r['length_error']:+.3f} %, dose {100 * r['dose_share']:.2f} %, "
                   f"speed share {100 * r['speed_share']:.2f} %, "
                   f"outside {1000 * r['max_outside_mm']:.3f} um, corner {1000 * r['max_corner_miss_mm']:.3f} um, "
-                  f"path {1000 * r['max_path_dev_mm']:.3f} um "
+                  f"own pass: path {1000 * r['max_path_dev_mm']:.3f} um, vertices {1000 * r['max_vertex_miss_mm']:.3f} um "
                   f"({time.time() - t0:.0f} s)", flush=True)
     print(table(rows))
     return 0

@@ -20,8 +20,10 @@ Figures (:class:`MotionReport`):
 - largest distance from a drawn corner (every vertex of a pass path that is a true corner of the
   drawing, :func:`camtube.machine.bound.design_corners`: every vertex of a rectangle, none of a
   slot or an ellipse; matched by focus level) to the beam-on path at that focus;
-- largest distance of the beam-on path from the pass's commanded path (curves followed within
-  the path tolerance).
+- each stretch of the beam-on path against its own pass (the k-th stretch with the gate open is the
+  k-th pass): the farthest sample from the pass's commanded path, and the farthest vertex of that
+  path (on a curve: a point of the drawn curve) from the stretch (curves followed within the path
+  tolerance).
 """
 from __future__ import annotations
 
@@ -67,6 +69,7 @@ class JobGeometry:
     lower_bound_s: float
     frequency_khz: float = math.nan
     paths: tuple = ()
+    pass_paths: tuple = ()
 
     @classmethod
     def from_job(cls, job, estimate_s: float = math.nan) -> "JobGeometry":
@@ -83,10 +86,12 @@ class JobGeometry:
         pk = job.packed
         seen = sorted({(int(g), float(z)) for g, z in zip(pk.pass_geom.tolist(), pk.pass_z.tolist())})
         paths = tuple((np.asarray(pk.path_points(g), float), bool(pk.geom_closed[g]), z) for g, z in seen)
+        index = {(g, z): k for k, (g, z) in enumerate(seen)}
+        order = tuple(index[(int(g), float(z))] for g, z in zip(pk.pass_geom.tolist(), pk.pass_z.tolist()))
         return cls(job.name, float(job.outer_radius_mm), float(job.process.scan_speed_mm_s),
                    float(job.cut_length_mm), tuple(np.asarray(c.points, float) for c in job.design), corners,
                    float(estimate_s), float(job.cut_length_mm / job.process.scan_speed_mm_s),
-                   float(job.process.frequency_khz), paths)
+                   float(job.process.frequency_khz), paths, order)
 
     @classmethod
     def from_job_file(cls, path: str | os.PathLike) -> "JobGeometry":
@@ -133,6 +138,7 @@ class MotionReport:
     nominal_pulses_per_mm: float = math.nan
     distance_gated: bool = False
     max_path_dev_mm: float = math.nan
+    max_vertex_miss_mm: float = math.nan
 
     @property
     def estimate_error(self) -> float:
@@ -163,8 +169,9 @@ class MotionReport:
                                                                  + ("distance-gated rate recorded)" if self.distance_gated
                                                                     else "time-gated: set frequency / speed)")),
             ("beam on outside cut regions", f"{1000 * self.max_outside_mm:.3f}", "um at most"),
-            ("path followed within", f"{1000 * self.max_path_dev_mm:.3f}", "um at most (beam-on samples from the "
-                                                                          "pass's commanded path)"),
+            ("own pass: path, vertices", f"{1000 * self.max_path_dev_mm:.3f}, {1000 * self.max_vertex_miss_mm:.3f}",
+             "um at most (each beam-on stretch against its own pass: samples from the path, the path's vertices "
+             "from the beam)"),
             ("drawn corner missed by", f"{1000 * self.max_corner_miss_mm:.3f}", f"um at most ({self.corners} "
                                                                                 "corners)"),
         ]
@@ -242,33 +249,27 @@ def _corner_miss_mm(corners: np.ndarray, a: np.ndarray, b: np.ndarray, fz: np.nd
     return worst
 
 
-def _path_dev_mm(paths, pts: np.ndarray, fz: np.ndarray, circ: float) -> float:
-    """Largest distance from beam-on points to the commanded pass paths at their focus (periodic in y)."""
+def _own_pass_mm(rec_x, rec_y, gate, geom) -> tuple[float, float]:
+    """(farthest beam-on sample from its own pass's path, farthest vertex of a pass's path from its own beam-on
+    path), mm: the k-th stretch of samples with the gate open is the k-th pass (NaN if the counts differ)."""
     import shapely
 
-    if len(pts) == 0 or not paths:
-        return math.nan
-    worst = 0.0
-    periodic = math.isfinite(circ)
-    for f in np.unique(np.round(fz, 6)):
-        segs = []
-        for pp, closed, z in paths:
-            if abs(z - f) > 1e-6:
-                continue
-            ring = np.vstack([pp, pp[:1]]) if closed else pp
-            for dy in ((-circ, 0.0, circ) if periodic else (0.0,)):
-                shifted = ring - [0.0, (np.floor(ring[:, 1].min() / circ) * circ if periodic else 0.0) - dy]
-                segs.extend(shapely.linestrings(np.stack([shifted[:-1], shifted[1:]], axis=1)))
-        if not segs:
-            return math.inf
-        tree = shapely.STRtree(segs)
-        q = pts[np.abs(fz - f) < 1e-4]
-        if periodic:
-            q = np.column_stack([q[:, 0], np.mod(q[:, 1], circ)])
-        q = np.unique(np.round(q, 9), axis=0)
-        _, dist = tree.query_nearest(shapely.points(q), return_distance=True, all_matches=False)
-        worst = max(worst, float(np.max(dist)))
-    return worst
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], gate.astype(np.int8), [0]))))
+    starts, ends = edges[::2], edges[1::2]  # the beam is on from sample s to sample e (gate set at s .. e - 1)
+    if len(starts) != len(geom.pass_paths) or not geom.pass_paths:
+        return math.nan, math.nan
+    dev = miss = 0.0
+    lines = {}
+    for s, e, k in zip(starts.tolist(), ends.tolist(), geom.pass_paths):
+        pts = np.column_stack([rec_x[s:e + 1], rec_y[s:e + 1]])
+        line = lines.get(k)
+        if line is None:
+            pp, closed, _ = geom.paths[k]
+            line = lines[k] = shapely.LineString(np.vstack([pp, pp[:1]]) if closed else pp)
+        dev = max(dev, float(shapely.distance(line, shapely.points(pts)).max()))
+        beam = shapely.LineString(pts) if len(pts) > 1 else shapely.Point(pts[0])
+        miss = max(miss, float(shapely.distance(beam, shapely.points(np.asarray(line.coords))).max()))
+    return dev, miss
 
 
 def analyse(rec, geom: JobGeometry, profile, estimate_s: float | None = None) -> MotionReport:
@@ -314,8 +315,7 @@ def analyse(rec, geom: JobGeometry, profile, estimate_s: float | None = None) ->
         pts = np.unique(np.concatenate([a, b]), axis=0)
         outside = _outside_mm(pts[:, 0], pts[:, 1], geom.regions, big)
         miss = _corner_miss_mm(geom.corners, a, b, z[ia], big)
-    zz = np.concatenate([z[ia], z[ia]])
-    path_dev = _path_dev_mm(geom.paths, np.concatenate([a, b]), zz, circ if profile.rotary else math.inf)
+    path_dev, vertex_miss = _own_pass_mm(x, y, rec.gate, geom)
     est = geom.estimate_s if estimate_s is None else float(estimate_s)
     nominal = 1000.0 * geom.frequency_khz / v
     rate = getattr(rec, "rate_khz", None)
@@ -328,4 +328,4 @@ def analyse(rec, geom: JobGeometry, profile, estimate_s: float | None = None) ->
     dose_share = float(lo[good].sum() / length) if length > 0 else 0.0
     return MotionReport(geom.name, profile.name, rec.run_time_s, est, geom.lower_bound_s, float(dt[on].sum()),
                         length, geom.cut_length_mm, v, share, median, outside, miss, len(geom.corners), len(rec),
-                        rec.wall_s, dose_share, nominal, rate is not None, path_dev)
+                        rec.wall_s, dose_share, nominal, rate is not None, path_dev, vertex_miss)
