@@ -86,6 +86,11 @@ def rescore(r: dict) -> dict:
     return dict(r, estimate_s=est, estimate_error=est / r["run_time_s"] - 1.0, optimal_s=time_optimal_s(job, profile))
 
 
+def _um(mm) -> str:
+    """mm as um with 3 decimals; a dash where the figure was not measured (a run made before it existed)."""
+    return "–" if mm is None or mm != mm else f"{1000 * mm:.3f}"
+
+
 def table(rows: list[dict]) -> str:
     head = ("| machine | job | LinuxCNC run s | estimate s (error) | lower bound s | run / lower bound | "
             "time-optimal s | run / time-optimal | beam-on path vs cut length | dose within +-5 % | "
@@ -100,8 +105,8 @@ def table(rows: list[dict]) -> str:
                    f"{r['run_time_s'] / r['lower_bound_s']:.3f} | {opt:.2f} | {r['run_time_s'] / opt:.3f} | "
                    f"{100 * r['length_error']:+.3f} % | {100 * dose:.2f} % | "
                    f"{100 * r['speed_share']:.2f} % | {1000 * r['max_outside_mm']:.3f} | "
-                   f"{1000 * r['max_corner_miss_mm']:.3f} | {1000 * r.get('max_path_dev_mm', float('nan')):.3f} / "
-                   f"{1000 * r.get('max_vertex_miss_mm', float('nan')):.3f} |")
+                   f"{1000 * r['max_corner_miss_mm']:.3f} | {_um(r.get('max_path_dev_mm'))} / "
+                   f"{_um(r.get('max_vertex_miss_mm'))} |")
     return "\n".join(out)
 
 
