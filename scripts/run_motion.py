@@ -100,13 +100,15 @@ def table(rows: list[dict]) -> str:
     for r in rows:
         opt = r.get("optimal_s", float("nan"))
         dose = r.get("dose_share", float("nan"))
+        # the own-pass figures come as a pair; a run made before them has neither
+        own = (f"{_um(r['max_path_dev_mm'])} / {_um(r['max_vertex_miss_mm'])}" if "max_vertex_miss_mm" in r
+               else "– / –")
         out.append(f"| {r['machine']} | {r['preset']} | {r['run_time_s']:.2f} | {r['estimate_s']:.2f} "
                    f"({100 * r['estimate_error']:+.2f} %) | {r['lower_bound_s']:.2f} | "
                    f"{r['run_time_s'] / r['lower_bound_s']:.3f} | {opt:.2f} | {r['run_time_s'] / opt:.3f} | "
                    f"{100 * r['length_error']:+.3f} % | {100 * dose:.2f} % | "
                    f"{100 * r['speed_share']:.2f} % | {1000 * r['max_outside_mm']:.3f} | "
-                   f"{1000 * r['max_corner_miss_mm']:.3f} | {_um(r.get('max_path_dev_mm'))} / "
-                   f"{_um(r.get('max_vertex_miss_mm'))} |")
+                   f"{1000 * r['max_corner_miss_mm']:.3f} | {own} |")
     return "\n".join(out)
 
 
@@ -127,7 +129,9 @@ def main() -> int:
     if args.table:
         rows = [json.loads(x) for x in Path(args.table).read_text().splitlines() if x.strip()]
         last = {(r["machine"], r["preset"]): r for r in rows if "error" not in r}  # a rerun replaces a run
-        rows = list(last.values())
+        kinds = {name: k for k, name in enumerate(PRESETS + DRAWINGS)}
+        rows = sorted(last.values(), key=lambda r: (r["preset"].split()[0] in DRAWINGS, r["machine"] != "linuxcnc-rotary",
+                                                    kinds.get(r["preset"].split()[0], 99)))
         if args.rescore:
             rows = [rescore(r) for r in rows]
         print(table(rows))
