@@ -9,7 +9,7 @@ import math
 import pytest
 import yaml
 
-from camtube.cli import main
+from camtube.commands import main
 from camtube.design import load
 from camtube.errors import PatternError
 from tests.conftest import PATTERNS

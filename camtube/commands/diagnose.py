@@ -1,7 +1,7 @@
 """``camtube model diagnose``: which physics is missing from the model (thin CLI over :mod:`camtube.model.diagnose`).
 
 ``register(model_sub)`` adds the sub-command to the ``model`` group that
-:mod:`camtube.model.cli` creates.
+:mod:`camtube.commands.model` creates.
 """
 from __future__ import annotations
 
@@ -74,7 +74,7 @@ def fit_command_prefix(args: argparse.Namespace) -> str:
 
 
 def cmd_diagnose(args: argparse.Namespace) -> int:
-    from camtube.cliutil import load_from_args
+    from camtube.commands.common import load_from_args
     from camtube.errors import DataError
     from camtube.io import write_atomic
     from camtube.model.core.build import build_registry, check_suffix, parse_assignments, parse_fix, split_names
