@@ -206,6 +206,10 @@ class _Reader:
         return int(x) if integer else x
 
 
+#: The reader that turns raw YAML values into checked values (also used by other input files, e.g. goals).
+Reader = _Reader
+
+
 def _section(reader: _Reader, raw: dict, name: str) -> dict:
     body = raw.get(name)
     if body is None:
@@ -364,6 +368,28 @@ def load(path: str | os.PathLike, overrides: Iterable[str] = ()) -> Loaded:
     raw = apply_overrides(raw, overrides, file)
     set_keys = {parse_override(o)[0] for o in overrides}
     lines = {k: v for k, v in lines.items() if k not in set_keys}  # a --set value has no line
+    return build(raw, file, lines, name=Path(path).stem)
+
+
+def load_text(text: str, path: str | os.PathLike) -> Loaded:
+    """Validate and build a pattern from YAML ``text`` as if it were the file ``path`` (which need not exist).
+
+    A ``process:`` file name is looked up beside ``path``, then among the shipped presets. Used to
+    check a generated pattern before it is written.
+    """
+    file = str(path)
+    try:
+        raw = parse_yaml(text)
+    except yaml.YAMLError as exc:
+        raise PatternError([Issue("yaml", f"not valid YAML: {exc}", None, "YAML mapping", "", file)]) from None
+    if not isinstance(raw, dict):
+        raise PatternError([Issue("<top>", "a pattern must be a mapping of sections", None, "", "", file, 1)])
+    lines = line_map(text)
+    proc = raw.get("process")
+    if isinstance(proc, str):
+        praw, _, _ = read_yaml(_process_file(proc, Path(path), file, lines.get("process")))
+        raw = dict(raw)
+        raw["process"] = praw.get("process", praw)
     return build(raw, file, lines, name=Path(path).stem)
 
 

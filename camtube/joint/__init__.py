@@ -9,5 +9,5 @@ model package.
 from __future__ import annotations
 
 from camtube.joint.forward import (  # noqa: F401
-    DirectionState, JointState, Mechanics, NotchSet, direction_notches, simulate, stroke_table,
+    DirectionState, JointState, Mechanics, NotchSet, direction_notches, notch_set, simulate, stroke_table,
 )

@@ -46,8 +46,9 @@ class Mechanics:
     ----------
     tube_modulus_gpa : float or None
         Young's modulus of the tube (None: from the material, 2.5 GPa for polyimide).
-    friction : float
-        Capstan friction coefficient of the tendon on the notch edges (dimensionless).
+    friction : float or None
+        Capstan friction coefficient of the tendon on the notch edges (None: the pattern's
+        ``tendon.friction``).
     tendon_modulus_gpa, tendon_length_mm : float or None
         E_t and L0 (None: the pattern's ``tendon``).
     slack_mm : float
@@ -69,7 +70,7 @@ class Mechanics:
     """
 
     tube_modulus_gpa: float | None = None
-    friction: float = 0.0
+    friction: float | None = None
     tendon_modulus_gpa: float | None = None
     tendon_length_mm: float | None = None
     slack_mm: float = 0.0
@@ -85,6 +86,10 @@ class Mechanics:
         if self.tube_modulus_gpa is not None:
             return self.tube_modulus_gpa
         return MATERIAL_MODULUS_GPA.get(material, FALLBACK_MODULUS_GPA)
+
+    def mu(self, pattern: Pattern) -> float:
+        """The capstan friction coefficient used for ``pattern``."""
+        return self.friction if self.friction is not None else pattern.tendon.friction
 
     def compliance_mm_per_N(self, pattern: Pattern) -> float:
         """Linear tendon compliance ``L0 / (E_t pi r_t^2)`` plus the series compliance (mm/N)."""
@@ -211,30 +216,41 @@ class NotchSet:
         return self.extreme_fibre_mm * np.asarray(angles_rad) / self.width_mm
 
 
+def notch_set(tube, tendon_radius_mm: float, angle_deg: float, x_mm, width_mm, arc_mm,
+              mechanics: Mechanics = Mechanics(), index=None) -> NotchSet:
+    """A :class:`NotchSet` from per-notch arrays (base to tip): centres, widths h and arcs s (mm).
+
+    ``mechanics.kerf_mm`` widens each arc; the arcs are kept inside ``(0, 2 pi r_o)``.
+    """
+    e = mechanics.modulus_gpa(tube.material) * 1e3  # N/mm^2
+    circ = tube.circumference_mm
+    geos = [joint_geometry(tube.outer_radius_mm, tube.inner_radius_mm,
+                           min(max(float(s) + mechanics.kerf_mm, 1e-6), circ - 1e-6), float(h), tendon_radius_mm)
+            for h, s in zip(width_mm, arc_mm)]
+    n = len(geos)
+    return NotchSet(
+        angle_deg=angle_deg,
+        index=np.arange(n) if index is None else np.asarray(index, int),
+        x_mm=np.asarray(x_mm, float),
+        width_mm=np.array([g.notch_width_mm for g in geos]),
+        arc_mm=np.array([g.arc_mm for g in geos]),
+        arm_mm=np.array([g.moment_arm_mm * mechanics.arm_scale for g in geos]),
+        ybar_mm=np.array([g.ybar_mm for g in geos]),
+        stiffness_nmm_per_rad=np.array([e * g.second_moment_mm4 / g.notch_width_mm for g in geos]),
+        closure_rad=np.array([g.closure_angle_rad for g in geos]),
+        extreme_fibre_mm=np.array([g.extreme_fibre_mm for g in geos]),
+    )
+
+
 def direction_notches(pattern: Pattern, mechanics: Mechanics = Mechanics()) -> list[NotchSet]:
     """The pattern's notches grouped by direction (sorted by angle), each base to tip."""
-    t = pattern.tube
-    e = mechanics.modulus_gpa(t.material) * 1e3  # N/mm^2
-    circ = t.circumference_mm
     index_of = {id(n): k for k, n in enumerate(pattern.notches)}
     out = []
     for ang, notches in notches_by_direction(pattern):
         ns = sorted(notches, key=lambda n: -n.x_mm)
-        geos = [joint_geometry(t.outer_radius_mm, t.inner_radius_mm,
-                               min(max(n.arc_mm + mechanics.kerf_mm, 1e-6), circ - 1e-6), n.width_mm,
-                               pattern.tendon.radius_mm) for n in ns]
-        out.append(NotchSet(
-            angle_deg=ang,
-            index=np.array([index_of[id(n)] for n in ns], int),
-            x_mm=np.array([n.x_mm for n in ns]),
-            width_mm=np.array([g.notch_width_mm for g in geos]),
-            arc_mm=np.array([g.arc_mm for g in geos]),
-            arm_mm=np.array([g.moment_arm_mm * mechanics.arm_scale for g in geos]),
-            ybar_mm=np.array([g.ybar_mm for g in geos]),
-            stiffness_nmm_per_rad=np.array([e * g.second_moment_mm4 / g.notch_width_mm for g in geos]),
-            closure_rad=np.array([g.closure_angle_rad for g in geos]),
-            extreme_fibre_mm=np.array([g.extreme_fibre_mm for g in geos]),
-        ))
+        out.append(notch_set(pattern.tube, pattern.tendon.radius_mm, ang, [n.x_mm for n in ns],
+                             [n.width_mm for n in ns], [n.arc_mm for n in ns], mechanics,
+                             [index_of[id(n)] for n in ns]))
     return out
 
 
@@ -334,7 +350,7 @@ def _solve_force(ns: NotchSet, stroke_mm: float, pattern: Pattern, mech: Mechani
     keep = 1.0 - mech.sheath_loss
 
     def stroke_of(f: float) -> float:
-        th = ns.angles_at(f * keep, mech.friction)
+        th = ns.angles_at(f * keep, mech.mu(pattern))
         return float(ns.arm_mm @ th) + mech.elongation_mm(f, pattern) - eff
 
     hi = 1.0
@@ -374,7 +390,7 @@ def simulate(pattern: Pattern, strokes: float | Mapping[float, float],
         else:
             stroke = float(strokes)
         f = _solve_force(ns, stroke, pattern, mechanics)
-        th = ns.angles_at(f * (1.0 - mechanics.sheath_loss), mechanics.friction)
+        th = ns.angles_at(f * (1.0 - mechanics.sheath_loss), mechanics.mu(pattern))
         states.append(DirectionState(ns.angle_deg, stroke, f, th, ns.strain(th), th >= ns.closure_rad * (1 - 1e-9),
                                      ns))
         all_angles[ns.index] = th
@@ -442,7 +458,7 @@ def stroke_table(pattern: Pattern, stroke_mm: float, mechanics: Mechanics = Mech
     strain; then the tip pose with all tendons at ``stroke_mm`` when there is one direction.
     """
     lines = [f"forward model at a tendon stroke of {stroke_mm:g} mm (notch by notch; friction mu "
-             f"{mechanics.friction:g}, tube E {mechanics.modulus_gpa(pattern.tube.material):g} GPa, "
+             f"{mechanics.mu(pattern):g}, tube E {mechanics.modulus_gpa(pattern.tube.material):g} GPa, "
              f"mechanics: {mechanics.source})"]
     sets = direction_notches(pattern, mechanics)
     for ns in sets:
