@@ -60,7 +60,8 @@ class Mechanics:
     arm_scale : float
         Factor on every moment arm.
     kerf_mm : float
-        Widening of each notch arc by the laser kerf (added to ``arc``).
+        Overcut of the laser: each notch is cut this much wider than drawn, in arc and in width
+        (a job planned without kerf compensation cuts its first pass on the design line).
     sheath_loss : float
         Fraction of the motor-side force lost before the joint (tendon-sheath friction while pulling).
     source : str
@@ -177,7 +178,7 @@ class NotchSet:
     index : (n,) int
         Index of each notch in ``pattern.notches``.
     x_mm, width_mm, arc_mm : (n,) float
-        Centre, axial width h and (kerf-widened) arc s.
+        Centre, axial width h and arc s, as cut (drawn + ``kerf_mm``).
     arm_mm : (n,) float
         Moment arm of the tendon about each backbone's neutral axis (times ``arm_scale``).
     ybar_mm : (n,) float
@@ -220,12 +221,13 @@ def notch_set(tube, tendon_radius_mm: float, angle_deg: float, x_mm, width_mm, a
               mechanics: Mechanics = Mechanics(), index=None) -> NotchSet:
     """A :class:`NotchSet` from per-notch arrays (base to tip): centres, widths h and arcs s (mm).
 
-    ``mechanics.kerf_mm`` widens each arc; the arcs are kept inside ``(0, 2 pi r_o)``.
+    ``mechanics.kerf_mm`` widens each arc and width (as cut); the arcs are kept inside ``(0, 2 pi r_o)``.
     """
     e = mechanics.modulus_gpa(tube.material) * 1e3  # N/mm^2
     circ = tube.circumference_mm
     geos = [joint_geometry(tube.outer_radius_mm, tube.inner_radius_mm,
-                           min(max(float(s) + mechanics.kerf_mm, 1e-6), circ - 1e-6), float(h), tendon_radius_mm)
+                           min(max(float(s) + mechanics.kerf_mm, 1e-6), circ - 1e-6),
+                           max(float(h) + mechanics.kerf_mm, 1e-6), tendon_radius_mm)
             for h, s in zip(width_mm, arc_mm)]
     n = len(geos)
     return NotchSet(
@@ -433,7 +435,8 @@ def centerline(pattern: Pattern, notch_angles_rad: np.ndarray, mechanics: Mechan
         p = p + r[:, 2] * (pos - start)
         pts.append(p.copy())
         arc = min(max(n.arc_mm + mechanics.kerf_mm, 1e-6), circ - 1e-6)
-        g = joint_geometry(t.outer_radius_mm, t.inner_radius_mm, arc, n.width_mm, pattern.tendon.radius_mm)
+        g = joint_geometry(t.outer_radius_mm, t.inner_radius_mm, arc, n.width_mm + mechanics.kerf_mm,
+                           pattern.tendon.radius_mm)
         a = math.radians(n.angle_deg)
         towards = r[:, 0] * math.cos(a) + r[:, 1] * math.sin(a)  # notch side, in the local section
         axis = np.cross(r[:, 2], towards)  # closing the notch turns the tip towards it

@@ -266,6 +266,31 @@ def load_goal(path: str | os.PathLike) -> Goal:
     return build_goal(raw, file, line_map(text), name=Path(path).stem)
 
 
+def goal_process(goal: Goal):
+    """The :class:`~camtube.design.pattern.Process` the written pattern will use (validated).
+
+    A process file name is looked up beside the goal file, then among the shipped presets.
+    """
+    from camtube.design.loader import PRESETS_DIR, build_settings, read_yaml
+
+    proc = goal.process
+    if isinstance(proc, str):
+        here = Path(goal.source).parent if goal.source else Path(".")
+        for cand in (here / proc, here / f"{proc}.yaml", PRESETS_DIR / proc, PRESETS_DIR / f"{proc}.yaml"):
+            if cand.is_file():
+                praw, _, _ = read_yaml(cand)
+                proc = praw.get("process", praw)
+                break
+        else:
+            raise PatternError([Issue("process", "names a process file that is not there", goal.process,
+                                      "a process YAML beside the goal or a shipped one (femto-polyimide.yaml)",
+                                      "put the file beside the goal or write the process keys under 'process:'",
+                                      goal.source)])
+    raw = {"tube": {"outer_radius": goal.tube.outer_radius_mm, "inner_radius": goal.tube.inner_radius_mm,
+                    "length": 1.0}, "process": proc}
+    return build_settings(raw, goal.source)[1]
+
+
 def shares_from_tip(goal: Goal, n: int) -> tuple[float, ...]:
     """Target share of each of ``n`` notches of one direction, from the tip (sums to 1)."""
     d = goal.distribution

@@ -152,6 +152,9 @@ def summary_text(design: Design, checks, seconds: float | None = None) -> str:
              f"tube {p.tube.length_mm:g} mm; mechanics: {m.source}"
              + (f" (not used: {', '.join(m.ignored)})" if m.ignored else "")
              + (f"; solved in {seconds:.2f} s" if seconds is not None else "")]
+    if m.kerf_mm:
+        lines.append(f"notches drawn {1000 * m.kerf_mm:.0f} um narrower (arc and width) than they are to be cut: the "
+                     "expected overcut of a process without kerf compensation")
     lines.append("direction  notches  stroke mm  target deg  predicted deg  force N  strain   shares err  "
                  "deg/10um depth  deg/10um kerf")
     for d, c in zip(design.directions, checks):

@@ -116,23 +116,47 @@ class Design:
     notch_section: dict
 
 
-def goal_mechanics(goal: Goal, calibration: Mechanics | None = None) -> Mechanics:
-    """The mechanics a goal is designed with: the goal's tube modulus and friction, plus a calibration."""
+def expected_overcut_mm(process, calibration: Mechanics | None = None) -> float:
+    """How much wider than drawn the laser cuts each notch (mm, in arc and in width).
+
+    A process with kerf compensation (``process.kerf > 0``) cuts the drawing; without it the first pass
+    runs on the design line and the cut is one kerf wider: the calibration's fitted ``kerf.kerf_mm`` when
+    given, else the kerf the CAD verification assumes (:data:`camtube.cad.ascut.DEFAULT_SIM_KERF_MM`).
+    """
+    if process is not None and process.kerf_mm > 0:
+        return 0.0
+    if calibration is not None and calibration.kerf_mm:
+        return max(calibration.kerf_mm, 0.0)
+    from camtube.cad.ascut import DEFAULT_SIM_KERF_MM
+
+    return DEFAULT_SIM_KERF_MM
+
+
+def goal_mechanics(goal: Goal, calibration: Mechanics | None = None, process=None) -> Mechanics:
+    """The mechanics a goal is designed with: the goal's tube modulus and friction, a calibration, and the
+    expected overcut (:func:`expected_overcut_mm`): notches are drawn that much narrower than the cut."""
     m = calibration or Mechanics()
     return replace(m, tube_modulus_gpa=goal.tube_modulus_gpa if goal.tube_modulus_gpa is not None
                    else m.tube_modulus_gpa,
                    friction=goal.tendon.friction if m.friction is None else m.friction,
-                   kerf_mm=0.0)  # a fitted kerf is the laser's: the design is drawn net of it below
+                   kerf_mm=expected_overcut_mm(process, calibration))
 
 
 class _Grid:
     """Section properties of one tube over a grid of notch arcs (mm)."""
 
-    def __init__(self, goal: Goal, mech: Mechanics):
+    def __init__(self, goal: Goal, mech: Mechanics, process=None):
         t = goal.tube
         ro, ri = t.outer_radius_mm, t.inner_radius_mm
-        self.s_lo = max(goal.limits.min_feature_mm, 2.0 * ro * math.acos(ri / ro) * 1.02)  # reaches the lumen
+        k = mech.kerf_mm  # grid arcs are as cut; the drawing is k narrower
+        self.kerf = k
+        self.s_lo = max(goal.limits.min_feature_mm + k, 2.0 * ro * math.acos(ri / ro) * 1.02)  # reaches the lumen
         self.s_hi = t.circumference_mm - max(goal.limits.min_backbone_arc_mm, 1e-3)
+        if process is not None and process.repeats is None and process.repeat_rule:
+            # the process cuts at most this beam depth r_o (1 - cos(s / 2 r_o)): a bound on the arc
+            deepest = max(r.max_depth_mm for r in process.repeat_rule)
+            if deepest < 2.0 * ro:
+                self.s_hi = min(self.s_hi, 2.0 * ro * math.acos(1.0 - deepest / ro) - 1e-4 + k)
         s = np.linspace(self.s_lo, self.s_hi, ARC_GRID) if self.s_hi > self.s_lo else np.array([self.s_lo])
         geos = [joint_geometry(ro, ri, float(x), 1.0, goal.tendon.radius_mm) for x in s]
         self.s = s
@@ -155,7 +179,7 @@ def _choose(grid: _Grid, goal: Goal, th: np.ndarray, tension: np.ndarray):
     strain = m * grid.e[None, :] / grid.ei[None, :]
     h = th[:, None] * grid.ei[None, :] / np.maximum(m, 1e-300)
     h_close = th[:, None] * (grid.ro + grid.ybar[None, :]) / CLOSE_MARGIN
-    ok = (strain <= STRAIN_DESIGN * lim.max_strain) & (h >= lim.min_feature_mm) & (h >= h_close)
+    ok = (strain <= STRAIN_DESIGN * lim.max_strain) & (h >= lim.min_feature_mm + grid.kerf) & (h >= h_close)
     idx = np.where(ok.any(axis=1), ok.shape[1] - 1 - np.argmax(ok[:, ::-1], axis=1), -1)
     return idx, h, strain, h_close
 
@@ -173,7 +197,7 @@ def _solve_count(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget, n
     keep = (1.0 - mech.sheath_loss) * np.exp(-mu * wrap)
     stroke = target.stroke_mm - mech.slack_mm
     if stroke <= 0.0:
-        return _Fail("goal.bends.stroke_mm", f"the stroke {target.stroke_mm:g} mm is taken up by the tendon slack "
+        return _Fail("goal.bends[].stroke_mm", f"the stroke {target.stroke_mm:g} mm is taken up by the tendon slack "
                      f"{mech.slack_mm:g} mm", "bend")
 
     def state(f: float):
@@ -198,7 +222,7 @@ def _solve_count(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget, n
             continue
         if g >= 0.0:
             if prev is None:
-                return _Fail("goal.bends.stroke_mm", f"the bend needs {g + stroke + mech.slack_mm:.3f} mm of tendon "
+                return _Fail("goal.bends[].stroke_mm", f"the bend needs {g + stroke + mech.slack_mm:.3f} mm of tendon "
                              f"travel even without stretching the tendon, more than the stroke "
                              f"{target.stroke_mm:g} mm", "bend")
             bracket = (prev, float(f))
@@ -218,9 +242,10 @@ def _solve_count(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget, n
     if g is None:
         f0 = bracket[0]
         g, idx, h, strain, h_close = state(f0)
-    widths = np.ceil(h[np.arange(n), idx] / WIDTH_STEP_MM - 1e-9) * WIDTH_STEP_MM
+    k = grid.kerf  # drawn = as cut - k
+    widths = np.ceil((h[np.arange(n), idx] - k) / WIDTH_STEP_MM - 1e-9) * WIDTH_STEP_MM
     widths = np.maximum(widths, lim.min_feature_mm)
-    arcs0 = grid.s[idx]
+    arcs0 = grid.s[idx] - k
 
     x = np.zeros(n)  # positions do not enter the angles
     probe = Pattern("goal", goal.tube, (), tendon=goal.tendon)
@@ -232,13 +257,14 @@ def _solve_count(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget, n
         return np.concatenate([(ang - th) * 1e3, [st * 1e2]])
 
     v0 = np.concatenate([arcs0, [f0]])
-    res = least_squares(residuals, v0, bounds=(np.r_[np.full(n, grid.s_lo), 1e-9], np.r_[np.full(n, grid.s_hi), np.inf]),
+    res = least_squares(residuals, v0, bounds=(np.r_[np.full(n, grid.s_lo - k), 1e-9],
+                                               np.r_[np.full(n, grid.s_hi - k), np.inf]),
                         x_scale=np.r_[np.full(n, 0.1), max(f0, 1e-3)], xtol=1e-12, ftol=1e-12, gtol=1e-12,
                         max_nfev=200)
     arcs = np.round(res.x[:n] / ARC_STEP_MM) * ARC_STEP_MM
     force = float(res.x[n])
     if np.max(np.abs(res.fun)) > 5.0:  # 5 mrad or 0.05 mm: the polish could not meet the targets
-        return _Fail("limits.min_backbone_arc", "the notches cannot be made compliant enough within the arc range "
+        return _Fail("limits.min_backbone_arc", "(or the process's deepest cut, process.repeat_rule) the notches cannot be made compliant enough within the arc range "
                      f"{grid.s_lo:.3f}-{grid.s_hi:.3f} mm", "stroke")
     if force > lim.max_force_N:
         return _Fail("limits.max_force_N", f"the tendon force at {target.stroke_mm:g} mm of stroke would be "
@@ -286,11 +312,9 @@ def _counts(goal: Goal, target: BendTarget) -> list[int]:
         return [len(goal.distribution)]
     if goal.notches is not None:
         return [goal.notches]
-    n0 = max(2, math.ceil(target.bend_deg / goal.max_notch_bend_deg))
-    order = [n0]
-    for k in range(1, 40):
-        order += [n0 + k] + ([n0 - k] if n0 - k >= 2 else [])
-    return order[:24]
+    n_min = max(4, 2 * len(goal.curve_deg_per_mm) - 1) if goal.curve_deg_per_mm else 2  # resolve the curve
+    n0 = max(n_min, math.ceil(target.bend_deg / goal.max_notch_bend_deg))
+    return list(range(n0, n0 + 24))  # fewer notches would bend more than max_notch_bend_deg each
 
 
 def _solve_direction(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget,
@@ -377,15 +401,19 @@ def synthesize(goal: Goal, calibration: Mechanics | None = None) -> Design:
     InfeasibleGoal
         One line: the limit that forbids the goal and the nearest feasible target.
     """
-    mech = goal_mechanics(goal, calibration)
-    grid = _Grid(goal, mech)
+    from camtube.synthesis.goal import goal_process
+
+    process = goal_process(goal)
+    mech = goal_mechanics(goal, calibration, process)
+    grid = _Grid(goal, mech, process)
     r = _solve_all(goal, mech, grid)
     if isinstance(r, tuple) and r and isinstance(r[0], DirectionDesign):
         return _assemble(goal, r, mech)
     i, fail = r
     nearest = _nearest(goal, mech, grid, fail.knob)
     b = goal.bends[i]
-    raise InfeasibleGoal(f"goal.bends[{i}] ({b.bend_deg:g} deg at {b.stroke_mm:g} mm towards {b.angle_deg:g} deg) "
+    where = f"{goal.source}: " if goal.source else ""
+    raise InfeasibleGoal(f"{where}goal.bends[{i}] ({b.bend_deg:g} deg at {b.stroke_mm:g} mm towards {b.angle_deg:g} deg) "
                          f"is infeasible: {fail.limit}: {fail.why}; nearest feasible target: {nearest}",
                          fail.limit, nearest)
 
