@@ -320,11 +320,15 @@ def _counts(goal: Goal, target: BendTarget) -> list[int]:
 def _solve_direction(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget,
                      budget_mm: float) -> DirectionDesign | _Fail:
     first: _Fail | None = None
+    tries = 0
     for n in _counts(goal, target):
         r = _solve_count(goal, mech, grid, target, n, budget_mm)
         if isinstance(r, DirectionDesign):
             return r
         first = first or r
+        tries += 1
+        if tries >= 6 and first.limit in ("limits.max_force_N", "goal.bends[].stroke_mm"):
+            break  # the force and the kinematic travel hardly depend on the notch count
     return first
 
 
@@ -414,7 +418,10 @@ def synthesize(goal: Goal, calibration: Mechanics | None = None) -> Design:
     b = goal.bends[i]
     where = f"{goal.source}: " if goal.source else ""
     raise InfeasibleGoal(f"{where}goal.bends[{i}] ({b.bend_deg:g} deg at {b.stroke_mm:g} mm towards {b.angle_deg:g} deg) "
-                         f"is infeasible: {fail.limit}: {fail.why}; nearest feasible target: {nearest}",
+                         f"is infeasible: {fail.limit}: {fail.why}; nearest feasible target: {nearest}; fix: "
+                         + (f"lower bend_deg to the nearest target, or give more stroke or relax {fail.limit}"
+                            if fail.knob == "bend" else
+                            f"lower stroke_mm to the nearest target, or relax {fail.limit}"),
                          fail.limit, nearest)
 
 
@@ -426,14 +433,14 @@ def _nearest(goal: Goal, mech: Mechanics, grid: _Grid, knob: str) -> str:
         return isinstance(r, tuple) and bool(r) and isinstance(r[0], DirectionDesign)
 
     lo, hi = 0.0, 1.0
-    for q in (0.5, 0.25, 0.1, 0.03):
+    for q in (0.95, 0.85, 0.7, 0.55, 0.4, 0.25, 0.1, 0.03):
         if ok(q):
             lo = q
             break
         hi = q
     else:
         return "none found by scaling the " + ("bends" if knob == "bend" else "strokes") + " down (change the stock)"
-    for _ in range(10):
+    for _ in range(9):
         mid = 0.5 * (lo + hi)
         if ok(mid):
             lo = mid
@@ -442,5 +449,6 @@ def _nearest(goal: Goal, mech: Mechanics, grid: _Grid, knob: str) -> str:
     parts = []
     for b in goal.bends:
         s = b.scaled(bend=lo) if knob == "bend" else b.scaled(stroke=lo)
-        parts.append(f"{s.bend_deg:.1f} deg at {s.stroke_mm:.3f} mm")
-    return ", ".join(parts) + (" (lower the bend)" if knob == "bend" else " (lower the stroke)")
+        # rounded towards the feasible side
+        parts.append(f"{math.floor(s.bend_deg * 10) / 10:.1f} deg at {math.floor(s.stroke_mm * 1000) / 1000:.3f} mm")
+    return ", ".join(parts)
