@@ -19,6 +19,13 @@ def register(sub) -> None:
                         "and strain, tendon force, tip position and direction, one tendon pulled at a time")
     p.add_argument("--calibration", metavar="FIT.json",
                    help="with --stroke: use the parameters of a 'camtube model fit/diagnose --json' file")
+    p.add_argument("--hinge", choices=("beam", "fe_fit"), default="beam",
+                   help="with --stroke: notch stiffness E I / h (beam, default) or with the root length a "
+                        "finite-element model shows (fe_fit; see docs/design.md)")
+    p.add_argument("--overcut", type=float, metavar="MM",
+                   help="with --stroke: how much wider than drawn each notch is cut, mm (default: 0 with kerf "
+                        "compensation, else the calibration's kerf or the 0.02 mm the CAD verification assumes; "
+                        "the value 'camtube synthesize' designs with)")
     p.set_defaults(func=cmd_design)
 
     p = sub.add_parser("dxf", help="write the unrolled design DXF",
@@ -101,7 +108,16 @@ def cmd_design(args: argparse.Namespace) -> int:
     if args.stroke is not None:
         from camtube.joint.forward import Mechanics
 
-        mech = Mechanics.from_fit_json(args.calibration) if args.calibration else Mechanics()
+        from dataclasses import replace
+
+        from camtube.synthesis.solve import expected_overcut_mm
+
+        calib = Mechanics.from_fit_json(args.calibration) if args.calibration else None
+        mech = calib or Mechanics()
+        overcut = args.overcut if args.overcut is not None else expected_overcut_mm(loaded.pattern.process, calib)
+        if not 0.0 <= overcut < 0.5:
+            raise CamtubeError(f"--overcut {overcut:g}: must be >= 0 and < 0.5 mm; fix: give the laser's overcut in mm")
+        mech = replace(mech, kerf_mm=overcut, hinge=args.hinge)
     print(design_report(loaded.pattern))
     extra = _design_extras(loaded.pattern)
     if extra:

@@ -37,6 +37,22 @@ from camtube.errors import CamtubeError
 #: Tube modulus (GPa) when the material has no entry in MATERIAL_MODULUS_GPA.
 FALLBACK_MODULUS_GPA = 2.5
 
+#: ``hinge="fe_fit"``: the backbone bends over ``h + r_o * poly(phi)`` instead of ``h``. The cubic (highest
+#: power first) was fitted to ten finite-element runs of :mod:`camtube.joint.fe` (tubes r_o/r_i 0.75/0.45,
+#: 0.85/0.55, 1.25/0.75; phi 1.1-4.3 rad; h 0.3-0.8 mm), none of them a preset notch: the extra length hardly
+#: depends on h, and peaks near phi = 3 (a half-tube backbone) at about one outer radius.
+HINGE_FE_POLY = (-0.0737, 0.5155, -0.8976, 1.0071)
+HINGES = ("beam", "fe_fit")
+
+
+def hinge_extra_mm(outer_radius_mm: float, phi_rad: float, hinge: str = "beam") -> float:
+    """Extra bending length (mm) of a notch's backbone beyond its width h (0 for the plain beam model)."""
+    if hinge == "beam":
+        return 0.0
+    if hinge != "fe_fit":
+        raise ValueError(f"unknown hinge model {hinge!r}; one of {', '.join(HINGES)}")
+    return outer_radius_mm * max(float(np.polyval(HINGE_FE_POLY, phi_rad)), 0.0)
+
 
 @dataclass(frozen=True)
 class Mechanics:
@@ -64,6 +80,10 @@ class Mechanics:
         (a job planned without kerf compensation cuts its first pass on the design line).
     sheath_loss : float
         Fraction of the motor-side force lost before the joint (tendon-sheath friction while pulling).
+    hinge : {"beam", "fe_fit"}
+        How long a beam the backbone is: ``beam`` (the paper's and ``design``'s: the notch width h) or
+        ``fe_fit`` (h plus the root length that a finite-element model of the notch shows,
+        :data:`HINGE_FE_POLY`).
     source : str
         Where the values came from (``defaults`` or a fit file).
     ignored : tuple[str, ...]
@@ -80,6 +100,7 @@ class Mechanics:
     arm_scale: float = 1.0
     kerf_mm: float = 0.0
     sheath_loss: float = 0.0
+    hinge: str = "beam"
     source: str = "defaults"
     ignored: tuple[str, ...] = ()
 
@@ -189,6 +210,8 @@ class NotchSet:
         Angle at which each notch closes.
     extreme_fibre_mm : (n,) float
         Largest distance of backbone material from the neutral axis.
+    bending_length_mm : (n,) float
+        Length over which each backbone bends (h, or more with a hinge model).
     """
 
     angle_deg: float
@@ -201,6 +224,7 @@ class NotchSet:
     stiffness_nmm_per_rad: np.ndarray
     closure_rad: np.ndarray
     extreme_fibre_mm: np.ndarray
+    bending_length_mm: np.ndarray
 
     def angles_at(self, tension_N: float, friction: float) -> np.ndarray:
         """Per-notch angles (rad, base to tip) when the tendon enters the joint at ``tension_N``."""
@@ -214,7 +238,7 @@ class NotchSet:
 
     def strain(self, angles_rad: np.ndarray) -> np.ndarray:
         """Peak backbone strain of each notch at ``angles_rad``."""
-        return self.extreme_fibre_mm * np.asarray(angles_rad) / self.width_mm
+        return self.extreme_fibre_mm * np.asarray(angles_rad) / self.bending_length_mm
 
 
 def notch_set(tube, tendon_radius_mm: float, angle_deg: float, x_mm, width_mm, arc_mm,
@@ -230,6 +254,8 @@ def notch_set(tube, tendon_radius_mm: float, angle_deg: float, x_mm, width_mm, a
                            max(float(h) + mechanics.kerf_mm, 1e-6), tendon_radius_mm)
             for h, s in zip(width_mm, arc_mm)]
     n = len(geos)
+    bend_len = np.array([g.notch_width_mm + hinge_extra_mm(g.outer_radius_mm, g.phi_rad, mechanics.hinge)
+                         for g in geos])
     return NotchSet(
         angle_deg=angle_deg,
         index=np.arange(n) if index is None else np.asarray(index, int),
@@ -238,9 +264,10 @@ def notch_set(tube, tendon_radius_mm: float, angle_deg: float, x_mm, width_mm, a
         arc_mm=np.array([g.arc_mm for g in geos]),
         arm_mm=np.array([g.moment_arm_mm * mechanics.arm_scale for g in geos]),
         ybar_mm=np.array([g.ybar_mm for g in geos]),
-        stiffness_nmm_per_rad=np.array([e * g.second_moment_mm4 / g.notch_width_mm for g in geos]),
+        stiffness_nmm_per_rad=np.array([e * g.second_moment_mm4 for g in geos]) / bend_len,
         closure_rad=np.array([g.closure_angle_rad for g in geos]),
         extreme_fibre_mm=np.array([g.extreme_fibre_mm for g in geos]),
+        bending_length_mm=bend_len,
     )
 
 
@@ -461,8 +488,8 @@ def stroke_table(pattern: Pattern, stroke_mm: float, mechanics: Mechanics = Mech
     strain; then the tip pose with all tendons at ``stroke_mm`` when there is one direction.
     """
     lines = [f"forward model at a tendon stroke of {stroke_mm:g} mm (notch by notch; friction mu "
-             f"{mechanics.mu(pattern):g}, tube E {mechanics.modulus_gpa(pattern.tube.material):g} GPa, "
-             f"mechanics: {mechanics.source})"]
+             f"{mechanics.mu(pattern):g}, hinge {mechanics.hinge}, tube E {mechanics.modulus_gpa(pattern.tube.material):g} GPa, "
+             f"mechanics: {mechanics.source}; notches cut {1000 * mechanics.kerf_mm:.0f} um wider than drawn)"]
     sets = direction_notches(pattern, mechanics)
     for ns in sets:
         st = simulate(pattern, {ns.angle_deg: stroke_mm}, mechanics)

@@ -32,6 +32,8 @@ GOAL_SCHEMA: dict = {
         "material": Field("choice", "", "tube material", "polyimide",
                           choices=("polyimide", "pebax", "nitinol", "other")),
         "modulus_gpa": Field("float", "GPa", "Young's modulus of the tube (default: 2.5 for polyimide)", None, **POS),
+        "hinge": Field("choice", "", "notch stiffness: beam (E I / h, the paper's) or fe_fit (h plus the root "
+                       "length a finite-element model shows; see docs/design.md)", "beam", choices=("beam", "fe_fit")),
     },
     "tendon": {
         "radius": Field("float", "mm", "tendon radius r_t", 0.04, **POS),
@@ -142,6 +144,7 @@ class Goal:
     base_length_mm: float = 1.5
     limits: Limits = field(default_factory=Limits)
     process: object = "femto-polyimide.yaml"
+    hinge: str = "beam"
     name: str = "goal"
     source: str | None = None
 
@@ -251,7 +254,7 @@ def build_goal(raw: dict, file: str | None = None, lines: dict[str, int] | None 
         base_length_mm=goal["base_length"],
         limits=Limits(lim["max_strain"], lim["max_force_N"], lim["max_length"], lim["min_web"],
                       lim["min_backbone_arc"], lim["min_feature"]),
-        process=process, name=raw.get("name") or name or "goal", source=file)
+        process=process, hinge=tube["hinge"], name=raw.get("name") or name or "goal", source=file)
 
 
 def load_goal(path: str | os.PathLike) -> Goal:

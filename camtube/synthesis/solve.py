@@ -29,7 +29,7 @@ import numpy as np
 from camtube.design.geometry import joint_geometry
 from camtube.design.pattern import Pattern, Process, Rules, Tube, hole, notch, sort_cuts
 from camtube.errors import CamtubeError
-from camtube.joint.forward import Mechanics, notch_set
+from camtube.joint.forward import Mechanics, hinge_extra_mm, notch_set
 from camtube.synthesis.goal import BendTarget, Goal, shares_from_tip
 
 #: Backbone strain aimed at, as a fraction of ``limits.max_strain`` (room for the laser's tolerance).
@@ -139,7 +139,7 @@ def goal_mechanics(goal: Goal, calibration: Mechanics | None = None, process=Non
     return replace(m, tube_modulus_gpa=goal.tube_modulus_gpa if goal.tube_modulus_gpa is not None
                    else m.tube_modulus_gpa,
                    friction=goal.tendon.friction if m.friction is None else m.friction,
-                   kerf_mm=expected_overcut_mm(process, calibration))
+                   kerf_mm=expected_overcut_mm(process, calibration), hinge=goal.hinge)
 
 
 class _Grid:
@@ -164,6 +164,7 @@ class _Grid:
         self.arm = np.array([g.moment_arm_mm for g in geos]) * mech.arm_scale
         self.e = np.array([g.extreme_fibre_mm for g in geos])
         self.ybar = np.array([g.ybar_mm for g in geos])
+        self.extra = np.array([hinge_extra_mm(ro, g.phi_rad, mech.hinge) for g in geos])  # beyond h
         self.ro = ro
 
 
@@ -177,7 +178,7 @@ def _choose(grid: _Grid, goal: Goal, th: np.ndarray, tension: np.ndarray):
     lim = goal.limits
     m = tension[:, None] * grid.arm[None, :]  # (n, m) moment N mm
     strain = m * grid.e[None, :] / grid.ei[None, :]
-    h = th[:, None] * grid.ei[None, :] / np.maximum(m, 1e-300)
+    h = th[:, None] * grid.ei[None, :] / np.maximum(m, 1e-300) - grid.extra[None, :]  # as-cut width
     h_close = th[:, None] * (grid.ro + grid.ybar[None, :]) / CLOSE_MARGIN
     ok = (strain <= STRAIN_DESIGN * lim.max_strain) & (h >= lim.min_feature_mm + grid.kerf) & (h >= h_close)
     idx = np.where(ok.any(axis=1), ok.shape[1] - 1 - np.argmax(ok[:, ::-1], axis=1), -1)

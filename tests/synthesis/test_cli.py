@@ -115,6 +115,12 @@ def test_calibration_changes_the_design_and_is_met_under_it(tmp_path):
 def test_design_stroke_prints_the_forward_model(tmp_path):
     r = camtube("design", "tube1", "--stroke", "1.5")
     assert r.returncode == 0, r.stderr
+    assert "cut 20 um wider than drawn" in r.stdout  # the preset's process has no kerf compensation
+    from camtube.joint import Mechanics
+
+    st = simulate(load_pattern("tube1"), 1.5, Mechanics(kerf_mm=0.02)).direction(180.0)
+    assert f"bend {st.bend_deg:.2f} deg" in r.stdout and f"force {st.force_N:.3f} N" in r.stdout
+    r = camtube("design", "tube1", "--stroke", "1.5", "--overcut", "0")
     st = simulate(load_pattern("tube1"), 1.5).direction(180.0)
     assert f"bend {st.bend_deg:.2f} deg" in r.stdout and f"force {st.force_N:.3f} N" in r.stdout
     assert r.stdout.count("\n       ") >= 10  # a row per notch
