@@ -65,21 +65,21 @@ class PublishedInterrupt(KeyboardInterrupt):
 def _uninterrupted():
     """Hold Ctrl-C (SIGINT) back while the body runs; one that came meanwhile is raised at the end.
 
-    Only in the main thread of a platform with ``pthread_sigmask``; elsewhere the body runs as is.
+    The Python-level handler is swapped for one that only notes the signal (whichever thread the
+    operating system delivered it to, Python runs handlers in the main thread), then put back and
+    called. Only in the main thread, where handlers can be set; elsewhere the body runs as is.
     """
-    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    noted: list[tuple[int, object]] = []
+    old = signal.signal(signal.SIGINT, lambda signum, frame: noted.append((signum, frame)))
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
-        _pending_handlers_run_here()
-
-
-def _pending_handlers_run_here() -> None:
-    """A Python call: a signal unblocked just before raises its ``KeyboardInterrupt`` at this point."""
+        signal.signal(signal.SIGINT, old)
+        if noted and callable(old):
+            old(*noted[0])  # the default handler raises KeyboardInterrupt here
 
 
 class OutputError(CamtubeError, OSError):
@@ -112,6 +112,12 @@ def _publish(tmp: str, path: Path) -> None:
     """Give the temporary file ordinary permissions (0666 less the umask) and move it into place."""
     os.chmod(tmp, 0o666 & ~_umask())
     os.replace(tmp, path)
+
+
+def _not_empty(path: str | os.PathLike, what: str) -> None:
+    """Refuse an empty path (``-o ''`` would otherwise mean the working directory)."""
+    if not str(path).strip():
+        raise OutputError(repr(str(path)), "the path is empty", f"give the output {what}'s name")
 
 
 def _check_file_target(path: Path) -> None:
@@ -167,6 +173,7 @@ def write_atomic(path: str | os.PathLike, data: Payload) -> Path:
     OutputError
         The file cannot be written (read-only location, a directory of that name, ...).
     """
+    _not_empty(path, "file")
     path = Path(path)
     with _staged(path, f".{path.name}.", ".tmp") as (fd, _tmp):
         with os.fdopen(fd, "wb") as fh:
@@ -275,6 +282,7 @@ def check_writable_dir(outdir: str | os.PathLike) -> None:
     OutputError
         The location is read-only, not a folder, or cannot hold new entries.
     """
+    _not_empty(outdir, "directory")
     out = Path(outdir).absolute()
     probe_in = out if out.is_dir() else out.parent
     while not probe_in.exists() and probe_in != probe_in.parent:
@@ -311,6 +319,7 @@ def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload]) -> list[P
         ``outdir`` cannot be created or written (it names a file, the location is
         read-only, ...); nothing of the new set is visible then.
     """
+    _not_empty(outdir, "directory")
     out = Path(outdir)
     if out.exists() and not out.is_dir():
         raise OutputError(out, "a file of that name exists", "name a directory (new or existing), not a file")

@@ -24,8 +24,16 @@ COMMAND_MODULES = (
 )
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose mistakes are one line with a fix, like every other camtube error
+    (argparse's own prints the whole usage first). Sub-command parsers are of this class too."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message}; fix: see `{self.prog} --help`\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="camtube",
         description="Design, plan, cut and explain laser-micromachined notched-tube joints. "
                     "Lengths are mm, angles deg unless an option says otherwise.",

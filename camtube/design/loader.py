@@ -134,8 +134,11 @@ class _Reader:
 
     def __init__(self, file: str | None, lines: dict[str, int]):
         self.file, self.lines, self.issues = file, lines, []
+        self.broken: set[str] = set()  # sections that are not mappings: their keys are not reported one by one
 
     def issue(self, key, message, value=None, allowed="", fix=""):
+        if any(key.startswith(b + ".") for b in self.broken):
+            return
         self.issues.append(Issue(key, message, value, allowed, fix, self.file, self.lines.get(key)))
 
     def check_keys(self, mapping: dict, allowed: dict, prefix: str) -> None:
@@ -216,6 +219,7 @@ def _section(reader: _Reader, raw: dict, name: str) -> dict:
         body = {}
     if not isinstance(body, dict):
         reader.issue(name, "expected a mapping", body, "key: value pairs", f"indent the keys under '{name}:'")
+        reader.broken.add(name)
         body = {}
     spec = SCHEMA[name]
     reader.check_keys(body, spec, name)

@@ -74,7 +74,7 @@ def test_tip_pose_points_towards_the_notches_and_keeps_the_straight_lengths():
 def test_calibration_from_a_real_fit_json(tmp_path):
     from camtube.model.core.fit import fit
     from camtube.model.data import prepare
-    from camtube.model.predict import model_for_pattern, pattern_values
+    from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.report.fit import fit_json
     from camtube.model.sim.synth import synthesize
 
