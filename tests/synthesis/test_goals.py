@@ -120,3 +120,19 @@ def test_force_limit_asks_for_less_stroke():
     assert bend == pytest.approx(60.0) and stroke < 1.5
     d = synthesize(tight.with_bends([type(goal.bends[0])(180.0, 60.0, stroke)]))
     assert d.directions[0].force_N <= 0.5
+
+
+def test_fe_fit_hinge_design_meets_the_goal_under_that_model(tmp_path):
+    from dataclasses import replace
+
+    goal = replace(load_goal(ROOT / "examples" / "goals" / "04-tube1-tip-first.yaml"), hinge="fe_fit")
+    design = synthesize(goal)
+    assert design.mechanics.hinge == "fe_fit"
+    p = load_text(pattern_yaml(design), tmp_path / "p.yaml").pattern
+    d = simulate(p, {180.0: 1.5}, design.mechanics).direction(180.0)
+    assert abs(d.bend_deg - 60.0) <= 0.5
+    want = expected_shares(goal, len(d.shares))[::-1]
+    assert np.max(np.abs(d.shares - want) / want) <= 0.02
+    assert float(d.strain.max()) <= goal.limits.max_strain
+    # the same pattern under the beam model is stiffer: it bends less
+    assert simulate(p, {180.0: 1.5}, replace(design.mechanics, hinge="beam")).direction(180.0).bend_deg < 57.0
