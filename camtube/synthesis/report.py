@@ -56,7 +56,9 @@ def pattern_yaml(design: Design, process: object | None = None) -> str:
     lines.append(f"tendon: {{radius: {_num(td.radius_mm)}, length: {_num(td.length_mm)}, modulus_gpa: "
                  f"{_num(td.modulus_gpa)}, material: {td.material}, friction: {_num(td.friction)}}}")
     if isinstance(proc, dict):
-        lines.append("process: {" + ", ".join(f"{k}: {v}" for k, v in proc.items()) + "}")
+        import yaml
+
+        lines.append("process: " + yaml.safe_dump(proc, default_flow_style=True, sort_keys=False, width=10**6).strip())
     else:
         lines.append(f"process: {proc}")
     lines.append(f"rules: {{min_backbone_arc: {_num(r.min_backbone_arc_mm)}, min_web: {_num(r.min_web_mm)}, "

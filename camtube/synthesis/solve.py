@@ -370,7 +370,7 @@ def _layout_length(goal: Goal, dirs) -> float:
     return sum(r[0] for r in rows) + goal.web_mm * (len(rows) - 1)
 
 
-def _assemble(goal: Goal, dirs: tuple[DirectionDesign, ...], mech: Mechanics) -> Design:
+def _assemble(goal: Goal, dirs: tuple[DirectionDesign, ...], mech: Mechanics, process=None) -> Design:
     rows = _layout(goal, dirs)
     widths = [r[0] for r in rows]
     if len(dirs) == 1 and dirs[0].pitch_mm is not None:
@@ -394,7 +394,7 @@ def _assemble(goal: Goal, dirs: tuple[DirectionDesign, ...], mech: Mechanics) ->
     tube = Tube(goal.tube.outer_radius_mm, goal.tube.inner_radius_mm, round(length, 4), goal.tube.material)
     rules = Rules(min_backbone_arc_mm=lim.min_backbone_arc_mm, min_web_mm=lim.min_web_mm,
                   max_strain=lim.max_strain, max_stroke_mm=max(b.stroke_mm for b in goal.bends))
-    pattern = Pattern(goal.name, tube, sort_cuts(cuts), Process(), goal.tendon, rules, goal.source)
+    pattern = Pattern(goal.name, tube, sort_cuts(cuts), process or Process(), goal.tendon, rules, goal.source)
     return Design(goal, pattern, dirs, mech, section)
 
 
@@ -413,7 +413,7 @@ def synthesize(goal: Goal, calibration: Mechanics | None = None) -> Design:
     grid = _Grid(goal, mech, process)
     r = _solve_all(goal, mech, grid)
     if isinstance(r, tuple) and r and isinstance(r[0], DirectionDesign):
-        return _assemble(goal, r, mech)
+        return _assemble(goal, r, mech, process)
     i, fail = r
     nearest = _nearest(goal, mech, grid, fail.knob)
     b = goal.bends[i]
