@@ -83,7 +83,7 @@ def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm: float, widt
         Plain tube on each side of the notch (default ``2 r_o``).
     """
     import skfem
-    from skfem.helpers import ddot, sym_grad, trace, eye
+    from skfem.helpers import ddot, sym_grad, trace
     from skfem.models.elasticity import lame_parameters
 
     ro, ri, s, h = outer_radius_mm, inner_radius_mm, arc_mm, width_mm

@@ -15,6 +15,8 @@ Along one tendon, notches are taken from the base (large ``x``) to the tip:
 * the stroke is ``slack + sum_i arm_i theta_i + elongation(F)``, with the elastic elongation
   ``F L0 / (E_t pi r_t^2)`` (plus a toe region and a series compliance when calibrated).
 
+``Mechanics(hinge="fe_fit")`` lengthens each backbone beam by the root length a finite-element model of
+the notch shows (:data:`HINGE_FE_POLY`, :mod:`camtube.joint.fe`); the default ``beam`` is the paper's ``h``.
 For a given stroke the motor-side force ``F`` is the root of that (monotone) stroke equation.
 The tip pose follows by chaining the notch rotations, each about its backbone's neutral axis.
 """
@@ -22,7 +24,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
 

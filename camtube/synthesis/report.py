@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass, replace
 
 from camtube.design.pattern import Pattern
-from camtube.joint.forward import Mechanics, simulate
+from camtube.joint.forward import simulate
 from camtube.synthesis.solve import Design
 
 #: Step of the tolerance figures (mm): 10 um.

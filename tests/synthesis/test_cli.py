@@ -4,7 +4,6 @@ into a job that verifies; the independent re-simulation from the job's cut geome
 from __future__ import annotations
 
 import json
-import math
 import re
 
 import pytest

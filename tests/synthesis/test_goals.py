@@ -4,7 +4,6 @@ and the limits kept. The target shares are recomputed here from the goal's words
 the solver."""
 from __future__ import annotations
 
-import math
 import re
 import time
 
