@@ -124,3 +124,10 @@ def test_design_stroke_prints_the_forward_model(tmp_path):
     assert f"bend {st.bend_deg:.2f} deg" in r.stdout and f"force {st.force_N:.3f} N" in r.stdout
     assert r.stdout.count("\n       ") >= 10  # a row per notch
     assert_refused(camtube("design", "tube1", "--stroke", "-1"), "--stroke", ">= 0")
+
+
+def test_missing_process_file_is_named(tmp_path):
+    g = tmp_path / "g.yaml"
+    g.write_text(GOOD + "process: nowhere.yaml\n")
+    assert_refused(camtube("synthesize", str(g), "-o", str(tmp_path / "p.yaml")), "process", "nowhere.yaml")
+    assert listing(tmp_path) == ["g.yaml"]
