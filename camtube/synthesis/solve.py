@@ -37,7 +37,7 @@ STRAIN_DESIGN = 0.85
 #: A notch's target angle is at most this fraction of its closure angle (no contact at the design stroke).
 CLOSE_MARGIN = 0.75
 #: Points of the arc grid the first pass chooses from.
-ARC_GRID = 600
+ARC_GRID = 400
 #: Widths are rounded up to this step (mm), arcs written to ARC_STEP.
 WIDTH_STEP_MM = 0.001
 ARC_STEP_MM = 0.0001
@@ -209,7 +209,7 @@ def _solve_count(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget, n
         return kin + _elongation(goal, mech, f) - stroke, idx, h, strain, h_close
 
     f_top = max(10.0 * lim.max_force_N, 1.0)
-    fs = np.geomspace(1e-6, f_top, 160)
+    fs = np.geomspace(1e-6, f_top, 100)
     prev = None
     bracket = None
     first_bad = None
@@ -319,10 +319,14 @@ def _counts(goal: Goal, target: BendTarget) -> list[int]:
 
 
 def _solve_direction(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget,
-                     budget_mm: float) -> DirectionDesign | _Fail:
+                     budget_mm: float, deadline: float = math.inf) -> DirectionDesign | _Fail:
+    import time
+
     first: _Fail | None = None
     tries = 0
     for n in _counts(goal, target):
+        if first is not None and time.perf_counter() > deadline:
+            break
         r = _solve_count(goal, mech, grid, target, n, budget_mm)
         if isinstance(r, DirectionDesign):
             return r
@@ -330,13 +334,16 @@ def _solve_direction(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarge
         tries += 1
         if tries >= 6 and first.limit in ("limits.max_force_N", "goal.bends[].stroke_mm"):
             break  # the force and the kinematic travel hardly depend on the notch count
+        if tries >= 4 and r.limit == first.limit == "limits.max_length":
+            break  # more notches only add webs
     return first
 
 
-def _solve_all(goal: Goal, mech: Mechanics, grid: _Grid) -> tuple[DirectionDesign, ...] | tuple[int, _Fail]:
+def _solve_all(goal: Goal, mech: Mechanics, grid: _Grid,
+               deadline: float = math.inf) -> tuple[DirectionDesign, ...] | tuple[int, _Fail]:
     out = []
     for i, b in enumerate(goal.bends):
-        r = _solve_direction(goal, mech, grid, b, goal.limits.max_length_mm)
+        r = _solve_direction(goal, mech, grid, b, goal.limits.max_length_mm, deadline)
         if isinstance(r, _Fail):
             return i, r
         out.append(r)
@@ -398,24 +405,30 @@ def _assemble(goal: Goal, dirs: tuple[DirectionDesign, ...], mech: Mechanics, pr
     return Design(goal, pattern, dirs, mech, section)
 
 
-def synthesize(goal: Goal, calibration: Mechanics | None = None) -> Design:
+def synthesize(goal: Goal, calibration: Mechanics | None = None, time_limit_s: float = 8.0) -> Design:
     """The pattern that meets ``goal`` (see the module docstring).
+
+    ``time_limit_s`` bounds the search: past it no further notch count is tried and the nearest feasible
+    target of an infeasible goal is reported as found so far (still feasible, perhaps not the largest).
 
     Raises
     ------
     InfeasibleGoal
         One line: the limit that forbids the goal and the nearest feasible target.
     """
+    import time
+
     from camtube.synthesis.goal import goal_process
 
+    deadline = time.perf_counter() + time_limit_s
     process = goal_process(goal)
     mech = goal_mechanics(goal, calibration, process)
     grid = _Grid(goal, mech, process)
-    r = _solve_all(goal, mech, grid)
+    r = _solve_all(goal, mech, grid, deadline - 0.5 * time_limit_s)
     if isinstance(r, tuple) and r and isinstance(r[0], DirectionDesign):
         return _assemble(goal, r, mech, process)
     i, fail = r
-    nearest = _nearest(goal, mech, grid, fail.knob)
+    nearest = _nearest(goal, mech, grid, fail.knob, deadline)
     b = goal.bends[i]
     where = f"{goal.source}: " if goal.source else ""
     raise InfeasibleGoal(f"{where}goal.bends[{i}] ({b.bend_deg:g} deg at {b.stroke_mm:g} mm towards {b.angle_deg:g} deg) "
@@ -426,11 +439,13 @@ def synthesize(goal: Goal, calibration: Mechanics | None = None) -> Design:
                          fail.limit, nearest)
 
 
-def _nearest(goal: Goal, mech: Mechanics, grid: _Grid, knob: str) -> str:
+def _nearest(goal: Goal, mech: Mechanics, grid: _Grid, knob: str, deadline: float = math.inf) -> str:
     """The largest scale of the bends (knob 'bend') or strokes ('stroke') below 1 that is feasible, in words."""
+    import time
+
     def ok(q: float) -> bool:
         g = goal.with_bends(b.scaled(bend=q) if knob == "bend" else b.scaled(stroke=q) for b in goal.bends)
-        r = _solve_all(g, mech, grid)
+        r = _solve_all(g, mech, grid, deadline)
         return isinstance(r, tuple) and bool(r) and isinstance(r[0], DirectionDesign)
 
     lo, hi = 0.0, 1.0
@@ -439,9 +454,14 @@ def _nearest(goal: Goal, mech: Mechanics, grid: _Grid, knob: str) -> str:
             lo = q
             break
         hi = q
+        if time.perf_counter() > deadline:
+            return ("none found within the time limit by scaling the " + ("bends" if knob == "bend" else "strokes")
+                    + f" down to {q:g} x")
     else:
         return "none found by scaling the " + ("bends" if knob == "bend" else "strokes") + " down (change the stock)"
     for _ in range(9):
+        if time.perf_counter() > deadline:
+            break
         mid = 0.5 * (lo + hi)
         if ok(mid):
             lo = mid
