@@ -135,3 +135,17 @@ def test_fe_fit_hinge_design_meets_the_goal_under_that_model(tmp_path):
     assert float(d.strain.max()) <= goal.limits.max_strain
     # the same pattern under the beam model is stiffer: it bends less
     assert simulate(p, {180.0: 1.5}, replace(design.mechanics, hinge="beam")).direction(180.0).bend_deg < 57.0
+
+
+def test_a_hopeless_goal_is_refused_within_the_time_limit():
+    from camtube.synthesis.goal import build_goal
+
+    raw = {"tube": {"outer_radius": 1.54, "inner_radius": 0.55}, "tendon": {"friction": 1.5},
+           "goal": {"bends": [{"bend_deg": 168, "stroke_mm": 9.3}], "distribution": "tip_first",
+                    "max_notch_bend_deg": 2.1},
+           "limits": {"max_strain": 0.048, "max_force_N": 12.7, "max_length": 34, "min_feature": 0.03}}
+    t0 = time.perf_counter()
+    with pytest.raises(InfeasibleGoal) as ei:
+        synthesize(build_goal(raw, "g.yaml", {}))
+    assert time.perf_counter() - t0 < 10.0
+    assert "\n" not in str(ei.value) and ei.value.limit == "limits.max_length"
