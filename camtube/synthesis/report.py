@@ -35,6 +35,9 @@ def pattern_yaml(design: Design, process: object | None = None) -> str:
         f"# Written by camtube synthesize from {g.source or 'a goal'}: per-notch values from the tip.",
         "# Targets (bend at the tendon stroke, per direction): "
         + "; ".join(f"{b.bend_deg:g} deg at {b.stroke_mm:g} mm towards {b.angle_deg:g} deg" for b in g.bends),
+        f"# Check: camtube design THIS.yaml --stroke {g.bends[0].stroke_mm:g} --overcut {design.mechanics.kerf_mm:g}"
+        + (f" --hinge {design.mechanics.hinge}" if design.mechanics.hinge != "beam" else "")
+        + (" --calibration FIT.json (the same fit)" if design.mechanics.source != "defaults" else ""),
         f"name: {p.name}",
         f"tube: {{outer_radius: {_num(t.outer_radius_mm)}, inner_radius: {_num(t.inner_radius_mm)}, "
         f"length: {_num(t.length_mm)}, material: {t.material}}}",
