@@ -121,16 +121,22 @@ def outputs(loaded: Loaded, request: Request, progress: Progress = NO_PROGRESS):
     est = cad = None
     if request.what in (TOOLPATH, BUILD):
         from camtube.export.dialects import DIALECTS
-        from camtube.export.motion_time import job_estimate
         from camtube.export.outputs import toolpath_streams
+        from camtube.machine.motion_time import job_estimate
 
         if request.what == BUILD:
             from camtube.export.dxf import design_dxf
 
             files[f"{job.name}.design.dxf"] = design_dxf(pattern)
         dialects = tuple(request.dialects) if request.dialects else tuple(DIALECTS.values())
-        files.update(toolpath_streams(job, dialects, progress))
-        est = job_estimate(job, dialects[0])  # motion-aware on the first dialect's machine
+        from camtube.machine.kinematics import check_feeds
+
+        for d in dialects:  # a feed the G-code cannot carry makes the job meaningless: refused before writing
+            check_feeds(job, d)
+        # the estimate on the first dialect's machine, computed once here: the G-code header and the
+        # job file of that machine read the same one from the job's cache
+        est = job_estimate(job, dialects[0])
+        files.update(toolpath_streams(job, dialects, progress))  # the exporter table, walked
     if request.what in (BUILD, CAD):
         from camtube.cad.outputs import cad_outputs
 
@@ -151,10 +157,15 @@ def run(loaded: Loaded, outdir: str | os.PathLike, request: Request, progress: P
 
     files, job, est, cad = outputs(loaded, request, progress)
     if warn is not None and est is not None:
+        from camtube.machine.motion_time import slow_job_warning
         from camtube.plan.moves import time_warning
 
-        w = time_warning(job, est)
-        if w:
-            warn(w)
+        from camtube.export.dialects import DIALECTS
+
+        first = request.dialects[0] if request.dialects else next(iter(DIALECTS.values()))
+        profile = getattr(first, "profile", None)  # the machine the estimate is for
+        for w in (time_warning(job, est), slow_job_warning(job, est, profile)):
+            if w:
+                warn(w)
     paths = write_set(Path(outdir), files)
     return Result(paths, job, est, cad)

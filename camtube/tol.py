@@ -35,6 +35,18 @@ class Tolerances:
     outline : float
         Drawing import: the tube outline's height may differ from 2 pi r_o by
         this much (1 um) before the radius is called a mismatch.
+    path : float
+        Chord tolerance of a pass (1 um): a tangent-continuous run of a closed pass
+        path (a flattened arc, spline, fillet or ellipse) is cut as chords that lie
+        within this of the drawn path, and only on its inside
+        (:func:`camtube.plan.paths.simplify_closed`). A machine that blends the
+        chords adds its blending tolerance (``G64 P0.001`` on ``linuxcnc-path``):
+        the beam stays within 2 um of the drawing, a tenth of a 20 um kerf
+        (``MachineProfile.path_tolerance_mm``).
+    corner_deg : float
+        A vertex where the path turns by more than this (deg) is a true corner:
+        the time-optimal bound stops there (:mod:`camtube.machine.bound`); below it
+        the path is tangent-continuous, its speed limited only by its curvature.
     """
 
     merge: float = 1e-7
@@ -43,6 +55,8 @@ class Tolerances:
     chord: float = 2.5e-5
     gap: float = 1e-3
     outline: float = 1e-3
+    path: float = 1e-3
+    corner_deg: float = 5.0
 
 
 TOL = Tolerances()

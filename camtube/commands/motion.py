@@ -42,8 +42,8 @@ def cmd_motion(args: argparse.Namespace) -> int:
     from camtube.errors import CamtubeError
     from camtube.machine import load_profile
     from camtube.motion.analysis import JobGeometry, analyse
-    from camtube.motion.linuxcnc import run_program, unavailable_reason
-    from camtube.export.motion_time import estimate_program
+    from camtube.motion.linuxcnc import check_program, run_program, unavailable_reason
+    from camtube.machine.motion_time import estimate_program
 
     why = unavailable_reason()
     if why:
@@ -53,8 +53,9 @@ def cmd_motion(args: argparse.Namespace) -> int:
     program = Path(args.program)
     if not program.is_file():
         raise CamtubeError(f"{program}: no such G-code file")
+    text = check_program(program, profile)  # one line and exit 2 for a file LinuxCNC cannot run, before it starts
     geom = JobGeometry.from_job_file(_job_path(program, args.job))
-    est = estimate_program(program.read_text(encoding="utf-8"), profile)
+    est = estimate_program(text, profile)
     rec = run_program(program, profile, workdir=args.keep)
     report = analyse(rec, geom, profile, estimate_s=est.total_s)
     if args.json:
@@ -73,6 +74,7 @@ def cmd_machines(args: argparse.Namespace) -> int:
         blend = p.blending if isinstance(p.blending, str) else f"G64 P{p.blending:g}"
         mark = " (default)" if name == DEFAULT_MACHINE else ""
         print(f"{name}{mark}: {p.dialect} {p.suffix}, axes {''.join(p.axes)}, max vel/acc {lim}, "
-              f"blending {blend}, corners {p.corner_strategy}")
+              f"blending {blend}, corners {p.corner_strategy}"
+              + (f", laser gated by {p.gating}" if p.dialect == "linuxcnc" else ""))
         print(f"    {p.description}")
     return 0

@@ -25,59 +25,95 @@ Z is the focus height relative to the outer surface: ``Z = -focus_offset``
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Literal
+from dataclasses import dataclass
+from typing import Any
 
 
 @dataclass(frozen=True)
 class Dialect:
-    """A G-code post-processor, as data.
+    """A G-code post-processor, as data: the codes of one G-code family for one machine profile.
+
+    Everything that describes the machine (axes, rotary or flat, decimals, comment style, feed
+    mode, S per watt, suffix) is read from :attr:`profile`, never stored twice; the dialect holds
+    only the lines and codes the emitter writes.
 
     Attributes
     ----------
-    name, suffix, description : str
-        Key, file suffix (with the dot) and one-line description.
-    rotary : bool
-        True: the second axis is rotary, ``degrees(y / r_o)``; False: flat, ``y`` mm.
-    axes : tuple[str, str, str]
-        Letters of the axial, circumferential and focus axes.
+    name : str
+        Key of the G-code family (``linuxcnc``, ``grbl``).
+    profile : MachineProfile
+        The machine the G-code is for (limits, blending, corner strategy, axes, number format).
     preamble, postamble : tuple[str, ...]
         Lines before the first and after the last pass (comments written in
         this dialect's style are added by the emitter).
     laser_on, laser_off : str
         Beam gate; ``laser_on`` may use ``{power_w}``, ``{frequency_khz}``, ``{spindle}``.
     settings : tuple[str, ...]
-        Lines written before a pass whose power/frequency differ from the
-        previous pass (same fields as ``laser_on``).
-    feed_mode : {"inverse_time", "units_per_minute"}
-        G93 (F = 1/min of each cutting move) or G94 (F per move in the units
-        the controller applies it to: XYZ mm/min, or deg/min for a pure rotary move).
-    decimals, feed_decimals : int
-        Fixed decimals of coordinates (mm, deg) and of F.
-    comment : {"paren", "semicolon"}
-        ``(text)`` or ``; text``.
-    spindle_per_watt : float
-        S value per watt for ``{spindle}``.
-    profile : MachineProfile | None
-        The machine profile the dialect was built from (limits, blending, corner strategy).
+        Lines written before a pass whose settings differ from the previous pass (same fields
+        as ``laser_on``, and ``{pulses_per_mm}``, ``{outer_radius_mm}``).
+    blend_on, blend_off : str | None
+        ``blend`` corner strategy: the lines written before the first beam-on move of a pass
+        (``G64 P<tol>``) and before its last (``G61``, so the machine stops where the gate closes);
+        None otherwise.
     """
 
     name: str
-    suffix: str
-    description: str
-    rotary: bool
-    axes: tuple[str, str, str]
+    profile: Any
     preamble: tuple[str, ...]
     postamble: tuple[str, ...]
     laser_on: str
     laser_off: str
     settings: tuple[str, ...] = ()
-    feed_mode: Literal["inverse_time", "units_per_minute"] = "inverse_time"
-    decimals: int = 6
-    feed_decimals: int = 3
-    comment: Literal["paren", "semicolon"] = "paren"
-    spindle_per_watt: float = 0.0
-    profile: object = field(default=None, compare=False, repr=False)
+    blend_on: str | None = None
+    blend_off: str | None = None
+
+    # ---- read from the profile
+    @property
+    def suffix(self) -> str:
+        """File suffix, with the dot."""
+        return self.profile.suffix
+
+    @property
+    def description(self) -> str:
+        return self.profile.description
+
+    @property
+    def rotary(self) -> bool:
+        """True: the second axis is rotary, ``degrees(y / r_o)``; False: flat, ``y`` mm."""
+        return self.profile.rotary
+
+    @property
+    def axes(self) -> tuple[str, str, str]:
+        """Letters of the axial, circumferential and focus axes."""
+        return self.profile.axes
+
+    @property
+    def feed_mode(self) -> str:
+        """``inverse_time`` (G93) or ``units_per_minute`` (G94)."""
+        return self.profile.feed_mode
+
+    @property
+    def decimals(self) -> int:
+        return self.profile.decimals
+
+    @property
+    def feed_decimals(self) -> int:
+        return self.profile.feed_decimals
+
+    @property
+    def comment(self) -> str:
+        """``paren`` ``(text)`` or ``semicolon`` ``; text``."""
+        return self.profile.comment
+
+    @property
+    def spindle_per_watt(self) -> float:
+        """S value per watt for ``{spindle}``."""
+        return self.profile.s_per_watt
+
+    @property
+    def uses_speed(self) -> bool:
+        """True when a settings line depends on the pass's scan speed (the pulses per mm)."""
+        return any("pulses_per_mm" in x for x in self.settings)
 
     def comment_line(self, text: str) -> str:
         """``text`` as a comment line (parentheses removed from paren comments)."""
@@ -85,13 +121,25 @@ class Dialect:
             return "(" + text.replace("(", "[").replace(")", "]") + ")"
         return "; " + text
 
-    def fields(self, power_w: float, frequency_khz: float) -> dict:
-        return {"power_w": power_w, "frequency_khz": frequency_khz, "spindle": power_w * self.spindle_per_watt}
+    def fields(self, power_w: float, frequency_khz: float, speed_mm_s: float = 0.0,
+               outer_radius_mm: float = 0.0) -> dict:
+        """Values of the format fields of ``laser_on`` and ``settings`` for one pass's settings.
+
+        ``pulses_per_mm`` = pulses per mm of path at the scan speed (1/mm, the dose of a
+        distance-gated laser), ``outer_radius_mm`` the tube's (mm).
+        """
+        ppmm = 1000.0 * frequency_khz / speed_mm_s if speed_mm_s > 0 else 0.0
+        return {"power_w": power_w, "frequency_khz": frequency_khz, "spindle": power_w * self.spindle_per_watt,
+                "pulses_per_mm": ppmm, "outer_radius_mm": outer_radius_mm}
 
 
 def blending_line(profile) -> str | None:
-    """The G-code line that sets ``profile.blending`` (None: leave the controller's own)."""
-    if profile.blending == "exact_stop":
+    """The G-code line that sets ``profile.blending`` (None: leave the controller's own).
+
+    Under the ``blend`` corner strategy the program starts in exact stop; the emitter switches to
+    the tolerance for the beam-on moves of each pass (:attr:`Dialect.blend_on`).
+    """
+    if profile.blending == "exact_stop" or profile.corner_strategy == "blend":
         return "G61"
     if profile.blending == "controller":
         return None
@@ -107,20 +155,21 @@ def dialect_from_profile(profile) -> Dialect:
     """
     ax, ay, az = profile.axes
     blend = blending_line(profile)
-    common = dict(name=profile.dialect, suffix=profile.suffix, description=profile.description,
-                  rotary=profile.rotary, axes=profile.axes, comment=profile.comment, decimals=profile.decimals,
-                  feed_decimals=profile.feed_decimals, profile=profile)
+    common = dict(name=profile.dialect, profile=profile)
     if profile.dialect == "linuxcnc":
         g = profile.gate_output
         settings = tuple(line for out, line in ((profile.power_output, "M68 E{} Q{{power_w:.3f}}"),
-                                                (profile.frequency_output, "M68 E{} Q{{frequency_khz:.3f}}"))
+                                                (profile.frequency_output, "M68 E{} Q{{frequency_khz:.3f}}"),
+                                                (profile.dose_output, "M68 E{} Q{{pulses_per_mm:.6f}}"),
+                                                (profile.radius_output, "M68 E{} Q{{outer_radius_mm:.6f}}"))
                          if out is not None for line in [line.format(out)])
         pre = ("G21 G90 G17 G40 G49 G80",) + ((blend,) if blend else ()) + (f"M65 P{g}", "G93", f"G0 {az}0")
+        blend = (f"G64 P{profile.blending:g}", "G61") if profile.corner_strategy == "blend" else (None, None)
         return Dialect(preamble=pre, postamble=(f"M65 P{g}", "G94", "M2"), laser_on=f"M62 P{g}",
-                       laser_off=f"M63 P{g}", settings=settings, feed_mode="inverse_time", **common)
+                       laser_off=f"M63 P{g}", settings=settings, blend_on=blend[0], blend_off=blend[1], **common)
     pre = ("G21 G90 G17 G94",) + ((blend,) if blend else ()) + ("M5", f"G0 {az}0")
     return Dialect(preamble=pre, postamble=("M5", "M2"), laser_on=f"{profile.spindle} S{{spindle:.0f}}",
-                   laser_off="M5", feed_mode="units_per_minute", spindle_per_watt=profile.s_per_watt, **common)
+                   laser_off="M5", **common)
 
 
 def _shipped(name: str) -> Dialect:

@@ -1,7 +1,7 @@
 """G-code post-processor: one streaming emitter for every :class:`~camtube.export.dialects.Dialect`.
 
-The wrap to the rotary axis happens here and only here: ``A = degrees(y / r_o)``
-with the same x, A = 0 at y = 0. Passes are cut at the angles of their
+The wrap to the rotary axis happens in :mod:`camtube.machine.kinematics` and only there:
+``A = degrees(y / r_o)`` with the same x, A = 0 at y = 0. Passes are cut at the angles of their
 unwrapped contour, whose centre lies in [0, 360) deg, so A stays within
 (-180, 540) deg however long the job: A never winds up, and a rotary stage
 with cables or a limited range never needs an unwind (a rapid between cuts may
@@ -22,15 +22,14 @@ the end of every pass, so a LEAD move (over-travel, lead-in) runs with the gate 
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Iterable, Iterator, Sequence
-
-import numpy as np
 
 from camtube import __version__
 from camtube.export.dialects import LINUXCNC, Dialect
 from camtube.fmt import format_duration_s
-from camtube.plan.moves import CUT, FOCUS, LEAD, RAPID, Moves, iter_moves, job_moves, time_warning
+from camtube.machine.kinematics import MachineMoves, machine_moves
+from camtube.machine.motion_time import job_estimate, slow_job_warning
+from camtube.plan.moves import FOCUS, RAPID, Moves, iter_moves, time_warning
 from camtube.plan.packed import no_gc
 from camtube.plan.safety import check_moves
 from camtube.progress import NO_PROGRESS, Progress
@@ -38,78 +37,6 @@ from camtube.progress import NO_PROGRESS, Progress
 #: Distinct (path, speed) blocks whose text is kept for reuse (bounds the memo's memory).
 MEMO_MAX = 200_000
 _REOPEN = "\x00"  # placeholder of a gate-on inside a pass (see _Emitter._rows)
-
-
-@dataclass(frozen=True, eq=False)
-class MachineMoves:
-    """The moves of a job (or of a chunk of it) in one dialect's machine axes, rounded as printed.
-
-    Attributes
-    ----------
-    neutral : Moves
-        The unrolled move list they come from.
-    ax, ay, az : (m,) float
-        Axis values (mm, or deg for a rotary second axis), rounded to ``dialect.decimals``.
-    feed : (m,) float
-        F of every feed move (CUT, LEAD; 1/min in G93, else mm/min or deg/min), rounded; 0 elsewhere.
-    start : tuple[float, float, float]
-        Axis values before the first move (the rounded start of ``neutral``).
-    """
-
-    neutral: Moves
-    ax: np.ndarray
-    ay: np.ndarray
-    az: np.ndarray
-    feed: np.ndarray
-    dialect: Dialect
-    outer_radius_mm: float
-    start: tuple[float, float, float] = (0.0, 0.0, 0.0)
-
-    def _unroll(self, ay):
-        return np.radians(ay) * self.outer_radius_mm if self.dialect.rotary else ay
-
-    def unrolled(self) -> Moves:
-        """The emitted moves back in the unrolled frame (what the safety check sees)."""
-        n = self.neutral
-        sx, sa, sz = self.start
-        start = (sx, float(self._unroll(np.float64(sa))), -sz + 0.0)
-        return Moves(self.ax, self._unroll(self.ay), -self.az, n.kind, n.laser, n.pass_index, n.vertex, n.speed,
-                     start)
-
-
-def machine_moves(job, dialect: Dialect = LINUXCNC, moves: Moves | None = None) -> MachineMoves:
-    """Map moves (default: all of the job's) to ``dialect``'s axes and feeds (vectorised)."""
-    mv = job_moves(job) if moves is None else moves
-    ro = job.outer_radius_mm
-    dec = dialect.decimals
-    sx, sy, sz = mv.start
-    rot = (lambda y: np.degrees(y / ro)) if dialect.rotary else (lambda y: y)  # noqa: E731
-    ax = np.round(mv.x, dec)
-    ay = np.round(rot(mv.y), dec)
-    az = np.round(-mv.z, dec) + 0.0  # + 0.0: no "-0.000000"
-    s_ax, s_ay, s_az = (float(np.round(np.float64(v), dec)) for v in (sx, rot(np.float64(sy)), -sz))
-    s_az += 0.0
-    # surface length of each move from the printed coordinates
-    ys = np.radians(ay) * ro if dialect.rotary else ay
-    s_ys = float(np.radians(s_ay) * ro) if dialect.rotary else s_ay
-    dx = np.diff(np.concatenate(([s_ax], ax)))
-    dy = np.diff(np.concatenate(([s_ys], ys)))
-    dz = np.diff(np.concatenate(([s_az], az)))
-    surf = np.hypot(dx, dy)
-    feedrow = (mv.kind == CUT) | (mv.kind == LEAD)
-    feed = np.zeros(len(mv))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        minutes = surf / (mv.speed * 60.0)
-        if dialect.feed_mode == "inverse_time":
-            feed[feedrow] = 1.0 / minutes[feedrow]
-        else:
-            # G94: F applies to the XYZ distance if the move has any, else to the rotary angle
-            lin = np.hypot(dx, dz) if dialect.rotary else np.sqrt(dx * dx + dy * dy + dz * dz)
-            rota = np.abs(np.diff(np.concatenate(([s_ay], ay)))) if dialect.rotary else np.zeros(len(mv))
-            per = np.where(lin > 0, lin, rota)
-            feed[feedrow] = per[feedrow] / minutes[feedrow]
-    feed = np.round(feed, dialect.feed_decimals)
-    return MachineMoves(mv, ax, ay, az, feed, dialect, ro, (s_ax, s_ay, s_az))
 
 
 def _header(job, dialect: Dialect, est) -> list[str]:
@@ -128,9 +55,9 @@ def _header(job, dialect: Dialect, est) -> list[str]:
           f"{format_duration_s(est.total_s)}" + (f" on machine {est.machine}" if est.machine else "")
           + f", lower bound {format_duration_s(est.lower_bound_s)}, ratio {est.ratio:.4f}"),
     ]
-    warning = time_warning(job, est)
-    if warning:
-        lines.append(c("WARNING: " + warning))
+    for warning in (time_warning(job, est), slow_job_warning(job, est, dialect.profile, short=True)):
+        if warning:
+            lines.append(c("WARNING: " + warning))
     return lines
 
 
@@ -150,11 +77,11 @@ class _Emitter:
         lead, tail = ("(", ")") if d.comment == "paren" else ("; ", "")
         self.comment = (lead + "pass {}: cut {} {}, repeat {}, focus {} at {:g} mm, drill {} offset {:.4f} mm"
                         + tail).format
-        self.gates: dict[tuple[float, float], tuple[str, str]] = {}
-        self.prev_key: tuple[float, float] | None = None
+        self.gates: dict[tuple[float, float, float], tuple[str, str]] = {}
+        self.prev_key: tuple[float, float, float] | None = None
         self.blocks: dict[tuple[int, float], tuple[str, str, bool, bool]] = {}
 
-    def _gate_on(self, key: tuple[float, float]) -> tuple[str, str]:
+    def _gate_on(self, key: tuple[float, float, float]) -> tuple[str, str]:
         """(settings lines where they change, the gate-on line).
 
         The settings (``M68`` on LinuxCNC) are not motion-synchronised: the controller stops to
@@ -164,10 +91,13 @@ class _Emitter:
         d = self.d
         g = self.gates.get(key)
         if g is None:
-            fields = d.fields(*key)
+            fields = d.fields(*key, self.job.outer_radius_mm)
             g = self.gates[key] = ("".join(x.format(**fields) + "\n" for x in d.settings),
                                    d.laser_on.format(**fields))
-        out = (g[0] if key != self.prev_key else ""), g[1]
+        # power and frequency (and the dose, for a distance-gated laser) are written where they change
+        same = self.prev_key is not None and (key == self.prev_key or (key[:2] == self.prev_key[:2]
+                                                                       and not self.d.uses_speed))
+        out = ("" if same else g[0]), g[1]
         self.prev_key = key
         return out
 
@@ -183,6 +113,7 @@ class _Emitter:
         parts: list[str] = []
         before = None
         state = False
+        blend_on, blend_off = d.blend_on, d.blend_off
         for i in range(lo, hi):
             on = L[i]
             if on != state:
@@ -191,6 +122,11 @@ class _Emitter:
                 else:
                     parts.append((_REOPEN if on else d.laser_off) + "\n")
                 state = on
+                last = on and (i + 1 == hi or not L[i + 1])
+                if on and blend_on is not None and not last:
+                    parts.append(blend_on + "\n")  # the beam-on run is one blended path ...
+            if on and blend_off is not None and (i + 1 == hi or not L[i + 1]):
+                parts.append(blend_off + "\n")  # ... that ends at rest, where the gate closes
             k = K[i]
             if k == RAPID:
                 parts.append(self.rapid(X[i], Y[i]) + "\n")
@@ -241,7 +177,7 @@ class _Emitter:
                 blk = self._rows(X, Y, Z, F, K, L, i, r1)
             before, after, opened, reopened = blk
             if opened:
-                settings, gate_on = self._gate_on((pw, fq))
+                settings, gate_on = self._gate_on((pw, fq, speed))
                 text.append(settings + before + gate_on)
                 text.append(after.replace(_REOPEN, gate_on) if reopened else after)
             elif before:
@@ -282,7 +218,6 @@ def iter_gcode(job, dialect: Dialect = LINUXCNC, *, progress: Progress = NO_PROG
         text is never yielded (the file layer discards the partial file).
     """
     from camtube.machine.corners import strategy_moves
-    from camtube.export.motion_time import job_estimate
 
     if moves is None and dialect.profile is not None:
         moves = strategy_moves(job, dialect.profile)  # the profile's corner strategy (None: the job's moves)

@@ -88,7 +88,7 @@ def _head(job, dialect=None) -> dict:
     move at its nominal speed).
     """
     from camtube.export.dialects import LINUXCNC
-    from camtube.export.motion_time import job_estimate
+    from camtube.machine.motion_time import job_estimate
 
     dialect = LINUXCNC if dialect is None else dialect
     est = job_estimate(job, dialect)

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Iterable, Iterator, Sequence
+from typing import Callable, Iterable, Iterator, Sequence
 
 from camtube.export.dialects import DIALECTS, Dialect
 from camtube.io import write_set
@@ -28,9 +28,9 @@ from camtube.progress import NO_PROGRESS, Progress
 def survey(job, progress: Progress = NO_PROGRESS):
     """Safety-check the job's neutral moves and estimate its time in one pass over the chunks.
 
-    Both results are remembered on the Job (as :func:`~camtube.plan.safety.check_job` and
-    :func:`~camtube.plan.moves.estimate` remember them), so the writers that follow reuse
-    them; a second call costs nothing. Returns the :class:`~camtube.plan.moves.Estimate`.
+    Both results are kept in the Job's :class:`~camtube.plan.job.JobCache` (where
+    :func:`~camtube.plan.safety.check_job` and :func:`~camtube.plan.moves.estimate` keep them), so
+    the writers that follow reuse them; a second call costs nothing. Returns the :class:`~camtube.plan.moves.Estimate`.
 
     Raises
     ------
@@ -40,8 +40,9 @@ def survey(job, progress: Progress = NO_PROGRESS):
     from camtube.plan.moves import estimate, iter_moves
     from camtube.plan.safety import check_moves
 
-    if "_estimate" in job.__dict__ and job.__dict__.get("_checked"):
-        return job.__dict__["_estimate"]
+    cache = job.cache
+    if cache.estimate is not None and cache.checked:
+        return cache.estimate
     with progress.task("safety check, estimate", total=len(job.passes)) as task:
         def checked():
             for mv in iter_moves(job):
@@ -50,34 +51,46 @@ def survey(job, progress: Progress = NO_PROGRESS):
                 yield mv
 
         est = estimate(job, checked())
-    job.__dict__["_checked"] = True
-    return job.cached("_estimate", lambda: est)
+    cache.checked = True
+    if cache.estimate is None:
+        cache.estimate = est
+    return cache.estimate
 
 
-def toolpath_streams(job, dialects: Sequence[Dialect] = tuple(DIALECTS.values()),
-                     progress: Progress = NO_PROGRESS) -> dict[str, Iterator[str]]:
-    """File name -> lazy iterator of text chunks of the job's toolpath outputs.
+def exporters(dialects: Sequence[Dialect] = tuple(DIALECTS.values())) -> dict[str, Callable[..., Iterator[str]]]:
+    """The toolpath writers of a job, as a table: file suffix -> ``writer(job, progress)`` -> text chunks.
 
-    Nothing is computed until a stream is iterated; the first one iterated runs
-    :func:`survey` (check + estimate, shared by all), and each stream safety-checks what
-    it writes (raising :class:`~camtube.errors.SafetyError` before yielding unsafe text).
+    One entry per output (as trimesh's ``exchange/export.py`` keeps its exporters): the
+    toolpath DXF, the G-code of each dialect (by its suffix) and the job file, which records
+    the machine of the first dialect. Every writer is pure (it yields text; the file layer
+    writes it) and safety-checks what it writes.
     """
     from camtube.export.gcode import iter_gcode
     from camtube.export.jobfile import iter_job_json
     from camtube.export.toolpath_dxf import iter_toolpath_dxf
 
-    def surveyed(make):
-        survey(job, progress)
-        yield from make()
-
-    streams: dict[str, Iterator[str]] = {
-        f"{job.name}.toolpath.dxf": surveyed(lambda: iter_toolpath_dxf(job, progress=progress))}
+    table: dict[str, Callable[..., Iterator[str]]] = {
+        ".toolpath.dxf": lambda job, progress=NO_PROGRESS: iter_toolpath_dxf(job, progress=progress)}
     for d in dialects:
-        streams[f"{job.name}{d.suffix}"] = surveyed(lambda d=d: iter_gcode(job, d, progress=progress))
-    # the job file records the machine of the first dialect (the rotary stage by default)
+        table[d.suffix] = lambda job, progress=NO_PROGRESS, d=d: iter_gcode(job, d, progress=progress)
     first = dialects[0] if dialects else None
-    streams[f"{job.name}.job.json"] = surveyed(lambda: iter_job_json(job, progress=progress, dialect=first))
-    return streams
+    table[".job.json"] = lambda job, progress=NO_PROGRESS: iter_job_json(job, progress=progress, dialect=first)
+    return table
+
+
+def toolpath_streams(job, dialects: Sequence[Dialect] = tuple(DIALECTS.values()),
+                     progress: Progress = NO_PROGRESS) -> dict[str, Iterator[str]]:
+    """File name -> lazy iterator of text chunks of the job's toolpath outputs (:func:`exporters`, walked).
+
+    Nothing is computed until a stream is iterated; the first one iterated runs
+    :func:`survey` (check + estimate, shared by all), and each stream safety-checks what
+    it writes (raising :class:`~camtube.errors.SafetyError` before yielding unsafe text).
+    """
+    def surveyed(writer):
+        survey(job, progress)
+        yield from writer(job, progress)
+
+    return {f"{job.name}{suffix}": surveyed(writer) for suffix, writer in exporters(dialects).items()}
 
 
 def toolpath_texts(job, dialects: Sequence[Dialect] = tuple(DIALECTS.values())) -> dict[str, str]:

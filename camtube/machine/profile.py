@@ -12,10 +12,20 @@ Keys (units in the comments of the shipped files; ``docs/motion.md`` has the tab
 ``axes`` (axial, circumferential, focus letters), ``limits.<LETTER>.max_velocity``
 (mm/s or deg/s) and ``.max_acceleration`` (mm/s^2 or deg/s^2), ``blending``
 (``exact_stop``, a path tolerance in mm, or ``controller``), ``corner_strategy``
-(``overtravel`` | ``none``), ``servo_period_s``, ``laser`` (``gate_output``,
-``power_output``, ``frequency_output`` for LinuxCNC; ``spindle`` M3/M4 and
+(``overtravel`` | ``none`` | ``blend``), ``servo_period_s``, ``laser`` (``gate_output``,
+``power_output``, ``frequency_output``, ``gating`` (``time`` | ``distance``),
+``dose_output``, ``radius_output`` for LinuxCNC; ``spindle`` M3/M4 and
 ``s_per_watt`` for GRBL), ``rotary_range_deg``, ``wrap``, ``comment``
-(``paren`` | ``semicolon``), ``decimals``, ``feed_decimals``.
+(``paren`` | ``semicolon``), ``decimals``, ``feed_decimals``, ``warn_time_factor``.
+
+``laser.gating`` says how the laser's pulses follow the motion. ``time``: the laser
+fires at its set frequency whenever the gate is open, so the dose per millimetre
+rises wherever the stage slows down (corners, curves). ``distance``: the pulse rate
+follows the surface speed (position-synchronised output, as Aerotech's PSO does),
+so the pulses per millimetre stay at their nominal value however the stage moves;
+the program gives the pulses per millimetre on analog output ``dose_output`` (and
+the tube's outer radius on ``radius_output`` for a rotary axis), and
+:mod:`camtube.motion.linuxcnc` wires the HAL that scales the pulse rate.
 """
 from __future__ import annotations
 
@@ -32,7 +42,8 @@ from camtube.yamltext import closest, line_map, read_yaml_file
 MACHINES_DIR = Path(__file__).resolve().parent / "profiles"
 DEFAULT_MACHINE = "linuxcnc-rotary"
 DIALECT_KINDS = ("linuxcnc", "grbl")
-CORNER_STRATEGIES = ("overtravel", "none")
+CORNER_STRATEGIES = ("overtravel", "none", "blend")
+GATINGS = ("time", "distance")
 COMMENT_STYLES = ("paren", "semicolon")
 
 
@@ -74,10 +85,14 @@ class MachineProfile:
     blending : str | float
         ``"exact_stop"`` (G61), a path tolerance in mm (G64 P..), or
         ``"controller"`` (nothing written; the controller's own junction handling).
-    corner_strategy : {"overtravel", "none"}
+    corner_strategy : {"overtravel", "none", "blend"}
         ``overtravel``: every cut edge is run at the scan speed from a beam-off
         lead-in to a beam-off lead-out along its own line (uniform dose, see
-        :mod:`camtube.machine.corners`); ``none``: edges run back to back.
+        :mod:`camtube.machine.corners`); ``none``: edges run back to back;
+        ``blend``: the beam-on moves of a pass are one path, blended within the
+        tolerance ``blending`` (``G64 P``: LinuxCNC joins them with tangent arcs at
+        the speed their curvature allows), and the machine stops exactly (``G61``)
+        wherever the gate switches, so the gate never switches in a blend.
     servo_period_s : float
         Controller servo period (s): the motion-synchronised gate switches on this clock.
     gate_output, power_output, frequency_output : int | None
@@ -93,6 +108,15 @@ class MachineProfile:
         ``none``: the rotary axis is continuous, never re-zeroed.
     comment : {"paren", "semicolon"}
     decimals, feed_decimals : int
+    gating : {"time", "distance"}
+        How the pulses follow the motion (module docstring): ``distance`` keeps the pulses
+        per millimetre uniform, ``time`` keeps the pulses per second.
+    dose_output, radius_output : int | None
+        LinuxCNC analog outputs (``M68 E..``) of the pulses per mm and of the outer radius (mm)
+        the distance gating's HAL reads; None with time gating.
+    warn_time_factor : float
+        Warn before writing when the estimate exceeds the lower bound (cut length / scan
+        speed) by more than this factor.
     source : str | None
         File the profile was read from.
     """
@@ -117,6 +141,10 @@ class MachineProfile:
     comment: str = "paren"
     decimals: int = 6
     feed_decimals: int = 3
+    gating: str = "time"
+    dose_output: int | None = None
+    radius_output: int | None = None
+    warn_time_factor: float = 3.0
     source: str | None = None
 
     def axis(self, letter: str) -> AxisLimits:
@@ -130,6 +158,27 @@ class MachineProfile:
     def exact_stop(self) -> bool:
         return self.blending == "exact_stop"
 
+    @property
+    def path_tolerance_mm(self) -> float:
+        """How far the beam may stray from a drawn curve (mm): the chords' ``TOL.path`` (1 um, all on the
+        inside) plus, where a pass is blended (``corner_strategy: blend``), the blending tolerance (``G64 P``):
+        2 um for ``linuxcnc-path``, a tenth of a 20 um femtosecond kerf."""
+        from camtube.tol import TOL
+
+        extra = float(self.blending) if self.corner_strategy == "blend" else 0.0
+        return TOL.path + extra
+
+    @property
+    def feed_mode(self) -> str:
+        """``inverse_time`` (G93: F = 1 / minutes of each move) for LinuxCNC, ``units_per_minute`` (G94) for GRBL."""
+        return "inverse_time" if self.dialect == "linuxcnc" else "units_per_minute"
+
+    @property
+    def uniform_dose(self) -> bool:
+        """True when the pulses per millimetre stay at their nominal value however the stage moves
+        (distance gating), or every beam-on move runs at the scan speed (over-travel)."""
+        return self.gating == "distance" or self.corner_strategy == "overtravel"
+
     def record(self) -> dict:
         """What a job file stores about the machine it was made for (plain data, fixed order)."""
         return {
@@ -139,14 +188,17 @@ class MachineProfile:
                      for k, v in self.limits},
             "blending": self.blending if isinstance(self.blending, str) else float(self.blending),
             "corner_strategy": self.corner_strategy, "servo_period_s": float(self.servo_period_s),
+            "gating": self.gating,
         }
 
 
 # ---------------------------------------------------------------- validation
 _LIMIT_KEYS = ("max_velocity", "max_acceleration")
-_LASER_KEYS = ("gate_output", "power_output", "frequency_output", "spindle", "s_per_watt")
+_LASER_KEYS = ("gate_output", "power_output", "frequency_output", "spindle", "s_per_watt", "gating", "dose_output",
+               "radius_output")
 _KEYS = ("description", "dialect", "suffix", "rotary", "axes", "limits", "blending", "corner_strategy",
-         "servo_period_s", "laser", "rotary_range_deg", "wrap", "comment", "decimals", "feed_decimals")
+         "servo_period_s", "laser", "rotary_range_deg", "wrap", "comment", "decimals", "feed_decimals",
+         "warn_time_factor")
 _REQUIRED = ("dialect", "axes", "limits")
 
 
@@ -259,6 +311,10 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
     if corner == "overtravel" and dialect != "linuxcnc":
         ck.add("corner_strategy", "overtravel needs motion-synchronised gating (dialect linuxcnc)", corner,
                "none for grbl", "write corner_strategy: none")
+    if corner == "blend" and (dialect != "linuxcnc" or isinstance(blending, str) or rotary):
+        ck.add("corner_strategy", "blend needs a LinuxCNC profile with a path tolerance (blending: 0.001) on linear "
+               "axes (LinuxCNC blends moves with rotary motion parabolically, at half the acceleration)", corner,
+               "none | overtravel", "write corner_strategy: none, or drive the rotary axis in surface mm (Y)")
     servo = ck.number(m.get("servo_period_s", 0.001), "servo_period_s")
     laser = m.get("laser", {}) or {}
     if not isinstance(laser, dict):
@@ -266,7 +322,7 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
         laser = {}
     ck.unknown(laser, _LASER_KEYS, "laser.")
     outs = {}
-    for k in ("gate_output", "power_output", "frequency_output"):
+    for k in ("gate_output", "power_output", "frequency_output", "dose_output", "radius_output"):
         if k in laser:
             outs[k] = ck.number(laser[k], f"laser.{k}", 0, strict=False, integer=True)
     spindle, spw = laser.get("spindle"), 0.0
@@ -283,6 +339,21 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
                    "use laser.spindle: M4 and laser.s_per_watt")
         spindle = ck.choice(spindle if spindle is not None else "M4", "laser.spindle", ("M3", "M4"))
         spw = ck.number(laser.get("s_per_watt"), "laser.s_per_watt") or 0.0
+    gating = ck.choice(laser.get("gating", "time"), "laser.gating", GATINGS)
+    if gating == "distance":
+        if dialect != "linuxcnc":
+            ck.add("laser.gating", "distance gating needs LinuxCNC's HAL (dialect linuxcnc)", gating, "time for grbl",
+                   "write laser.gating: time")
+        elif "dose_output" not in laser:
+            ck.add("laser.dose_output", "distance gating reads the pulses per mm from an analog output", None, "0..3",
+                   "add laser.dose_output: 2")
+        elif rotary and "radius_output" not in laser:
+            ck.add("laser.radius_output", "distance gating on a rotary axis reads the outer radius from an analog "
+                   "output", None, "0..3", "add laser.radius_output: 3")
+    elif "dose_output" in laser or "radius_output" in laser:
+        ck.add("laser.dose_output", "only distance gating uses dose_output and radius_output", None,
+               "laser.gating: distance", "add laser.gating: distance, or remove them")
+    warn_factor = ck.number(m.get("warn_time_factor", 3.0), "warn_time_factor", 1.0, strict=False)
     rng = m.get("rotary_range_deg")
     if rng is not None:
         if not (isinstance(rng, list) and len(rng) == 2 and all(isinstance(v, (int, float)) for v in rng)
@@ -310,7 +381,8 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
         gate_output=outs.get("gate_output"), power_output=outs.get("power_output"),
         frequency_output=outs.get("frequency_output"), spindle=spindle if dialect == "grbl" else None,
         s_per_watt=spw, rotary_range_deg=rng, wrap=wrap, comment=comment, decimals=dec, feed_decimals=fdec,
-        source=file)
+        gating=gating, dose_output=outs.get("dose_output"), radius_output=outs.get("radius_output"),
+        warn_time_factor=warn_factor if warn_factor is not None else 3.0, source=file)
 
 
 def read_profile(path: str | os.PathLike) -> MachineProfile:

@@ -12,9 +12,18 @@ Figures (:class:`MotionReport`):
 - run time (first to last cycle with motion) against the estimate and the lower bound;
 - beam-on path length against the job's cut length;
 - share of the beam-on path run within +-5 % of the scan speed;
+- dose: share of the beam-on path that gets within +-5 % of the nominal pulses per mm
+  (``1000 frequency_khz / scan_speed``): from the recorded pulse rate of a distance-gated
+  profile (the rate commanded at sample ``k`` is in force from ``k`` to ``k + 1``), or, for a
+  time-gated one, the set frequency over the recorded speed;
 - farthest beam-on position outside the design cut regions (the tube is periodic in y);
-- largest distance from a drawn corner (every vertex of every pass path, matched by
-  focus level) to the beam-on path at that focus.
+- largest distance from a drawn corner (every vertex of a pass path that is a true corner of the
+  drawing, :func:`camtube.machine.bound.design_corners`: every vertex of a rectangle, none of a
+  slot or an ellipse; matched by focus level) to the beam-on path at that focus;
+- each stretch of the beam-on path against its own pass (the k-th stretch with the gate open is the
+  k-th pass): the farthest sample from the pass's commanded path, and the farthest vertex of that
+  path (on a curve: a point of the drawn curve) from the stretch (curves followed within the path
+  tolerance).
 """
 from __future__ import annotations
 
@@ -42,7 +51,10 @@ class JobGeometry:
     regions : list of (k, 2) float
         Design cut regions (unwrapped unrolled frame, mm).
     corners : (c, 3) float
-        Every vertex of every pass path: x, y (mm), focus offset into the material (mm).
+        The vertices of the pass paths that are true corners of the drawing: x, y (mm), focus
+        offset into the material (mm).
+    paths : tuple of ((k, 2) float, bool, float)
+        Every distinct pass path (vertices, closed, focus offset mm).
     estimate_s, lower_bound_s : float
         The job's time estimate and lower bound (s), NaN if unknown.
     """
@@ -55,16 +67,31 @@ class JobGeometry:
     corners: np.ndarray
     estimate_s: float
     lower_bound_s: float
+    frequency_khz: float = math.nan
+    paths: tuple = ()
+    pass_paths: tuple = ()
 
     @classmethod
     def from_job(cls, job, estimate_s: float = math.nan) -> "JobGeometry":
         """From a planned :class:`~camtube.plan.job.Job`."""
-        corners = np.concatenate([np.column_stack([np.asarray(p.contour.points, float),
-                                                   np.full(len(p.contour.points), p.focus_offset_mm)])
-                                  for p in job.passes]) if job.passes else np.zeros((0, 3))
+        from camtube.machine.bound import design_corners, true_corner_flags
+
+        drawn = design_corners(job)
+        rows = []
+        for p in job.passes:
+            pts = np.asarray(p.contour.points, float)
+            keep = true_corner_flags(pts, drawn, p.offset_mm)
+            rows.append(np.column_stack([pts[keep], np.full(int(keep.sum()), p.focus_offset_mm)]))
+        corners = np.concatenate(rows) if rows else np.zeros((0, 3))
+        pk = job.packed
+        seen = sorted({(int(g), float(z)) for g, z in zip(pk.pass_geom.tolist(), pk.pass_z.tolist())})
+        paths = tuple((np.asarray(pk.path_points(g), float), bool(pk.geom_closed[g]), z) for g, z in seen)
+        index = {(g, z): k for k, (g, z) in enumerate(seen)}
+        order = tuple(index[(int(g), float(z))] for g, z in zip(pk.pass_geom.tolist(), pk.pass_z.tolist()))
         return cls(job.name, float(job.outer_radius_mm), float(job.process.scan_speed_mm_s),
                    float(job.cut_length_mm), tuple(np.asarray(c.points, float) for c in job.design), corners,
-                   float(estimate_s), float(job.cut_length_mm / job.process.scan_speed_mm_s))
+                   float(estimate_s), float(job.cut_length_mm / job.process.scan_speed_mm_s),
+                   float(job.process.frequency_khz), paths, order)
 
     @classmethod
     def from_job_file(cls, path: str | os.PathLike) -> "JobGeometry":
@@ -107,6 +134,11 @@ class MotionReport:
     corners: int
     samples: int
     wall_s: float
+    dose_share: float = math.nan
+    nominal_pulses_per_mm: float = math.nan
+    distance_gated: bool = False
+    max_path_dev_mm: float = math.nan
+    max_vertex_miss_mm: float = math.nan
 
     @property
     def estimate_error(self) -> float:
@@ -132,7 +164,14 @@ class MotionReport:
             ("within +-5 % of scan speed", f"{100 * self.speed_share:.2f}", f"% of the beam-on path (scan "
                                                                             f"{self.scan_speed_mm_s:g} mm/s, median "
                                                                             f"{self.median_speed_mm_s:.2f})"),
+            ("dose within +-5 %", f"{100 * self.dose_share:.2f}", f"% of the beam-on path (nominal "
+                                                                 f"{self.nominal_pulses_per_mm:.1f} pulses/mm, "
+                                                                 + ("distance-gated rate recorded)" if self.distance_gated
+                                                                    else "time-gated: set frequency / speed)")),
             ("beam on outside cut regions", f"{1000 * self.max_outside_mm:.3f}", "um at most"),
+            ("own pass: path, vertices", f"{1000 * self.max_path_dev_mm:.3f}, {1000 * self.max_vertex_miss_mm:.3f}",
+             "um at most (each beam-on stretch against its own pass: samples from the path, the path's vertices "
+             "from the beam)"),
             ("drawn corner missed by", f"{1000 * self.max_corner_miss_mm:.3f}", f"um at most ({self.corners} "
                                                                                 "corners)"),
         ]
@@ -210,6 +249,29 @@ def _corner_miss_mm(corners: np.ndarray, a: np.ndarray, b: np.ndarray, fz: np.nd
     return worst
 
 
+def _own_pass_mm(rec_x, rec_y, gate, geom) -> tuple[float, float]:
+    """(farthest beam-on sample from its own pass's path, farthest vertex of a pass's path from its own beam-on
+    path), mm: the k-th stretch of samples with the gate open is the k-th pass (NaN if the counts differ)."""
+    import shapely
+
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], gate.astype(np.int8), [0]))))
+    starts, ends = edges[::2], edges[1::2]  # the beam is on from sample s to sample e (gate set at s .. e - 1)
+    if len(starts) != len(geom.pass_paths) or not geom.pass_paths:
+        return math.nan, math.nan
+    dev = miss = 0.0
+    lines = {}
+    for s, e, k in zip(starts.tolist(), ends.tolist(), geom.pass_paths):
+        pts = np.column_stack([rec_x[s:e + 1], rec_y[s:e + 1]])
+        line = lines.get(k)
+        if line is None:
+            pp, closed, _ = geom.paths[k]
+            line = lines[k] = shapely.LineString(np.vstack([pp, pp[:1]]) if closed else pp)
+        dev = max(dev, float(shapely.distance(line, shapely.points(pts)).max()))
+        beam = shapely.LineString(pts) if len(pts) > 1 else shapely.Point(pts[0])
+        miss = max(miss, float(shapely.distance(beam, shapely.points(np.asarray(line.coords))).max()))
+    return dev, miss
+
+
 def analyse(rec, geom: JobGeometry, profile, estimate_s: float | None = None) -> MotionReport:
     """Measure a :class:`~camtube.motion.linuxcnc.Recording` against the job it ran.
 
@@ -253,7 +315,17 @@ def analyse(rec, geom: JobGeometry, profile, estimate_s: float | None = None) ->
         pts = np.unique(np.concatenate([a, b]), axis=0)
         outside = _outside_mm(pts[:, 0], pts[:, 1], geom.regions, big)
         miss = _corner_miss_mm(geom.corners, a, b, z[ia], big)
+    path_dev, vertex_miss = _own_pass_mm(x, y, rec.gate, geom)
     est = geom.estimate_s if estimate_s is None else float(estimate_s)
+    nominal = 1000.0 * geom.frequency_khz / v
+    rate = getattr(rec, "rate_khz", None)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if rate is not None:  # pulses fired over each beam-on interval per mm moved
+            ppmm = 1000.0 * rate[:-1][on] * dt[on] / lo
+        else:  # time gating: the set frequency, whatever the speed
+            ppmm = 1000.0 * geom.frequency_khz / speed
+    good = np.abs(ppmm / nominal - 1.0) <= SPEED_BAND
+    dose_share = float(lo[good].sum() / length) if length > 0 else 0.0
     return MotionReport(geom.name, profile.name, rec.run_time_s, est, geom.lower_bound_s, float(dt[on].sum()),
                         length, geom.cut_length_mm, v, share, median, outside, miss, len(geom.corners), len(rec),
-                        rec.wall_s)
+                        rec.wall_s, dose_share, nominal, rate is not None, path_dev, vertex_miss)

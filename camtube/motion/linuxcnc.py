@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
+import re
 import shutil
 import subprocess
 import tempfile
@@ -80,6 +82,9 @@ class Recording:
         Servo period (s).
     wall_s : float
         Real time the run took (s).
+    rate_khz : (n,) float or None
+        Distance gating (:func:`dose_hal`): the laser's pulse rate (kHz) the HAL commands at each
+        sample, in force until the next; None for a time-gated profile.
     """
 
     cycle: np.ndarray
@@ -89,6 +94,7 @@ class Recording:
     gate: np.ndarray
     period_s: float
     wall_s: float
+    rate_khz: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.cycle)
@@ -166,16 +172,20 @@ def config_texts(profile, workdir: str | os.PathLike, driver: str) -> dict[str, 
             "FERROR = 1000", "MIN_FERROR = 1000", "HOME = 0", "HOME_OFFSET = 0", "HOME_SEARCH_VEL = 0",
             "HOME_LATCH_VEL = 0", "HOME_SEQUENCE = 0"]
     n_dio = max(4, (profile.gate_output or 0) + 1)
-    n_aio = max(4, max((o for o in (profile.power_output, profile.frequency_output) if o is not None), default=0) + 1)
+    outs = (profile.power_output, profile.frequency_output, profile.dose_output, profile.radius_output)
+    n_aio = max(4, max((o for o in outs if o is not None), default=0) + 1)
+    dose = profile.gating == "distance"
     hal = [
         "loadrt [KINS]KINEMATICS",
         f"loadrt [EMCMOT]EMCMOT servo_period_nsec=[EMCMOT]SERVO_PERIOD num_joints=[KINS]JOINTS "
         f"num_dio={n_dio} num_aio={n_aio}",
-        "loadrt sampler depth=200000 cfg=fffb",
+        f"loadrt sampler depth=200000 cfg={'fffbf' if dose else 'fffb'}",
         "addf motion-command-handler servo-thread",
         "addf motion-controller servo-thread",
-        "addf sampler.0 servo-thread",
     ]
+    dose_lines = dose_hal(profile) if dose else []
+    hal += [ln for ln in dose_lines if ln.startswith(("loadrt", "addf"))]
+    hal += ["addf sampler.0 servo-thread"]
     hal += [f"net j{j} joint.{j}.motor-pos-cmd => joint.{j}.motor-pos-fb" for j in range(len(coords))]
     hal += [
         "net estop-loop iocontrol.0.user-enable-out iocontrol.0.emc-enable-in",
@@ -185,8 +195,103 @@ def config_texts(profile, workdir: str | os.PathLike, driver: str) -> dict[str, 
     hal += [f"net rec-{a.lower()} axis.{a.lower()}.pos-cmd => sampler.0.pin.{k}" for k, a in enumerate(profile.axes)]
     hal += [f"net rec-gate motion.digital-out-{profile.gate_output:02d} => sampler.0.pin.3",
             "setp sampler.0.enable 0"]
+    hal += [ln for ln in dose_lines if not ln.startswith(("loadrt", "addf"))]
+    if dose:
+        hal += ["net laser-rate-khz => sampler.0.pin.4"]
     return {"camtube.ini": "\n".join(ini) + "\n", "camtube.hal": "\n".join(hal) + "\n", "tool.tbl": "",
             "sim.var": ""}
+
+
+def dose_hal(profile) -> list[str]:
+    """HAL lines of distance gating: the laser's pulse rate (kHz) follows the surface speed.
+
+    Stock components only, as LinuxCNC's ``laserpower`` scales the power to the speed:
+    ``ddt`` differentiates the commanded axis positions (``axis.L.pos-cmd``) into velocities
+    and, once more, into accelerations; ``sum2`` extrapolates each velocity one servo cycle
+    ahead (``v + a T``: the rate set in a cycle is in force during the next one, when the stage
+    has already moved on); for a rotary axis ``mult2`` and ``scale`` turn deg/s into surface
+    mm/s (``x radius_output x pi/180``); ``hypot`` gives the surface speed; ``mult2`` times the
+    pulses per mm (analog output ``dose_output``) and the gate (``conv_bit_float``), ``scale``
+    x 0.001 gives kHz on the signal ``laser-rate-khz`` (wire it to the laser's external
+    pulse-rate or trigger input). The pulses per mm then stay at the nominal value however
+    the stage slows down into a corner.
+    """
+    ax, ac = profile.axes[0].lower(), profile.axes[1].lower()
+    T = profile.servo_period_s
+    hal = ["loadrt ddt count=4", "loadrt sum2 count=2", "loadrt mult2 count=3", "loadrt scale count=2",
+           "loadrt hypot count=1", "loadrt conv_bit_float count=1"]
+    for f in ("ddt.0", "ddt.1", "ddt.2", "ddt.3", "sum2.0", "sum2.1", "mult2.0", "scale.0", "hypot.0", "mult2.1",
+              "conv-bit-float.0", "mult2.2", "scale.1"):
+        hal.append(f"addf {f} servo-thread")
+    hal += [
+        f"net rec-{ax} ddt.0.in", f"net rec-{ac} ddt.1.in",  # the recorder's nets of axis.L.pos-cmd
+        "net dose-vel-ax ddt.0.out => ddt.2.in sum2.0.in0", "net dose-acc-ax ddt.2.out => sum2.0.in1",
+        "net dose-vel-c ddt.1.out => ddt.3.in sum2.1.in0", "net dose-acc-c ddt.3.out => sum2.1.in1",
+        f"setp sum2.0.gain1 {T!r}", f"setp sum2.1.gain1 {T!r}",
+        "net dose-v-ax sum2.0.out => hypot.0.in0",
+    ]
+    if profile.rotary:
+        hal += ["net dose-v-c-deg sum2.1.out => mult2.0.in0",
+                f"net dose-radius motion.analog-out-{profile.radius_output:02d} => mult2.0.in1",
+                "net dose-v-c-rad mult2.0.out => scale.0.in", f"setp scale.0.gain {math.pi / 180.0!r}",
+                "net dose-v-c scale.0.out => hypot.0.in1"]
+    else:
+        hal += ["net dose-v-c sum2.1.out => hypot.0.in1"]
+    hal += [
+        "net surface-speed hypot.0.out => mult2.1.in0",
+        f"net dose-ppmm motion.analog-out-{profile.dose_output:02d} => mult2.1.in1",
+        "net rec-gate conv-bit-float.0.in",
+        "net dose-gate-f conv-bit-float.0.out => mult2.2.in1",
+        "net dose-pps mult2.1.out => mult2.2.in0", "net dose-pps-gated mult2.2.out => scale.1.in",
+        "setp scale.1.gain 0.001", "net laser-rate-khz scale.1.out",
+    ]
+    return hal
+
+
+_AXIS_WORD = re.compile(r"(?<![A-Z])([XYZABCUVW])\s*[-+]?(?:\d+\.?\d*|\.\d+)")
+_HEADER_MACHINE = re.compile(r"on machine ([\w.-]+)")
+
+
+def check_program(path: str | os.PathLike, profile) -> str:
+    """The text of a program ``profile`` can run, or :class:`MotionRunError` with one line saying why not.
+
+    Read before LinuxCNC starts (a wrong file used to cost a 12 s timeout or a traceback):
+    refuses binary data, a YAML file (a pattern or profile given by mistake), a program with no
+    G0/G1 moves, and one that moves axes the profile does not have (a flat-bed GRBL ``.nc``, or a
+    program written for another machine: the message names the machine its header gives).
+    """
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise MotionRunError(f"{path}: cannot read the program: {exc.strerror}") from None
+    fix = "give the .ngc that `camtube toolpath` wrote for a LinuxCNC machine"
+    bad = raw.find(b"\x00")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        bad = exc.start if bad < 0 else min(bad, exc.start)
+    if bad >= 0:
+        raise MotionRunError(f"{path}: not a G-code program (binary data at byte {bad}); {fix}")
+    lines = [ln.split(";", 1)[0] for ln in text.splitlines()]
+    body = [re.sub(r"\(.*?\)", "", ln).strip().upper() for ln in lines]
+    moves = [ln for ln in body if re.match(r"^(N\d+\s*)?G0?[01](?!\d)", ln)]
+    if path.suffix.lower() in (".yaml", ".yml") or (not moves and any(re.match(r"^[a-z_]+:", ln) for ln in lines)):
+        raise MotionRunError(f"{path}: a YAML file, not a G-code program; run `camtube toolpath {path.name} -o DIR` "
+                             f"and give DIR/NAME.ngc")
+    if not moves:
+        raise MotionRunError(f"{path}: no G0/G1 moves: not a G-code program camtube wrote; {fix}")
+    used = sorted({m for ln in moves for m in _AXIS_WORD.findall(ln)})
+    foreign = [a for a in used if a not in profile.axes]
+    if foreign:
+        m = _HEADER_MACHINE.search(text[:2000])
+        whose = (f"it was written for machine {m.group(1)}: give --machine {m.group(1)}" if m and m.group(1) !=
+                 profile.name else f"give --machine NAME for the machine it was written for (`camtube machines`)")
+        if "M5" in body and "G93" not in body:  # a GRBL flat-bed program (G94, spindle-gated)
+            whose = "a flat-bed GRBL program (.nc) cannot run on LinuxCNC's motion controller; " + fix
+        raise MotionRunError(f"{path}: moves axis {', '.join(foreign)}, which machine {profile.name} does not have "
+                             f"(axes {' '.join(profile.axes)}); {whose}")
+    return text
 
 
 def split_program(text: str, max_moves: int = PIECE_MOVES) -> list[str]:
@@ -334,6 +439,7 @@ def _run(ngc: Path, profile, work: Path, timeout_s: float, keep_every_s: float, 
         why = "; ".join(status["errors"]) or "the sampler FIFO overflowed (samples lost)"
         raise MotionRunError(f"{ngc.name}: the controller reported: {why}")
     data = np.fromstring(samples.read_text(), sep=" ")  # noqa: NPY201 (fast text parse)
-    data = data.reshape(-1, 5)
+    data = data.reshape(-1, 6 if profile.gating == "distance" else 5)
     return Recording(data[:, 0].astype(np.int64), data[:, 1], data[:, 2], data[:, 3], data[:, 4] > 0.5,
-                     float(profile.servo_period_s), float(status["wall_s"]))
+                     float(profile.servo_period_s), float(status["wall_s"]),
+                     data[:, 5] if data.shape[1] > 5 else None)

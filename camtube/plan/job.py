@@ -13,56 +13,51 @@ Pass objects only when they are asked for.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-from functools import cached_property
-from typing import Sequence
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
 
 from camtube.design.contour import Contour
 from camtube.design.pattern import Process
+from camtube.plan.packed import PassView, pack
+from camtube.plan.passes import Pass
+
+__all__ = ["Job", "JobCache", "Pass"]
 
 
-@dataclass(frozen=True)
-class Pass:
-    """One laser pass.
+@dataclass(eq=False)
+class JobCache:
+    """What is worked out once per Job and shared by every writer of it (owned by the Job).
+
+    A Job is immutable, so whatever follows from it alone can be kept with it: the stages that
+    compute these fill them in, the writers read them. ``dataclasses.replace`` on a Job gives
+    the new Job a fresh, empty cache.
 
     Attributes
     ----------
-    contour : Contour
-        Path the beam follows, starting at ``contour.points[0]`` (closed, or an
-        open slit cut from its first point to its last).
-    cut_index : int
-        Index of the cut in the job's ``design`` (and ``Pattern.cuts``).
-    kind : str
-        ``notch``, ``hole`` or ``cut``.
-    repeat : int
-        0-based repeat of the focus+defocus group.
-    focus_level : int
-        0 = focus on the surface, 1 = defocused into the material.
-    focus_offset_mm : float
-        How far the focus lies into the material (0 or the defocus), >= 0.
-    drill_index : int
-        0-based cut within the drill group.
-    offset_mm : float
-        Inward offset of the path from the design line (drill steps, kerf); 0 for a slit.
-    power_w, frequency_khz, speed_mm_s : float
-        Laser settings; ``speed_mm_s`` is on the outer surface.
+    packed : camtube.plan.packed.Packed | None
+        The passes packed into arrays, for a Job made from Pass objects (a planned Job has them).
+    checked : bool
+        The job's neutral moves passed the safety check (:func:`camtube.plan.safety.check_job`).
+    estimate : camtube.plan.moves.Estimate | None
+        The time estimate of the job's own moves (:func:`camtube.plan.moves.estimate`).
+    regions : dict
+        The safety check's prepared cut regions, per tolerance.
+    motion : dict
+        Motion-aware estimates per machine profile (:func:`camtube.machine.motion_time.job_estimate`).
     """
 
-    contour: Contour
-    cut_index: int
-    kind: str
-    repeat: int
-    focus_level: int
-    focus_offset_mm: float
-    drill_index: int
-    offset_mm: float
-    power_w: float
-    frequency_khz: float
-    speed_mm_s: float
+    checked: bool = False
+    packed: Any = None
+    estimate: Any = None
+    regions: dict = field(default_factory=dict)
+    motion: dict = field(default_factory=dict)
 
-    @property
-    def length_mm(self) -> float:
-        return self.contour.length_mm
+    @staticmethod
+    def get(table: dict, key, make: Callable[[], Any]):
+        """``table[key]``, made with ``make()`` the first time."""
+        if key not in table:
+            table[key] = make()
+        return table[key]
 
 
 @dataclass(frozen=True)
@@ -88,6 +83,8 @@ class Job:
         Repeats actually used (explicit or from the thickness rule).
     ordering : str
         Name of the ordering strategy.
+    cache : JobCache
+        What is computed once per Job (safety check, estimates), owned by it; not compared.
     """
 
     name: str
@@ -98,6 +95,7 @@ class Job:
     process: Process
     repeats: int
     ordering: str
+    cache: JobCache = field(default_factory=JobCache, init=False, repr=False, compare=False)
 
     @property
     def cut_length_mm(self) -> float:
@@ -105,18 +103,11 @@ class Job:
         pk = self.packed
         return float(pk.geom_length_mm[pk.pass_geom].sum())
 
-    @cached_property
+    @property
     def packed(self):
-        """:class:`camtube.plan.packed.Packed` arrays of the passes (the planner's, or packed once and cached)."""
-        from camtube.plan.packed import PassView, pack
-
+        """:class:`camtube.plan.packed.Packed` arrays of the passes (the planner's, or packed once, kept in the cache)."""
         if isinstance(self.passes, PassView):
             return self.passes.packed
-        return pack(self)
-
-    def cached(self, key: str, make):
-        """``make()``, computed once per Job object (the Job is immutable; e.g. its time estimate)."""
-        d = self.__dict__
-        if key not in d:
-            d[key] = make()
-        return d[key]
+        if self.cache.packed is None:
+            self.cache.packed = pack(self)
+        return self.cache.packed

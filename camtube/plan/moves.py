@@ -191,7 +191,7 @@ class Estimate:
         Laser-off feed moves (LEAD) at their own speed.
     motion_s : float or None
         The motion-aware time for a machine profile (trapezoidal moves with its axis limits
-        and blending, :mod:`camtube.export.motion_time`); when set it is :attr:`total_s`.
+        and blending, :mod:`camtube.machine.motion_time`); when set it is :attr:`total_s`.
     machine : str or None
         Name of the profile ``motion_s`` was computed for.
     """
@@ -250,7 +250,9 @@ def estimate(job, moves: Moves | Iterable[Moves] | None = None) -> Estimate:
         Default: the job's own moves, chunk by chunk (computed once per Job and cached).
     """
     if moves is None:
-        return job.cached("_estimate", lambda: _estimate_of(job, iter_moves(job)))
+        if job.cache.estimate is None:
+            job.cache.estimate = _estimate_of(job, iter_moves(job))
+        return job.cache.estimate
     return _estimate_of(job, [moves] if isinstance(moves, Moves) else moves)
 
 

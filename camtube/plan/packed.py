@@ -20,6 +20,7 @@ from typing import Iterator, Sequence
 import numpy as np
 
 from camtube.design.contour import Contour
+from camtube.plan.passes import Pass
 
 
 @contextmanager
@@ -176,7 +177,7 @@ def pack(job) -> Packed:
 
 
 class PassView(SequenceABC):
-    """The passes of a planned job as a lazy, read-only sequence of :class:`~camtube.plan.job.Pass`.
+    """The passes of a planned job as a lazy, read-only sequence of :class:`~camtube.plan.passes.Pass`.
 
     ``len``, indexing, slicing and iteration build Pass objects on demand from the
     :class:`Packed` arrays; passes over the same path share one Contour object (made
@@ -204,8 +205,6 @@ class PassView(SequenceABC):
         return c
 
     def _make(self, lo: int, hi: int, step: int = 1) -> list:
-        from camtube.plan.job import Pass
-
         pk = self.packed
         s = slice(lo, hi, step)
         cols = [pk.pass_geom[s], pk.pass_cut[s], pk.pass_repeat[s], pk.pass_focus[s], pk.pass_z[s],

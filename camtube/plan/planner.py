@@ -40,6 +40,7 @@ from camtube.design.pattern import Pattern, Process
 from camtube.errors import Issue, PatternError
 from camtube.plan.job import Job
 from camtube.plan.packed import Packed, PassView, is_axis_rectangle, no_gc, points_bounds
+from camtube.plan.paths import simplify_closed
 from camtube.progress import NO_PROGRESS, Progress
 from camtube.tol import TOL
 
@@ -212,7 +213,13 @@ def pass_path(design: Contour, offset_mm: float, start: int, drill_index: int = 
         return Contour(tuple(pts), design.kind, design.cut_index, False)
     c = offset_contour(design, offset_mm, index)
     k = start if (c is design or is_axis_rectangle(design)) else _nearest_vertex(c.points, design.points[start])
-    return _rotate(c, k)
+    c = _rotate(c, k)
+    if len(c.points) > 4 and not is_axis_rectangle(design):
+        # a curve's flattened chords as few chords within TOL.path, all inside the region (plan.paths)
+        pts = simplify_closed(c.points, TOL.path, 0.5 * offset_mm)
+        if len(pts) < len(c.points):
+            c = Contour(tuple(map(tuple, pts.tolist())), c.kind, c.cut_index, c.closed)
+    return c
 
 
 # ---------------------------------------------------------------- the planner

@@ -59,7 +59,7 @@ class _Regions:
 
 
 def _regions(job, tol: float) -> _Regions:
-    return job.cached(f"_regions_{tol!r}", lambda: _Regions(job.design, tol))
+    return job.cache.get(job.cache.regions, tol, lambda: _Regions(job.design, tol))
 
 
 def _outside_rect(b, x0, y0, x1, y1, tol):
@@ -159,8 +159,8 @@ def check_job(job) -> None:
     A Job is immutable, so a passed check is remembered on it: the job file and the
     toolpath DXF of one job share one check.
     """
-    if job.__dict__.get("_checked"):
+    if job.cache.checked:
         return
     for mv in iter_moves(job):
         check_moves(job, mv)
-    job.__dict__["_checked"] = True
+    job.cache.checked = True

@@ -16,7 +16,7 @@ from camtube.export.dialects import LINUXCNC
 from camtube.export.gcode import gcode
 from camtube.export.jobfile import SCHEMA, iter_job_json, job_json, read_job
 from camtube.plan import estimate, plan_job
-from camtube.export.motion_time import estimate_program
+from camtube.machine.motion_time import estimate_program
 from tests.conftest import PATTERNS
 
 

@@ -19,7 +19,7 @@ from camtube.machine import load_profile
 from camtube.motion import linuxcnc as lc
 from camtube.motion.analysis import JobGeometry, analyse
 from camtube.plan import plan_job
-from camtube.export.motion_time import estimate_program
+from camtube.machine.motion_time import estimate_program
 from camtube.export.outputs import toolpath_streams
 from camtube.io import write_set
 from tests.conftest import PATTERNS

@@ -11,7 +11,7 @@ from camtube.export.dialects import LINUXCNC, dialect_from_profile
 from camtube.export.gcode import gcode
 from camtube.machine import load_profile
 from camtube.plan import plan_job
-from camtube.export.motion_time import estimate_program, job_estimate, trajectory_time
+from camtube.machine.motion_time import estimate_program, job_estimate, trajectory_time
 from tests.conftest import PATTERNS
 
 
@@ -63,3 +63,29 @@ def test_the_job_estimate_is_the_estimate_of_the_written_program(machine):
 
 def test_default_dialect_is_exact_stop():
     assert "G61" in LINUXCNC.preamble and LINUXCNC.profile.exact_stop
+
+
+def test_the_old_module_path_warns_and_nothing_of_camtube_imports_it():
+    """camtube.export.motion_time moved to camtube.machine.motion_time: the old path is a shim that warns."""
+    import ast
+    import importlib
+    import sys
+    import warnings
+
+    from tests.conftest import ROOT
+
+    sys.modules.pop("camtube.export.motion_time", None)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        old = importlib.import_module("camtube.export.motion_time")
+    assert any(issubclass(w.category, FutureWarning) and "camtube.machine.motion_time" in str(w.message)
+               for w in caught)
+    assert old.job_estimate is job_estimate
+    users = []
+    for path in (ROOT / "camtube").rglob("*.py"):
+        if path.name == "motion_time.py" and path.parent.name == "export":
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.module == "camtube.export.motion_time":
+                users.append(str(path))
+    assert not users

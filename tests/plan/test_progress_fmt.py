@@ -45,7 +45,7 @@ def test_time_warning_fires_above_max_time_h(job):
     header = text.split("(pass 0:")[0]
     # the header's figure is the motion-aware time on the dialect's machine; paren comments use []
     from camtube.export.dialects import LINUXCNC
-    from camtube.export.motion_time import job_estimate
+    from camtube.machine.motion_time import job_estimate
 
     hms = format_duration_s(job_estimate(short, LINUXCNC).total_s).split("(")[1].rstrip(")")
     assert "WARNING: the estimated laser time" in header and f"[{hms}]" in header

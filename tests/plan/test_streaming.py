@@ -150,13 +150,13 @@ def test_check_job_is_chunked_and_remembered(job):
     from dataclasses import replace
 
     fresh = replace(job)
-    assert "_checked" not in fresh.__dict__
+    assert fresh.cache.checked is False  # the cache is the Job's own: a new Job starts empty
     check_job(fresh)
-    assert fresh.__dict__["_checked"] is True
+    assert fresh.cache.checked is True
     short = replace(job, length_mm=1.0)
     with pytest.raises(SafetyError, match=r"unsafe move\(s\)"):
         check_job(short)
-    assert "_checked" not in short.__dict__
+    assert short.cache.checked is False
 
 
 def test_survey_checks_and_estimates_once_for_every_writer(job):
@@ -166,7 +166,7 @@ def test_survey_checks_and_estimates_once_for_every_writer(job):
 
     fresh = replace(job)
     est = survey(fresh)
-    assert fresh.__dict__["_checked"] is True and estimate(fresh) is est
+    assert fresh.cache.checked is True and estimate(fresh) is est is fresh.cache.estimate
     assert est == estimate(replace(job))  # the same figures as the estimate alone
     bad = replace(job, length_mm=1.0)
     streams = toolpath_streams(bad)

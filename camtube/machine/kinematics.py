@@ -1,0 +1,153 @@
+"""Kinematics: the job's unrolled moves in a machine's axes, rounded exactly as they are printed.
+
+The wrap to the rotary axis happens here and only here: ``A = degrees(y / r_o)`` with the
+same x, A = 0 at y = 0; ``Z = -focus offset``. Feeds follow the machine's feed mode: in
+G93 (inverse time) ``F = 1 / minutes`` of each feed move, from its surface length on the
+printed coordinates; in G94 mm/min of the XYZ distance (deg/min for a pure rotary move).
+The G-code writer prints these values, the motion-time estimate (:mod:`camtube.machine.motion_time`)
+times them, and the safety check reads them back (:meth:`MachineMoves.unrolled`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from camtube.machine.profile import MachineProfile
+from camtube.plan.moves import CUT, LEAD, Moves, job_moves
+
+
+@dataclass(frozen=True, eq=False)
+class MachineMoves:
+    """The moves of a job (or of a chunk of it) in one machine's axes, rounded as printed.
+
+    Attributes
+    ----------
+    neutral : Moves
+        The unrolled move list they come from.
+    ax, ay, az : (m,) float
+        Axis values (mm, or deg for a rotary second axis), rounded to ``profile.decimals``.
+    feed : (m,) float
+        F of every feed move (CUT, LEAD; 1/min in G93, else mm/min or deg/min), rounded; 0 elsewhere.
+    profile : MachineProfile
+        The machine (axes, rotary or flat, decimals, feed mode).
+    outer_radius_mm : float
+    start : tuple[float, float, float]
+        Axis values before the first move (the rounded start of ``neutral``).
+    """
+
+    neutral: Moves
+    ax: np.ndarray
+    ay: np.ndarray
+    az: np.ndarray
+    feed: np.ndarray
+    profile: MachineProfile
+    outer_radius_mm: float
+    start: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def _unroll(self, ay):
+        return np.radians(ay) * self.outer_radius_mm if self.profile.rotary else ay
+
+    def unrolled(self) -> Moves:
+        """The emitted moves back in the unrolled frame (what the safety check sees)."""
+        n = self.neutral
+        sx, sa, sz = self.start
+        start = (sx, float(self._unroll(np.float64(sa))), -sz + 0.0)
+        return Moves(self.ax, self._unroll(self.ay), -self.az, n.kind, n.laser, n.pass_index, n.vertex, n.speed,
+                     start)
+
+
+def machine_moves(job, machine, moves: Moves | None = None) -> MachineMoves:
+    """Map moves (default: all of the job's) to a machine's axes and feeds (vectorised).
+
+    Parameters
+    ----------
+    job : camtube.plan.Job
+    machine : MachineProfile, or anything with a ``profile`` (a G-code dialect)
+    moves : Moves, optional
+        The move list (a chunk) to map; default: all of the job's.
+    """
+    dialect = getattr(machine, "profile", machine)  # the profile: axes, rotary, decimals, feed mode
+    mv = job_moves(job) if moves is None else moves
+    ro = job.outer_radius_mm
+    dec = dialect.decimals
+    sx, sy, sz = mv.start
+    rot = (lambda y: np.degrees(y / ro)) if dialect.rotary else (lambda y: y)  # noqa: E731
+    ax = np.round(mv.x, dec)
+    ay = np.round(rot(mv.y), dec)
+    az = np.round(-mv.z, dec) + 0.0  # + 0.0: no "-0.000000"
+    s_ax, s_ay, s_az = (float(np.round(np.float64(v), dec)) for v in (sx, rot(np.float64(sy)), -sz))
+    s_az += 0.0
+    # surface length of each move from the printed coordinates
+    ys = np.radians(ay) * ro if dialect.rotary else ay
+    s_ys = float(np.radians(s_ay) * ro) if dialect.rotary else s_ay
+    dx = np.diff(np.concatenate(([s_ax], ax)))
+    dy = np.diff(np.concatenate(([s_ys], ys)))
+    dz = np.diff(np.concatenate(([s_az], az)))
+    surf = np.hypot(dx, dy)
+    feedrow = (mv.kind == CUT) | (mv.kind == LEAD)
+    feed = np.zeros(len(mv))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        minutes = surf / (mv.speed * 60.0)
+        if dialect.feed_mode == "inverse_time":
+            feed[feedrow] = 1.0 / minutes[feedrow]
+        else:
+            # G94: F applies to the XYZ distance if the move has any, else to the rotary angle
+            lin = np.hypot(dx, dz) if dialect.rotary else np.sqrt(dx * dx + dy * dy + dz * dz)
+            rota = np.abs(np.diff(np.concatenate(([s_ay], ay)))) if dialect.rotary else np.zeros(len(mv))
+            per = np.where(lin > 0, lin, rota)
+            feed[feedrow] = per[feedrow] / minutes[feedrow]
+    feed = np.round(feed, dialect.feed_decimals)
+    return MachineMoves(mv, ax, ay, az, feed, dialect, ro, (s_ax, s_ay, s_az))
+
+
+#: Largest rounding error of a printed feed, relative to the feed (the dose follows the speed).
+FEED_ROUNDING = 0.01
+
+
+def check_feeds(job, machine) -> None:
+    """Refuse a job whose feeds the machine's G-code cannot carry (before anything is written).
+
+    The smallest feed of a job is that of its longest cut move: in G93 (inverse time)
+    ``F = 60 v / L`` per minute, in G94 ``F = 60 v`` mm/min. Printed with
+    ``profile.feed_decimals`` it is off by up to half a unit of the last decimal; when that is
+    more than :data:`FEED_ROUNDING` of the feed (a feed that rounds to zero is the extreme), the
+    machine would run the job at another speed than planned, and the estimate could fall below
+    the lower bound: the job is meaningless.
+
+    Raises
+    ------
+    PatternError
+        One issue naming ``process.scan_speed_mm_s``, the feed, and the slowest speed that works.
+    """
+    from camtube.errors import Issue, PatternError
+
+    profile = getattr(machine, "profile", machine)
+    pk = job.packed
+    if pk.n_pass == 0:
+        return
+    v = float(np.min(pk.pass_speed))
+    v_edge = pk.vertices
+    nxt = np.arange(1, len(v_edge) + 1)
+    last = pk.geom_offset[1:] - 1
+    nxt[last] = pk.geom_offset[:-1]
+    seg = np.hypot(*(v_edge[nxt] - v_edge).T)
+    seg[last[~pk.geom_closed]] = 0.0
+    L = float(seg.max()) if len(seg) else 0.0
+    if not L > 0:
+        return
+    half = 0.5 * 10.0 ** -profile.feed_decimals
+    inverse = profile.feed_mode == "inverse_time"
+    f = 60.0 * v / L if inverse else 60.0 * v
+    if half <= FEED_ROUNDING * f:
+        return
+    f_min = half / FEED_ROUNDING
+    v_min = f_min * L / 60.0 if inverse else f_min / 60.0
+    unit = "/min (G93, inverse time)" if inverse else "mm/min (G94)"
+    printed = f"F{round(f, profile.feed_decimals):.{profile.feed_decimals}f}"
+    raise PatternError([Issue(
+        "process.scan_speed_mm_s",
+        f"too slow for machine {profile.name}: the longest cut move ({L:.4g} mm) would get F = {f:.3g} {unit}, "
+        f"written {printed} with {profile.feed_decimals} decimals (off by more than {100 * FEED_ROUNDING:g} %); "
+        "the job would be meaningless", f"{v:g} mm/s", f">= {v_min:.3g} mm/s on this machine",
+        f"set process.scan_speed_mm_s to at least {v_min:.3g}")])
