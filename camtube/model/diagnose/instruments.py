@@ -1,0 +1,332 @@
+"""The instruments before the physics: artefacts set aside, the logger's rates, the lag between channels.
+
+``check_instruments(data, lag_ms=None) -> Instruments``
+
+A diagnosis of the joint must not be a diagnosis of the sensors. Before any physics is fitted:
+
+* **Spikes** (interference in the tracker or the load cell): each channel minus the running median of
+  the six rows around it (the row itself left out) in the same sample; the scale of that difference is the median absolute deviation
+  (x 1.4826, robust to the spikes themselves); a row more than :data:`SPIKE_Z` scales out is a spike.
+  Smooth motion (ramps, turning points) leaves the running-median difference near zero, so only isolated
+  jumps qualify.
+* **Repeated time stamps**: a row whose stamp equals the previous row's (the logger wrote one instant
+  twice) is set aside. Rows whose stamp goes backwards, and rows with a missing value, are dropped when
+  the file is read (:func:`camtube.model.data.read_measurements`), and counted there.
+* **Rate changes**: the sampling interval's median over blocks of 200 rows; a block more than 20 % off the
+  sample's median is reported (the rate is stated, nothing is set aside).
+* **Lag of the angle channel** against the force (both see the same tendon tension; the drive, the tendon's
+  slack, toe and creep sit upstream of both, so they do not shift one against the other). For a trial lag
+  ``tau`` (whole rows: interpolating between rows averages the noise and favours half-row shifts) the
+  angle is read ``tau`` later and regressed, per sample, on the force (smoothed by a centred running mean):
+  a cubic, a hysteresis proportional to the force that flips with the direction of motion (friction at the
+  guide), and the force minus its low-passed copies with time constants of 2, 8 and 32 s (a slow relaxation
+  of the joint's backbone makes the angle follow the force's history: not a delay). A constant step between
+  the directions is *not* allowed: a delay makes one, and would hide in it. The lag minimising the residual
+  is refined by a parabola through the best three shifts. Its standard error is the spread of the same
+  estimate over blocks of
+  cycles (``sd / sqrt(blocks)``). It is a property of the instruments: it is corrected (the angle read
+  ``lag`` later) when it exceeds three standard errors and a quarter of the sampling interval, or when the
+  user gives ``--lag-ms``, and it is never offered as an effect of the joint.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from camtube.model.data.dataset import Dataset
+
+#: A row this many robust scales from its running median is a spike.
+SPIKE_Z = 8.0
+#: Running-median window (rows).
+MEDIAN_ROWS = 7
+#: A sampling interval this far off the sample's median is a rate change.
+RATE_CHANGE = 0.2
+
+
+@dataclass(frozen=True, eq=False)
+class Lag:
+    """Lag of the angle channel behind the force channel.
+
+    Attributes
+    ----------
+    lag_ms, se_ms : float
+        Estimate and its standard error (ms); positive: the angle is late.
+    given : bool
+        The user gave the lag (``--lag-ms``): no estimate.
+    applied_ms : float
+        The lag corrected (0 when none was).
+    """
+
+    lag_ms: float
+    se_ms: float
+    given: bool = False
+    applied_ms: float = 0.0
+
+
+@dataclass(frozen=True, eq=False)
+class Instruments:
+    """What the instruments did (:func:`check_instruments`).
+
+    Attributes
+    ----------
+    data : Dataset
+        The rows kept, the angle corrected for the lag.
+    raw : Dataset
+        The rows as read.
+    aside : dict[str, (k,) int]
+        Rows of ``raw`` set aside, by reason (``"angle spike"``, ``"force spike"``, ``"repeated time stamp"``).
+    kept : (n_raw,) bool
+        Rows of ``raw`` kept in ``data``.
+    rates_hz : dict[str, float]
+        Each sample's median sampling rate.
+    rate_changes : tuple[str, ...]
+        Sentences on blocks sampled at another rate.
+    lag : Lag
+    dropped : str
+        The reader's line on rows dropped (missing values, backward stamps), or ``""``.
+    n_dropped : int
+    """
+
+    data: Dataset
+    raw: Dataset
+    aside: dict
+    kept: np.ndarray
+    rates_hz: dict
+    rate_changes: tuple
+    lag: Lag
+    dropped: str = ""
+    n_dropped: int = 0
+
+    @property
+    def n_aside(self) -> int:
+        return int((~self.kept).sum())
+
+    def lines(self) -> list[str]:
+        """The instruments' findings, one sentence each."""
+        out = []
+        if self.dropped:
+            out.append(self.dropped)
+        parts = [f"{len(v)} {k}{'s' if len(v) != 1 else ''}" for k, v in self.aside.items() if len(v)]
+        n_raw = len(self.raw)
+        if parts:
+            out.append(f"set aside before fitting: {self.n_aside} of {n_raw} rows ({', '.join(parts)})")
+        else:
+            out.append(f"set aside before fitting: none of {n_raw} rows (no spikes, no repeated time stamps)")
+        out.append("sampling: " + ", ".join(f"{s} {r:.4g} Hz" for s, r in self.rates_hz.items()))
+        out.extend(self.rate_changes)
+        lg = self.lag
+        if lg.given:
+            out.append(f"angle lag: {lg.applied_ms:.4g} ms as given (--lag-ms); the angle is read that much later")
+        elif lg.applied_ms:
+            out.append(f"angle lag: the tracker lags the load cell by {lg.lag_ms:.3g} +- {lg.se_ms:.2g} ms "
+                       f"(an instrument property, not the joint's); corrected: the angle is read {lg.applied_ms:.3g}"
+                       " ms later (--lag-ms 0 to keep it)")
+        else:
+            out.append(f"angle lag: {lg.lag_ms:.2g} +- {lg.se_ms:.2g} ms against the load cell: none to correct")
+        return out
+
+
+def _neighbour_median(v: np.ndarray) -> np.ndarray:
+    """Median of the ``MEDIAN_ROWS - 1`` rows around each row of ``v`` (n,), the row itself left out (edges
+    repeated)."""
+    h = MEDIAN_ROWS // 2
+    pad = np.concatenate((np.full(h, v[0]), v, np.full(h, v[-1])))
+    win = np.lib.stride_tricks.sliding_window_view(pad, MEDIAN_ROWS)
+    return np.median(np.delete(win, h, axis=1), axis=1)
+
+
+def _spikes(x: np.ndarray, slices: list) -> np.ndarray:
+    """Rows of ``x`` (n,) that jump out of their running median by more than :data:`SPIKE_Z` robust scales."""
+    out = np.zeros(x.size, bool)
+    for _, sl in slices:
+        v = x[sl]
+        if v.size < 3 * MEDIAN_ROWS:
+            continue
+        d = v - _neighbour_median(v)
+        scale = 1.4826 * float(np.median(np.abs(d - np.median(d))))
+        if scale <= 0.0:
+            continue
+        out[sl] = np.abs(d) > SPIKE_Z * scale
+    return out
+
+
+def _rates(data: Dataset) -> tuple[dict, tuple]:
+    rates, notes = {}, []
+    for s, sl in data.sample_slices():
+        dt = np.diff(data.time_s[sl])
+        dt = dt[dt > 0]
+        if not dt.size:
+            continue
+        med = float(np.median(dt))
+        rates[s] = 1.0 / med
+        nb = dt.size // 200
+        if nb >= 2:
+            blk = np.median(dt[: nb * 200].reshape(nb, 200), axis=1)
+            off = np.flatnonzero(np.abs(blk / med - 1.0) > RATE_CHANGE)
+            if off.size:
+                t0 = float(data.time_s[sl][off[0] * 200])
+                notes.append(f"sampling rate of sample {s} changes: {1.0 / blk[off[0]]:.4g} Hz from t = {t0:.4g} s "
+                             f"({off.size} of {nb} blocks of 200 rows off the median {1.0 / med:.4g} Hz)")
+    return rates, tuple(notes)
+
+
+#: Time constants (s) of the low-passed force regressors that absorb a slow relaxation of the joint.
+RELAX_TAUS_S = (2.0, 8.0, 32.0)
+#: Rows of the centred running mean of the force in the lag regression.
+SMOOTH_ROWS = 9
+
+
+def _lag_design(data: Dataset) -> list:
+    """Per sample: ``(slice, basis)`` with the force regressors of :func:`_lag_sse`: a cubic of the force per
+    direction of motion, and the force low-passed with :data:`RELAX_TAUS_S` (a relaxation of the joint
+    makes the angle follow the force's history, not a delay)."""
+    from scipy.signal import lfilter
+
+    out = []
+    direction = data.direction
+    for _, sl in data.sample_slices():
+        f = data.force_N[sl]
+        if f.size > SMOOTH_ROWS:  # a centred running mean: less force noise in the regressors, no shift in time
+            f = np.convolve(np.pad(f, SMOOTH_ROWS // 2, mode="edge"), np.ones(SMOOTH_ROWS) / SMOOTH_ROWS, "valid")
+        x = (f - f.mean()) / (f.std() or 1.0)
+        dt = float(np.median(np.diff(data.time_s[sl]))) if f.size > 1 else 1.0
+        # a cubic of the force, and a hysteresis proportional to it (friction at the guide: the cell reads a
+        # tension that differs from the joint's by a ratio that flips with the direction); not a constant
+        # step between directions, which a delay also makes and would absorb it
+        dirn = direction[sl].astype(float)
+        cols = [np.ones_like(x), x, x * x, x ** 3, dirn * x]
+        for tau in RELAX_TAUS_S:
+            a = math.exp(-dt / tau)
+            lp = lfilter([1.0 - a], [1.0, -a], x, zi=[a * x[0]])[0]
+            cols.append(x - lp)
+        out.append((sl, np.stack(cols, axis=1)))
+    return out
+
+
+def _lag_sse(data: Dataset, design: list, shift: int, rows: np.ndarray) -> float:
+    """Residual sum of squares of the angle ``shift`` rows later, regressed on the force regressors
+    (:func:`_lag_design`), over ``rows`` (index array)."""
+    sse = 0.0
+    for sl, basis in design:
+        idx = rows[(rows >= sl.start + max(0, -shift)) & (rows < sl.stop - max(0, shift))]
+        if idx.size < 40:
+            continue
+        a = data.angle_deg[idx + shift]
+        x = basis[idx - sl.start]
+        coef, *_ = np.linalg.lstsq(x, a, rcond=None)
+        r = a - x @ coef
+        sse += float(r @ r)
+    return sse
+
+
+def _lag_of(data: Dataset, design: list, rows: np.ndarray, max_shift: int) -> float:
+    """Lag (rows) minimising :func:`_lag_sse` over whole-row shifts, refined by a parabola through the best
+    three (whole rows: interpolating between rows would average the noise and favour half-row shifts)."""
+    shifts = np.arange(-max_shift, max_shift + 1)
+    sse = np.array([_lag_sse(data, design, int(k), rows) for k in shifts])
+    k = int(np.argmin(sse))
+    if 0 < k < sse.size - 1:
+        y0, y1, y2 = sse[k - 1], sse[k], sse[k + 1]
+        den = y0 - 2 * y1 + y2
+        return float(shifts[k] + (0.5 * (y0 - y2) / den if den > 0 else 0.0))
+    return float(shifts[k])
+
+
+def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_ms: float = 250.0) -> Lag:
+    """Lag of the angle behind the force (ms) with its standard error (see the module docstring).
+
+    Parameters
+    ----------
+    data : Dataset
+        Rows free of artefacts.
+    max_rows : int
+        Rows used (evenly thinned in time).
+    blocks : int
+        Blocks of cycles per sample for the standard error.
+    max_lag_ms : float
+        Largest lag tried either way.
+    """
+    n = len(data)
+    dt = float(np.median(np.diff(data.time_s))) if n > 1 else 1.0
+    dt = dt if dt > 0 else 1.0
+    max_shift = max(2, int(round(max_lag_ms * 1e-3 / dt)))
+    step = max(1, n // max_rows)
+    rows = np.arange(0, n, step)
+    design = _lag_design(data)
+    est = _lag_of(data, design, rows, max_shift)
+    per = []
+    cyc = data.cycle
+    for _, sl in data.sample_slices():
+        c = cyc[sl]
+        edges = np.linspace(c.min(), c.max() + 1, blocks + 1)
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            r = rows[(rows >= sl.start) & (rows < sl.stop)]
+            r = r[(cyc[r] >= lo) & (cyc[r] < hi)]
+            if r.size >= 100:
+                per.append(_lag_of(data, design, r, max_shift))
+    se = float(np.std(per, ddof=1) / math.sqrt(len(per))) if len(per) > 1 else float("inf")
+    return Lag(est * dt * 1e3, se * dt * 1e3)
+
+
+def shift_angle(data: Dataset, lag_ms: float) -> tuple[Dataset, np.ndarray]:
+    """``data`` with the angle read ``lag_ms`` later (linear interpolation within each sample); rows whose
+    shifted time leaves the sample's record are dropped (returned mask of kept rows)."""
+    if lag_ms == 0.0:
+        return data, np.ones(len(data), bool)
+    ang = data.angle_deg.copy()
+    keep = np.ones(len(data), bool)
+    tau = lag_ms * 1e-3
+    for _, sl in data.sample_slices():
+        t = data.time_s[sl]
+        ts = t + tau
+        ang[sl] = np.interp(ts, t, data.angle_deg[sl])
+        keep[sl] = (ts >= t[0]) & (ts <= t[-1])
+    return data.with_angle(ang).take(keep), keep
+
+
+def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str = "", n_dropped: int = 0,
+                      ) -> Instruments:
+    """Find the instruments' artefacts, set them aside, estimate (or apply) the angle's lag.
+
+    Parameters
+    ----------
+    data : Dataset
+        The rows as read (``n`` rows).
+    lag_ms : float, optional
+        The angle channel's lag (ms) to correct; ``None``: estimate it and correct it when it is resolved.
+    dropped, n_dropped : str, int
+        The reader's line on dropped rows and their count (stated in the findings).
+
+    Returns
+    -------
+    Instruments
+    """
+    slices = data.sample_slices()
+    aside: dict[str, np.ndarray] = {}
+    rep = np.zeros(len(data), bool)
+    for _, sl in slices:
+        t = data.time_s[sl]
+        rep[sl.start + 1:sl.stop] = np.diff(t) <= 0.0
+    aside["repeated time stamp"] = np.flatnonzero(rep)
+    sa = _spikes(data.angle_deg, slices) & ~rep
+    sf = _spikes(data.force_N, slices) & ~rep & ~sa
+    aside["angle spike"] = np.flatnonzero(sa)
+    aside["force spike"] = np.flatnonzero(sf)
+    kept = ~(rep | sa | sf)
+    clean = data.take(kept)
+    rates, notes = _rates(clean)
+    if lag_ms is not None:
+        lag = Lag(float(lag_ms), 0.0, given=True, applied_ms=float(lag_ms))
+    else:
+        lag = estimate_lag(clean)
+        dt_ms = 1e3 / max(np.median(list(rates.values())) if rates else 1.0, 1e-9)
+        if abs(lag.lag_ms) > 3.0 * lag.se_ms and abs(lag.lag_ms) > 0.25 * dt_ms:
+            lag = Lag(lag.lag_ms, lag.se_ms, applied_ms=lag.lag_ms)
+    shifted, k2 = shift_angle(clean, lag.applied_ms)
+    idx = np.flatnonzero(kept)
+    kept[idx[~k2]] = False
+    if (~k2).any():
+        aside["end of record after the lag shift"] = idx[~k2]
+    return Instruments(shifted, data, aside, kept, rates, notes, lag, dropped, n_dropped)
