@@ -237,7 +237,7 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
                          f"{c.delta_bic:9.1f}  {verdict}")
     lines.append("")
     if d.recommended:
-        lines.append("recommended, in order:")
+        lines.append("recommended, in order" + (f" ({d.explanation} explanation)" if d.explanation else "") + ":")
         prev = base
         # the values are those of the whole chain (what the command below gives before any per-sample step):
         # a step's own refit can differ a lot (play alone takes up a toe's slack)

@@ -66,7 +66,10 @@ def text_lines(d, json_path: str = "DIAG.json") -> list[str]:
     if u is None:
         return []
     lines = describe(u)
-    if d.recommended:  # not reached by the diagnosis (a recommended chain is within 1.15 x the floor)
+    if d.recommended and getattr(d, "explanation", "") == "partial":
+        lines.append(f"  this is what is left with the recommended effects ({', '.join(d.recommended)}): they explain "
+                     f"most of the misfit, the error stays at {d.final.rmse_deg / d.noise_floor_deg:.2f} x the floor")
+    elif d.recommended:  # not reached by the diagnosis (a recommended chain is within 1.15 x the floor)
         lines.append(f"  note: with {', '.join(d.recommended)} the error stays at "
                      f"{d.final.rmse_deg / d.noise_floor_deg:.2f} x the floor; the recommended effect(s) may stand in "
                      f"for the physics above: try the starter effect without them")
