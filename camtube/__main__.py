@@ -1,5 +1,5 @@
 import sys
 
-from camtube.cli import main
+from camtube.commands import main
 
 sys.exit(main())

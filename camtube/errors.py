@@ -40,10 +40,10 @@ class Issue:
     line: int | None = None
 
     def __str__(self) -> str:
-        where = self.file or "<pattern>"
-        if self.line is not None:
+        where = self.file or ""
+        if self.line is not None and where:
             where += f":{self.line}"
-        parts = [f"{where}: {self.key}: {self.message}"]
+        parts = [f"{where}: {self.key}: {self.message}" if where else f"{self.key}: {self.message}"]
         if self.value is not None:
             parts.append(f"got {self.value!r}")
         if self.allowed:

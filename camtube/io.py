@@ -23,7 +23,9 @@ import ctypes.util
 import errno
 import os
 import shutil
+import signal
 import tempfile
+import threading
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterable, Mapping, Union
@@ -43,6 +45,41 @@ _FIXES = {
     errno.ENOSPC: "free some disk space or write elsewhere",
     errno.ENAMETOOLONG: "use a shorter path",
 }
+
+
+class PublishedInterrupt(KeyboardInterrupt):
+    """Ctrl-C arrived once a set of outputs had been published: the set on disk is whole and new.
+
+    Attributes
+    ----------
+    paths : list of Path
+        The files of the set, as published.
+    """
+
+    def __init__(self, paths: list[Path]):
+        super().__init__()
+        self.paths = list(paths)
+
+
+@contextmanager
+def _uninterrupted():
+    """Hold Ctrl-C (SIGINT) back while the body runs; one that came meanwhile is raised at the end.
+
+    The Python-level handler is swapped for one that only notes the signal (whichever thread the
+    operating system delivered it to, Python runs handlers in the main thread), then put back and
+    called. Only in the main thread, where handlers can be set; elsewhere the body runs as is.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    noted: list[tuple[int, object]] = []
+    old = signal.signal(signal.SIGINT, lambda signum, frame: noted.append((signum, frame)))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+        if noted and callable(old):
+            old(*noted[0])  # the default handler raises KeyboardInterrupt here
 
 
 class OutputError(CamtubeError, OSError):
@@ -75,6 +112,12 @@ def _publish(tmp: str, path: Path) -> None:
     """Give the temporary file ordinary permissions (0666 less the umask) and move it into place."""
     os.chmod(tmp, 0o666 & ~_umask())
     os.replace(tmp, path)
+
+
+def _not_empty(path: str | os.PathLike, what: str) -> None:
+    """Refuse an empty path (``-o ''`` would otherwise mean the working directory)."""
+    if not str(path).strip():
+        raise OutputError(repr(str(path)), "the path is empty", f"give the output {what}'s name")
 
 
 def _check_file_target(path: Path) -> None:
@@ -130,6 +173,7 @@ def write_atomic(path: str | os.PathLike, data: Payload) -> Path:
     OutputError
         The file cannot be written (read-only location, a directory of that name, ...).
     """
+    _not_empty(path, "file")
     path = Path(path)
     with _staged(path, f".{path.name}.", ".tmp") as (fd, _tmp):
         with os.fdopen(fd, "wb") as fh:
@@ -204,6 +248,54 @@ def _contains_cwd(path: Path) -> bool:
     return cwd == p or p in cwd.parents
 
 
+def _swap_in(stage: Path, out: Path, files: Mapping[str, Payload]) -> Path | None:
+    """Make the staged set ``out``'s; returns what is left to remove (the old folder), or None."""
+    if not out.exists():
+        os.chmod(stage, 0o777 & ~_umask())
+        os.rename(stage, out)
+        return None
+    if _contains_cwd(out):
+        # the working directory cannot be swapped away under the user: move the files in one by one
+        for name in files:
+            os.replace(stage / name, out / name)
+        return stage
+    for entry in out.iterdir():
+        if entry.name not in files:
+            _link_tree(entry, stage / entry.name)
+    os.chmod(stage, out.stat().st_mode & 0o7777)
+    if not _exchange(stage, out):
+        old = stage.with_name(stage.name + ".old")
+        os.rename(out, old)
+        os.rename(stage, out)
+        return old
+    return stage
+
+
+def check_writable_dir(outdir: str | os.PathLike) -> None:
+    """Refuse, before any work is done, an output directory that :func:`write_set` could not write.
+
+    The nearest existing folder of ``outdir`` (itself, or the parent it would be created in) must
+    take a new entry: a probe folder is made there and removed at once, so nothing is left behind.
+
+    Raises
+    ------
+    OutputError
+        The location is read-only, not a folder, or cannot hold new entries.
+    """
+    _not_empty(outdir, "directory")
+    out = Path(outdir).absolute()
+    probe_in = out if out.is_dir() else out.parent
+    while not probe_in.exists() and probe_in != probe_in.parent:
+        probe_in = probe_in.parent
+    if not probe_in.is_dir():
+        raise OutputError(out, f"{probe_in} is not a folder", "give an output directory under a folder")
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=".camtube-probe.", dir=probe_in))
+    except OSError as exc:
+        raise OutputError(out, f"{probe_in} takes no new folder ({exc.strerror or exc})",
+                          "give an output directory in a folder you can write to") from None
+
+
 def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload]) -> list[Path]:
     """Write a set of files into ``outdir`` so that they appear together or not at all.
 
@@ -227,6 +319,7 @@ def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload]) -> list[P
         ``outdir`` cannot be created or written (it names a file, the location is
         read-only, ...); nothing of the new set is visible then.
     """
+    _not_empty(outdir, "directory")
     out = Path(outdir)
     if out.exists() and not out.is_dir():
         raise OutputError(out, "a file of that name exists", "name a directory (new or existing), not a file")
@@ -235,6 +328,7 @@ def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload]) -> list[P
             raise ValueError(f"write_set: {name!r} is not a plain file name")
     parent = out.absolute().parent
     stage = None
+    published = False
     try:
         parent.mkdir(parents=True, exist_ok=True)
         stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".staging", dir=parent))
@@ -244,25 +338,16 @@ def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload]) -> list[P
                 fh.flush()
                 os.fsync(fh.fileno())
             os.chmod(stage / name, 0o666 & ~_umask())
-        if not out.exists():
-            os.chmod(stage, 0o777 & ~_umask())
-            os.rename(stage, out)
-            stage = None
-        elif _contains_cwd(out):
-            # the working directory cannot be swapped away under the user: move the files in one by one
-            for name in files:
-                os.replace(stage / name, out / name)
-        else:
-            for entry in out.iterdir():
-                if entry.name not in files:
-                    _link_tree(entry, stage / entry.name)
-            os.chmod(stage, out.stat().st_mode & 0o7777)
-            if not _exchange(stage, out):
-                old = stage.with_name(stage.name + ".old")
-                os.rename(out, old)
-                os.rename(stage, out)
-                stage = old
-        return [out / name for name in files]
+        paths = [out / name for name in files]
+        try:
+            with _uninterrupted():  # the swap runs whole: a Ctrl-C now is answered once it is done
+                stage = _swap_in(stage, out, files)
+                published = True
+        except KeyboardInterrupt:
+            if published:
+                raise PublishedInterrupt(paths) from None
+            raise
+        return paths
     except OSError as exc:
         raise output_error(out, exc) from None
     finally:

@@ -6,9 +6,90 @@ key the user wrote; "did you mean" hints come from :mod:`difflib`.
 from __future__ import annotations
 
 import difflib
+import os
+import re
+from pathlib import Path
 from typing import Iterable
 
 import yaml
+
+from camtube.errors import Issue, PatternError
+
+
+class StrictLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, stricter where a silent reading would be wrong.
+
+    - A key given twice in one mapping is an error (PyYAML keeps the last one silently).
+    - Every number YAML 1.2 accepts is a number: ``5e-1`` and ``1E3`` as well as ``5.0e-1``
+      (PyYAML follows YAML 1.1 there and reads ``5e-1`` as a string).
+    """
+
+    def construct_mapping(self, node, deep=False):
+        if isinstance(node, yaml.MappingNode):
+            seen: dict = {}
+            for key_node, _ in node.value:
+                if not isinstance(key_node, yaml.ScalarNode) or key_node.tag == "tag:yaml.org,2002:merge":
+                    continue
+                key = key_node.value
+                if key in seen:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, f"key '{key}' is given twice (first at line {seen[key] + 1})",
+                        key_node.start_mark)
+                seen[key] = key_node.start_mark.line
+        return super().construct_mapping(node, deep=deep)
+
+
+StrictLoader.yaml_implicit_resolvers = {k: list(v) for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+StrictLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+    list("-+0123456789"))
+
+
+def parse_yaml(text: str):
+    """``text`` parsed with :class:`StrictLoader` (raises ``yaml.YAMLError``)."""
+    return yaml.load(text, Loader=StrictLoader)  # noqa: S506 (a SafeLoader subclass)
+
+
+def read_yaml_file(path: str | os.PathLike, what: str, fix: str) -> tuple[object, str]:
+    """Parse a YAML file; ``(data, text)``. Every failure is a one-line :class:`PatternError`.
+
+    Parameters
+    ----------
+    path : path
+        The file.
+    what : str
+        What the file should be, in words (``pattern``, ``machine profile``), for the message.
+    fix : str
+        What to do when the file cannot be read at all.
+    """
+    file = str(path)
+    try:
+        data = Path(path).read_bytes()
+    except OSError as exc:
+        raise PatternError([Issue("file", f"cannot read {what}: {exc.strerror}", file, f"a readable YAML file",
+                                  fix)]) from None
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise PatternError([Issue("file", f"not a text file: byte 0x{data[exc.start]:02x} is not UTF-8",
+                                  None, f"a UTF-8 {what} YAML file",
+                                  "give the YAML file (save it as UTF-8 text)", file, line)]) from None
+    if "\x00" in text:
+        raise PatternError([Issue("file", "not a text file: it holds NUL bytes", None, f"a UTF-8 {what} YAML file",
+                                  "give the YAML file (save it as UTF-8 text)", file,
+                                  text[:text.index("\x00")].count("\n") + 1)])
+    try:
+        raw = parse_yaml(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        fix_ = ("keep one of the two (a later key would silently replace the earlier one)" if "given twice" in problem
+                else "fix the syntax at the line shown")
+        raise PatternError([Issue("yaml", f"not valid YAML: {problem}", None, "YAML mapping", fix_, file,
+                                  mark.line + 1 if mark else None)]) from None
+    return raw, text
 
 
 def line_map(text: str) -> dict[str, int]:

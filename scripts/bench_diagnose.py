@@ -469,7 +469,7 @@ def run_set(name, tube, hidden, want, truth, record=None, *, seed, n_cycles=50, 
     row["no_sample_worse"] = all(fin_ps[s] <= 1.02 * base_ps[s] for s in base_ps) or any(
         "ends worse" in n for n in d.sample_notes)
     if check_command and d.recommended:
-        from camtube.cli import main
+        from camtube.commands import main
 
         with tempfile.TemporaryDirectory() as tmp:
             csv = Path(tmp) / "data.csv"

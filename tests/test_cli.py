@@ -7,7 +7,7 @@ import sys
 import ezdxf
 import pytest
 
-from camtube.cli import build_parser, main
+from camtube.commands import build_parser, main
 from tests.conftest import PATTERNS
 
 

@@ -408,7 +408,29 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str) -> None:
                   "draws it", "save the drawing so the spline has control points, or convert it to a polyline",
                   entities=[ent])
         return
+    if t == "SPLINE" and entity.dxf.degree == 1:
+        _control_polygon(rd, entity, ent, layer, role)
+        return
     _flatten(rd, entity, ent, layer, role)
+
+
+def _control_polygon(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
+    """A degree-1 SPLINE is its control polygon (closed when the spline is flagged closed or ends where it began)."""
+    cps = [tuple(v) for v in entity.control_points]
+    zs = [v[2] if len(v) > 2 else 0.0 for v in cps]
+    if max(zs) - min(zs) > TOL.gap / rd.factor:
+        rd.refuse(ent.describe(), "is not drawn in the XY plane (its z varies by "
+                  f"{(max(zs) - min(zs)) * rd.factor:.4g} mm)", "flatten the drawing (FLATTEN) to the XY plane",
+                  entities=[ent])
+        return
+    pts = _dedupe([(v[0] * rd.factor, v[1] * rd.factor) for v in cps])
+    closed = bool(entity.closed) or (len(pts) > 2 and _isclose(pts[0], pts[-1], TOL.gap))
+    if closed and len(pts) > 1 and _isclose(pts[0], pts[-1], TOL.gap):
+        pts = pts[:-1]
+    if len(pts) < 2 or (closed and len(pts) < 3):
+        ent.status = "aside:zero length"
+        return
+    rd.pieces.append(_Piece(pts, closed, [ent], layer, role))
 
 
 def _flatten(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
@@ -501,13 +523,14 @@ def _dedupe(pts: list[tuple[float, float]]) -> list[tuple[float, float]]:
 
 
 def _close_and_chain(rd: _Reading) -> None:
-    """Chain the open pieces of each layer (not slit layers) into loops with ezdxf.edgeminer."""
+    """Chain the open pieces of each layer with ezdxf.edgeminer: into loops (outlines), and, on a slit
+    layer, pieces drawn end to end into one open path (a slit broken at a point, a zig-zag of LINEs)."""
     from ezdxf import edgeminer as em
     from ezdxf.math import Vec3
 
     by_layer: dict[str, list[_Piece]] = {}
     for p in rd.pieces:
-        if not p.closed and p.role != "slit":
+        if not p.closed:
             by_layer.setdefault(p.layer, []).append(p)
     for layer, pieces in sorted(by_layer.items()):
         edges = [em.make_edge(Vec3(p.points[0]), Vec3(p.points[-1]), length=1.0, payload=k)
@@ -554,6 +577,23 @@ def _rectangle(piece: _Piece) -> tuple[float, float, float, float] | None:
     if abs(area - (x1 - x0) * (y1 - y0)) > TOL.gap * (x1 - x0 + y1 - y0):
         return None
     return x0, y0, x1, y1
+
+
+def _largest_rectangle_with_a_cut_outside(pieces, cut_pieces, bounds):
+    """``(rectangle, a cut outside it)`` when the largest drawn rectangle holds at least one other cut
+    but not all of them (a cut drawn past a correctly drawn outline), else None."""
+    rects = [(p, _rectangle(p)) for p in pieces]
+    rects = [(p, box) for p, box in rects if box is not None]
+    if not rects:
+        return None
+    p, (x0, y0, x1, y1) = max(rects, key=lambda r: (r[1][2] - r[1][0]) * (r[1][3] - r[1][1]))
+    inside, outside = [], []
+    for q, bb in zip(cut_pieces, bounds):
+        if q is p:
+            continue
+        ok = bb[0] >= x0 - TOL.gap and bb[2] <= x1 + TOL.gap and y0 - TOL.gap <= 0.5 * (bb[1] + bb[3]) <= y1 + TOL.gap
+        (inside if ok else outside).append(q)
+    return (p, outside[0]) if inside and outside else None
 
 
 def _find_outline(rd: _Reading, ro: float | None, length: float | None):
@@ -606,6 +646,14 @@ def _find_outline(rd: _Reading, ro: float | None, length: float | None):
                               entities=p.entities)
                     return None, ro, length
         if missing:
+            largest = _largest_rectangle_with_a_cut_outside(rd.pieces, cut_pieces, b)
+            if largest is not None:
+                p, out = largest
+                rd.refuse(p.describe(), "would be the tube outline (the largest rectangle, around the other cuts) but "
+                          f"{out.describe()} lies outside it", "move that cut inside the outline (or delete it), or "
+                          "pass " + " and ".join(missing) + " if the tube is not this rectangle",
+                          entities=p.entities + out.entities)
+                return None, ro, length
             rd.refuse("tube outline", "no tube outline found (an axis-aligned rectangle L x 2 pi r_o around every cut)",
                       "draw the unrolled tube outline (any layer), or pass " + " and ".join(missing))
         return None, ro, length

@@ -21,7 +21,10 @@ from camtube.design.generate import notch_row
 from camtube.design.pattern import Pattern, Process, RepeatRule, Rules, Tendon, Tube, hole, notch, sort_cuts
 from camtube.design.schema import SCHEMA, Field
 from camtube.errors import Issue, PatternError
-from camtube.yamltext import closest, line_map
+from camtube.yamltext import closest, line_map, parse_yaml, read_yaml_file
+
+#: The shipped presets (package data): tube patterns and the process files they name.
+PRESETS_DIR = Path(__file__).resolve().parent / "presets"
 
 
 @dataclass(frozen=True)
@@ -59,7 +62,7 @@ def parse_override(item: str) -> tuple[str, Any]:
                                   "write the key, an equals sign and the value")])
     key, _, value = item.partition("=")
     try:
-        parsed = yaml.safe_load(value)
+        parsed = parse_yaml(value)
     except yaml.YAMLError:
         parsed = value
     return key.strip(), parsed
@@ -131,8 +134,11 @@ class _Reader:
 
     def __init__(self, file: str | None, lines: dict[str, int]):
         self.file, self.lines, self.issues = file, lines, []
+        self.broken: set[str] = set()  # sections that are not mappings: their keys are not reported one by one
 
     def issue(self, key, message, value=None, allowed="", fix=""):
+        if any(key.startswith(b + ".") for b in self.broken):
+            return
         self.issues.append(Issue(key, message, value, allowed, fix, self.file, self.lines.get(key)))
 
     def check_keys(self, mapping: dict, allowed: dict, prefix: str) -> None:
@@ -209,6 +215,7 @@ def _section(reader: _Reader, raw: dict, name: str) -> dict:
         body = {}
     if not isinstance(body, dict):
         reader.issue(name, "expected a mapping", body, "key: value pairs", f"indent the keys under '{name}:'")
+        reader.broken.add(name)
         body = {}
     spec = SCHEMA[name]
     reader.check_keys(body, spec, name)
@@ -216,20 +223,10 @@ def _section(reader: _Reader, raw: dict, name: str) -> dict:
 
 
 def read_yaml(path: str | os.PathLike) -> tuple[dict, dict[str, int], str]:
-    """Read a YAML mapping; returns ``(raw, line_map, file)``; syntax errors name the line."""
+    """Read a YAML mapping; returns ``(raw, line_map, file)``; every failure names the file and line."""
     file = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise PatternError([Issue("file", f"cannot read pattern: {exc.strerror}", file, "a readable YAML file",
-                                  "check the path")]) from None
-    try:
-        raw = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise PatternError([Issue("yaml", f"not valid YAML: {getattr(exc, 'problem', exc)}", None,
-                                  "YAML mapping", "fix the syntax at the line shown", file,
-                                  mark.line + 1 if mark else None)]) from None
+    raw, text = read_yaml_file(path, "pattern", "check the path, or give a preset name (" +
+                               ", ".join(preset_names()) + ")")
     if raw is None:
         raw = {}
     if not isinstance(raw, dict):
@@ -331,23 +328,59 @@ def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = Non
 
 
 def load(path: str | os.PathLike, overrides: Iterable[str] = ()) -> Loaded:
-    """Load, override, validate and build a pattern file.
+    """Load, override, validate and build a pattern file (or a shipped preset by name, ``tube1``).
 
     ``process:`` may be a mapping or the name of a process YAML file next to
     the pattern (its keys are the ``process`` keys); the pattern's own
     ``process_overrides``-style changes go through ``--set process.KEY=...``.
     """
+    path = resolve_preset(path)
     raw, lines, file = read_yaml(path)
     proc = raw.get("process")
     if isinstance(proc, str):
-        ppath = Path(path).parent / proc
-        praw, _, pfile = read_yaml(ppath)
+        praw, _, _ = read_yaml(_process_file(proc, Path(path), file, lines.get("process")))
         raw = dict(raw)
         raw["process"] = praw.get("process", praw)
     raw = apply_overrides(raw, overrides, file)
     set_keys = {parse_override(o)[0] for o in overrides}
     lines = {k: v for k, v in lines.items() if k not in set_keys}  # a --set value has no line
     return build(raw, file, lines, name=Path(path).stem)
+
+
+def _process_file(name: str, pattern_path: Path, file: str, line: int | None) -> Path:
+    """The process YAML that ``process: NAME`` names: beside the pattern, else a shipped preset."""
+    folders = (pattern_path.parent, PRESETS_DIR)
+    for folder in folders:
+        for cand in (folder / name, folder / f"{name}.yaml"):
+            if cand.is_file():
+                return cand
+    raise PatternError([Issue("process", "names a process file that is not there", name,
+                              f"a process YAML in {pattern_path.parent} or a shipped one: "
+                              + ", ".join(_shipped()[1]), "put the file beside the pattern, name a "
+                              "shipped process, or write the process keys under 'process:'", file, line)])
+
+
+def _shipped() -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """``(pattern presets, process files)`` shipped in :data:`PRESETS_DIR`, by name."""
+    patterns, processes = [], []
+    for p in sorted(PRESETS_DIR.glob("*.yaml")):
+        (patterns if "\ntube:" in "\n" + p.read_text(encoding="utf-8") else processes).append(p.stem)
+    return tuple(patterns), tuple(processes)
+
+
+def preset_names() -> tuple[str, ...]:
+    """Names of the shipped pattern presets (``tube1``, ...), without the process files."""
+    return _shipped()[0]
+
+
+def resolve_preset(path: str | os.PathLike) -> Path:
+    """``path`` itself when it is a file, else the shipped preset of that name (``tube1``), else ``path``."""
+    p = Path(path)
+    if p.exists() or p.suffix.lower() in (".dxf",) or os.sep in str(path):
+        return p
+    name = p.stem if p.suffix.lower() in (".yaml", ".yml") else p.name
+    cand = PRESETS_DIR / f"{name}.yaml"
+    return cand if cand.is_file() and name in preset_names() else p
 
 
 def load_pattern(path: str | os.PathLike, overrides: Iterable[str] = ()) -> Pattern:

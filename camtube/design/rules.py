@@ -109,6 +109,20 @@ def _pair_key(origin_a: str, origin_b: str, a: Cut, b: Cut) -> str:
     return "notch.spacing"
 
 
+def _row_too_long(pattern: Pattern, origins: list, err) -> None:
+    """The generated row of notches ends past the tube's end: name the count and the length, with both fixes."""
+    row = [c for c, o in zip(pattern.cuts, origins) if o == "notch"]
+    length = pattern.tube.length_mm
+    start = min(c.x_start_mm for c in row)
+    end = max(c.x_end_mm for c in row)
+    pitch = (row[1].x_mm - row[0].x_mm) if len(row) > 1 else row[0].width_mm
+    fit = sum(1 for c in row if c.x_end_mm <= length + 1e-12)
+    err("notch.count", f"{len(row)} notches from x = {start:.4g} mm end at x = {end:.4g} mm, past the tube's end "
+        f"(tube.length = {length:g} mm)", len(row), f"at most {fit} notches in this tube at pitch "
+        f"h + c = {pitch:.4g} mm", f"lower notch.count to {fit}, lengthen tube.length to at least {end:.4g} mm, "
+        "or shorten notch.spacing / notch.first_offset")
+
+
 def _describe(cut: Cut) -> str:
     return f"{cut.kind} at x={cut.x_mm:.4g} mm, angle {cut.angle_deg:.4g} deg"
 
@@ -188,6 +202,10 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
         err("tube.inner_radius", "inner radius must be smaller than the outer radius",
             ri, f"< tube.outer_radius = {ro:g} mm", "check r_i and r_o (radii, not diameters)")
         return errors, warnings  # everything below depends on a valid section
+    rt = pattern.tendon.radius_mm
+    if not rt < ri:
+        err("tendon.radius", "the tendon is thicker than the tube's lumen (it runs inside the tube)", rt,
+            f"< tube.inner_radius = {ri:g} mm", "check r_t (a radius, not a diameter) and r_i")
 
     seen_keys: set[str] = set()
     for cut, origin in zip(pattern.cuts, origins):
@@ -216,7 +234,11 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
             err(key_arc, "hole is wider than half the circumference", cut.arc_mm, f"< {circ / 2:.4f} mm",
                 "use a smaller hole")
         slack = 1e-12 if cut.outline is None else 1e-9
-        if cut.x_start_mm < -slack or cut.x_end_mm > t.length_mm + slack:
+        if origin == "notch" and cut.x_end_mm > t.length_mm + slack and cut.x_start_mm >= -slack:
+            if "row" not in seen_keys:  # the row of notches is longer than the tube: one line for the row
+                seen_keys.add("row")
+                _row_too_long(pattern, origins, err)
+        elif cut.x_start_mm < -slack or cut.x_end_mm > t.length_mm + slack:
             err(key_x, f"{_describe(cut)} spans x = [{cut.x_start_mm:.4g}, {cut.x_end_mm:.4g}] mm, outside the tube",
                 round(cut.x_mm, 9), f"the cut inside 0 <= x <= tube.length = {t.length_mm:g} mm",
                 "move the cut or lengthen tube.length")

@@ -26,10 +26,10 @@ from pathlib import Path
 from typing import Any
 
 from camtube.errors import Issue, PatternError
-from camtube.yamltext import closest, line_map
+from camtube.yamltext import closest, line_map, read_yaml_file
 
-#: Folder of the shipped profiles (``machines/`` at the top of the repository).
-MACHINES_DIR = Path(__file__).resolve().parents[2] / "machines"
+#: Folder of the shipped profiles (package data; ``machines/`` at the top of the repository links to it).
+MACHINES_DIR = Path(__file__).resolve().parent / "profiles"
 DEFAULT_MACHINE = "linuxcnc-rotary"
 DIALECT_KINDS = ("linuxcnc", "grbl")
 CORNER_STRATEGIES = ("overtravel", "none")
@@ -315,22 +315,8 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
 
 def read_profile(path: str | os.PathLike) -> MachineProfile:
     """Read and validate one profile file (raises :class:`PatternError`)."""
-    import yaml
-
     file = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise PatternError([Issue("file", f"cannot read machine profile: {exc.strerror}", file,
-                                  "a readable YAML file", "check the path, or give a name from `camtube machines`")]
-                           ) from None
-    try:
-        raw = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise PatternError([Issue("yaml", f"not valid YAML: {getattr(exc, 'problem', exc)}", None, "YAML mapping",
-                                  "fix the syntax at the line shown", file, mark.line + 1 if mark else None)]
-                           ) from None
+    raw, text = read_yaml_file(path, "machine profile", "check the path, or give a name from `camtube machines`")
     return build_profile(raw, Path(path).stem, file, line_map(text))
 
 

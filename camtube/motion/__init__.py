@@ -3,6 +3,6 @@
 :mod:`camtube.motion.linuxcnc` writes a configuration from a machine profile, runs the program in
 LinuxCNC's motion controller and records the commanded axes and the laser gate every servo cycle;
 :mod:`camtube.motion.analysis` measures the recording against the job (run time, beam-on length,
-speed uniformity, beam outside the cut regions, missed corners); :mod:`camtube.motion.cli` is
+speed uniformity, beam outside the cut regions, missed corners); :mod:`camtube.commands.motion` is
 ``camtube motion`` and ``camtube machines``.
 """

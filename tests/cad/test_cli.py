@@ -6,7 +6,7 @@ import json
 import pytest
 import trimesh
 
-from camtube.cli import main
+from camtube.commands import main
 from tests.cad.conftest import analytic_volume, preset
 from tests.conftest import PATTERNS
 

@@ -216,7 +216,7 @@ def test_design_dxf_with_drawn_cuts_reads_back_the_same(tmp_path):
 
 @pytest.mark.parametrize("name", REFUSED)
 def test_cli_refusal_writes_nothing(name, tmp_path, capsys):
-    from camtube.cli import main
+    from camtube.commands import main
 
     case = EXPECTED["cases"][name]
     argv = ["toolpath", str(EXAMPLES / case["file"]), "-o", str(tmp_path / "o")]

@@ -9,7 +9,7 @@ import math
 import pytest
 import yaml
 
-from camtube.cli import main
+from camtube.commands import main
 from camtube.design import load
 from camtube.errors import PatternError
 from tests.conftest import PATTERNS
@@ -45,8 +45,11 @@ CASES = [
     (["tendon.radius=-0.04"], "tendon.radius", ["out of range"]),
     (["notch.arc=4.8"], "notch.arc", ["shorter than the outer circumference", "4.8", "< 2 pi r_o = 4.7124"]),
     (["notch.arc=4.6"], "notch.arc", ["backbone arc", "min_backbone_arc", "reduce the arc"]),
-    (["notch.first_offset=9"], "notch.first_offset", ["outside the tube", "tube.length = 14"]),
-    (["tube.length=5"], "notch.first_offset", ["outside the tube", "lengthen tube.length"]),
+    # a row of notches past the tube's end names the row's count and the length, and every way out
+    (["notch.first_offset=9"], "notch.count", ["from x = 9 mm", "past the tube's end", "tube.length = 14",
+                                               "lower notch.count to 5", "notch.first_offset"]),
+    (["tube.length=5"], "notch.count", ["past the tube's end", "lower notch.count to 4",
+                                        "lengthen tube.length to at least 11"]),
     (["notch.spacing=0.05"], "notch.spacing", ["too close", "web 0.05", ">= rules.min_web = 0.1", "increase notch.spacing"]),
     (["holes.0.x=1.5"], "holes[0]", ["collides with", "notch at x=1.75", "move the hole"]),
     (["holes.0.x=1.3"], "holes[0]", ["collides with (web too thin)", "web 0.05"]),

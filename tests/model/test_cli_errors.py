@@ -10,7 +10,7 @@ import sys
 import numpy as np
 import pytest
 
-from camtube.cli import build_parser, main
+from camtube.commands import build_parser, main
 from tests.conftest import PATTERNS, ROOT
 
 TUBE2 = str(PATTERNS / "tube2.yaml")

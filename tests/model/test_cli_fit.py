@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from camtube.cli import build_parser, main
+from camtube.commands import build_parser, main
 from camtube.model.synth import noise_floor_deg
 from tests.conftest import PATTERNS
 

@@ -105,7 +105,7 @@ def test_loading_an_effect_file_changes_nothing_for_later_calls():
 
 
 def test_no_import_circles_between_cli_modules_or_api_and_effects():
-    code = ("import sys; import camtube.model.diagnose_cli; assert 'camtube.model.cli' not in sys.modules; "
+    code = ("import sys; import camtube.commands.diagnose; assert 'camtube.commands.model' not in sys.modules; "
             "import camtube.model.effects; assert 'camtube.model.api' not in sys.modules; "
             "import camtube.model.core.registry")
     subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from camtube.cli import main
+from camtube.commands import main
 from camtube.design.loader import load_pattern
 from camtube.model.atlas import residual_atlas
 from camtube.model.data import format_csv

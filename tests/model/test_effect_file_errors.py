@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pytest
 
-from camtube.cli import main
+from camtube.commands import main
 from tests.conftest import PATTERNS
 
 TUBE2 = str(PATTERNS / "tube2.yaml")

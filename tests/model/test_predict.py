@@ -86,7 +86,7 @@ def test_design_summary_table_reaches_max_stroke():
 
 
 def test_camtube_design_shows_the_prediction(capsys):
-    from camtube.cli import main
+    from camtube.commands import main
 
     assert main(["design", str(PATTERNS / "tube2.yaml"), "-q"]) == 0
     out = capsys.readouterr().out

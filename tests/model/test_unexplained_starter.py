@@ -17,7 +17,7 @@ import pytest
 from camtube.errors import DataError
 from camtube.model.dataset import Dataset
 from camtube.model.unexplained import analyse, variables_of
-from camtube.model.unexplained.cli import register_effect_commands
+from camtube.commands.effect import register_effect_commands
 from camtube.model.unexplained.starter import starter_from_json, starter_source
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -10,7 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from camtube.cli import main
+from camtube.commands import main
 
 ROOT = Path(__file__).resolve().parents[2]
 

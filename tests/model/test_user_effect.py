@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from camtube.cli import main
+from camtube.commands import main
 from tests.conftest import PATTERNS, ROOT
 
 EXAMPLE = ROOT / "examples" / "user_effect"

@@ -11,7 +11,7 @@ import os
 
 import pytest
 
-from camtube.cli import main
+from camtube.commands import main
 from camtube.design.loader import load_pattern
 from camtube.errors import CamtubeError
 from camtube.export.dialects import dialect_from_profile

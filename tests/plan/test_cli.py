@@ -5,7 +5,7 @@ import json
 
 import ezdxf
 
-from camtube.cli import main
+from camtube.commands import main
 from tests.conftest import PATTERNS
 
 

@@ -4,6 +4,8 @@ These used to live in the CLI modules; the CLI and the Python API share them.
 """
 from __future__ import annotations
 
+import math
+
 from typing import Iterable, Sequence
 
 from camtube.model.core.model import FitError, JointModel
@@ -36,9 +38,49 @@ def parse_assignments(items: Iterable[str], option: str = "--fix") -> dict[str, 
     return out
 
 
-def parse_fix(items: Iterable[str]) -> dict[str, float]:
-    """``--fix NAME=VALUE`` items -> ``{name: value}``."""
-    return parse_assignments(items, "--fix")
+def parse_fix(items: Iterable[str], model: JointModel | None = None) -> dict[str, float]:
+    """``--fix NAME=VALUE`` items -> ``{name: value}``; with ``model``, each value within its parameter's bounds.
+
+    Raises
+    ------
+    FitError
+        A malformed item, or a value outside the bounds the parameter declares (named with its unit).
+    """
+    out = parse_assignments(items, "--fix")
+    if model is not None:
+        specs = model.param_specs
+        for name, value in out.items():
+            sp = specs.get(name.split("@")[0])
+            if sp is not None and not (sp.lo <= value <= sp.hi and math.isfinite(value)):
+                raise FitError(f"--fix {name}={value:g}: outside the range {name} can take, {sp.lo:g}..{sp.hi:g} "
+                               f"{sp.unit}; fix: give a value in that range")
+    return out
+
+
+def fitted_and_held(model: JointModel, fit_text: str | None, fix_items: Iterable[str],
+                    base: Sequence[str] = ("E_t",), with_effects: bool = True) -> tuple[list[str], dict[str, float]]:
+    """The parameters to fit and the ``--fix`` values to hold, consistent with each other.
+
+    A parameter held with ``--fix`` leaves the default fitted set (``base``, and every effect
+    parameter when ``with_effects``); naming it in an explicit ``--fit`` as well is a
+    contradiction and refused.
+
+    Returns
+    -------
+    (list of str, dict)
+        Full names to fit; ``{name: value}`` held.
+    """
+    held = parse_fix(fix_items, model)
+    if fit_text is None:
+        default = fit_param_names(model, None, base) if with_effects else list(base)
+        names = [n for n in default if n not in held]
+    else:
+        names = fit_param_names(model, fit_text)
+        both = [n for n in names if n in held]
+        if both:
+            raise FitError(f"--fit and --fix both name {', '.join(both)}: a parameter is either fitted or held; "
+                           f"fix: drop it from --fit to hold it, or drop --fix {both[0]}=... to fit it")
+    return names, held
 
 
 def build_registry(effect_files: Iterable[str] = ()) -> tuple[Registry, tuple]:

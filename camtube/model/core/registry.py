@@ -121,7 +121,14 @@ def load_effect_file(path: str | Path) -> tuple[Effect, ...]:
     try:
         spec.loader.exec_module(mod)
     except SyntaxError as exc:
-        raise EffectError(f"{path}:{exc.lineno}: cannot load the effect file: {exc.msg}") from None
+        if exc.lineno is None:  # not Python source at all (binary, null bytes)
+            raise EffectError(f"{path}: cannot load the effect file: {exc.msg}; fix: give a Python source file "
+                              "(UTF-8 text; see docs/diagnose.md)") from None
+        raise EffectError(f"{path}:{exc.lineno}: cannot load the effect file: {exc.msg}; fix: correct the Python "
+                          "at that line") from None
+    except ValueError as exc:  # the source is not text (null bytes)
+        raise EffectError(f"{path}: cannot load the effect file: {exc}; fix: give a Python source file "
+                          "(UTF-8 text; see docs/diagnose.md)") from None
     except Exception as exc:  # noqa: BLE001 - a user's file may raise anything; report it with its line
         import traceback
 

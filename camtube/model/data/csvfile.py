@@ -266,7 +266,8 @@ def _read_text(path: Path) -> str:
     except OSError as exc:
         raise DataError(f"{path}: cannot read the measurement file ({exc.strerror or exc})") from None
     except UnicodeDecodeError as exc:
-        raise DataError(f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start})") from None
+        raise DataError(f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start}); fix: give the "
+                        "measurement CSV (save it as UTF-8 text)") from None
     return text
 
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from camtube.cliutil import add_cad_options, add_pattern_argument, run_outputs
+from camtube.commands.common import add_cad_options, add_pattern_argument, run_outputs
 
 def register(sub) -> None:
     from camtube.export.dialects import DIALECTS

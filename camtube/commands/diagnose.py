@@ -1,7 +1,7 @@
 """``camtube model diagnose``: which physics is missing from the model (thin CLI over :mod:`camtube.model.diagnose`).
 
 ``register(model_sub)`` adds the sub-command to the ``model`` group that
-:mod:`camtube.model.cli` creates.
+:mod:`camtube.commands.model` creates.
 """
 from __future__ import annotations
 
@@ -36,8 +36,8 @@ def register(model_sub) -> None:
     d.add_argument("--candidates", default="", metavar="A,B",
                    help="effects to try (default: every registered effect not in the model, i.e. the built-in "
                         + ", ".join(EFFECT_NAMES) + " and those of --effect-file)")
-    d.add_argument("--fit", dest="fit_params", default="E_t", metavar="P1,P2",
-                   help="base parameters fitted besides the effects' own (default E_t)")
+    d.add_argument("--fit", dest="fit_params", default=None, metavar="P1,P2",
+                   help="base parameters fitted besides the effects' own (default E_t, unless held with --fix)")
     d.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
                    help="hold a parameter at a value (E_t GPa, L0 mm); repeatable")
     d.add_argument("--max-rows", type=int, default=4000, metavar="N",
@@ -74,10 +74,10 @@ def fit_command_prefix(args: argparse.Namespace) -> str:
 
 
 def cmd_diagnose(args: argparse.Namespace) -> int:
-    from camtube.cliutil import load_from_args
+    from camtube.commands.common import load_from_args
     from camtube.errors import DataError
     from camtube.io import write_atomic
-    from camtube.model.core.build import build_registry, check_suffix, parse_assignments, parse_fix, split_names
+    from camtube.model.core.build import build_registry, check_suffix, fitted_and_held, parse_assignments, split_names
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import load_csv, select_cycles
     from camtube.model.diagnose import diagnose
@@ -93,8 +93,9 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects)])
     raw = load_csv(args.data)
     rows = select_cycles(raw, args.cycles)
+    fit_names, held = fitted_and_held(model, args.fit_params, args.fix, with_effects=False)
     fixed = pattern_values(pattern)
-    fixed.update(parse_fix(args.fix))
+    fixed.update(held)
     cands = [reg.get_effect(c) for c in split_names(args.candidates)] or None
     try:
         lo, hi = (float(v) for v in args.modulus_range.split(","))
@@ -102,7 +103,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
         raise DataError(f"--modulus-range {args.modulus_range!r}: use LO,HI in GPa, e.g. 1,300") from None
     if not 0 < lo < hi:
         raise DataError(f"--modulus-range {args.modulus_range!r}: need 0 < LO < HI (GPa)")
-    d = diagnose(model, rows, split_names(args.fit_params), fixed, candidates=cands,
+    d = diagnose(model, rows, fit_names, fixed, candidates=cands,
                  max_rows=args.max_rows, max_effects=args.max_effects, registry=reg,
                  stop_ratio=1.15 if args.stop_rule else None, modulus_range_gpa=(lo, hi),
                  per_sample=args.per_sample, init=parse_assignments(args.init, "--init"),

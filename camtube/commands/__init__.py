@@ -1,26 +1,38 @@
 """camtube command line: parses arguments and calls the library.
 
-Each stage contributes its sub-commands through a light ``register``
-function in its own ``cli`` module; heavy libraries are imported only inside
-the handlers that need them.
+This package sits above every stage: its modules import from the stages
+(design, plan, export, machine, cad, model, motion) and :mod:`camtube.pipeline`,
+and no stage imports it (``tests/test_layers.py`` holds that). One module per
+group of sub-commands, each with ``register(subparsers)``; heavy libraries are
+imported only inside the handlers that need them.
 """
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 from camtube import __version__
 from camtube.errors import CamtubeError
+from camtube.io import PublishedInterrupt
 
-#: Stage CLI modules, each with ``register(subparsers)``; missing ones are skipped.
+#: Command modules, each with ``register(subparsers)``, in the order ``--help`` lists them.
 COMMAND_MODULES = (
-    "camtube.design.cli", "camtube.plan.cli", "camtube.cad.cli", "camtube.model.cli", "camtube.motion.cli",
+    "camtube.commands.design", "camtube.commands.plan", "camtube.commands.cad", "camtube.commands.model", "camtube.commands.motion",
 )
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose mistakes are one line with a fix, like every other camtube error
+    (argparse's own prints the whole usage first). Sub-command parsers are of this class too."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message}; fix: see `{self.prog} --help`\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="camtube",
         description="Design, plan, cut and explain laser-micromachined notched-tube joints. "
                     "Lengths are mm, angles deg unless an option says otherwise.",
@@ -28,13 +40,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"camtube {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMAND_MODULES:
-        try:
-            mod = importlib.import_module(name)
-        except ModuleNotFoundError as exc:
-            if exc.name and name.startswith(exc.name):
-                continue
-            raise
-        mod.register(sub)
+        importlib.import_module(name).register(sub)
     return parser
 
 
@@ -52,6 +58,11 @@ def main(argv: list[str] | None = None) -> int:
             parser.print_help()
             return 1
         return _run(args)
+    except PublishedInterrupt as exc:
+        where = os.path.dirname(exc.paths[0]) if exc.paths else "the output folder"
+        print(f"camtube: interrupted after the outputs were published: the set in {where} is complete and new",
+              file=sys.stderr)
+        return 0
     except KeyboardInterrupt:
         print("camtube: interrupted; no output of this command was published", file=sys.stderr)
         return 130
@@ -59,6 +70,23 @@ def main(argv: list[str] | None = None) -> int:
         # the reader of our output went away (e.g. `camtube design ... | head -1`): stop quietly
         _silence_stdout()
         return 0
+    except Exception as exc:  # noqa: BLE001: only to tell an interrupted import from a failure; re-raised
+        if not _interrupted(exc):
+            raise
+        print("camtube: interrupted; no output of this command was published", file=sys.stderr)
+        return 130
+
+
+def _interrupted(exc: BaseException) -> bool:
+    """True when ``exc`` was caused by a Ctrl-C (an extension module's import fails with an
+    ``ImportError`` whose context is the ``KeyboardInterrupt`` that stopped it)."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -82,8 +110,6 @@ def _run(args: argparse.Namespace) -> int:
 
 def _silence_stdout() -> None:
     """Point stdout at /dev/null so the interpreter's final flush cannot raise again."""
-    import os
-
     try:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())

@@ -1,8 +1,8 @@
 """``camtube model effect new NAME --from DIAG.json``: write a starter effect file (thin CLI over :mod:`.starter`).
 
-Hook (in :func:`camtube.model.cli.register`, with the ``model`` sub-parsers)::
+Hook (in :func:`camtube.commands.model.register`, with the ``model`` sub-parsers)::
 
-    from camtube.model.unexplained.cli import register_effect_commands; register_effect_commands(model_sub)
+    from camtube.commands.effect import register_effect_commands; register_effect_commands(model_sub)
 """
 from __future__ import annotations
 

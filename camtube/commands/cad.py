@@ -3,11 +3,11 @@ from __future__ import annotations
 
 import argparse
 
-from camtube.cliutil import add_pattern_argument
+from camtube.commands.common import add_pattern_argument
 
 
 def register(sub) -> None:
-    from camtube.cliutil import add_cad_options
+    from camtube.commands.common import add_cad_options
 
     p = sub.add_parser(
         "cad", help="write the 3-D model of the cut tube (STEP, STL), its as-cut simulation and a verification report",
@@ -23,6 +23,6 @@ def register(sub) -> None:
 
 
 def cmd_cad(args: argparse.Namespace) -> int:
-    from camtube.cliutil import run_outputs
+    from camtube.commands.common import run_outputs
 
     return run_outputs(args, "cad")

@@ -1,7 +1,7 @@
 """CLI of the model stage: ``camtube model fit`` and ``camtube model synth``.
 
 ``register(sub)`` adds the ``model`` command and its own sub-commands; other
-modules add theirs to the same group: if :mod:`camtube.model.diagnose_cli`
+modules add theirs to the same group: if :mod:`camtube.commands.diagnose`
 exists, its ``register(model_sub)`` is called with the ``model`` sub-parsers.
 Handlers import numpy/scipy/matplotlib lazily.
 """
@@ -84,15 +84,10 @@ def register(sub) -> None:
                    help="tendon E_t used to generate, GPa (default: the pattern's)")
     s.set_defaults(func=cmd_synth)
 
-    try:
-        diag = importlib.import_module("camtube.model.diagnose_cli")
-    except ModuleNotFoundError as exc:
-        if exc.name != "camtube.model.diagnose_cli":
-            raise
-    else:
-        diag.register(model_sub)
-    from camtube.model.unexplained.cli import register_effect_commands
-    register_effect_commands(model_sub)
+    from camtube.commands import diagnose, effect
+
+    diagnose.register(model_sub)
+    effect.register_effect_commands(model_sub)
 
 
 def _add_pattern_option(p: argparse.ArgumentParser) -> None:
@@ -103,10 +98,10 @@ def _add_pattern_option(p: argparse.ArgumentParser) -> None:
 
 
 def cmd_fit(args: argparse.Namespace) -> int:
-    from camtube.cliutil import load_from_args
+    from camtube.commands.common import load_from_args
     from camtube.io import write_atomic
     from camtube.model.core.build import (
-        build_registry, fit_param_names, history_warning, parse_assignments, parse_fix, split_names,
+        build_registry, fitted_and_held, history_warning, parse_assignments, split_names,
     )
     from camtube.model.core.fit import FitError, fit
     from camtube.model.core.predict import model_for_pattern, pattern_values
@@ -121,10 +116,10 @@ def cmd_fit(args: argparse.Namespace) -> int:
     raw = load_csv(args.data)
     rows = prepare(raw, args.cycles, args.branch, args.deadband, args.deadband_threshold)
     check_fittable(rows, f"{args.data} (cycles {args.cycles}, {args.branch} branch)")
+    names, held = fitted_and_held(model, args.fit_params, args.fix)
     fixed = pattern_values(pattern)
-    fixed.update(parse_fix(args.fix))
+    fixed.update(held)
     init = parse_assignments(args.init, "--init")
-    names = fit_param_names(model, args.fit_params)
     params = model.make_params(rows, names, fixed, initial=init, per_sample=split_names(args.per_sample))
     warn = history_warning(model, args.branch, min((len(set(rows.cycle[sl].tolist()))
                                                     for _, sl in rows.sample_slices()), default=0),
@@ -165,7 +160,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
 
 
 def cmd_synth(args: argparse.Namespace) -> int:
-    from camtube.cliutil import load_from_args
+    from camtube.commands.common import load_from_args
     from camtube.model.sim.synth import noise_floor_deg, synthesize, write
 
     check_suffix(args.output, (".csv",), "-o/--output")

@@ -1,4 +1,4 @@
-"""Helpers shared by the stage CLIs: pattern arguments and loading with warnings."""
+"""Helpers shared by the commands: pattern arguments, loading with warnings, output checks."""
 from __future__ import annotations
 
 import argparse
@@ -7,6 +7,7 @@ import sys
 
 from camtube.design.loader import Loaded
 from camtube.errors import CamtubeError
+from camtube.io import PublishedInterrupt
 
 #: Roles a drawing's layer can be given with ``--layer NAME=ROLE``.
 LAYER_ROLES = ("notch", "hole", "slit", "ignore")
@@ -15,7 +16,8 @@ LAYER_ROLES = ("notch", "hole", "slit", "ignore")
 def add_pattern_argument(parser: argparse.ArgumentParser) -> None:
     """Add ``PATTERN``, repeatable ``--set KEY=VALUE``, ``-q`` and the drawing options to a sub-command."""
     parser.add_argument("pattern", metavar="PATTERN",
-                        help="pattern YAML file (see patterns/) or a DXF drawing of the unrolled tube")
+                        help="pattern YAML file, a preset name (tube1, tube2, tube3, tube1-bidirectional) "
+                             "or a DXF drawing of the unrolled tube")
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                         help="override any scalar of the pattern, e.g. --set notch.count=20 "
                              "--set process.repeats=6 (units as in the YAML: mm, deg)")
@@ -54,11 +56,13 @@ def drawing_options(args: argparse.Namespace):
 
 def load_from_args(args: argparse.Namespace) -> Loaded:
     """Load the pattern or drawing named by ``args``; print the import summary and design warnings to stderr."""
+    from camtube.design.loader import preset_names, resolve_preset
     from camtube.design.source import load_source
 
-    path = args.pattern
+    path = str(resolve_preset(args.pattern))
     if not os.path.exists(path):
-        raise CamtubeError(f"{path}: no such file; fix: give the path of a pattern YAML or a DXF drawing")
+        raise CamtubeError(f"{args.pattern}: no such file or preset; fix: give the path of a pattern YAML or a DXF "
+                           f"drawing, or a preset name ({', '.join(preset_names())})")
     if os.path.isdir(path):
         raise CamtubeError(f"{path}: is a directory; fix: give the path of a pattern YAML or a DXF drawing")
     loaded = load_source(path, args.overrides, drawing_options(args))
@@ -98,10 +102,13 @@ def cad_options(args: argparse.Namespace):
 
 
 def check_output_dir(path: str) -> None:
-    """Refuse an output directory that names an existing file."""
+    """Refuse, before any work, an output directory that names a file or cannot be written."""
+    from camtube.io import check_writable_dir
+
     if os.path.exists(path) and not os.path.isdir(path):
         raise CamtubeError(f"{path}: is a file, but -o names the output directory; fix: give a directory "
                            "(new or existing)")
+    check_writable_dir(path)
 
 
 def run_outputs(args: argparse.Namespace, what: str) -> int:
@@ -128,6 +135,19 @@ def run_outputs(args: argparse.Namespace, what: str) -> int:
     with make_progress(quiet=args.quiet) as progress:
         result = run(loaded, args.output, request, progress,
                      warn=None if args.quiet else (lambda w: print(f"warning: {w}", file=sys.stderr)))
+    try:
+        _report(args, result, summary_table)
+    except KeyboardInterrupt:
+        raise PublishedInterrupt(result.paths) from None
+    if result.cad is not None and not result.verified:
+        print(f"camtube {args.command}: the job failed its own verification (see the report above): "
+              "do not cut it; exit status 1", file=sys.stderr)
+        return 0 if args.allow_fail else 1
+    return 0
+
+
+def _report(args: argparse.Namespace, result, summary_table) -> None:
+    """Print what a published run wrote: the summary, the paths and the verification verdict."""
     if result.estimate is not None:
         print(summary_table(result.job, result.estimate))
     for p in result.paths:
@@ -135,8 +155,3 @@ def run_outputs(args: argparse.Namespace, what: str) -> int:
     if result.cad is not None:
         for line in result.cad.verdict_lines():
             print(line)
-        if not result.verified:
-            print(f"camtube {args.command}: the job failed its own verification (see the report above): "
-                  "do not cut it; exit status 1", file=sys.stderr)
-            return 0 if args.allow_fail else 1
-    return 0

@@ -5,7 +5,7 @@ import argparse
 import math
 from pathlib import Path
 
-from camtube.cliutil import add_pattern_argument, load_from_args
+from camtube.commands.common import add_pattern_argument, load_from_args
 from camtube.errors import CamtubeError
 
 

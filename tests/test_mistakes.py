@@ -1,0 +1,221 @@
+"""The mistakes a new user made (issue 20): each gets one line naming the file, line or key and the
+fix, exit 2 (130 / 0 for Ctrl-C as said), and nothing left behind."""
+from __future__ import annotations
+
+import json
+import os
+import signal
+
+import pytest
+
+from camtube.commands import main
+from tests.conftest import PATTERNS
+from tests.test_cli_errors import TUBE1, assert_refused, camtube, listing
+
+
+def pattern_text(**notch) -> str:
+    n = {"count": 3, "width": 0.5, "spacing": 0.5, "arc": 2.83, "first_offset": 1.0, **notch}
+    return ("name: p\ntube: {outer_radius: 0.75, inner_radius: 0.45, length: 14}\n"
+            "notch: {" + ", ".join(f"{k}: {v}" for k, v in n.items()) + "}\n"
+            "process: femto-polyimide.yaml\n")
+
+
+def test_random_bytes_as_a_pattern(tmp_path):
+    bad = tmp_path / "p.yaml"
+    bad.write_bytes(bytes(range(256)) * 4)
+    assert_refused(camtube("design", str(bad)), str(bad), "not a text file")
+    assert_refused(camtube("toolpath", str(bad), "-o", str(tmp_path / "o")), "not a text file")
+    assert listing(tmp_path) == ["p.yaml"]
+
+
+def test_a_key_given_twice_is_refused_with_both_lines(tmp_path):
+    p = tmp_path / "p.yaml"
+    p.write_text(pattern_text() + "name: q\n")
+    r = camtube("design", str(p))
+    assert_refused(r, f"{p}:5", "'name' is given twice", "first at line 1")
+
+
+def test_a_nested_key_given_twice_too(tmp_path):
+    p = tmp_path / "p.yaml"
+    p.write_text(pattern_text().replace("count: 3,", "count: 3, count: 4,"))
+    assert_refused(camtube("design", str(p)), "'count' is given twice")
+
+
+@pytest.mark.parametrize("form", ["5e-1", "5E-1", "0.5", "5.0e-1", "+5e-1"])
+def test_every_yaml_number_form_is_a_number(tmp_path, form):
+    p = tmp_path / "p.yaml"
+    p.write_text(pattern_text(width=form))
+    r = camtube("design", str(p))
+    assert r.returncode == 0, r.stderr
+    r = camtube("design", TUBE1, "--set", f"notch.width={form}")
+    assert r.returncode == 0, r.stderr
+
+
+def test_a_missing_process_file_names_the_key_and_where_it_looked(tmp_path):
+    p = tmp_path / "p.yaml"
+    p.write_text(pattern_text().replace("femto-polyimide.yaml", "nothere.yaml"))
+    assert_refused(camtube("design", str(p)), f"{p}:4", "process:", "nothere.yaml", str(tmp_path),
+                   "femto-polyimide")
+
+
+def test_a_shipped_process_is_found_for_a_pattern_anywhere(tmp_path):
+    p = tmp_path / "p.yaml"
+    p.write_text(pattern_text())
+    r = camtube("design", str(p), cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+
+
+def test_presets_by_name_from_any_folder(tmp_path):
+    r = camtube("design", "tube2", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "0.850" in r.stdout
+    assert_refused(camtube("design", "tube9", cwd=tmp_path), "tube9", "no such file or preset", "tube1")
+
+
+def test_no_message_prints_a_placeholder_for_the_file():
+    r = camtube("design", TUBE1, "--set", "notch.count")
+    assert r.returncode == 2 and "<pattern>" not in r.stderr
+    r = camtube("design", TUBE1, "--set", "nosuch.key=1")
+    assert r.returncode == 2 and "<pattern>" not in r.stderr
+
+
+def test_an_unwritable_output_is_refused_before_any_work(tmp_path, monkeypatch, capsys):
+    import camtube.pipeline
+
+    def never(*a, **k):
+        raise AssertionError("the job was built before the output was checked")
+
+    monkeypatch.setattr(camtube.pipeline, "run", never)
+    assert main(["toolpath", TUBE1, "-o", "/proc/camtube-x/out", "-q"]) == 2
+    err = capsys.readouterr().err
+    assert "/proc/camtube-x/out" in err and "fix:" in err and len(err.strip().splitlines()) == 1
+
+
+def test_too_many_notches_blame_the_count_and_the_length():
+    r = camtube("design", TUBE1, "--set", "notch.count=15")
+    assert_refused(r, "notch.count", "15 notches", "tube.length = 14", "lower notch.count to 13",
+                   "lengthen tube.length to at least 16")
+    assert "notch.first_offset:" not in r.stderr
+
+
+def test_fix_holds_a_parameter_the_default_fit_would_vary(tmp_path):
+    data = tmp_path / "d.csv"
+    assert camtube("model", "synth", "--pattern", str(PATTERNS / "tube2.yaml"), "-o", str(data)).returncode == 0
+    out = tmp_path / "fit.json"
+    r = camtube("model", "fit", str(data), "--pattern", str(PATTERNS / "tube2.yaml"), "--fix", "E_t=20",
+                "--json", str(out))
+    assert r.returncode == 0, r.stderr
+    fit = json.loads(out.read_text())
+    e_t = fit["params"]["E_t"] if "params" in fit else fit["parameters"]["E_t"]
+    value = e_t["value"] if isinstance(e_t, dict) else e_t
+    assert value == pytest.approx(20.0)
+    r = camtube("model", "fit", str(data), "--pattern", str(PATTERNS / "tube2.yaml"), "--fix", "E_t=-20")
+    assert_refused(r, "--fix E_t=-20", "0.5..500 GPa")
+    r = camtube("model", "fit", str(data), "--pattern", str(PATTERNS / "tube2.yaml"), "--fix", "E_t=20",
+                "--fit", "E_t")
+    assert_refused(r, "--fit and --fix both name E_t")
+
+
+def test_ctrl_c_while_the_set_is_published_publishes_it_whole_and_says_so(tmp_path, monkeypatch, capsys):
+    """A real SIGINT arrives in the middle of the swap: it is held until the set is in place, then
+    the command exits 0 saying the set is complete (not 130 'nothing published')."""
+    import camtube.io as io
+
+    swap = io._swap_in
+
+    def interrupted_swap(stage, out, files):
+        os.kill(os.getpid(), signal.SIGINT)  # Ctrl-C now, while the swap runs
+        return swap(stage, out, files)
+
+    monkeypatch.setattr(io, "_swap_in", interrupted_swap)
+    out = tmp_path / "o"
+    assert main(["toolpath", TUBE1, "-o", str(out), "-q"]) == 0
+    err = capsys.readouterr().err
+    assert "interrupted after the outputs were published" in err and str(out) in err
+    assert sorted(p.name for p in out.iterdir()) == ["tube1.job.json", "tube1.nc", "tube1.ngc", "tube1.toolpath.dxf"]
+
+
+def test_ctrl_c_before_the_swap_publishes_nothing(tmp_path, monkeypatch, capsys):
+    import camtube.io as io
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(io, "_swap_in", interrupted)
+    assert main(["toolpath", TUBE1, "-o", str(tmp_path / "o"), "-q"]) == 130
+    assert "no output of this command was published" in capsys.readouterr().err
+    assert listing(tmp_path) == []
+
+
+def test_ctrl_c_during_an_extension_import_exits_130_without_a_traceback(tmp_path, monkeypatch, capsys):
+    """An extension module stopped by Ctrl-C while it initialises fails as an ImportError whose context
+    is the KeyboardInterrupt (the CAD kernel did this): that is an interrupt, not a crash."""
+    import camtube.pipeline
+
+    def importing(*a, **k):
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt:
+            raise ImportError("initialization failed")  # noqa: B904 (as the extension does)
+
+    monkeypatch.setattr(camtube.pipeline, "run", importing)
+    assert main(["build", TUBE1, "-o", str(tmp_path / "o"), "-q"]) == 130
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert listing(tmp_path) == []
+
+
+def test_a_real_import_error_is_not_taken_for_an_interrupt(monkeypatch, tmp_path):
+    import camtube.pipeline
+
+    def broken(*a, **k):
+        raise ImportError("no module named nothing")
+
+    monkeypatch.setattr(camtube.pipeline, "run", broken)
+    with pytest.raises(ImportError):
+        main(["build", TUBE1, "-o", str(tmp_path / "o"), "-q"])
+
+
+@pytest.mark.parametrize("content,words", [(b"\x00\x01binary\xff" * 50, ("bad.py:", "fix: give a Python source file")),
+                                           (b"def x(:\n", ("bad.py:1:", "fix: correct the Python at that line"))])
+def test_an_effect_file_that_is_not_python(tmp_path, content, words):
+    data = tmp_path / "d.csv"
+    assert camtube("model", "synth", "--pattern", str(PATTERNS / "tube2.yaml"), "-o", str(data)).returncode == 0
+    bad = tmp_path / "bad.py"
+    bad.write_bytes(content)
+    r = camtube("model", "fit", str(data), "--pattern", str(PATTERNS / "tube2.yaml"), "--effect-file", str(bad))
+    assert_refused(r, *words)
+    assert ":None" not in r.stderr
+
+
+def test_a_binary_measurement_file(tmp_path):
+    bad = tmp_path / "d.csv"
+    bad.write_bytes(bytes(range(128, 256)) * 8)
+    assert_refused(camtube("model", "fit", str(bad), "--pattern", TUBE1), str(bad), "not a UTF-8 text file")
+
+
+@pytest.mark.parametrize("section,value", [("tube", "3"), ("notch", "[1,2]"), ("process", "fast")])
+def test_a_section_that_is_not_a_mapping_is_one_line_not_one_per_missing_key(section, value):
+    assert_refused(camtube("design", TUBE1, "--set", f"{section}={value}"), f"{section}: expected a mapping")
+
+
+def test_a_tendon_thicker_than_the_lumen():
+    assert_refused(camtube("design", TUBE1, "--set", "tendon.radius=0.5"), "tendon.radius", "inner_radius = 0.45")
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["build", TUBE1], ("required: -o/--output", "camtube build --help")),
+    (["toolpath", TUBE1, "-o", "x", "--ordering", "fastest"], ("invalid choice: 'fastest'",)),
+    (["model", "fit", "x.csv"], ("--pattern", "camtube model fit --help")),
+    (["nosuch"], ("invalid choice: 'nosuch'",)),
+])
+def test_command_line_mistakes_are_one_line_too(tmp_path, argv, words):
+    assert_refused(camtube(*argv, cwd=tmp_path), *words)
+    assert listing(tmp_path) == []
+
+
+@pytest.mark.parametrize("cmd", [["toolpath", TUBE1, "-o", ""], ["dxf", TUBE1, "-o", ""], ["build", TUBE1, "-o", " "]])
+def test_an_empty_output_path_is_refused_not_taken_for_the_working_directory(tmp_path, cmd):
+    r = camtube(*cmd, cwd=tmp_path)
+    assert r.returncode == 2 and "Traceback" not in r.stderr and "fix:" in r.stderr
+    assert listing(tmp_path) == []
