@@ -4,11 +4,10 @@
 
 A diagnosis of the joint must not be a diagnosis of the sensors. Before any physics is fitted:
 
-* **Spikes** (interference in the tracker or the load cell): each channel minus the running median of
-  the six rows around it (the row itself left out) in the same sample; the scale of that difference is the median absolute deviation
-  (x 1.4826, robust to the spikes themselves); a row more than :data:`SPIKE_Z` scales out is a spike.
-  Smooth motion (ramps, turning points) leaves the running-median difference near zero, so only isolated
-  jumps qualify.
+* **Spikes** (interference in the tracker or the load cell): a row outside the range of its two neighbours
+  either side (same sample) by more than :data:`SPIKE_Z` noise scales; the scale is the median absolute
+  row-to-row change (x 1.4826 / sqrt 2, robust to the spikes themselves). Turning points and kinks of the
+  motion stay within their neighbours' range, so only isolated jumps qualify.
 * **Repeated time stamps**: a row whose stamp equals the previous row's (the logger wrote one instant
   twice) is set aside. Rows whose stamp goes backwards, and rows with a missing value, are dropped when
   the file is read (:func:`camtube.model.data.read_measurements`), and counted there.
@@ -39,8 +38,8 @@ from camtube.model.data.dataset import Dataset
 
 #: A row this many robust scales from its running median is a spike.
 SPIKE_Z = 8.0
-#: Running-median window (rows).
-MEDIAN_ROWS = 7
+#: Neighbours either side whose range a row is compared with.
+NEIGHBOURS = 2
 #: A sampling interval this far off the sample's median is a rate change.
 RATE_CHANGE = 0.2
 
@@ -128,27 +127,23 @@ class Instruments:
         return out
 
 
-def _neighbour_median(v: np.ndarray) -> np.ndarray:
-    """Median of the ``MEDIAN_ROWS - 1`` rows around each row of ``v`` (n,), the row itself left out (edges
-    repeated)."""
-    h = MEDIAN_ROWS // 2
-    pad = np.concatenate((np.full(h, v[0]), v, np.full(h, v[-1])))
-    win = np.lib.stride_tricks.sliding_window_view(pad, MEDIAN_ROWS)
-    return np.median(np.delete(win, h, axis=1), axis=1)
-
-
 def _spikes(x: np.ndarray, slices: list) -> np.ndarray:
-    """Rows of ``x`` (n,) that jump out of their running median by more than :data:`SPIKE_Z` robust scales."""
+    """Rows of ``x`` (n,) outside the range of their neighbours (:data:`NEIGHBOURS` rows either side, same
+    sample) by more than :data:`SPIKE_Z` noise scales; the scale is ``1.4826 MAD(diff x) / sqrt(2)`` (robust
+    to the spikes). A turning point or a kink of the motion stays within its neighbours' range (within a
+    row's change), so only isolated jumps qualify."""
     out = np.zeros(x.size, bool)
+    h = NEIGHBOURS
     for _, sl in slices:
         v = x[sl]
-        if v.size < 3 * MEDIAN_ROWS:
+        if v.size < 10 * h:
             continue
-        d = v - _neighbour_median(v)
-        scale = 1.4826 * float(np.median(np.abs(d - np.median(d))))
+        scale = 1.4826 * float(np.median(np.abs(np.diff(v)))) / math.sqrt(2.0)
         if scale <= 0.0:
             continue
-        out[sl] = np.abs(d) > SPIKE_Z * scale
+        pad = np.concatenate((np.full(h, v[0]), v, np.full(h, v[-1])))
+        win = np.delete(np.lib.stride_tricks.sliding_window_view(pad, 2 * h + 1), h, axis=1)
+        out[sl] = (v > win.max(axis=1) + SPIKE_Z * scale) | (v < win.min(axis=1) - SPIKE_Z * scale)
     return out
 
 
@@ -221,10 +216,11 @@ def _lag_sse(data: Dataset, design: list, shift: int, rows: np.ndarray) -> float
     return sse
 
 
-def _lag_of(data: Dataset, design: list, rows: np.ndarray, max_shift: int) -> float:
-    """Lag (rows) minimising :func:`_lag_sse` over whole-row shifts, refined by a parabola through the best
-    three (whole rows: interpolating between rows would average the noise and favour half-row shifts)."""
-    shifts = np.arange(-max_shift, max_shift + 1)
+def _lag_of(data: Dataset, design: list, rows: np.ndarray, lo: int, hi: int) -> float:
+    """Lag (rows) minimising :func:`_lag_sse` over whole-row shifts ``lo .. hi``, refined by a parabola through
+    the best three (whole rows: interpolating between rows would average the noise and favour half-row
+    shifts)."""
+    shifts = np.arange(lo, hi + 1)
     sse = np.array([_lag_sse(data, design, int(k), rows) for k in shifts])
     k = int(np.argmin(sse))
     if 0 < k < sse.size - 1:
@@ -255,7 +251,8 @@ def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_
     step = max(1, n // max_rows)
     rows = np.arange(0, n, step)
     design = _lag_design(data)
-    est = _lag_of(data, design, rows, max_shift)
+    est = _lag_of(data, design, rows, -max_shift, max_shift)
+    near = int(round(est))
     per = []
     cyc = data.cycle
     for _, sl in data.sample_slices():
@@ -265,7 +262,7 @@ def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_
             r = rows[(rows >= sl.start) & (rows < sl.stop)]
             r = r[(cyc[r] >= lo) & (cyc[r] < hi)]
             if r.size >= 100:
-                per.append(_lag_of(data, design, r, max_shift))
+                per.append(_lag_of(data, design, r, near - 3, near + 3))
     se = float(np.std(per, ddof=1) / math.sqrt(len(per))) if len(per) > 1 else float("inf")
     return Lag(est * dt * 1e3, se * dt * 1e3)
 
