@@ -327,3 +327,49 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     if (~k2).any():
         aside["end of record after the lag shift"] = idx[~k2]
     return Instruments(shifted, data, aside, kept, rates, notes, lag, dropped, n_dropped)
+
+
+def with_aside(ins: Instruments, predicted_deg: np.ndarray, floor_deg: float) -> tuple[float, float, int]:
+    """Errors over the rows kept *and* the rows set aside (spikes, repeated stamps).
+
+    The model's prediction at a row set aside is interpolated in time from the rows kept around it (the
+    model is smooth in time), at the instant the angle was seen (``t - lag``).
+
+    Parameters
+    ----------
+    ins : Instruments
+    predicted_deg : (n,) float
+        A model's prediction on ``ins.data`` (the rows kept).
+    floor_deg : float
+        The noise floor estimated on the rows kept.
+
+    Returns
+    -------
+    rmse_deg : float
+        RMSE over the rows kept and set aside.
+    allowed_deg : float
+        What the data allow over the same rows: the floor on the rows kept, the artefacts' own size on the rows
+        set aside (a perfect model misses a spike by the spike).
+    n_aside : int
+        Rows set aside that were counted (those inside a sample's record).
+    """
+    clean = ins.data
+    resid = clean.angle_deg - predicted_deg
+    sse, n = float(resid @ resid), resid.size
+    extra = 0.0
+    aside = np.flatnonzero(~ins.kept)
+    raw = ins.raw
+    lag_s = ins.lag.applied_ms * 1e-3
+    counted = 0
+    for smp, sl in clean.sample_slices():
+        a = aside[raw.sample[aside] == smp]
+        if not a.size:
+            continue
+        t = raw.time_s[a] - lag_s
+        inside = (t >= clean.time_s[sl][0]) & (t <= clean.time_s[sl][-1])
+        r = raw.angle_deg[a][inside] - np.interp(t[inside], clean.time_s[sl], predicted_deg[sl])
+        extra += float(r @ r)
+        counted += int(inside.sum())
+    rmse = math.sqrt((sse + extra) / max(n + counted, 1))
+    allowed = math.sqrt((n * floor_deg ** 2 + extra) / max(n + counted, 1))
+    return rmse, allowed, counted

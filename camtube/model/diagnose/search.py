@@ -247,6 +247,9 @@ class Diagnosis:
         Effects chosen in an earlier round and dropped before stopping: the chain without them was not
         significantly worse on held-out cycles (a later effect explains what they did).
     stop_reason : str
+    instruments : Instruments or None
+        The instruments' check the rows went through (:func:`camtube.model.diagnose.instruments.check_instruments`):
+        rows set aside, the angle's lag; set by the caller.
     explanation : str
         ``complete`` or ``partial`` (see :func:`explanation_label`) when something is recommended, else ``""``.
     seconds : dict
@@ -281,6 +284,7 @@ class Diagnosis:
     baseline_gain: dict = field(default_factory=dict)
     dropped: tuple = ()
     explanation: str = ""
+    instruments: object = None
 
     @property
     def candidates(self) -> tuple:

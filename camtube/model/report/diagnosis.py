@@ -160,6 +160,15 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
     out["candidates"] = [_candidate_dict(d, c) for c in d.candidates]
     out["rounds"] = [[_candidate_dict(d, c) for c in r] for r in d.rounds]
     out["recommended"] = list(d.recommended)
+    out["explanation"] = d.explanation or None
+    ins = d.instruments
+    if ins is not None:
+        out["instruments"] = {
+            "rows_read": len(ins.raw), "rows_dropped": int(ins.n_dropped), "dropped": ins.dropped or None,
+            "rows_set_aside": {k: int(len(v)) for k, v in ins.aside.items()},
+            "rates_hz": {k: _num(v) for k, v in ins.rates_hz.items()}, "rate_changes": list(ins.rate_changes),
+            "lag_ms": _num(ins.lag.lag_ms), "lag_se_ms": _num(ins.lag.se_ms), "lag_given": bool(ins.lag.given),
+            "lag_applied_ms": _num(ins.lag.applied_ms)}
     out["replaced"] = [{"effects": list(old), "by": new} for old, new in d.replaced]
     out["dropped"] = list(d.dropped)
     out["waterfall"] = [{"effects": list(s.effects), "rmse_deg": _num(s.rmse_deg),
@@ -202,6 +211,85 @@ def baseline_lines(d: Diagnosis) -> list[str]:
     return out
 
 
+#: Where each built-in effect sits on the bench, and what the data cannot tell it from (with the measurement
+#: that would).
+SIDES = {
+    "slack": "tendon or drive: the data cannot tell slack in the tendon from lost motion between the motor and "
+             "the carriage (both take up stroke before the load cell sees tension); a displacement gauge on the "
+             "carriage would (lost motion in the drive also opens only after an unloading, so the first pull "
+             "differs)",
+    "play": "drive (lost motion between the motor and the carriage) or a tendon that slips at the guide; a "
+            "displacement gauge on the carriage would tell",
+    "toe": "tendon (its fibres straighten one after another)",
+    "toe_shape": "tendon (its fibres straighten one after another)",
+    "creep": "tendon (it lengthens under load); a drifting load-cell zero also grows with time: re-zero the load "
+             "cell with the tendon unloaded after the test, or hold a long dwell at zero stroke, to tell",
+    "viscoelastic": "tendon (delayed compliance); the joint's own relaxation does not show here (the measured "
+                    "force carries it)",
+    "friction": "tendon (friction at the guide or in a sheath)",
+    "series": "tendon or sheath (a compliance in series: the same as a softer tendon)",
+    "force_zero": "instruments (the load cell's zero)",
+    "angle_bias": "instruments (the tracker's offset), or a joint that rests bent",
+    "rest_angle": "joint (friction or a permanent set)",
+    "hardstop": "joint (the notches close)",
+    "kerf": "joint geometry", "flat_walls": "joint geometry", "chords": "joint geometry",
+}
+
+
+def answer_lines(d: Diagnosis) -> list[str]:
+    """The answer first: what to add in order with the error before and after each step, what is left and what
+    it follows, per sample, and the instruments' findings (rows set aside, lag)."""
+    floor = d.noise_floor_deg
+    steps = d.waterfall
+    out = []
+    if d.recommended:
+        label = f" ({d.explanation} explanation)" if d.explanation else ""
+        out.append(f"answer: add {', then '.join(d.recommended)}{label}")
+        out.append(f"  current model: RMSE {steps[0].rmse_deg:.3f} deg ({_times(steps[0].rmse_deg, floor)} the noise "
+                   f"floor {floor:.3f} deg)")
+        for k, name in enumerate(d.recommended, 1):
+            side = SIDES.get(name)
+            out.append(f"  {k}. + {name}: {steps[k - 1].rmse_deg:.3f} -> {steps[k].rmse_deg:.3f} deg "
+                       f"({_times(steps[k].rmse_deg, floor)} the floor)" + (f"; sits in the {side}" if side else ""))
+        if d.per_sample and len(steps) > len(d.recommended) + 1:
+            out.append(f"  {len(d.recommended) + 1}. per sample ({', '.join(d.per_sample)}): "
+                       f"{steps[-2].rmse_deg:.3f} -> {steps[-1].rmse_deg:.3f} deg")
+        samples = list(steps[0].rmse_per_sample)
+        if len(samples) > 1:
+            for smp in samples:
+                gains = [f"{name} {steps[k - 1].rmse_per_sample[smp]:.2f} -> {steps[k].rmse_per_sample[smp]:.2f}"
+                         for k, name in enumerate(d.recommended, 1)]
+                out.append(f"  sample {smp}: " + "; ".join(gains) + " deg")
+    elif d.partial:
+        out.append("answer: nothing the library has explains the misfit; the built-ins that lower it ("
+                   + ", ".join(d.partial) + f") leave {_times(d.partial_steps[-1].rmse_deg, floor)} the noise floor "
+                   "and are not recommended (see 'partial' and 'unexplained')")
+    else:
+        out.append(f"answer: nothing to add: the model is at {_times(steps[0].rmse_deg, floor)} the noise floor "
+                   f"({steps[0].rmse_deg:.3f} vs {floor:.3f} deg)")
+    u = unexplained_report.of_diagnosis(d)
+    if u is not None and (d.recommended or d.partial):
+        follows = ", ".join(u["follows"][:2]) if u.get("follows") else "nothing in particular (noise-like)"
+        out.append(f"  left: {100 * u['share']:.0f} % of the final error is above the noise floor; it follows "
+                   f"{follows}; carried by sample(s) {', '.join(u.get('samples') or []) or 'alike'}")
+    elif d.recommended:
+        out.append("  left: nothing structured (the error is at the noise floor)")
+    ins = d.instruments
+    if ins is not None:
+        from camtube.model.diagnose.instruments import with_aside
+
+        out.append("instruments:")
+        out += [f"  {line}" for line in ins.lines()]
+        if ins.n_aside:
+            r0, a0, _ = with_aside(ins, steps[0].predicted, floor)
+            r1, a1, _ = with_aside(ins, steps[-1].predicted, floor)
+            out.append(f"  with the {ins.n_aside} rows set aside counted: RMSE {r0:.3f} -> {r1:.3f} deg; the data allow "
+                       f"{a1:.3f} deg (noise floor and artefacts): {r1 / a1:.2f} x; without them: "
+                       f"{steps[0].rmse_deg:.3f} -> {steps[-1].rmse_deg:.3f} deg, floor {floor:.3f} deg: "
+                       f"{steps[-1].rmse_deg / floor:.2f} x")
+    return out
+
+
 def diagnosis_json(d: Diagnosis, command: str = "", meta: dict | None = None) -> str:
     """:func:`diagnosis_dict` as indented JSON with a final newline (deterministic)."""
     return json.dumps(diagnosis_dict(d, command, meta), indent=2, allow_nan=False) + "\n"
@@ -212,6 +300,8 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
     floor = d.noise_floor_deg
     base = d.waterfall[0]
     lines = [title] if title else []
+    lines += answer_lines(d)
+    lines.append("")
     given = d.given or base
     cur = ", ".join(given.effects) or "none"
     parts = d.noise_floor_parts_deg

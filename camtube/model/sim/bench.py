@@ -189,9 +189,10 @@ class BenchRecord:
     spike_rows, dropout_rows, repeat_rows : (k,) int
         Rows of ``data`` carrying a spike, a missing angle, a repeated time stamp.
     noise_deg : float
-        The tracker's white-noise standard deviation (the angle's sensor noise).
+        The tracker's white-noise standard deviation (the angle's sensor noise; RMS over the samples).
     floor_deg : float
-        RMSE a perfect model leaves: the tracker noise and the force noise through the tendon's compliance.
+        RMSE a perfect model leaves: the tracker noise and the force noise through the tendon's compliance
+        (RMS over the samples, which have the same number of rows).
     params : dict
     """
 
@@ -404,7 +405,8 @@ def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | 
     data = Dataset(cat["sample"], cat["cycle"], cat["time"], cat["stroke"], cat["force"], cat["angle"])
     params = {"arm_mm": arm, "samples": [repr(b) for b in per], "protocol": repr(protocol), "clock": repr(clock)}
     return BenchRecord(data, cat["true"], cat["cell"], np.concatenate(spikes), np.concatenate(drops),
-                       np.concatenate(reps), float(per[0].tracker.noise_deg), float(np.mean(floors)), params)
+                       np.concatenate(reps), float(math.sqrt(np.mean([b.tracker.noise_deg ** 2 for b in per]))),
+                       float(math.sqrt(np.mean(np.square(floors)))), params)
 
 
 def with_tracker(b: SampleBench, **kw) -> SampleBench:
