@@ -150,8 +150,8 @@ def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
                s_instruments=t1 - t0, s_diagnose=t2 - t1)
     if verbose:
         print(f"{name:18s} {tube} {rate:4.0f} Hz {len(rec.data):6d} rows | first {first:11s} rec {','.join(rec_list) or '-':24s}"
-              f" {d.explanation or '-':8s} partial {','.join(d.partial) or '-':18s} RMSE {out['base']:.3f} -> {final:.3f} deg ({final / floor_true:.2f} x true floor; partial chain """
-              f"""{(d.partial_steps[-1].rmse_deg / floor_true) if d.partial else float('nan'):.2f} x) | floor est "
+              f" {d.explanation or '-':8s} partial {','.join(d.partial) or '-':18s} RMSE {out['base']:.3f} -> {final:.3f} deg ({final / floor_true:.2f} x true floor; partial chain "
+              f"{(d.partial_steps[-1].rmse_deg / floor_true) if d.partial else float('nan'):.2f} x) | floor est "
               f"{d.noise_floor_deg:.3f} true {floor_true:.3f} ({'ok' if floor_ok else 'OFF'}) | lag {lag_true:.0f} -> "
               f"{ins.lag.lag_ms:.1f}+-{ins.lag.se_ms:.1f} ms (applied {ins.lag.applied_ms:.1f}) | aside {ins.n_aside} "
               f"(spikes {len(rec.spike_rows)}), dropped {meas.missing_lines.size} | {'RIGHT' if ok else 'wrong'} | "
