@@ -17,14 +17,17 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
   slack, toe and creep sit upstream of both, so they do not shift one against the other). For a trial lag
   ``tau`` (whole rows: interpolating between rows averages the noise and favours half-row shifts) the
   angle is read ``tau`` later and regressed, per sample, on the force (smoothed by a centred running mean):
-  a cubic, a hysteresis proportional to the force that flips with the direction of motion (friction at the
-  guide), and the force minus its low-passed copies with time constants of 2, 8 and 32 s (a slow relaxation
-  of the joint's backbone makes the angle follow the force's history: not a delay). A constant step between
-  the directions is *not* allowed: a delay makes one, and would hide in it. The lag minimising the residual
+  a cubic, a step and a hysteresis proportional to the force that flip with the direction of motion
+  (friction in the joint, at the guide), and the force minus its low-passed copies with time constants of
+  2, 8 and 32 s (a slow relaxation of the joint's backbone makes the angle follow the force's history: not
+  a delay). The step also absorbs what a delay does at constant speed, so the lag is resolved by the parts
+  of the record where the speed changes (ramps that start and stop smoothly, reversals, dwells); on a
+  constant-speed triangle it is usually not resolved and not corrected. The lag minimising the residual
   is refined by a parabola through the best three shifts. Its standard error is the spread of the same
   estimate over blocks of
   cycles (``sd / sqrt(blocks)``). It is a property of the instruments: it is corrected (the angle read
-  ``lag`` later) when it exceeds three standard errors and a quarter of the sampling interval, or when the
+  ``lag`` later) when it exceeds three standard errors and a quarter of the sampling interval, is a minimum inside
+  the range tried (+-250 ms) and lowers the regression's residual RMS by :data:`MIN_FALL` (2 %), or when the
   user gives ``--lag-ms``, and it is never offered as an effect of the joint.
 """
 from __future__ import annotations
@@ -40,6 +43,8 @@ from camtube.model.data.dataset import Dataset
 SPIKE_Z = 8.0
 #: Neighbours either side whose range a row is compared with.
 NEIGHBOURS = 2
+#: A lag is corrected only when it lowers the residual RMS of the lag regression by this fraction.
+MIN_FALL = 0.02
 #: A sampling interval this far off the sample's median is a rate change.
 RATE_CHANGE = 0.2
 
@@ -56,12 +61,15 @@ class Lag:
         The user gave the lag (``--lag-ms``): no estimate.
     applied_ms : float
         The lag corrected (0 when none was).
+    fall : float
+        Relative fall of the residual RMS of the lag regression from no lag to the estimate.
     """
 
     lag_ms: float
     se_ms: float
     given: bool = False
     applied_ms: float = 0.0
+    fall: float = 0.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -123,7 +131,9 @@ class Instruments:
                        f"(an instrument property, not the joint's); corrected: the angle is read {lg.applied_ms:.3g}"
                        " ms later (--lag-ms 0 to keep it)")
         else:
-            out.append(f"angle lag: {lg.lag_ms:.2g} +- {lg.se_ms:.2g} ms against the load cell: none to correct")
+            out.append(f"angle lag: {lg.lag_ms:.2g} +- {lg.se_ms:.2g} ms against the load cell: none to correct"
+                       if math.isfinite(lg.se_ms) else "angle lag: not resolved by these data (no minimum within "
+                       "+-250 ms): none corrected; give --lag-ms if it is known")
         return out
 
 
@@ -169,8 +179,27 @@ def _rates(data: Dataset) -> tuple[dict, tuple]:
 
 #: Time constants (s) of the low-passed force regressors that absorb a slow relaxation of the joint.
 RELAX_TAUS_S = (2.0, 8.0, 32.0)
-#: Rows of the centred running mean of the force in the lag regression.
-SMOOTH_ROWS = 9
+#: Widths (fractions of the force's range) of the play operators that absorb friction in the joint (it holds
+#: the angle while the force reverses, which a delay would otherwise be fitted to).
+STICK_WIDTHS = (0.01, 0.03, 0.08)
+#: Width (s) of the centred running mean of the force in the lag regression (short against the motion: a
+#: wide one flattens the force's turning points, which a shift of the angle then mimics).
+SMOOTH_S = 0.1
+
+
+def _play(x: np.ndarray, width: float) -> np.ndarray:
+    """Play (backlash) operator of ``x`` (n,) with full width ``width``: the output follows ``x`` only once
+    ``x`` has moved ``width`` from where it last pushed it."""
+    out = np.empty_like(x)
+    y = float(x[0])
+    h = 0.5 * width
+    for i, v in enumerate(x.tolist()):
+        if v > y + h:
+            y = v - h
+        elif v < y - h:
+            y = v + h
+        out[i] = y
+    return out
 
 
 def _lag_design(data: Dataset) -> list:
@@ -183,15 +212,18 @@ def _lag_design(data: Dataset) -> list:
     direction = data.direction
     for _, sl in data.sample_slices():
         f = data.force_N[sl]
-        if f.size > SMOOTH_ROWS:  # a centred running mean: less force noise in the regressors, no shift in time
-            f = np.convolve(np.pad(f, SMOOTH_ROWS // 2, mode="edge"), np.ones(SMOOTH_ROWS) / SMOOTH_ROWS, "valid")
-        x = (f - f.mean()) / (f.std() or 1.0)
         dt = float(np.median(np.diff(data.time_s[sl]))) if f.size > 1 else 1.0
-        # a cubic of the force, and a hysteresis proportional to it (friction at the guide: the cell reads a
-        # tension that differs from the joint's by a ratio that flips with the direction); not a constant
-        # step between directions, which a delay also makes and would absorb it
+        k = 2 * int(SMOOTH_S / max(dt, 1e-9) / 2) + 1
+        if 1 < k < f.size:  # a centred running mean: less force noise in the regressors, no shift in time
+            f = np.convolve(np.pad(f, k // 2, mode="edge"), np.ones(k) / k, "valid")
+        x = (f - f.mean()) / (f.std() or 1.0)
+        # a cubic of the force, a step (friction in the joint) and a hysteresis proportional to the force
+        # (friction at the guide: the cell reads a tension that differs from the joint's by a ratio) that flip
+        # with the direction of motion
         dirn = direction[sl].astype(float)
-        cols = [np.ones_like(x), x, x * x, x ** 3, dirn * x]
+        cols = [np.ones_like(x), x, x * x, x ** 3, dirn * x, dirn]
+        for w in STICK_WIDTHS:  # friction that holds the joint while the force reverses: a play of the force
+            cols.append(_play(x, w * float(np.ptp(x))) - x)
         for tau in RELAX_TAUS_S:
             a = math.exp(-dt / tau)
             lp = lfilter([1.0 - a], [1.0, -a], x, zi=[a * x[0]])[0]
@@ -220,14 +252,21 @@ def _lag_of(data: Dataset, design: list, rows: np.ndarray, lo: int, hi: int) -> 
     """Lag (rows) minimising :func:`_lag_sse` over whole-row shifts ``lo .. hi``, refined by a parabola through
     the best three (whole rows: interpolating between rows would average the noise and favour half-row
     shifts)."""
+    return _lag_scan(data, design, rows, lo, hi)[0]
+
+
+def _lag_scan(data: Dataset, design: list, rows: np.ndarray, lo: int, hi: int) -> tuple[float, bool, float]:
+    """``(lag in rows, interior minimum?, relative fall of the residual RMS from no shift to the best)``."""
     shifts = np.arange(lo, hi + 1)
     sse = np.array([_lag_sse(data, design, int(k), rows) for k in shifts])
     k = int(np.argmin(sse))
+    zero = sse[shifts == 0][0] if (shifts == 0).any() else sse[k]
+    fall = 1.0 - math.sqrt(sse[k] / zero) if zero > 0 else 0.0
     if 0 < k < sse.size - 1:
         y0, y1, y2 = sse[k - 1], sse[k], sse[k + 1]
         den = y0 - 2 * y1 + y2
-        return float(shifts[k] + (0.5 * (y0 - y2) / den if den > 0 else 0.0))
-    return float(shifts[k])
+        return float(shifts[k] + (0.5 * (y0 - y2) / den if den > 0 else 0.0)), True, fall
+    return float(shifts[k]), False, fall
 
 
 def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_ms: float = 250.0) -> Lag:
@@ -247,11 +286,11 @@ def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_
     n = len(data)
     dt = float(np.median(np.diff(data.time_s))) if n > 1 else 1.0
     dt = dt if dt > 0 else 1.0
-    max_shift = max(2, int(round(max_lag_ms * 1e-3 / dt)))
+    max_shift = max(3, int(round(max_lag_ms * 1e-3 / dt)))
     step = max(1, n // max_rows)
     rows = np.arange(0, n, step)
     design = _lag_design(data)
-    est = _lag_of(data, design, rows, -max_shift, max_shift)
+    est, interior, fall = _lag_scan(data, design, rows, -max_shift, max_shift)
     near = int(round(est))
     per = []
     cyc = data.cycle
@@ -264,7 +303,9 @@ def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_
             if r.size >= 100:
                 per.append(_lag_of(data, design, r, near - 3, near + 3))
     se = float(np.std(per, ddof=1) / math.sqrt(len(per))) if len(per) > 1 else float("inf")
-    return Lag(est * dt * 1e3, se * dt * 1e3)
+    if not interior:  # no minimum inside the range tried: not a delay the data resolve
+        se = float("inf")
+    return Lag(est * dt * 1e3, se * dt * 1e3, fall=fall)
 
 
 def shift_angle(data: Dataset, lag_ms: float) -> tuple[Dataset, np.ndarray]:
@@ -319,8 +360,8 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     else:
         lag = estimate_lag(clean)
         dt_ms = 1e3 / max(np.median(list(rates.values())) if rates else 1.0, 1e-9)
-        if abs(lag.lag_ms) > 3.0 * lag.se_ms and abs(lag.lag_ms) > 0.25 * dt_ms:
-            lag = Lag(lag.lag_ms, lag.se_ms, applied_ms=lag.lag_ms)
+        if abs(lag.lag_ms) > 3.0 * lag.se_ms and abs(lag.lag_ms) > 0.25 * dt_ms and lag.fall >= MIN_FALL:
+            lag = Lag(lag.lag_ms, lag.se_ms, applied_ms=lag.lag_ms, fall=lag.fall)
     shifted, k2 = shift_angle(clean, lag.applied_ms)
     idx = np.flatnonzero(kept)
     kept[idx[~k2]] = False
