@@ -38,7 +38,7 @@ FAMILIES = {
     "toe": (TOES, None),
     "slack": ({"slack"}, None),
     "lost motion": ({"slack", "play"}, None),
-    "creep": ({"creep"}, None),
+    "creep": ({"creep", "viscoelastic"}, None),  # a slow viscoelastic element and creep: known equivalents
     "backbone": (set(), None),
     "zero drift": (set(), "time"),
     "lag": (set(), None),

@@ -8,14 +8,14 @@ The chain, per time step ``dt`` (the logger's own row times, 25-100 Hz):
 
 * **motor + lead screw** (:class:`Drive`): the motor follows the commanded profile (raised-cosine ramps,
   a dwell at the top, a rest at zero; the first cycle dwells longer). The nut drives a carriage through a
-  lug with a gap ``backlash_mm``. The tendon pulls the carriage back against the nut; while the tension
-  exceeds the rail's friction the lug stays on the pushing flank, below it the carriage sticks and the
-  retreating nut opens the gap, which the next pull must close: lost motion that appears only after an
-  unloading to low tension (never in the first pull).
+  lug with a gap ``backlash_mm``. The tendon pulls the carriage back onto the nut's pushing flank while the
+  tension exceeds the rail's friction; below it, on unloading, the carriage stays where it is while the
+  nut retreats (up to the gap), so the joint rests slightly bent and the next pull first takes the gap up:
+  lost motion at the bottom of the stroke that the first pull (from a carriage on the flank) does not have.
 * **load cell** on the carriage (:class:`LoadCell`): tension at the carriage, plus a zero that can wander
   (a slow thermal ramp plus a random walk), plus white noise.
 * **guide** (:class:`Guide`): the tendon wraps a pin; capstan friction ``exp(mu wrap)`` between the load
-  cell's side and the joint's side, its sign following the tendon's sliding.
+  cell's side and the joint's side, its sign following the tendon's sliding (held while the carriage rests).
 * **braided tendon** (:class:`Tendon`): a bundle of fibres of equal stiffness with crimp lengths drawn
   from a gamma distribution (the toe: fibres become taut one by one); an optional loose length (slack);
   a power-law, strain-hardening creep ``de/dt = A (T/T1)^n / (1 + e/e_sat)^2`` that never recovers.
@@ -275,6 +275,7 @@ def _run_sample(pattern: Pattern, b: SampleBench, t: np.ndarray, motor: np.ndarr
     tension = 0.0
     cell = 0.0
     v_prev = 0.0
+    slide = 0.0
     carriage_prev = 0.0
     out_theta = np.zeros(n)
     out_cell = np.zeros(n)
@@ -305,7 +306,8 @@ def _run_sample(pattern: Pattern, b: SampleBench, t: np.ndarray, motor: np.ndarr
         alpha = arm / k_tot
         beta = (k_notch * set_n - q_carry) / k_tot
         a_sum, b_sum = float(alpha.sum()), float(beta.sum())
-        slide = math.tanh(v / 0.05)
+        if abs(v) > 1e-6:  # sliding at the guide: friction in the direction of motion; at rest it holds its state
+            slide = math.tanh(v / 0.05)
         ratio = ewrap ** slide          # cell tension / joint tension
 
         def gap(tj: float) -> float:
