@@ -425,13 +425,47 @@ def model_png(d: Diagnosis, max_samples: int = 4) -> bytes:
                 label="current model" + (f" + {', '.join(d.baseline)} (baseline)" if d.baseline else ""))
         if final is not base:
             ax.plot(st, final.predicted[s], "-", lw=0.7, color="black",
-                    label="+ " + ", ".join(d.recommended))
+                    label="+ " + ", ".join(d.recommended) + (f" ({d.explanation})" if d.explanation else ""))
+        elif d.partial and d.partial_steps:
+            ax.plot(st, d.partial_steps[-1].predicted[s], "--", lw=0.7, color="tab:blue",
+                    label="+ " + ", ".join(d.partial) + " (partial, not recommended)")
         ax.set_title(f"sample {smp}: RMSE {base.rmse_per_sample[smp]:.2f} -> {final.rmse_per_sample[smp]:.2f} deg",
                      fontsize=9)
         ax.set_xlabel("stroke (mm)")
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("joint angle (deg)")
     axes[0].legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    return _png(fig)
+
+
+def artefacts_png(d: Diagnosis, max_samples: int = 4) -> bytes | None:
+    """Angle against time per sample as read, with the rows the instruments' check set aside marked (``None``
+    without an instruments' check)."""
+    ins = d.instruments
+    if ins is None:
+        return None
+    raw = ins.raw
+    sl = raw.sample_slices()[:max_samples]
+    fig = _figure(13.0, 2.4 * len(sl) + 0.6)
+    axes = np.atleast_1d(fig.subplots(len(sl), 1, squeeze=False)[:, 0])
+    marks = {"angle spike": ("x", "tab:red"), "force spike": ("+", "tab:purple"),
+             "repeated time stamp": ("|", "tab:orange")}
+    for ax, (smp, s) in zip(axes, sl):
+        t = raw.time_s[s]
+        ax.plot(t, raw.angle_deg[s], "-", lw=0.4, color="0.55", label="angle as read", rasterized=True)
+        for why, rows in ins.aside.items():
+            r = rows[(rows >= s.start) & (rows < s.stop)]
+            if r.size:
+                m, c = marks.get(why, ("o", "black"))
+                ax.plot(raw.time_s[r], raw.angle_deg[r], m, ms=6, color=c, label=f"{why} ({r.size}), set aside")
+        ax.set_ylabel(f"{smp}: angle (deg)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper right")
+    axes[-1].set_xlabel("time (s)")
+    lag = ins.lag
+    axes[0].set_title(f"rows read {len(raw)}; set aside {ins.n_aside}; dropped before (missing values, backward "
+                      f"stamps) {ins.n_dropped}; angle lag corrected {lag.applied_ms:.3g} ms", fontsize=9)
     fig.tight_layout()
     return _png(fig)
 
@@ -516,6 +550,9 @@ def report_files(d: Diagnosis, command: str = "", title: str = "camtube diagnosi
     """``{file name: bytes}`` of the report: four PNGs and ``index.html`` (self-contained, offline)."""
     files = {"model.png": model_png(d), "atlas.png": atlas_png(d), "ranking.png": ranking_png(d),
              "waterfall.png": waterfall_png(d)}
+    art = artefacts_png(d)
+    if art is not None:
+        files["artefacts.png"] = art
     esc = html.escape
     rows = []
     for k, c in enumerate(d.candidates, 1):
@@ -532,18 +569,24 @@ def report_files(d: Diagnosis, command: str = "", title: str = "camtube diagnosi
 white-space:pre-wrap}}table{{border-collapse:collapse;font-size:90%}}td,th{{border:1px solid #ccc;padding:2px 6px}}
 img{{max-width:100%}}</style></head><body>
 <h1>{esc(title)}</h1>
-<pre>{esc(diagnosis_text(d, command))}</pre>
-{unexplained_report.html_section(d)}<h2>Model vs measurement</h2><img src="model.png" alt="angle vs stroke">
-<h2>Residual atlas</h2>
-<p>Residual (measured - model) against each variable; lines are binned medians, the band the quartiles of the
-current model; dashed/dotted: loading/unloading.</p><img src="atlas.png" alt="residual atlas">
-<h2>Candidate ranking</h2><img src="ranking.png" alt="ranking">
+<h2>Answer</h2>
+<pre>{esc(chr(10).join(answer_lines(d)))}</pre>
+{("<p>Add them: <code>" + esc(add_command(d, command)) + "</code></p>") if d.recommended and add_command(d, command) else ""}
+<h2>Model vs measurement</h2><p>Measured angle, the current model and the model with the recommended effects
+(or, when nothing is recommended, the partial effects, dashed).</p><img src="model.png" alt="angle vs stroke">
+<h2>Waterfall</h2><p>RMSE as the recommended effects are added, refitted on all rows.</p>
+<img src="waterfall.png" alt="waterfall">
+{'<h2>Instruments</h2><p>The angle as read; the rows set aside before fitting are marked.</p><img src="artefacts.png" alt="artefacts">' if art is not None else ""}
+{unexplained_report.html_section(d)}<h2>Candidates</h2><img src="ranking.png" alt="ranking">
 <table><tr><th>#</th><th>effect</th><th>held-out RMSE deg</th><th>RMSE deg</th><th>delta BIC</th>
 <th>parameters</th><th>verdict</th></tr>
 {chr(10).join(rows)}
 </table>
-<h2>Waterfall</h2><p>RMSE as the recommended effects are added, refitted on all rows.</p>
-<img src="waterfall.png" alt="waterfall">
+<h2>Residual atlas</h2>
+<p>Residual (measured - model) against each variable; lines are binned medians, the band the quartiles of the
+current model; dashed/dotted: loading/unloading.</p><img src="atlas.png" alt="residual atlas">
+<h2>The diagnosis in full</h2>
+<pre>{esc(diagnosis_text(d, command))}</pre>
 </body></html>
 """
     files["index.html"] = page.encode("utf-8")
