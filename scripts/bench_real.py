@@ -142,9 +142,16 @@ def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
         if kinds[0] != kinds[1]:
             ok = bool(rec_list) and set(rec_list) >= {next(iter(FAMILIES[k][0] & set(rec_list)), None) or "?" for k in kinds}
     floor_ok = abs(d.noise_floor_deg / floor_true - 1.0) <= 0.2
+    from camtube.model.unexplained import report as unexplained_report
+
+    u = unexplained_report.of_diagnosis(d)
+    left = (u.get("follows") or ["-"])[0] if u else "-"
+    want = FAMILIES[kinds[0]][1]
+    if want is not None:  # the library lacks it: nothing of a wrong family, and what is left follows `want`
+        ok = ok and left == want
     out = dict(name=name, tube=tube, rate=rate, rows=len(rec.data), first=first, recommended=rec_list,
                partial=list(d.partial), explanation=d.explanation, base=d.waterfall[0].rmse_deg, final=final, floor_est=d.noise_floor_deg,
-               floor_true=floor_true, floor_ok=floor_ok, lag_true=lag_true, lag_est=ins.lag.lag_ms,
+               floor_true=floor_true, floor_ok=floor_ok, left=left, lag_true=lag_true, lag_est=ins.lag.lag_ms,
                lag_se=ins.lag.se_ms, lag_applied=ins.lag.applied_ms, n_aside=ins.n_aside,
                n_dropped=meas.missing_lines.size, spikes_true=len(rec.spike_rows), ok=ok,
                s_instruments=t1 - t0, s_diagnose=t2 - t1)
@@ -153,7 +160,7 @@ def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
               f" {d.explanation or '-':8s} partial {','.join(d.partial) or '-':18s} RMSE {out['base']:.3f} -> {final:.3f} deg ({final / floor_true:.2f} x true floor; partial chain "
               f"{(d.partial_steps[-1].rmse_deg / floor_true) if d.partial else float('nan'):.2f} x) | floor est "
               f"{d.noise_floor_deg:.3f} true {floor_true:.3f} ({'ok' if floor_ok else 'OFF'}) | lag {lag_true:.0f} -> "
-              f"{ins.lag.lag_ms:.1f}+-{ins.lag.se_ms:.1f} ms (applied {ins.lag.applied_ms:.1f}) | aside {ins.n_aside} "
+              f"{ins.lag.lag_ms:.1f}+-{ins.lag.se_ms:.1f} ms (applied {ins.lag.applied_ms:.1f}) | left follows {left} | aside {ins.n_aside} "
               f"(spikes {len(rec.spike_rows)}), dropped {meas.missing_lines.size} | {'RIGHT' if ok else 'wrong'} | "
               f"{t1 - t0:.1f}+{t2 - t1:.1f} s", flush=True)
     return out

@@ -125,11 +125,12 @@ class Instruments:
         out.extend(self.rate_changes)
         lg = self.lag
         if lg.given:
-            out.append(f"angle lag: {lg.applied_ms:.4g} ms as given (--lag-ms); the angle is read that much later")
+            out.append(f"angle lag: {lg.lag_ms:.4g} ms as given (--lag-ms); the angle is read {lg.applied_ms:.4g} ms "
+                       "later (whole rows)")
         elif lg.applied_ms:
             out.append(f"angle lag: the tracker lags the load cell by {lg.lag_ms:.3g} +- {lg.se_ms:.2g} ms "
                        f"(an instrument property, not the joint's); corrected: the angle is read {lg.applied_ms:.3g}"
-                       " ms later (--lag-ms 0 to keep it)")
+                       " ms later (whole rows; --lag-ms 0 to keep it)")
         else:
             out.append(f"angle lag: {lg.lag_ms:.2g} +- {lg.se_ms:.2g} ms against the load cell: none to correct"
                        if math.isfinite(lg.se_ms) else "angle lag: not resolved by these data (no minimum within "
@@ -181,7 +182,7 @@ def _rates(data: Dataset) -> tuple[dict, tuple]:
 RELAX_TAUS_S = (2.0, 8.0, 32.0)
 #: Widths (fractions of the force's range) of the play operators that absorb friction in the joint (it holds
 #: the angle while the force reverses, which a delay would otherwise be fitted to).
-STICK_WIDTHS = (0.01, 0.03, 0.08)
+STICK_WIDTHS = (0.01, 0.03)
 #: Width (s) of the centred running mean of the force in the lag regression (short against the motion: a
 #: wide one flattens the force's turning points, which a shift of the angle then mimics).
 SMOOTH_S = 0.1
@@ -308,20 +309,36 @@ def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_
     return Lag(est * dt * 1e3, se * dt * 1e3, fall=fall)
 
 
-def shift_angle(data: Dataset, lag_ms: float) -> tuple[Dataset, np.ndarray]:
-    """``data`` with the angle read ``lag_ms`` later (linear interpolation within each sample); rows whose
-    shifted time leaves the sample's record are dropped (returned mask of kept rows)."""
+def shift_angle(data: Dataset, lag_ms: float) -> tuple[Dataset, np.ndarray, float]:
+    """``data`` with the angle read ``lag_ms`` later, by whole rows of each sample (interpolating between rows
+    would average the tracker's noise and hide it from the noise floor); the rows at the end whose later angle
+    is past the record are dropped.
+
+    Returns
+    -------
+    data : Dataset
+    kept : (n,) bool
+        Rows of the input kept.
+    applied_ms : float
+        The shift applied: whole rows times the median sampling interval (within half a row of ``lag_ms``).
+    """
     if lag_ms == 0.0:
-        return data, np.ones(len(data), bool)
+        return data, np.ones(len(data), bool), 0.0
     ang = data.angle_deg.copy()
     keep = np.ones(len(data), bool)
-    tau = lag_ms * 1e-3
+    applied = []
     for _, sl in data.sample_slices():
         t = data.time_s[sl]
-        ts = t + tau
-        ang[sl] = np.interp(ts, t, data.angle_deg[sl])
-        keep[sl] = (ts >= t[0]) & (ts <= t[-1])
-    return data.with_angle(ang).take(keep), keep
+        dt = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+        k = int(round(lag_ms * 1e-3 / dt)) if dt > 0 else 0
+        applied.append(k * dt * 1e3)
+        if k == 0:
+            continue
+        idx = np.arange(sl.start, sl.stop)
+        src = np.clip(idx + k, sl.start, sl.stop - 1)
+        ang[idx] = data.angle_deg[src]
+        keep[idx] = (idx + k >= sl.start) & (idx + k < sl.stop)
+    return data.with_angle(ang).take(keep), keep, float(np.mean(applied))
 
 
 def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str = "", n_dropped: int = 0,
@@ -356,13 +373,15 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     clean = data.take(kept)
     rates, notes = _rates(clean)
     if lag_ms is not None:
-        lag = Lag(float(lag_ms), 0.0, given=True, applied_ms=float(lag_ms))
+        lag = Lag(float(lag_ms), 0.0, given=True, applied_ms=float(lag_ms))  # whole rows below
     else:
         lag = estimate_lag(clean)
         dt_ms = 1e3 / max(np.median(list(rates.values())) if rates else 1.0, 1e-9)
         if abs(lag.lag_ms) > 3.0 * lag.se_ms and abs(lag.lag_ms) > 0.25 * dt_ms and lag.fall >= MIN_FALL:
             lag = Lag(lag.lag_ms, lag.se_ms, applied_ms=lag.lag_ms, fall=lag.fall)
-    shifted, k2 = shift_angle(clean, lag.applied_ms)
+    shifted, k2, applied = shift_angle(clean, lag.applied_ms)
+    if lag.applied_ms:
+        lag = Lag(lag.lag_ms, lag.se_ms, lag.given, applied, lag.fall)
     idx = np.flatnonzero(kept)
     kept[idx[~k2]] = False
     if (~k2).any():
