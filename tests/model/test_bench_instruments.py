@@ -83,7 +83,7 @@ def test_the_tracker_lag_is_estimated_within_its_uncertainty_and_corrected(tube2
     assert math.isfinite(ins.lag.se_ms) and ins.lag.se_ms < 5.0
     assert abs(ins.lag.lag_ms - lag_ms) < max(3.0 * ins.lag.se_ms, 3.0)
     if lag_ms:
-        assert ins.lag.applied_ms == ins.lag.lag_ms
+        assert abs(ins.lag.applied_ms - ins.lag.lag_ms) <= 10.0 + 1e-9  # whole rows at 50 Hz
         # corrected, the paper's model fits at the floor again; uncorrected it does not
         model, fixed = model_for_pattern(tube2), pattern_values(tube2)
         after = fit(model, ins.data, ["E_t"], fixed).rmse
