@@ -85,7 +85,6 @@ others are ratios of errors or multiples of standard errors.
 from __future__ import annotations
 
 import math
-import weakref
 import time
 from dataclasses import dataclass, field, replace
 from typing import Mapping, Sequence
@@ -96,7 +95,7 @@ from camtube.model.core.fit import FitResult, fit
 from camtube.model.core.model import Effect, JointModel
 from camtube.model.core.registry import Registry, builtin_registry
 from camtube.model.data.csvfile import check_fittable
-from camtube.model.data.dataset import Dataset
+from camtube.model.data.dataset import Cache, Dataset
 
 #: Parameter correlation above which two parameters cannot be told apart.
 CORR_LIMIT = 0.99
@@ -252,6 +251,8 @@ class Diagnosis:
         rows set aside, the angle's lag; set by the caller.
     explanation : str
         ``complete`` or ``partial`` (see :func:`explanation_label`) when something is recommended, else ``""``.
+    cache : Cache
+        Derived results computed once per diagnosis (the ``unexplained`` analysis); not part of the value.
     seconds : dict
         Wall time of the parts (not written to JSON: output is deterministic).
     """
@@ -285,6 +286,7 @@ class Diagnosis:
     dropped: tuple = ()
     explanation: str = ""
     instruments: object = None
+    cache: Cache = field(default_factory=Cache, init=False, compare=False, repr=False)
 
     @property
     def candidates(self) -> tuple:
@@ -498,19 +500,18 @@ def _names_for(model: JointModel, fit_params: Sequence[str]) -> tuple:
     return tuple(dict.fromkeys(out))
 
 
-_SCALES: "weakref.WeakKeyDictionary[Dataset, tuple]" = weakref.WeakKeyDictionary()
 
 
 def _resolution_scales(data: Dataset) -> tuple[float, float, float]:
     """``(sample interval s, record length s, stroke span mm)`` of ``data``, cached per Dataset."""
-    hit = _SCALES.get(data)
+    hit = data.cache.get("search.resolution_scales")
     if hit is None:
         t = np.asarray(data.time_s, float)
         dts = [np.median(np.diff(t[sl])) for _, sl in data.sample_slices() if sl.stop - sl.start > 2]
         dt = float(np.median(dts)) if dts else 0.0
         record = max((float(np.ptp(t[sl])) for _, sl in data.sample_slices()), default=0.0)
         span = float(np.ptp(np.asarray(data.stroke_mm, float))) if len(data) else 0.0
-        hit = _SCALES[data] = (dt, record, span)
+        hit = data.cache.set("search.resolution_scales", (dt, record, span))
     return hit
 
 

@@ -7,16 +7,12 @@
 from __future__ import annotations
 
 import math
-import weakref
 
 import numpy as np
 
 from camtube.model.data.dataset import Dataset
 
 # speed: derived per-Dataset data, cached (fits evaluate the model hundreds of times on the same rows)
-_SEGMENTS: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
-_SEG_ARRAYS: "weakref.WeakKeyDictionary[Dataset, tuple]" = weakref.WeakKeyDictionary()
-_SAMPLING: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
 
 
 def monotone_segments(data: Dataset) -> list[tuple[int, int, int, bool]]:
@@ -24,7 +20,7 @@ def monotone_segments(data: Dataset) -> list[tuple[int, int, int, bool]]:
 
     Cached per :class:`Dataset` object (the fit evaluates the model many times on the same rows).
     """
-    hit = _SEGMENTS.get(data)
+    hit = data.cache.get("history.segments")
     if hit is not None:
         return hit
     d = data.direction
@@ -36,13 +32,13 @@ def monotone_segments(data: Dataset) -> list[tuple[int, int, int, bool]]:
         stops = np.concatenate((cut, [dd.size]))
         for k, (a, b) in enumerate(zip(starts, stops)):
             out.append((sl.start + int(a), sl.start + int(b), int(dd[a]), k == 0))
-    _SEGMENTS[data] = out
+    data.cache.set("history.segments", out)
     return out
 
 
 def _segment_arrays(data: Dataset) -> tuple:
     """Cached ``(starts, stops, dirs, firsts, lengths, row_dir)`` of :func:`monotone_segments` as arrays/lists."""
-    hit = _SEG_ARRAYS.get(data)
+    hit = data.cache.get("history.segment_arrays")
     if hit is None:
         segs = monotone_segments(data)
         starts = np.array([s[0] for s in segs], np.int64)
@@ -50,7 +46,7 @@ def _segment_arrays(data: Dataset) -> tuple:
         dirs = [s[2] for s in segs]
         firsts = [s[3] for s in segs]
         hit = (starts, stops, dirs, firsts, stops - starts, np.repeat(np.array(dirs, np.int64), stops - starts))
-        _SEG_ARRAYS[data] = hit
+        data.cache.set("history.segment_arrays", hit)
     return hit
 
 
@@ -85,7 +81,7 @@ def play_operator(data: Dataset, x: np.ndarray, width_mm: float) -> np.ndarray:
 
 def _sampling(data: Dataset) -> list:
     """Cached per sample: ``(slice, h, uniform, dt)`` (median step, whether the sampling is uniform)."""
-    hit = _SAMPLING.get(data)
+    hit = data.cache.get("history.sampling")
     if hit is None:
         t = np.asarray(data.time_s, float)
         hit = []
@@ -94,7 +90,7 @@ def _sampling(data: Dataset) -> list:
             h = float(np.median(dt)) if dt.size else 0.0
             uniform = bool(dt.size and h > 0 and np.all(np.abs(dt - h) <= 1e-6 * h + 1e-12))
             hit.append((sl, h, uniform, dt))
-        _SAMPLING[data] = hit
+        data.cache.set("history.sampling", hit)
     return hit
 
 
