@@ -8,7 +8,10 @@ corrected), then ``diagnose`` runs on the rows kept.
 
 Run: ``python scripts/bench_diagnose.py --batch bench`` (the sets the method was tuned on) or
 ``--batch bench-heldout`` (drawn once the method was settled, from a seed not used before; see
-docs/diagnose.md for when it was run).
+docs/diagnose.md for when it was run); or ``python scripts/bench_real.py bench bench-heldout``.
+Each prints, per file, what was recommended, the RMSE before/after against the true floor, the noise-floor
+estimate against the truth, the lag, the rows set aside, and the seconds (instruments + diagnosis); then the
+count right and the seconds per 60,000-row file.
 """
 from __future__ import annotations
 
@@ -110,7 +113,11 @@ def draw_batch(seed: int, kinds: list) -> list:
 
 TUNE_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
               ("toe", "creep"), "friction"]
-BATCHES = {"bench": (20261124, TUNE_KINDS)}
+#: The fresh held-out batch: drawn once the method was settled (commit after the search object), from a seed
+#: not used before, with another pair of mechanisms in one file; run once, reported separately.
+HELDOUT_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
+                 ("slack", "toe"), "friction"]
+BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS)}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
@@ -135,7 +142,13 @@ def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
     for k in kinds:
         right |= FAMILIES[k][0]
     first = rec_list[0] if rec_list else "-"
-    if not right:
+    if kinds[0] == "lag":
+        # an instrument property: found and corrected (within 3 standard errors or 20 %), never offered as a
+        # joint effect; the secondary mechanisms may still be explained, to the floor
+        lag_ok = (ins.lag.applied_ms > 0 and abs(ins.lag.applied_ms - benches[0].tracker.lag_ms)
+                  <= max(3.0 * ins.lag.se_ms, 0.2 * benches[0].tracker.lag_ms))
+        ok = lag_ok and (not rec_list or final <= 1.15 * floor_true)
+    elif not right:
         ok = not rec_list
     else:
         ok = bool(rec_list) and rec_list[0] in right and final <= 1.15 * floor_true
