@@ -191,8 +191,23 @@ def run_batch(name: str) -> list:
     return res
 
 
+def write_file(batch: str, kind: str, path: str) -> None:
+    """Write the file of ``kind`` (its name in the batch's table) of ``batch`` as CSV, as a lab would have it."""
+    seed, kinds = BATCHES[batch]
+    spec = next(s for s in draw_batch(seed, kinds) if s[0] == kind)
+    name, tube, rate, benches, _, sim_seed = spec
+    pattern = load_pattern(ROOT / "patterns" / f"{tube}.yaml")
+    rec = simulate_bench(pattern, benches, protocol_for(rate), Clock(rate_hz=rate), seed=sim_seed)
+    Path(path).write_text(format_csv(rec.data))
+    print(f"wrote {path}: {name}, {tube}, {rate:g} Hz, {len(rec.data)} rows; true floor {rec.floor_deg:.3f} deg, "
+          f"spikes {len(rec.spike_rows)}, missing angles {len(rec.dropout_rows)}")
+
+
 if __name__ == "__main__":
     import sys
 
-    for b in sys.argv[1:] or ["bench"]:
-        run_batch(b)
+    if sys.argv[1:2] == ["--write"]:  # --write BATCH KIND OUT.csv
+        write_file(*sys.argv[2:5])
+    else:
+        for b in sys.argv[1:] or ["bench"]:
+            run_batch(b)
