@@ -29,9 +29,9 @@ def main() -> int:
     from camtube.design.loader import load_pattern
     from camtube.io import write_atomic
     from camtube.model.data import format_csv, load_csv, prepare
-    from camtube.model.fit import fit
-    from camtube.model.predict import model_for_pattern, pattern_values
-    from camtube.model.synth import noise_floor_deg, synthesize
+    from camtube.model.core.fit import fit
+    from camtube.model.core.predict import model_for_pattern, pattern_values
+    from camtube.model.sim.synth import noise_floor_deg, synthesize
 
     cold = True
     worst = 0.0

@@ -15,10 +15,10 @@ def main() -> int:
     from camtube.design.loader import load_pattern
     from camtube.io import write_atomic
     from camtube.model.data import prepare, remove_deadband
-    from camtube.model.fit import fit
-    from camtube.model.plot import fit_png
-    from camtube.model.predict import model_for_pattern, pattern_values
-    from camtube.model.synth import synthesize
+    from camtube.model.core.fit import fit
+    from camtube.model.report.plot import fit_png
+    from camtube.model.core.predict import model_for_pattern, pattern_values
+    from camtube.model.sim.synth import synthesize
 
     p = load_pattern(ROOT / "patterns" / "tube2.yaml")
     data = synthesize(p, seed=0)

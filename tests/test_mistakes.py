@@ -41,7 +41,7 @@ def test_a_nested_key_given_twice_too(tmp_path):
     assert_refused(camtube("design", str(p)), "'count' is given twice")
 
 
-@pytest.mark.parametrize("form", ["5e-1", "5E-1", "0.5", "5.0e-1", "+5e-1"])
+@pytest.mark.parametrize("form", ["5e-1", "5E-1", "0.5", "5.0e-1", "+5e-1", ".5e0", "5_0e-2"])
 def test_every_yaml_number_form_is_a_number(tmp_path, form):
     p = tmp_path / "p.yaml"
     p.write_text(pattern_text(width=form))

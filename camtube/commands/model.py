@@ -1,4 +1,4 @@
-"""CLI of the model stage: ``camtube model fit`` and ``camtube model synth``.
+"""CLI of the model stage: ``camtube model fit``, ``camtube model synth`` and ``camtube model ingest``.
 
 ``register(sub)`` adds the ``model`` command and its own sub-commands; other
 modules add theirs to the same group: if :mod:`camtube.commands.diagnose`
@@ -88,6 +88,29 @@ def register(sub) -> None:
     s.add_argument("--modulus", type=float, default=None, metavar="GPA",
                    help="tendon E_t used to generate, GPa (default: the pattern's)")
     s.set_defaults(func=cmd_synth)
+
+    i = model_sub.add_parser(
+        "ingest", help="turn a bench's raw logs (NDI tracker, load-cell DAQ, motor) into a measurement CSV",
+        description="Read an NDI Aurora/Polaris tool-tracking CSV export, a DAQ log of the load cell and the motor's "
+                    "log; compute the bend angle from the coils' poses, align the three clocks (offset and drift, "
+                    "from a shared trigger or the shared motion), put stroke (mm) and force (N) on the tracker's "
+                    "frames without bridging gaps, number the cycles, and write sample, cycle, time_s, stroke_mm, "
+                    "force_N, angle_deg (deg). See docs/bench.md.")
+    src = i.add_mutually_exclusive_group(required=True)
+    src.add_argument("--tracker", metavar="TRACKER.csv", help="NDI Track CSV export (positions mm)")
+    src.add_argument("--angle-log", metavar="ANGLE.csv",
+                     help="instead of a tracker: a log of the joint angle (deg, or rad with --map angle.unit=rad)")
+    i.add_argument("--daq", required=True, metavar="DAQ.csv", help="load cell log: a time column and a force column")
+    i.add_argument("--motor", required=True, metavar="MOTOR.csv", help="motor log: a time column and a position column")
+    i.add_argument("--bench", metavar="BENCH.yaml", help="bench map: tools, columns, units, calibrations (docs/bench.md)")
+    i.add_argument("--map", dest="map_overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a bench map value, e.g. --map motor.gear_ratio=64 --map daq.N_per_V=2.2; repeatable")
+    i.add_argument("--sample", default=None, metavar="NAME", help="sample name (default: the tracker file's stem)")
+    i.add_argument("--max-lag", type=float, default=None, metavar="S",
+                   help="largest clock offset between instruments to consider, s (default: any)")
+    i.add_argument("-o", "--output", required=True, metavar="DATA.csv", help="the measurement CSV to write")
+    i.add_argument("--report", metavar="DIR", help="write index.html and figures (alignment, angle, dropouts) here")
+    i.set_defaults(func=cmd_ingest)
 
     from camtube.commands import diagnose, effect
 
@@ -192,4 +215,42 @@ def cmd_synth(args: argparse.Namespace) -> int:
     floor = noise_floor_deg(pattern, args.noise_angle, args.noise_force, args.modulus)
     print(f"wrote {path}: {len(data)} rows, {args.samples} sample(s) x {args.cycles} cycles, "
           f"stroke 0-{pattern.rules.max_stroke_mm:g} mm; a perfect fit leaves RMSE ~{floor:.3f} deg")
+    return 0
+
+
+def cmd_ingest(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from camtube.commands.common import check_output_dir
+    from camtube.io import check_writable_dir, write_atomic, write_set
+    from camtube.model.data.csvfile import format_csv
+    from camtube.model.ingest.merge import ingest_files
+    from camtube.model.ingest.series import load_bench_map
+
+    check_suffix(args.output, (".csv",), "-o/--output")
+    if Path(args.output).is_dir():
+        from camtube.errors import DataError
+
+        raise DataError(f"-o {args.output}: is a directory; fix: name the measurement CSV to write")
+    check_writable_dir(Path(args.output).absolute().parent)
+    if args.report:
+        check_output_dir(args.report)
+    bench = load_bench_map(args.bench, args.map_overrides)
+    first = args.tracker or args.angle_log
+    ing = ingest_files(first, args.daq, args.motor, bench, args.sample, max_lag_s=args.max_lag,
+                       angle_log=args.angle_log is not None)
+    text = format_csv(ing.data)
+    files = None
+    if args.report:
+        from camtube.model.ingest.report import report_files
+
+        files = report_files(ing, f"ingest of {Path(first).name}")
+    from camtube.model.ingest.report import summary_lines
+
+    for line in summary_lines(ing):
+        print(line)
+    print(f"wrote {write_atomic(args.output, text)}")
+    if files is not None:
+        write_set(args.report, files)
+        print(f"wrote {Path(args.report) / 'index.html'} (+ alignment.png, angle.png, dropouts.png)")
     return 0

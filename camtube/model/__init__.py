@@ -10,12 +10,13 @@ order data flows through them:
 ``effects``    the built-in effects (slack, play, creep, ...) and their history operators
 ``diagnose``   which effect is missing: the candidate search and the residual atlas
 ``report``     text, JSON, HTML and figures of fits and diagnoses
-``sim``        synthetic data (``model synth``) and the independent truth simulator
+``sim``        synthetic data (``model synth``), the independent truth and bench simulators, raw instrument logs
+``ingest``     the bench's instrument logs (tracker poses, DAQ, motor) to one measurement file (``model ingest``)
 
-``cli`` and ``diagnose_cli`` are the thin command-line layer. ``api`` is the stable import path for
-users' effect files (``from camtube.model.api import Effect, Param``); ``dataset``, ``fit``,
-``predict``, ``synth``, ``truth``, ``atlas``, ``plot`` and ``report_fit`` are compatibility paths of
-the earlier flat layout.
+The command line is :mod:`camtube.commands` (``model``, ``diagnose``, ``effect``). ``api`` is the
+stable import path for users' effect files (``from camtube.model.api import Effect, Param``);
+``dataset``, ``fit``, ``predict``, ``synth``, ``truth``, ``atlas``, ``plot`` and ``report_fit`` are
+old paths of the earlier flat layout: they warn (``FutureWarning``) and go in the next release.
 """
 from __future__ import annotations
 

@@ -22,9 +22,9 @@ from camtube.design.geometry import pattern_geometry
 from camtube.design.loader import load_pattern
 from camtube.io import write_atomic
 from camtube.model.data import format_csv
-from camtube.model.dataset import Dataset
-from camtube.model.predict import joint_stiffness_nmm_per_rad
-from camtube.model.synth import triangle_stroke
+from camtube.model.data.dataset import Dataset
+from camtube.model.core.predict import joint_stiffness_nmm_per_rad
+from camtube.model.sim.synth import triangle_stroke
 
 ROOT = Path(__file__).resolve().parents[2]
 SLIP_MM, F_SLIP_N, F_SCALE_N = 0.12, 1.0, 0.8

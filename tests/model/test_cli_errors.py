@@ -114,9 +114,9 @@ def test_fit_of_an_unidentifiable_parameter_exits_2_and_names_it(data_csv, tmp_p
 
 def test_unidentified_names_parameters_at_a_bound():
     from camtube.design.loader import load_pattern
-    from camtube.model.fit import fit
-    from camtube.model.predict import model_for_pattern, pattern_values
-    from camtube.model.synth import synthesize
+    from camtube.model.core.fit import fit
+    from camtube.model.core.predict import model_for_pattern, pattern_values
+    from camtube.model.sim.synth import synthesize
 
     p = load_pattern(TUBE2)
     d = synthesize(p, 1, 2, seed=3, slack_mm=0.0)

@@ -7,7 +7,7 @@ import json
 import pytest
 
 from camtube.commands import build_parser, main
-from camtube.model.synth import noise_floor_deg
+from camtube.model.sim.synth import noise_floor_deg
 from tests.conftest import PATTERNS
 
 TUBE2 = str(PATTERNS / "tube2.yaml")

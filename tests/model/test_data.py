@@ -12,7 +12,7 @@ from camtube.model.data import (
     find_slack, format_csv, load_csv, parse_csv, parse_cycles, prepare, remove_deadband,
     select_branch, select_cycles,
 )
-from camtube.model.synth import synthesize
+from camtube.model.sim.synth import synthesize
 from tests.conftest import PATTERNS
 
 HEADER = "sample,cycle,time_s,stroke_mm,force_N,angle_deg"

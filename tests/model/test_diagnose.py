@@ -9,11 +9,11 @@ import pytest
 
 from camtube.commands import main
 from camtube.design.loader import load_pattern
-from camtube.model.atlas import residual_atlas
+from camtube.model.diagnose.atlas import residual_atlas
 from camtube.model.data import format_csv
 from camtube.model.diagnose import diagnose, noise_floor
-from camtube.model.predict import model_for_pattern, pattern_values
-from camtube.model.truth import Hidden, simulate
+from camtube.model.core.predict import model_for_pattern, pattern_values
+from camtube.model.sim.truth import Hidden, simulate
 from tests.conftest import PATTERNS
 
 TRAP = 0.05  # N mm of joint friction in every case: measured-force hysteresis the model absorbs

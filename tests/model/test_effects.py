@@ -9,9 +9,9 @@ import pytest
 from camtube.design.geometry import joint_geometry
 from camtube.design.loader import load_pattern
 from camtube.model.api import STAGES, get_effect, registry
-from camtube.model.dataset import Dataset
+from camtube.model.data.dataset import Dataset
 from camtube.model.effects import BUILTINS, _flat_wall_ybar, first_order_lag, play_operator
-from camtube.model.predict import model_for_pattern, pattern_values
+from camtube.model.core.predict import model_for_pattern, pattern_values
 from tests.conftest import PATTERNS
 
 

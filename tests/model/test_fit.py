@@ -9,9 +9,9 @@ import pytest
 from camtube.design.loader import load_pattern
 from camtube.model.api import Effect, JointModel, Param
 from camtube.model.data import prepare
-from camtube.model.fit import FitError, fit
-from camtube.model.predict import model_for_pattern, pattern_values
-from camtube.model.synth import noise_floor_deg, synthesize
+from camtube.model.core.fit import FitError, fit
+from camtube.model.core.predict import model_for_pattern, pattern_values
+from camtube.model.sim.synth import noise_floor_deg, synthesize
 from tests.conftest import PATTERNS, PRESETS
 
 

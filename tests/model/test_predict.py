@@ -9,11 +9,11 @@ import pytest
 from camtube.design.geometry import pattern_geometry
 from camtube.design.loader import load_pattern
 from camtube.model.api import Effect, Param
-from camtube.model.predict import (
+from camtube.model.core.predict import (
     design_summary, joint_stiffness_nmm_per_rad, model_for_pattern, pattern_values, predict_from_stroke,
     stiffness_from_data, stroke_only_angle_rad,
 )
-from camtube.model.synth import synthesize
+from camtube.model.sim.synth import synthesize
 from tests.conftest import PATTERNS, PRESETS
 
 
@@ -40,7 +40,7 @@ def test_closed_form_satisfies_both_equations(name):
     c = vals["L0"] / (vals["E_t"] * 1e3 * math.pi * p.tendon.radius_mm**2)
     np.testing.assert_allclose(arm * np.radians(ang) + force * c, stroke, atol=1e-12)
     # and the fit's model (a), fed the predicted force, returns the same angle
-    from camtube.model.dataset import Dataset
+    from camtube.model.data.dataset import Dataset
 
     n = stroke.size
     d = Dataset(np.full(n, "a", dtype=object), np.ones(n, int), np.arange(n, dtype=float), stroke, force,

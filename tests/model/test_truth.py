@@ -8,8 +8,8 @@ import pytest
 
 from camtube.design.geometry import pattern_geometry
 from camtube.design.loader import load_pattern
-from camtube.model.predict import joint_stiffness_nmm_per_rad, stroke_only_angle_rad
-from camtube.model.truth import Hidden, simulate
+from camtube.model.core.predict import joint_stiffness_nmm_per_rad, stroke_only_angle_rad
+from camtube.model.sim.truth import Hidden, simulate
 from tests.conftest import PATTERNS
 
 

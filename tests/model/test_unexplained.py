@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from camtube.model.dataset import Dataset
+from camtube.model.data.dataset import Dataset
 from camtube.model.unexplained import analyse, first_cycle_mask, variables_of
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -39,8 +39,8 @@ def _dataset(rows: dict) -> Dataset:
 def _base_residual(data: Dataset, effects=()):
     from camtube.design.loader import load_pattern
     from camtube.model.diagnose import noise_floor
-    from camtube.model.fit import fit
-    from camtube.model.predict import model_for_pattern, pattern_values
+    from camtube.model.core.fit import fit
+    from camtube.model.core.predict import model_for_pattern, pattern_values
 
     p = load_pattern(ROOT / "patterns" / "tube2.yaml")
     m = model_for_pattern(p, list(effects))
@@ -104,8 +104,8 @@ def test_rest_moment_is_a_per_sample_offset():
     data = _dataset(rows)
     from camtube.design.loader import load_pattern
     from camtube.model.diagnose import noise_floor
-    from camtube.model.fit import fit
-    from camtube.model.predict import model_for_pattern, pattern_values
+    from camtube.model.core.fit import fit
+    from camtube.model.core.predict import model_for_pattern, pattern_values
 
     p = load_pattern(ROOT / "patterns" / "tube2.yaml")
     r = fit(model_for_pattern(p, ["angle_bias"]), data, ("E_t", "angle_bias.bias_deg"), pattern_values(p))

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from camtube.errors import DataError
-from camtube.model.dataset import Dataset
+from camtube.model.data.dataset import Dataset
 from camtube.model.unexplained import analyse, variables_of
 from camtube.commands.effect import register_effect_commands
 from camtube.model.unexplained.starter import starter_from_json, starter_source
@@ -49,8 +49,8 @@ def _effect_from(text: str, tmp_path: Path, name: str):
 def _setup(effect: str, params: dict | None, seed: int):
     from camtube.design.loader import load_pattern
     from camtube.model.diagnose import noise_floor
-    from camtube.model.fit import fit
-    from camtube.model.predict import model_for_pattern, pattern_values
+    from camtube.model.core.fit import fit
+    from camtube.model.core.predict import model_for_pattern, pattern_values
 
     rows, truth = GEN.simulate(effect, params, cycles=20, seed=seed, joint=GEN.Joint(rate_hz=20.0))
     data = Dataset(rows["sample"], rows["cycle"].astype(int), rows["time"], rows["stroke"], rows["force"],
@@ -68,8 +68,8 @@ def _setup(effect: str, params: dict | None, seed: int):
 def test_periodic_starter_reaches_the_floor_and_leads(effect, params, seed, key, tmp_path):
     from camtube.model.api import registry
     from camtube.model.diagnose import diagnose
-    from camtube.model.fit import fit
-    from camtube.model.predict import model_for_pattern, pattern_values
+    from camtube.model.core.fit import fit
+    from camtube.model.core.predict import model_for_pattern, pattern_values
 
     data, pattern, floor, u, truth = _setup(effect, params, seed)
     assert u is not None
@@ -94,7 +94,7 @@ def test_periodic_starter_reaches_the_floor_and_leads(effect, params, seed, key,
 
 def test_starter_for_each_variable_runs(tmp_path):
     from camtube.design.loader import load_pattern
-    from camtube.model.predict import model_for_pattern, pattern_values
+    from camtube.model.core.predict import model_for_pattern, pattern_values
 
     rows, _ = GEN.simulate("none", cycles=3, seed=1, joint=GEN.Joint(rate_hz=10.0))
     data = Dataset(rows["sample"], rows["cycle"].astype(int), rows["time"], rows["stroke"], rows["force"],

@@ -267,11 +267,17 @@ class JointModel:
     effects: tuple[Effect, ...] = ()
 
     def with_effects(self, effects: Sequence[Effect | str], registry=None) -> "JointModel":
-        """The model with ``effects`` (objects, or names looked up in ``registry``, default the built-ins)."""
-        from camtube.model.core.registry import builtin_registry
+        """The model with ``effects``: :class:`Effect` objects, or names looked up in ``registry``.
 
-        reg = registry if registry is not None else builtin_registry()
-        effs = tuple(reg.get_effect(e) if isinstance(e, str) else e for e in effects)
+        The model knows no table of effects itself (the registry sits above it and the built-in
+        effects above that): pass ``registry`` (e.g. :func:`camtube.model.core.registry.builtin_registry`)
+        to give effects by name.
+        """
+        names = [e for e in effects if isinstance(e, str)]
+        if names and registry is None:
+            raise FitError(f"effects by name ({', '.join(names)}) need a registry to look them up in; "
+                           "fix: pass registry=builtin_registry() or the Effect objects")
+        effs = tuple(registry.get_effect(e) if isinstance(e, str) else e for e in effects)
         return replace(self, effects=effs)
 
     @property

@@ -43,7 +43,13 @@ def model_for_pattern(pattern: Pattern, effects: Sequence[Effect | str] = (), re
     geo = pattern_geometry(pattern)
     model = JointModel(geometry=geo.first, n_notches=len(geo.notches),
                        tendon_radius_mm=pattern.tendon.radius_mm)
-    return model.with_effects(effects, registry) if effects else model
+    if not effects:
+        return model
+    if registry is None and any(isinstance(e, str) for e in effects):
+        from camtube.model.core.registry import builtin_registry
+
+        registry = builtin_registry()
+    return model.with_effects(effects, registry)
 
 
 def pattern_compliance_mm_per_N(pattern: Pattern, modulus_gpa: float | None = None) -> float:

@@ -1,4 +1,4 @@
-"""Text and JSON reports of a :class:`~camtube.model.fit.FitResult` (pure: return strings).
+"""Text and JSON reports of a :class:`~camtube.model.core.fit.FitResult` (pure: return strings).
 
 ``rmse_table(result)``: per-sample RMSE like the paper's Table III;
 ``param_table(result)``: values with standard errors, units and correlations;

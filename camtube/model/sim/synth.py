@@ -6,7 +6,7 @@ What the generator does (per sample, all lengths mm, forces N, angles deg):
   lead-screw speed, sampled at ``rate_hz`` (an EM tracker's rate);
 * tendon slack: the first ``slack_mm`` of stroke moves nothing (deadband);
 * angle and force from the closed base model with a joint bending stiffness
-  (:func:`camtube.model.predict.stroke_only_angle_rad`):
+  (:func:`camtube.model.core.predict.stroke_only_angle_rad`):
   ``theta = s / (arm + K C / arm)``, ``F = K theta / arm``,
   ``s = max(stroke - slack, 0)``; each sample's stiffness is the
   pattern's ``K`` times a factor drawn from ``1 +- stiffness_spread``;

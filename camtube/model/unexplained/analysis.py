@@ -98,7 +98,7 @@ def first_cycle_mask(sample: np.ndarray, cycle: np.ndarray) -> np.ndarray:
 
 
 def variables_of(data) -> dict[str, np.ndarray]:
-    """The variables :func:`analyse` reads, from a :class:`~camtube.model.dataset.Dataset`-like object."""
+    """The variables :func:`analyse` reads, from a :class:`~camtube.model.data.dataset.Dataset`-like object."""
     return {"stroke": np.asarray(data.stroke_mm, float), "angle": np.asarray(data.angle_deg, float),
             "force": np.asarray(data.force_N, float), "direction": np.asarray(data.direction, int),
             "cycle": np.asarray(data.cycle, int), "time": np.asarray(data.time_s, float),

@@ -1,0 +1,268 @@
+"""From the three instruments' logs to the measurement rows: check units and signs, align the clocks,
+put stroke and force on the tracker's frames, number the cycles.
+
+The tracker's frames are the time base: the angle (the quantity the model is fitted to) is never
+interpolated, and a frame in which a coil was not tracked gives no row. Stroke and force are interpolated
+linearly at each frame's time once their clocks are mapped onto the tracker's; a frame that falls between
+two samples of an instrument further apart than 1.5 of its usual sample interval (a gap in its log), or
+outside its recording, gives no row either. Every row left out is counted by cause.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from camtube.errors import DataError
+from camtube.model.data.dataset import Dataset
+from camtube.model.ingest.clock import align_trigger, align_xcorr
+from camtube.model.ingest.cycles import cycle_numbers, cycle_starts
+from camtube.model.ingest.ndi import TrackerLog
+from camtube.model.ingest.poses import BendAngle, bend_angle
+from camtube.model.ingest.series import BenchMap, Series, force_N, stroke_mm
+
+
+@dataclass(frozen=True, eq=False)
+class Ingested:
+    """The measurement rows and how they were made.
+
+    Attributes
+    ----------
+    data : Dataset
+        One sample; ``extra["out_of_plane_deg"]`` per row.
+    bend : BendAngle
+        The angle at every tracker frame (tracker clock from its first frame, s).
+    clocks : dict of str -> ClockFit
+        ``daq`` and ``motor`` onto the tracker clock (seconds from the tracker's first frame).
+    flagged : dict of (str, str) -> int
+        Frames a coil was not tracked in, by coil (``tip``, ``base``) and state as written.
+    absent_frames : int
+        Frames missing from the export (from gaps in its frame times).
+    dropped : dict of str -> int
+        Frames that gave no row, by cause: ``tracker`` (a coil not tracked), ``daq gap``, ``motor gap``,
+        ``outside`` (before or after a log's recording).
+    gaps : dict of str -> int
+        Gaps (intervals > 1.5 x the usual sample interval) in each log: ``tracker``, ``daq``, ``motor``.
+    traces : dict of str -> ndarray
+        Signals on the tracker clock for the report: ``motor_t``, ``motor_stroke``, ``daq_t``, ``daq_force``,
+        ``tip_state``, ``base_state``.
+    sources : dict of str -> str
+        The files.
+    """
+
+    data: Dataset
+    bend: BendAngle
+    clocks: dict
+    flagged: dict
+    absent_frames: int
+    dropped: dict
+    gaps: dict
+    traces: dict = field(default_factory=dict)
+    sources: dict = field(default_factory=dict)
+
+    @property
+    def dropouts(self) -> int:
+        """Tracker frames lost: flagged by the tracker (either coil) or absent from the export."""
+        return int(np.sum(~self.bend.valid)) + self.absent_frames
+
+
+def _pick_tools(log: TrackerLog, bm: BenchMap):
+    tip_key, base_key = bm.tracker.tip, bm.tracker.base
+    if not tip_key:
+        if len(log.tools) == 1 and not base_key:
+            return log.tools[0], None
+        raise DataError(f"{log.source}: {len(log.tools)} tools ({'; '.join(t.label for t in log.tools)}); fix: name "
+                        "the tip coil and the base coil (--map tracker.tip=0B --map tracker.base=0A)")
+    tip = log.tool(tip_key, "tip")
+    base = log.tool(base_key, "base") if base_key else None
+    if base is tip:
+        raise DataError(f"{log.source}: tracker.tip and tracker.base name the same tool ({tip.label}); "
+                        "fix: name two different coils, or leave tracker.base empty for one coil")
+    return tip, base
+
+
+def _angle_from_poses(tracker: TrackerLog, bench: BenchMap):
+    tip, base = _pick_tools(tracker, bench)
+    tm = bench.tracker
+    ok_pos = tip.position_mm[tip.valid]
+    if tm.unit == "mm" and ok_pos.size and 0 < float(np.nanmax(np.abs(ok_pos))) < 2.0:
+        raise DataError(f"{tracker.source}: columns Tx, Ty, Tz of {tip.label!r} stay below "
+                        f"{float(np.nanmax(np.abs(ok_pos))):.3g}: the positions look like metres; "
+                        "fix: --map tracker.unit=m (NDI Track writes mm)")
+    t0 = float(tip.time_s[0])
+    try:
+        bend = bend_angle(tip.time_s - t0, tip.quat_wxyz, tip.valid, None if base is None else base.quat_wxyz,
+                          None if base is None else base.valid, rest_s=tm.rest_s)
+    except ValueError:
+        raise DataError(f"{tracker.source}: no frame in which the tip{' and the base' if base else ''} coil is "
+                        "tracked (state OK); fix: check the tool names (tracker.tip, tracker.base)") from None
+    flagged: dict = {}
+    for role, tool in (("tip", tip), ("base", base)):
+        if tool is None:
+            continue
+        for st in tool.state[~tool.valid]:
+            flagged[(role, str(st))] = flagged.get((role, str(st)), 0) + 1
+    return bend, t0, flagged, tip, base
+
+
+def _angle_from_log(log: Series, bench: BenchMap):
+    """A joint angle logged directly (an encoder on the joint, a camera): deg, or rad when the map says so."""
+    unit = bench.angle.unit
+    v = log.value
+    peak = float(np.nanmax(np.abs(v))) if v.size else 0.0
+    if unit == "" and 0 < peak < 3.2:
+        raise DataError(f"{log.source}: column {log.column!r} peaks at {peak:.3g}: an angle in radians? "
+                        "fix: --map angle.unit=rad (or --map angle.unit=deg if the bend really stays below 3.2 deg)")
+    ang = np.degrees(v) if unit == "rad" else np.asarray(v, float)
+    t0 = float(log.time_s[0])
+    t = log.time_s - t0
+    valid = np.isfinite(ang)
+    if abs(np.nanmax(ang)) < abs(np.nanmin(ang)):
+        ang = -ang
+    bend = BendAngle(t, ang, np.full(t.size, np.nan), np.full(3, np.nan), valid, 0)
+    return bend, t0, {}, None, None
+
+
+def _gap_mask(t: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """For times ``at``: (outside the recording, inside a gap) masks, and the number of gaps in ``t``."""
+    dt = np.diff(t)
+    med = float(np.median(dt))
+    big = dt > 1.5 * med
+    j = np.searchsorted(t, at, side="right")
+    outside = (at < t[0]) | (at > t[-1])
+    jj = np.clip(j, 1, t.size - 1)
+    in_gap = ~outside & big[jj - 1]
+    return outside, in_gap, int(big.sum())
+
+
+def _check_duration(name: str, s: Series, unit: str, key: str, tracker_span: float) -> None:
+    span = float(s.time_s[-1] - s.time_s[0])
+    ratio = span / tracker_span if tracker_span > 0 else 1.0
+    if not 0.05 <= ratio <= 20.0:
+        units = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "min": 60.0}
+        cur = units[unit]
+        best = min(units, key=lambda u: abs(np.log(span / cur * units[u] / tracker_span)))
+        raise DataError(f"{s.source}: column {key!r} read in {unit} spans {span:g} s, the tracker export "
+                        f"{tracker_span:g} s; fix: {name}.time_unit: {best} in the bench map "
+                        f"(--map {name}.time_unit={best})")
+
+
+def ingest(tracker: TrackerLog | Series, daq: Series, motor: Series, bench: BenchMap, sample: str = "1", *,
+           max_lag_s: float | None = None) -> Ingested:
+    """Merge the three logs into measurement rows (see the module docstring).
+
+    Parameters
+    ----------
+    tracker : TrackerLog or Series
+        The NDI export, or a log of the joint angle itself (read with the map's ``angle`` section).
+    daq, motor : Series
+        The load cell's and the motor's logs as read (uncalibrated columns).
+    bench : BenchMap
+        Which tools and columns, units and calibrations.
+    sample : str
+        The sample name written in every row.
+    max_lag_s : float, optional
+        Largest clock offset to consider when aligning from the motion, s.
+
+    Raises
+    ------
+    DataError
+        A unit or sign that cannot be right (one line naming the file, the column and the fix), logs that
+        do not overlap, no frame with both coils tracked.
+    """
+    if isinstance(tracker, Series):
+        bend, t0, flagged, tip, base = _angle_from_log(tracker, bench)
+    else:
+        bend, t0, flagged, tip, base = _angle_from_poses(tracker, bench)
+    t_trk = bend.time_s
+    dtt = np.diff(t_trk)
+    med = float(np.median(dtt))
+    absent = int(np.sum(np.maximum(np.round(dtt / med) - 1, 0)[dtt > 1.5 * med]))
+    span = float(t_trk[-1] - t_trk[0])
+
+    # ---- units and signs of the motor and the DAQ
+    _check_duration("motor", motor, bench.motor.time_unit, bench.motor.time, span)
+    _check_duration("daq", daq, bench.daq.time_unit, bench.daq.time, span)
+    stroke = stroke_mm(motor, bench.motor)
+    if -float(stroke.min()) > float(stroke.max()):
+        raise DataError(f"{motor.source}: column {motor.column!r} gives a stroke that runs negative "
+                        f"({stroke.max():.3g} to {stroke.min():.3g} mm); fix: --map motor.sign=-1 (the position counts "
+                        "down as the tendon is pulled)")
+    force = force_N(daq, bench.daq, bench.tracker.rest_s)
+
+    # ---- clocks: the motor and the DAQ onto the tracker
+    ang = bend.angle_deg
+    c_motor = align_xcorr("motor", t_trk, ang, motor.time_s, stroke, max_lag_s=max_lag_s)
+    if c_motor.sign < 0:
+        bend = BendAngle(bend.time_s, -bend.angle_deg, bend.out_of_plane_deg, -bend.axis, bend.valid, bend.n_rest)
+        ang = bend.angle_deg
+        c_motor = align_xcorr("motor", t_trk, ang, motor.time_s, stroke, max_lag_s=max_lag_s)
+    if bench.daq.trigger and bench.motor.trigger:
+        c_daq = align_trigger("daq", daq.time_s, daq.trigger, motor.time_s, motor.trigger,
+                              f"{daq.source} / {motor.source}").then(c_motor)
+        c_check = align_xcorr("daq", t_trk, ang, daq.time_s, force, max_lag_s=max_lag_s)
+        sign = c_check.sign
+    else:
+        c_daq = align_xcorr("daq", t_trk, ang, daq.time_s, force, max_lag_s=max_lag_s)
+        sign = c_daq.sign
+    if sign < 0:
+        what = "N_per_V" if bench.daq.force_unit == "V" else "force_unit"
+        raise DataError(f"{daq.source}: column {daq.column!r} falls as the stroke rises (the load cell reads "
+                        f"compression); fix: negate the calibration (--map daq.{what}={-bench.daq.N_per_V:g})"
+                        if what == "N_per_V" else
+                        f"{daq.source}: column {daq.column!r} falls as the stroke rises; fix: log the tension as positive")
+
+    # ---- onto the tracker's frames
+    m_t = c_motor.to_ref(motor.time_s)
+    d_t = c_daq.to_ref(daq.time_s)
+    frames = t_trk
+    out_m, gap_m, n_gap_m = _gap_mask(m_t, frames)
+    out_d, gap_d, n_gap_d = _gap_mask(d_t, frames)
+    valid = bend.valid
+    keep = valid & ~out_m & ~out_d & ~gap_m & ~gap_d
+    dropped = {"tracker": int(np.sum(~valid)),
+               "outside": int(np.sum(valid & (out_m | out_d))),
+               "motor gap": int(np.sum(valid & ~out_m & ~out_d & gap_m)),
+               "daq gap": int(np.sum(valid & ~out_m & ~out_d & ~gap_m & gap_d))}
+    if not keep.any():
+        raise DataError(f"{tracker.source}, {daq.source}, {motor.source}: no tracker frame falls inside both logs; "
+                        "fix: give logs of the same run")
+    tk = frames[keep]
+    s_row = np.interp(tk, m_t, stroke)
+    f_row = np.interp(tk, d_t, force)
+    starts = cycle_starts(m_t, stroke)
+    cyc = cycle_numbers(tk, starts)
+    cyc = cyc - cyc.min() + 1
+    data = Dataset(np.full(tk.size, sample, dtype=object), cyc.astype(np.int64), tk - tk[0], s_row, f_row,
+                   bend.angle_deg[keep], {"out_of_plane_deg": bend.out_of_plane_deg[keep]})
+    traces = {"motor_t": m_t, "motor_stroke": stroke, "daq_t": d_t, "daq_force": force,
+              "tip_state": None if tip is None else tip.state, "base_state": None if base is None else base.state,
+              "row_t": tk, "t0_s": t0}
+    return Ingested(data, bend, {"motor": c_motor, "daq": c_daq}, flagged, absent, dropped,
+                    {"tracker": int(np.sum(dtt > 1.5 * med)), "daq": n_gap_d, "motor": n_gap_m}, traces,
+                    {"tracker": tracker.source, "daq": daq.source, "motor": motor.source})
+
+
+def ingest_files(tracker_path, daq_path, motor_path, bench: BenchMap, sample: str | None = None, *,
+                 max_lag_s: float | None = None, angle_log: bool = False) -> Ingested:
+    """Read the three logs named by the bench map's columns and :func:`ingest` them.
+
+    ``sample`` defaults to the tracker file's name without its suffix. With ``angle_log`` the first file is
+    a time-series log of the joint angle (the map's ``angle`` section), not an NDI export.
+    """
+    from pathlib import Path
+
+    from camtube.model.ingest.ndi import load_ndi
+    from camtube.model.ingest.series import load_series
+
+    tm = bench.tracker
+    if angle_log:
+        a = bench.angle
+        log = load_series(tracker_path, a.time, a.time_unit, a.angle, role="angle")
+    else:
+        log = load_ndi(tracker_path, unit=tm.unit, rate_hz=tm.rate_hz or None)
+    d = bench.daq
+    daq = load_series(daq_path, d.time, d.time_unit, d.force, d.trigger, role="daq")
+    m = bench.motor
+    motor = load_series(motor_path, m.time, m.time_unit, m.stroke, m.trigger, role="motor")
+    return ingest(log, daq, motor, bench, sample or Path(tracker_path).stem, max_lag_s=max_lag_s)

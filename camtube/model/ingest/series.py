@@ -1,0 +1,382 @@
+"""Generic time-series logs (the load cell's DAQ, the motor's controller) and the bench map that says how
+to read them.
+
+A log is a CSV with a header line; lines starting with ``#`` and blank lines are skipped. The bench map
+names, per instrument, the time column and its unit, the value column and its calibration, and an
+optional trigger column shared with another instrument::
+
+    tracker:  {tip: "0B", base: "0A", unit: mm, rest_s: 1.0}
+    daq:      {time: t_ms, time_unit: ms, force: load_V, force_unit: V, N_per_V: 2.2, offset_V: rest, trigger: sync}
+    motor:    {time: t_us, time_unit: us, stroke: counts, stroke_unit: counts, counts_per_rev: 512,
+               gear_ratio: 64, lead_mm_per_rev: 0.5, sign: 1, trigger: sync}
+    angle:    {time: t, time_unit: s, angle: theta, unit: rad}     # only for --angle-log (no tracker)
+
+:func:`load_bench_map` reads such a YAML file; ``--map KEY=VALUE`` pairs (``daq.N_per_V=2.2``) override it.
+Unknown keys are errors with a "did you mean" hint.
+"""
+from __future__ import annotations
+
+import csv
+import difflib
+import io
+from dataclasses import dataclass, field, fields, replace
+from pathlib import Path
+
+import numpy as np
+
+from camtube.errors import DataError
+
+#: Seconds per unit of a time column.
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "min": 60.0}
+
+
+@dataclass(frozen=True)
+class TrackerMap:
+    """How to read the tracker export.
+
+    Attributes
+    ----------
+    tip : str
+        The tool on the joint's tip: port handle (``0B``) or a part of its label.
+    base : str
+        The tool on the joint's base; ``""`` for one sensor (the bend is then taken against the first frames).
+    unit : str
+        Unit of the positions in the export: ``mm`` (NDI's default) or ``m``.
+    rate_hz : float
+        Frame rate, only needed when the export has no time column (0: not given).
+    rest_s : float
+        Length of the rest at the start of the recording that defines zero bend, s.
+    """
+
+    tip: str = ""
+    base: str = ""
+    unit: str = "mm"
+    rate_hz: float = 0.0
+    rest_s: float = 1.0
+
+
+@dataclass(frozen=True)
+class DaqMap:
+    """How to read the load cell's DAQ log.
+
+    Attributes
+    ----------
+    time, time_unit : str
+        Time column and its unit (s, ms, us, ns, min).
+    force : str
+        The force column.
+    force_unit : str
+        ``V`` (converted with ``N_per_V``) or ``N``.
+    N_per_V : float
+        Load cell calibration, N per V (negative for a load cell that reads tension as a falling voltage).
+    offset_V : float or "rest"
+        Output at zero force (V, or N for ``force_unit: N``); ``rest``: the median over the first ``rest_s``.
+    trigger : str
+        A trigger column shared with the motor log (``""``: none).
+    """
+
+    time: str = "time_s"
+    time_unit: str = "s"
+    force: str = "force_N"
+    force_unit: str = "N"
+    N_per_V: float = 1.0
+    offset_V: float | str = 0.0
+    trigger: str = ""
+
+
+@dataclass(frozen=True)
+class MotorMap:
+    """How to read the motor's log.
+
+    Attributes
+    ----------
+    time, time_unit : str
+        Time column and its unit.
+    stroke : str
+        The position column.
+    stroke_unit : str
+        ``counts`` (encoder counts on the motor shaft), ``rev`` (motor revolutions) or ``mm`` (stroke).
+    counts_per_rev : float
+        Encoder counts per motor revolution (after quadrature).
+    gear_ratio : float
+        Motor revolutions per lead-screw revolution (the paper's gearbox: 64).
+    lead_mm_per_rev : float
+        Lead of the screw, mm per revolution.
+    sign : int
+        +1, or -1 when the position counts down as the tendon is pulled.
+    trigger : str
+        A trigger column shared with the DAQ log (``""``: none).
+    """
+
+    time: str = "time_s"
+    time_unit: str = "s"
+    stroke: str = "stroke_mm"
+    stroke_unit: str = "mm"
+    counts_per_rev: float = 1.0
+    gear_ratio: float = 1.0
+    lead_mm_per_rev: float = 1.0
+    sign: int = 1
+    trigger: str = ""
+
+    @property
+    def mm_per_unit(self) -> float:
+        """Stroke (mm) per unit of the position column, sign included."""
+        per = {"mm": 1.0, "rev": self.lead_mm_per_rev / self.gear_ratio,
+               "counts": self.lead_mm_per_rev / (self.gear_ratio * self.counts_per_rev)}[self.stroke_unit]
+        return self.sign * per
+
+
+@dataclass(frozen=True)
+class AngleMap:
+    """How to read a log of the joint angle itself (instead of a tracker export).
+
+    Attributes
+    ----------
+    time, time_unit : str
+        Time column and its unit.
+    angle : str
+        The angle column.
+    unit : str
+        ``deg`` or ``rad``; left empty, the angle is read in deg and refused if it looks like radians.
+    """
+
+    time: str = "time_s"
+    time_unit: str = "s"
+    angle: str = "angle_deg"
+    unit: str = ""
+
+
+@dataclass(frozen=True)
+class BenchMap:
+    """The instruments' maps (see the module docstring)."""
+
+    tracker: TrackerMap = field(default_factory=TrackerMap)
+    daq: DaqMap = field(default_factory=DaqMap)
+    motor: MotorMap = field(default_factory=MotorMap)
+    angle: AngleMap = field(default_factory=AngleMap)
+
+
+_ALLOWED = {
+    ("tracker", "unit"): ("mm", "m"),
+    ("daq", "time_unit"): tuple(TIME_UNITS), ("motor", "time_unit"): tuple(TIME_UNITS),
+    ("angle", "time_unit"): tuple(TIME_UNITS), ("angle", "unit"): ("", "deg", "rad"),
+    ("daq", "force_unit"): ("V", "N"), ("motor", "stroke_unit"): ("counts", "rev", "mm"),
+}
+_POSITIVE = {("motor", "counts_per_rev"), ("motor", "gear_ratio"), ("motor", "lead_mm_per_rev")}
+
+
+def _map_err(source: str, key: str, msg: str, fix: str) -> DataError:
+    return DataError(f"{source}: {key}: {msg}; fix: {fix}")
+
+
+def _coerce(section: str, name: str, value, default, source: str):
+    key = f"{section}.{name}"
+    if name == "offset_V" and isinstance(value, str) and value.strip().lower() == "rest":
+        return "rest"
+    if isinstance(default, bool) or isinstance(default, int) and name == "sign":
+        try:
+            v = int(float(value))
+        except (TypeError, ValueError):
+            raise _map_err(source, key, f"{value!r} is not a number", "sign: 1 or -1") from None
+        if v not in (1, -1):
+            raise _map_err(source, key, f"{value!r} is not allowed", "sign: 1 or -1")
+        return v
+    if isinstance(default, float):
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise _map_err(source, key, f"{value!r} is not a number", f"give a number (default {default:g})") from None
+        if (not np.isfinite(v) or ((section, name) in _POSITIVE and v <= 0) or (v < 0 and name in ("rate_hz", "rest_s"))
+                or (name == "N_per_V" and v == 0)):
+            raise _map_err(source, key, f"{value!r} is out of range", "give a positive number")
+        return v
+    v = "" if value is None else str(value).strip()
+    allowed = _ALLOWED.get((section, name))
+    if allowed and v not in allowed:
+        raise _map_err(source, key, f"{v!r} is not allowed", f"one of {', '.join(allowed)}")
+    return v
+
+
+def bench_map_from_dict(doc: dict, source: str = "<bench map>", overrides: list[str] = ()) -> BenchMap:
+    """A :class:`BenchMap` from a nested mapping plus ``KEY=VALUE`` overrides (``daq.N_per_V=2.2``).
+
+    Raises
+    ------
+    DataError
+        An unknown section or key (with a "did you mean"), a value of the wrong type or out of range.
+    """
+    doc = {k: dict(v or {}) for k, v in (doc or {}).items()} if isinstance(doc, dict) else None
+    if doc is None:
+        raise DataError(f"{source}: the bench map must be a mapping of tracker/daq/motor; fix: see docs/bench.md")
+    for item in overrides:
+        if "=" not in item:
+            raise DataError(f"--map {item!r}: expected KEY=VALUE, e.g. daq.N_per_V=2.2")
+        k, v = item.split("=", 1)
+        parts = k.strip().split(".")
+        if len(parts) != 2:
+            raise DataError(f"--map {item!r}: the key must be SECTION.NAME, e.g. motor.gear_ratio")
+        doc.setdefault(parts[0], {})[parts[1]] = v
+    base = BenchMap()
+    sections = {}
+    for sec, body in doc.items():
+        if not hasattr(base, sec):
+            hint = difflib.get_close_matches(sec, ["tracker", "daq", "motor", "angle"], n=1)
+            raise _map_err(source, sec, "unknown section", f"did you mean {hint[0]!r}?" if hint
+                           else "use tracker, daq, motor and angle")
+        default = getattr(base, sec)
+        names = {f.name: getattr(default, f.name) for f in fields(default)}
+        vals = {}
+        for name, value in body.items():
+            if name not in names:
+                hint = (difflib.get_close_matches(name, list(names), n=1, cutoff=0.5)
+                        or [k for k in names if k.startswith(name) or name.startswith(k)])
+                raise _map_err(source, f"{sec}.{name}", "unknown key",
+                               f"did you mean {hint[0]!r}?" if hint else f"known keys: {', '.join(names)}")
+            vals[name] = _coerce(sec, name, value, names[name], source)
+        sections[sec] = replace(default, **vals)
+    return replace(base, **sections)
+
+
+def load_bench_map(path: str | Path | None, overrides: list[str] = ()) -> BenchMap:
+    """Read a bench map YAML (``None``: defaults) and apply ``--map`` overrides."""
+    doc: dict = {}
+    source = "--map"
+    if path is not None:
+        import yaml
+
+        from camtube.model.ingest.ndi import read_text
+        from camtube.yamltext import StrictLoader
+
+        source = str(path)
+        try:
+            doc = yaml.load(read_text(path, "bench map"), Loader=StrictLoader) or {}
+        except yaml.YAMLError as exc:
+            mark = getattr(exc, "problem_mark", None)
+            where = f"{path}:{mark.line + 1}" if mark else str(path)
+            raise DataError(f"{where}: not valid YAML ({getattr(exc, 'problem', exc)})") from None
+    return bench_map_from_dict(doc, source, list(overrides))
+
+
+@dataclass(frozen=True, eq=False)
+class Series:
+    """One column of a log over time, its own clock.
+
+    Attributes
+    ----------
+    source : str
+        File name.
+    column : str
+        The value column's name.
+    time_s : (n,) float
+        The instrument's clock, s, strictly increasing.
+    value : (n,) float
+        The column as read (not yet calibrated).
+    trigger : (n,) float or None
+        The trigger column, if mapped.
+    lines : (n,) int
+        File line of each sample.
+    """
+
+    source: str
+    column: str
+    time_s: np.ndarray
+    value: np.ndarray
+    trigger: np.ndarray | None
+    lines: np.ndarray
+
+    def with_value(self, value: np.ndarray) -> "Series":
+        """The same samples with another value column (e.g. calibrated)."""
+        return replace(self, value=np.asarray(value, float))
+
+
+def parse_series(text: str, source: str, time: str, time_unit: str, value: str, trigger: str = "",
+                 role: str = "log") -> Series:
+    """Read the time, value and trigger columns of a CSV log.
+
+    Raises
+    ------
+    DataError
+        A missing column (with a "did you mean" and the map key to change), a non-numeric or empty cell
+        (file, line and column), a time that does not increase.
+    """
+    reader = csv.reader(io.StringIO(text))
+    header = None
+    hline = 0
+    rows: list[list[str]] = []
+    lines: list[int] = []
+    try:
+        for rec in reader:
+            if not rec or not any(c.strip() for c in rec) or rec[0].lstrip().startswith("#"):
+                continue
+            if header is None:
+                header = [c.strip() for c in rec]
+                hline = reader.line_num
+                continue
+            rows.append(rec)
+            lines.append(reader.line_num)
+    except csv.Error as exc:
+        raise DataError(f"{source}:{reader.line_num}: not valid CSV ({exc})") from None
+    if header is None:
+        raise DataError(f"{source}: the file is empty")
+    if len(header) == 1 and (";" in header[0] or "\t" in header[0]):
+        raise DataError(f"{source}:{hline}: the columns are not separated by commas; fix: save the log as "
+                        "comma-separated values with a decimal point")
+    wanted = [("time", time), ("value", value)] + ([("trigger", trigger)] if trigger else [])
+    idx = {}
+    for what, col in wanted:
+        if col not in header:
+            key = {"time": f"{role}.time", "value": f"{role}.{ {'daq': 'force', 'angle': 'angle'}.get(role, 'stroke')}",
+                   "trigger": f"{role}.trigger"}[what]
+            hint = difflib.get_close_matches(col, header, n=1, cutoff=0.4)
+            fix = f"set {key}: {hint[0]} in the bench map" if hint else f"set {key} to one of: {', '.join(header)}"
+            raise DataError(f"{source}:{hline}: no column {col!r} for the {what} (found: {', '.join(header)}); fix: {fix}")
+        idx[what] = header.index(col)
+    if not rows:
+        raise DataError(f"{source}:{hline}: no data lines after the header")
+    ln = np.asarray(lines, dtype=np.int64)
+    out = {}
+    for what, j in idx.items():
+        col = np.empty(len(rows))
+        for k, r in enumerate(rows):
+            cell = r[j].strip() if j < len(r) else ""
+            try:
+                col[k] = float(cell)
+            except ValueError:
+                bad = "is empty" if not cell else f"is not a number: {cell!r}"
+                raise DataError(f"{source}:{lines[k]}: column {header[j]!r} {bad}; fix: every cell of the "
+                                "time, value and trigger columns must be a number") from None
+            if not np.isfinite(col[k]):
+                raise DataError(f"{source}:{lines[k]}: column {header[j]!r} is {cell!r}; fix: drop the line "
+                                "(a gap is found from the time stamps)")
+        out[what] = col
+    t = out["time"] * TIME_UNITS[time_unit]
+    back = np.flatnonzero(np.diff(t) <= 0)
+    if back.size:
+        k = int(back[0]) + 1
+        raise DataError(f"{source}:{lines[k]}: column {time!r} does not increase ({out['time'][k]:g} after "
+                        f"{out['time'][k - 1]:g} on line {lines[k - 1]}); fix: one recording per file, in time order")
+    return Series(source, value, t, out["value"], out.get("trigger"), ln)
+
+
+def load_series(path: str | Path, time: str, time_unit: str, value: str, trigger: str = "",
+                role: str = "log") -> Series:
+    """Read a CSV log (see :func:`parse_series`)."""
+    from camtube.model.ingest.ndi import read_text
+
+    return parse_series(read_text(path, f"{role} log"), str(path), time, time_unit, value, trigger, role)
+
+
+def force_N(series: Series, m: DaqMap, rest_s: float) -> np.ndarray:
+    """(n,) force, N, from the DAQ column: ``(value - offset) * N_per_V`` (or ``value - offset`` in N)."""
+    v = series.value
+    if m.offset_V == "rest":
+        at_rest = series.time_s <= series.time_s[0] + max(rest_s, 0.0)
+        off = float(np.median(v[at_rest])) if at_rest.any() else float(v[0])
+    else:
+        off = float(m.offset_V)
+    return (v - off) * (m.N_per_V if m.force_unit == "V" else 1.0)
+
+
+def stroke_mm(series: Series, m: MotorMap) -> np.ndarray:
+    """(n,) stroke, mm, from the motor's position column, zero at the first sample."""
+    return (series.value - series.value[0]) * m.mm_per_unit
