@@ -141,3 +141,23 @@ def test_motor_profile_dwells_rests_and_a_longer_first_dwell():
     assert x.max() == pytest.approx(2.0) and x.min() == pytest.approx(0.0)
     top = [float(np.sum((cyc == k) & (x > 1.999)) * 0.01) for k in (1, 2, 3)]
     assert top[0] == pytest.approx(2.0, abs=0.05) and top[1] == pytest.approx(0.5, abs=0.05)
+
+
+def test_the_report_opens_with_the_answer_then_the_pictures_then_the_table(tube2, tmp_path, capsys):
+    tr = Tracker(noise_deg=0.15, n_spikes=4, n_dropouts=1, dropout_rows=(2, 3))
+    slow = Protocol(n_cycles=6, ramp_s=4.0, dwell_s=2.0, rest_s=2.0, first_dwell_s=4.0)
+    rec = simulate_bench(tube2, SampleBench(tendon=Tendon(slack_mm=0.12), tracker=tr), slow,
+                         Clock(rate_hz=25.0, n_repeats=1), seed=6)
+    path = tmp_path / "slack.csv"
+    path.write_text(format_csv(rec.data))
+    rep = tmp_path / "rep"
+    assert main(["model", "diagnose", str(path), "--pattern", str(TUBE2), "-q", "--report", str(rep),
+                 "--no-per-sample"]) == 0
+    out = capsys.readouterr().out
+    assert out.splitlines()[1].startswith("answer: add slack")
+    page = (rep / "index.html").read_text()
+    order = [page.index(k) for k in ("<h2>Answer</h2>", "model.png", "waterfall.png", "artefacts.png",
+                                     "<h2>Candidates</h2>", "<h2>The diagnosis in full</h2>")]
+    assert order == sorted(order)
+    assert "answer: add slack" in page[:page.index("model.png")]
+    assert (rep / "artefacts.png").stat().st_size > 1000
