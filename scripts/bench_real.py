@@ -15,7 +15,6 @@ count right and the seconds per 60,000-row file.
 """
 from __future__ import annotations
 
-import math
 import tempfile
 import time
 from dataclasses import replace

@@ -33,7 +33,7 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
