@@ -20,6 +20,7 @@ from camtube.io import PublishedInterrupt
 #: Command modules, each with ``register(subparsers)``, in the order ``--help`` lists them.
 COMMAND_MODULES = (
     "camtube.commands.design", "camtube.commands.plan", "camtube.commands.cad", "camtube.commands.model", "camtube.commands.motion",
+    "camtube.commands.synthesize",
 )
 
 

@@ -14,6 +14,18 @@ def register(sub) -> None:
                        description="Print phi, ybar, moment arm, closure angle, tube length, backbone "
                                    "area and second moment of area (mm, rad and deg).")
     add_pattern_argument(p)
+    p.add_argument("--stroke", type=float, metavar="MM",
+                   help="also print the notch-by-notch forward model at this tendon stroke (mm): per-notch angles "
+                        "and strain, tendon force, tip position and direction, one tendon pulled at a time")
+    p.add_argument("--calibration", metavar="FIT.json",
+                   help="with --stroke: use the parameters of a 'camtube model fit/diagnose --json' file")
+    p.add_argument("--hinge", choices=("beam", "fe_fit"), default="beam",
+                   help="with --stroke: notch stiffness E I / h (beam, default) or with the root length a "
+                        "finite-element model shows (fe_fit; see docs/design.md)")
+    p.add_argument("--overcut", type=float, metavar="MM",
+                   help="with --stroke: how much wider than drawn each notch is cut, mm (default: 0 with kerf "
+                        "compensation, else the calibration's kerf or the 0.02 mm the CAD verification assumes; "
+                        "the value 'camtube synthesize' designs with)")
     p.set_defaults(func=cmd_design)
 
     p = sub.add_parser("dxf", help="write the unrolled design DXF",
@@ -86,11 +98,34 @@ def _table(rows) -> str:
 
 
 def cmd_design(args: argparse.Namespace) -> int:
+    if args.stroke is not None and not (0.0 <= args.stroke < 1e3):
+        raise CamtubeError(f"--stroke {args.stroke:g}: the tendon stroke must be >= 0 and < 1000 mm; fix: give a "
+                           "stroke in mm, e.g. --stroke 1.5")
+    if args.calibration and args.stroke is None:
+        raise CamtubeError("--calibration is used by the forward model: fix: add --stroke MM")
     loaded = load_from_args(args)
+    mech = None
+    if args.stroke is not None:
+        from camtube.joint.forward import Mechanics
+
+        from dataclasses import replace
+
+        from camtube.synthesis.solve import expected_overcut_mm
+
+        calib = Mechanics.from_fit_json(args.calibration) if args.calibration else None
+        mech = calib or Mechanics()
+        overcut = args.overcut if args.overcut is not None else expected_overcut_mm(loaded.pattern.process, calib)
+        if not 0.0 <= overcut < 0.5:
+            raise CamtubeError(f"--overcut {overcut:g}: must be >= 0 and < 0.5 mm; fix: give the laser's overcut in mm")
+        mech = replace(mech, kerf_mm=overcut, hinge=args.hinge)
     print(design_report(loaded.pattern))
     extra = _design_extras(loaded.pattern)
     if extra:
         print(extra)
+    if mech is not None and loaded.pattern.notches:
+        from camtube.joint.forward import stroke_table
+
+        print(stroke_table(loaded.pattern, args.stroke, mech))
     return 0
 
 

@@ -209,6 +209,10 @@ class _Reader:
         return int(x) if integer else x
 
 
+#: The reader that turns raw YAML values into checked values (also used by other input files, e.g. goals).
+Reader = _Reader
+
+
 def _section(reader: _Reader, raw: dict, name: str) -> dict:
     body = raw.get(name)
     if body is None:
@@ -248,6 +252,25 @@ def _process(proc: dict) -> Process:
     )
 
 
+#: Per-notch list key -> (the scalar it replaces, how many values it needs given the notch count).
+_NOTCH_LISTS = {"widths": ("width", 0), "arcs": ("arc", 0), "spacings": ("spacing", -1), "angles_deg": (None, 0)}
+
+
+def _check_notch_lists(r: _Reader, gen: dict) -> None:
+    """Each per-notch list has one value per notch (per gap for ``spacings``); a scalar is given or replaced."""
+    count = gen.get("count")
+    for key, (scalar, extra) in _NOTCH_LISTS.items():
+        values = gen.get(key) or ()
+        if values and count is not None and len(values) != max(count + extra, 0):
+            need = max(count + extra, 0)
+            r.issue(f"notch.{key}", f"has {len(values)} values for notch.count = {count}", len(values),
+                    f"{need} values ({'one per gap between notches' if extra else 'one per notch'}, from the tip)",
+                    f"give {need} values or set notch.count to match")
+        if scalar and not values and gen.get(scalar) is None and not (scalar == "spacing" and count == 1):
+            r.issue(f"notch.{scalar}", "required key is missing", None, SCHEMA["notch"][scalar].allowed(),
+                    f"add '{scalar}: <value>' or a per-notch list '{key}: [...]'")
+
+
 def build_settings(raw: dict, file: str | None = None) -> tuple[Tube, Process, Tendon, Rules]:
     """The tube, process, tendon and rules sections of raw pattern data, validated.
 
@@ -262,7 +285,8 @@ def build_settings(raw: dict, file: str | None = None) -> tuple[Tube, Process, T
     if r.issues:
         raise PatternError(r.issues)
     return (Tube(tube["outer_radius"], tube["inner_radius"], tube["length"], tube["material"]), _process(proc),
-            Tendon(tendon["radius"], tendon["length"], tendon["modulus_gpa"], tendon["material"]),
+            Tendon(tendon["radius"], tendon["length"], tendon["modulus_gpa"], tendon["material"],
+                          tendon["friction"]),
             Rules(rl["min_backbone_arc"], rl["min_web"], rl["max_strain"], rl["max_stroke"]))
 
 
@@ -282,7 +306,9 @@ def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = Non
     gen = _section(r, raw, "notch") if has_notch else None
     holes = r.convert(raw.get("holes") or [], SCHEMA["holes"], "holes")
     extra = r.convert(raw.get("cuts") or [], SCHEMA["cuts"], "cuts")
-    if gen and gen.get("layout") == "directions" and not gen.get("directions_deg"):
+    if gen:
+        _check_notch_lists(r, gen)
+    if gen and gen.get("layout") == "directions" and not gen.get("directions_deg") and not gen.get("angles_deg"):
         r.issue("notch.directions_deg", "layout 'directions' needs a list of angles", None,
                 "a non-empty list of angles in deg", "add e.g. directions_deg: [0, 90, 180, 270]")
     if not has_notch and not extra:
@@ -294,7 +320,8 @@ def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = Non
     cuts, origins = [], []
     if gen:
         row = notch_row(gen["count"], gen["width"], gen["spacing"], gen["arc"], gen["first_offset"],
-                        gen["angle_deg"], gen["layout"], gen["directions_deg"])
+                        gen["angle_deg"], gen["layout"], gen["directions_deg"], gen["widths"], gen["arcs"],
+                        gen["spacings"], gen["angles_deg"])
         cuts += row
         origins += ["notch"] * len(row)
     for i, c in enumerate(extra):
@@ -313,7 +340,8 @@ def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = Non
         tube=Tube(tube["outer_radius"], tube["inner_radius"], tube["length"], tube["material"]),
         cuts=cuts,
         process=process,
-        tendon=Tendon(tendon["radius"], tendon["length"], tendon["modulus_gpa"], tendon["material"]),
+        tendon=Tendon(tendon["radius"], tendon["length"], tendon["modulus_gpa"], tendon["material"],
+                          tendon["friction"]),
         rules=Rules(rl["min_backbone_arc"], rl["min_web"], rl["max_strain"], rl["max_stroke"]),
         source=file,
     )
@@ -344,6 +372,28 @@ def load(path: str | os.PathLike, overrides: Iterable[str] = ()) -> Loaded:
     raw = apply_overrides(raw, overrides, file)
     set_keys = {parse_override(o)[0] for o in overrides}
     lines = {k: v for k, v in lines.items() if k not in set_keys}  # a --set value has no line
+    return build(raw, file, lines, name=Path(path).stem)
+
+
+def load_text(text: str, path: str | os.PathLike) -> Loaded:
+    """Validate and build a pattern from YAML ``text`` as if it were the file ``path`` (which need not exist).
+
+    A ``process:`` file name is looked up beside ``path``, then among the shipped presets. Used to
+    check a generated pattern before it is written.
+    """
+    file = str(path)
+    try:
+        raw = parse_yaml(text)
+    except yaml.YAMLError as exc:
+        raise PatternError([Issue("yaml", f"not valid YAML: {exc}", None, "YAML mapping", "", file)]) from None
+    if not isinstance(raw, dict):
+        raise PatternError([Issue("<top>", "a pattern must be a mapping of sections", None, "", "", file, 1)])
+    lines = line_map(text)
+    proc = raw.get("process")
+    if isinstance(proc, str):
+        praw, _, _ = read_yaml(_process_file(proc, Path(path), file, lines.get("process")))
+        raw = dict(raw)
+        raw["process"] = praw.get("process", praw)
     return build(raw, file, lines, name=Path(path).stem)
 
 

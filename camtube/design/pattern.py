@@ -208,12 +208,16 @@ class Tendon:
         Unloaded length L0.
     modulus_gpa : float
         Young's modulus E_t (fitted; 28 GPa in the paper).
+    material : str
+    friction : float
+        Capstan friction coefficient of the tendon on the notch edges (forward model; 0 = none).
     """
 
     radius_mm: float = 0.04
     length_mm: float = 70.0
     modulus_gpa: float = 28.0
     material: str = "UHMWPE"
+    friction: float = 0.0
 
     @property
     def area_mm2(self) -> float:

@@ -226,8 +226,8 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
                 err(key_arc, f"backbone arc 2 pi r_o - s = {circ - arc:.4f} mm is thinner than "
                     f"rules.min_backbone_arc = {rules.min_backbone_arc_mm:g} mm", round(arc, 9),
                     f"<= {circ - rules.min_backbone_arc_mm:.4f} mm", fix_arc + " or lower rules.min_backbone_arc")
-            if origin == "notch":
-                seen_keys.add("arc")
+            if origin == "notch" and circ - arc < rules.min_backbone_arc_mm:
+                seen_keys.add("arc")  # per-notch arcs: every notch is checked, the key is reported once
         if cut.kind == "slit":
             pass
         elif cut.kind == "hole" and cut.arc_mm >= circ / 2.0:

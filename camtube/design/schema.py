@@ -85,13 +85,22 @@ SCHEMA: dict[str, dict[str, Field]] | dict = {
                         "angle_deg and angle_deg+180; directions: cycle through directions_deg",
                         "uan", choices=("uan", "bidirectional", "directions")),
         "count": Field("int", "", "number of notches n", ..., 0, 100000),
-        "width": Field("float", "mm", "axial notch width h", ..., **POS),
-        "spacing": Field("float", "mm", "web c between adjacent notches (edge to edge)", ..., **POS),
-        "arc": Field("float", "mm", "notch arc s on the outer surface", ..., **POS),
+        "width": Field("float", "mm", "axial notch width h (required unless 'widths' is given)", None, **POS),
+        "spacing": Field("float", "mm", "web c between adjacent notches, edge to edge (required unless "
+                         "'spacings' is given)", None, **POS),
+        "arc": Field("float", "mm", "notch arc s on the outer surface (required unless 'arcs' is given)",
+                     None, **POS),
         "first_offset": Field("float", "mm", "tip to the tip-side edge of the first notch", ..., 0.0),
         "angle_deg": Field("float", "deg", "rotary angle of the (first) notch centre", 180.0, -360.0, 720.0),
         "directions_deg": Field("floats", "deg", "with layout: directions, the centre angle of "
                                 "successive notches, repeated", ()),
+        "widths": Field("floats", "mm", "per-notch width h, one per notch from the tip (replaces 'width')",
+                        (), **POS),
+        "arcs": Field("floats", "mm", "per-notch arc s, one per notch from the tip (replaces 'arc')", (), **POS),
+        "spacings": Field("floats", "mm", "per-gap web c, count - 1 values from the tip (replaces 'spacing')",
+                          (), **POS),
+        "angles_deg": Field("floats", "deg", "per-notch centre angle, one per notch from the tip (replaces "
+                            "layout, angle_deg and directions_deg)", (), -360.0, 720.0),
     },
     "holes": Field("rows", "", "square tendon holes", (), row=_HOLE_ROW),
     "cuts": Field("rows", "", "extra notches placed by hand", (), row=_CUT_ROW),
@@ -100,6 +109,8 @@ SCHEMA: dict[str, dict[str, Field]] | dict = {
         "length": Field("float", "mm", "unloaded tendon length L0", 70.0, **POS),
         "modulus_gpa": Field("float", "GPa", "tendon Young's modulus E_t (initial value for fits)", 28.0, **POS),
         "material": Field("str", "", "tendon material", "UHMWPE"),
+        "friction": Field("float", "", "capstan friction coefficient of the tendon on the notch edges "
+                          "(forward model)", 0.0, 0.0, 2.0),
     },
     "process": {
         "power_w": Field("float", "W", "average laser power", 2.0, **POS),

@@ -1,0 +1,55 @@
+"""CLI of the synthesis stage: ``camtube synthesize GOAL.yaml -o PATTERN.yaml``."""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from camtube.errors import CamtubeError
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "synthesize", help="design the notch pattern that meets a goal (bend at a stroke, limits)",
+        description="Read a goal YAML (stock, tendon, goal.bends: bend_deg at stroke_mm per direction, "
+                    "distribution or curve, limits), choose every notch's width and arc with the notch-by-notch "
+                    "forward model, write a pattern YAML that camtube's rules accept, and print target vs "
+                    "predicted, the active limit and the bend change per 10 um of notch depth and of kerf. "
+                    "An infeasible goal: one line naming the limit and the nearest feasible target, exit 2. "
+                    "Lengths mm, angles deg, forces N.")
+    p.add_argument("goal", metavar="GOAL.yaml", help="goal file (see examples/goals/ and docs/design.md)")
+    p.add_argument("-o", "--output", required=True, metavar="PATTERN.yaml", help="pattern YAML to write")
+    p.add_argument("--calibration", metavar="FIT.json",
+                   help="parameters of an earlier tube's 'camtube model fit --json' or 'model diagnose --json' "
+                        "(E_t, L0, slack, toe, kerf, friction, ...) to design with")
+    p.set_defaults(func=cmd_synthesize)
+
+
+def cmd_synthesize(args: argparse.Namespace) -> int:
+    from camtube.design.loader import load_text
+    from camtube.io import write_atomic
+    from camtube.joint.forward import Mechanics
+    from camtube.synthesis.goal import load_goal
+    from camtube.synthesis.report import check_design, pattern_yaml, summary_text
+    from camtube.synthesis.solve import synthesize
+
+    out = Path(args.output)
+    if out.suffix.lower() not in (".yaml", ".yml"):
+        raise CamtubeError(f"{args.output}: synthesize writes a pattern YAML; fix: name the output PATTERN.yaml")
+    if out.is_dir():
+        raise CamtubeError(f"{args.output}: is a directory; fix: name the pattern file, e.g. {out / 'pattern.yaml'}")
+    goal = load_goal(args.goal)
+    calib = Mechanics.from_fit_json(args.calibration) if args.calibration else None
+    t0 = time.perf_counter()
+    design = synthesize(goal, calib)
+    seconds = time.perf_counter() - t0
+    text = pattern_yaml(design)
+    loaded = load_text(text, out)  # camtube's own rules, before anything is written
+    checks = check_design(design, loaded.pattern)
+    path = write_atomic(out, text)
+    print(summary_text(design, checks, seconds))
+    for w in loaded.warnings:
+        print(f"warning: {w}", file=sys.stderr)
+    print(f"wrote {path}")
+    return 0

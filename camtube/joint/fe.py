@@ -1,0 +1,159 @@
+"""Finite-element check of one notch: its bending stiffness and closure angle (scikit-fem, 3-D elasticity).
+
+The model: a tube segment (r_i..r_o) of length ``lead + h + lead`` with one notch (arc ``s`` on the
+outer surface, width ``h``, radial walls, centred on angle pi) in the middle, meshed with quadratic
+tetrahedra (a structured grid in ``(r, angle, z)`` mapped to the cylinder, every cell split into six
+tetrahedra, the grid lines on the notch's edges). The base face ``z = 0`` is clamped; the far face
+carries the linear axial traction of a pure bending moment ``M`` about the axis normal to the notch's
+plane of symmetry (exact for the plain tube, so the load causes no end disturbance).
+
+From the solution:
+
+* the far face's rotation ``phi`` (least-squares plane through its axial displacements);
+* the notch's own rotation ``theta_n = phi - M (L - h) / (E I_tube)``: the plain tube's share is
+  taken off (whatever the notch disturbs in the webs next to it stays with the notch);
+* stiffness ``K_fe = M / theta_n`` (N mm/rad), to compare with the model's ``E I_backbone / h``;
+* closure angle ``h theta_n / d_gap``, where ``d_gap`` is how much the notch's gap at its mouth (angle pi,
+  outer surface) shrinks: the notch closes when the mouth does; the model's is ``h / (r_o + ybar)``.
+
+scikit-fem is needed (``pip install scikit-fem``, in the ``test`` extra); it is imported only here.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from camtube.design.geometry import joint_geometry
+
+
+@dataclass(frozen=True)
+class NotchFE:
+    """FE result for one notch, beside the model's values.
+
+    Attributes
+    ----------
+    stiffness_nmm_per_rad, model_stiffness_nmm_per_rad : float
+        Notch bending stiffness from the FE model and from ``E I / h``.
+    closure_deg, model_closure_deg : float
+        Notch closure angle from the FE model and from ``h / (r_o + ybar)``.
+    dofs : int
+        Unknowns of the FE model.
+    """
+
+    outer_radius_mm: float
+    inner_radius_mm: float
+    arc_mm: float
+    width_mm: float
+    stiffness_nmm_per_rad: float
+    model_stiffness_nmm_per_rad: float
+    closure_deg: float
+    model_closure_deg: float
+    dofs: int
+
+    @property
+    def stiffness_error(self) -> float:
+        """(model - FE) / FE."""
+        return self.model_stiffness_nmm_per_rad / self.stiffness_nmm_per_rad - 1.0
+
+    @property
+    def closure_error(self) -> float:
+        return self.model_closure_deg / self.closure_deg - 1.0
+
+
+def _axis(lo: float, hi: float, n: int) -> np.ndarray:
+    return np.linspace(lo, hi, max(int(n), 1) + 1)
+
+
+def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm: float, width_mm: float,
+             modulus_gpa: float = 2.5, poisson: float = 0.34, *, n_r: int = 2, n_backbone: int = 20,
+             n_cut: int = 12, n_lead: int = 8, n_notch: int = 4, lead_mm: float | None = None) -> NotchFE:
+    """Bending stiffness and closure angle of one notch by 3-D finite elements (see the module docstring).
+
+    Parameters
+    ----------
+    outer_radius_mm, inner_radius_mm, arc_mm, width_mm : float
+        Tube and notch (arc on the outer surface, axial width).
+    modulus_gpa, poisson : float
+        Tube material (2.5 GPa, 0.34: polyimide).
+    n_r, n_backbone, n_cut, n_lead, n_notch : int
+        Grid cells through the wall, around the backbone, around the cut, along each lead and along the notch.
+    lead_mm : float, optional
+        Plain tube on each side of the notch (default ``2 r_o``).
+    """
+    import skfem
+    from skfem.helpers import ddot, sym_grad, trace
+    from skfem.models.elasticity import lame_parameters
+
+    ro, ri, s, h = outer_radius_mm, inner_radius_mm, arc_mm, width_mm
+    lead = 2.0 * ro if lead_mm is None else lead_mm
+    half = s / (2.0 * ro)  # half-angle of the cut, centred on pi
+    e = modulus_gpa * 1e3
+    r_nodes = _axis(ri, ro, n_r)
+    t_nodes = np.unique(np.concatenate([
+        _axis(-math.pi, -math.pi + half, max(2, n_cut // 2)),
+        _axis(-math.pi + half, math.pi - half, n_backbone),
+        _axis(math.pi - half, math.pi, max(2, n_cut // 2))]))
+    length = 2.0 * lead + h
+    z_nodes = np.unique(np.concatenate([_axis(0.0, lead, n_lead), _axis(lead, lead + h, n_notch),
+                                        _axis(lead + h, length, n_lead)]))
+    box = skfem.MeshTet.init_tensor(r_nodes, t_nodes, z_nodes)
+    p, t = box.p.copy(), box.t.copy()
+    # cells of the notch: z inside the notch and angle within the cut (near +-pi)
+    c = p[:, t].mean(axis=1)
+    in_notch = (c[2] > lead) & (c[2] < lead + h) & (np.abs(c[1]) > math.pi - half)
+    t = t[:, ~in_notch]
+    # close the seam: nodes at angle +pi are the nodes at -pi
+    seam = np.isclose(p[1], math.pi)
+    partner = np.arange(p.shape[1])
+    key = {(round(p[0, i], 9), round(p[2, i], 9)): i for i in np.flatnonzero(np.isclose(p[1], -math.pi))}
+    for i in np.flatnonzero(seam):
+        partner[i] = key[(round(p[0, i], 9), round(p[2, i], 9))]
+    t = partner[t]
+    used = np.unique(t)
+    remap = -np.ones(p.shape[1], int)
+    remap[used] = np.arange(used.size)
+    rr, tt, zz = p[0, used], p[1, used], p[2, used]
+    xyz = np.vstack([rr * np.cos(tt), rr * np.sin(tt), zz])  # x towards the backbone (angle 0)
+    mesh = skfem.MeshTet(xyz, remap[t])
+    elem = skfem.ElementVector(skfem.ElementTetP2())
+    basis = skfem.Basis(mesh, elem, intorder=3)
+    lam, mu = lame_parameters(e, poisson)
+
+    @skfem.BilinearForm
+    def stiffness(u, v, w):
+        eps_u, eps_v = sym_grad(u), sym_grad(v)
+        return 2.0 * mu * ddot(eps_u, eps_v) + lam * trace(eps_u) * trace(eps_v)
+
+    i_tube = math.pi / 4.0 * (ro**4 - ri**4)
+    moment = 1.0  # N mm; linear: any value
+
+    far = mesh.facets_satisfying(lambda x: np.isclose(x[2], length))
+    fbasis = skfem.FacetBasis(mesh, elem, facets=far, intorder=4)
+
+    @skfem.LinearForm
+    def traction(v, w):
+        # axial stress M x / I: tension on the backbone side, compression on the notch side
+        return moment * w.x[0] / i_tube * v[2]
+
+    a = stiffness.assemble(basis)
+    b = traction.assemble(fbasis)
+    fixed = basis.get_dofs(lambda x: np.isclose(x[2], 0.0)).all()
+    u = skfem.solve(*skfem.condense(a, b, D=fixed))
+    # nodal displacements (vertex dofs come first in the P2 basis)
+    uz = u[basis.nodal_dofs[2]]
+    pts = mesh.p
+    on_far = np.isclose(pts[2], length)
+    g = np.c_[np.ones(on_far.sum()), pts[0, on_far], pts[1, on_far]]
+    coef = np.linalg.lstsq(g, uz[on_far], rcond=None)[0]
+    phi = coef[1]  # du_z/dx: rotation of the far face about y (rad)
+    theta_n = phi - moment * (length - h) / (e * i_tube)
+    mouth = np.isclose(np.hypot(pts[0], pts[1]), ro) & np.isclose(np.abs(np.arctan2(pts[1], pts[0])), math.pi, atol=1e-9)
+    lo = mouth & np.isclose(pts[2], lead)
+    hi = mouth & np.isclose(pts[2], lead + h)
+    d_gap = float(uz[lo].mean() - uz[hi].mean())  # the gap shrinks by this much
+    g_model = joint_geometry(ro, ri, s, h)
+    return NotchFE(ro, ri, s, h, moment / theta_n, e * g_model.second_moment_mm4 / h,
+                   math.degrees(h * theta_n / d_gap), math.degrees(g_model.closure_angle_rad),
+                   int(basis.N))

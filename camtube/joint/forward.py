@@ -1,0 +1,508 @@
+"""Notch-by-notch forward model: tendon stroke -> per-notch angles, force, strain and tip pose.
+
+Model (lengths mm, forces N, angles rad unless named ``_deg``)
+---------------------------------------------------------------
+Each bending direction (the rotary angle its notches share) has its own tendon, anchored at
+the tip, that pulls only its own notches (as in :func:`camtube.design.geometry.bends_at_stroke`).
+Along one tendon, notches are taken from the base (large ``x``) to the tip:
+
+* notch ``i`` is a short beam: its backbone sector (arc ``s_i``, width ``h_i``) has second
+  moment ``I_i`` about its own neutral axis, stiffness ``k_i = E I_i / h_i`` (N mm/rad), and the
+  tendon, ``arm_i = ybar_i + r_i - r_t`` from that axis, bends it by ``theta_i = T_i arm_i / k_i``;
+* the notch closes (contact) at ``h_i / (r_o + ybar_i)``: it then stops bending;
+* capstan friction: the tendon wraps each notch's edges by the notch's angle, so the tension
+  reaching the next notch is ``T_{i+1} = T_i exp(-mu theta_i)``;
+* the stroke is ``slack + sum_i arm_i theta_i + elongation(F)``, with the elastic elongation
+  ``F L0 / (E_t pi r_t^2)`` (plus a toe region and a series compliance when calibrated).
+
+``Mechanics(hinge="fe_fit")`` lengthens each backbone beam by the root length a finite-element model of
+the notch shows (:data:`HINGE_FE_POLY`, :mod:`camtube.joint.fe`); the default ``beam`` is the paper's ``h``.
+For a given stroke the motor-side force ``F`` is the root of that (monotone) stroke equation.
+The tip pose follows by chaining the notch rotations, each about its backbone's neutral axis.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+
+from camtube.design.geometry import (
+    MATERIAL_MODULUS_GPA, joint_geometry, notches_by_direction, tendon_compliance_mm_per_N,
+)
+from camtube.design.pattern import Pattern
+from camtube.errors import CamtubeError
+
+#: Tube modulus (GPa) when the material has no entry in MATERIAL_MODULUS_GPA.
+FALLBACK_MODULUS_GPA = 2.5
+
+#: ``hinge="fe_fit"``: the backbone bends over ``h + r_o * poly(phi)`` instead of ``h``. The cubic (highest
+#: power first) was fitted to ten finite-element runs of :mod:`camtube.joint.fe` (tubes r_o/r_i 0.75/0.45,
+#: 0.85/0.55, 1.25/0.75; phi 1.1-4.3 rad; h 0.3-0.8 mm), none of them a preset notch: the extra length hardly
+#: depends on h, and peaks near phi = 3 (a half-tube backbone) at about one outer radius.
+HINGE_FE_POLY = (-0.0737, 0.5155, -0.8976, 1.0071)
+HINGES = ("beam", "fe_fit")
+
+
+def hinge_extra_mm(outer_radius_mm: float, phi_rad: float, hinge: str = "beam") -> float:
+    """Extra bending length (mm) of a notch's backbone beyond its width h (0 for the plain beam model)."""
+    if hinge == "beam":
+        return 0.0
+    if hinge != "fe_fit":
+        raise ValueError(f"unknown hinge model {hinge!r}; one of {', '.join(HINGES)}")
+    return outer_radius_mm * max(float(np.polyval(HINGE_FE_POLY, phi_rad)), 0.0)
+
+
+@dataclass(frozen=True)
+class Mechanics:
+    """Physical constants of the forward model beyond the cut geometry.
+
+    Attributes
+    ----------
+    tube_modulus_gpa : float or None
+        Young's modulus of the tube (None: from the material, 2.5 GPa for polyimide).
+    friction : float or None
+        Capstan friction coefficient of the tendon on the notch edges (None: the pattern's
+        ``tendon.friction``).
+    tendon_modulus_gpa, tendon_length_mm : float or None
+        E_t and L0 (None: the pattern's ``tendon``).
+    slack_mm : float
+        Stroke taken up before the tendon is taut.
+    toe_mm : float
+        Elongation over which the tendon's fibres straighten (0: linear tendon).
+    series_compliance_mm_per_N : float
+        Extra compliance in series with the tendon (sheath, fixture).
+    arm_scale : float
+        Factor on every moment arm.
+    kerf_mm : float
+        Overcut of the laser: each notch is cut this much wider than drawn, in arc and in width
+        (a job planned without kerf compensation cuts its first pass on the design line).
+    sheath_loss : float
+        Fraction of the motor-side force lost before the joint (tendon-sheath friction while pulling).
+    hinge : {"beam", "fe_fit"}
+        How long a beam the backbone is: ``beam`` (the paper's and ``design``'s: the notch width h) or
+        ``fe_fit`` (h plus the root length that a finite-element model of the notch shows,
+        :data:`HINGE_FE_POLY`).
+    source : str
+        Where the values came from (``defaults`` or a fit file).
+    ignored : tuple[str, ...]
+        Parameters of a calibration file the model does not use.
+    """
+
+    tube_modulus_gpa: float | None = None
+    friction: float | None = None
+    tendon_modulus_gpa: float | None = None
+    tendon_length_mm: float | None = None
+    slack_mm: float = 0.0
+    toe_mm: float = 0.0
+    series_compliance_mm_per_N: float = 0.0
+    arm_scale: float = 1.0
+    kerf_mm: float = 0.0
+    sheath_loss: float = 0.0
+    hinge: str = "beam"
+    source: str = "defaults"
+    ignored: tuple[str, ...] = ()
+
+    def modulus_gpa(self, material: str) -> float:
+        if self.tube_modulus_gpa is not None:
+            return self.tube_modulus_gpa
+        return MATERIAL_MODULUS_GPA.get(material, FALLBACK_MODULUS_GPA)
+
+    def mu(self, pattern: Pattern) -> float:
+        """The capstan friction coefficient used for ``pattern``."""
+        return self.friction if self.friction is not None else pattern.tendon.friction
+
+    def compliance_mm_per_N(self, pattern: Pattern) -> float:
+        """Linear tendon compliance ``L0 / (E_t pi r_t^2)`` plus the series compliance (mm/N)."""
+        td = pattern.tendon
+        e_t = self.tendon_modulus_gpa if self.tendon_modulus_gpa is not None else td.modulus_gpa
+        l0 = self.tendon_length_mm if self.tendon_length_mm is not None else td.length_mm
+        return tendon_compliance_mm_per_N(l0, e_t, td.radius_mm) + self.series_compliance_mm_per_N
+
+    def elongation_mm(self, force_N: float, pattern: Pattern) -> float:
+        """Tendon elongation (mm) at motor-side force ``force_N`` (toe region, then linear)."""
+        c = self.compliance_mm_per_N(pattern)
+        f = max(force_N, 0.0)
+        et = self.toe_mm
+        if et > 0.0 and f < et / (2.0 * c):
+            return math.sqrt(2.0 * et * c * f)
+        return c * f + 0.5 * et
+
+    @classmethod
+    def from_fit_json(cls, path: str | Path, **base) -> "Mechanics":
+        """Mechanics with the parameters of a ``camtube model fit --json`` or ``model diagnose --json`` file.
+
+        Used: ``E_t``, ``L0``, ``arm_scale``, ``slack.deadband_mm``, ``toe.toe_mm``, ``kerf.kerf_mm``,
+        ``series.compliance_mm_per_N``, ``friction.mu`` (as the sheath loss while pulling). Per-sample
+        copies (``name@S``) are averaged. Other parameters are listed in :attr:`ignored`.
+
+        Raises
+        ------
+        CamtubeError
+            The file is unreadable, not JSON, or has no parameters.
+        """
+        p = Path(path)
+        try:
+            doc = json.loads(p.read_text(encoding="utf-8"))
+        except OSError as exc:
+            raise CamtubeError(f"{p}: cannot read the calibration: {exc.strerror}; fix: check the path") from None
+        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+            raise CamtubeError(f"{p}: the calibration is not JSON ({exc}); fix: pass the file written by "
+                               "'camtube model fit --json' or 'camtube model diagnose --json'") from None
+        params = _fit_params(doc)
+        if not params:
+            raise CamtubeError(f"{p}: no fitted parameters found (expected 'params' or 'final.params' of a "
+                               "camtube.fit/1 or camtube.diagnose/1 file); fix: pass the JSON of 'camtube model "
+                               "fit --json' or 'camtube model diagnose --json'")
+        used = {"E_t": "tendon_modulus_gpa", "L0": "tendon_length_mm", "arm_scale": "arm_scale",
+                "slack.deadband_mm": "slack_mm", "toe.toe_mm": "toe_mm", "kerf.kerf_mm": "kerf_mm",
+                "series.compliance_mm_per_N": "series_compliance_mm_per_N", "friction.mu": "sheath_loss"}
+        values: dict[str, float] = dict(base)
+        ignored = []
+        for name, v in params.items():
+            if name in used:
+                values[used[name]] = v
+            else:
+                ignored.append(name)
+        if values.get("sheath_loss", 0.0) < 0.0:  # a negative mu is a gain, not a loss: keep it at 0
+            values["sheath_loss"] = 0.0
+        return cls(**values, source=str(p), ignored=tuple(sorted(ignored)))
+
+
+def _fit_params(doc) -> dict[str, float]:
+    """``{name: value}`` of a fit or diagnose JSON, per-sample copies averaged."""
+    if not isinstance(doc, dict):
+        return {}
+    block = doc.get("params")
+    if not isinstance(block, dict) and isinstance(doc.get("final"), dict):
+        block = doc["final"].get("params")
+    if not isinstance(block, dict):
+        return {}
+    sums: dict[str, list[float]] = {}
+    for name, entry in block.items():
+        v = entry.get("value") if isinstance(entry, dict) else entry
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            continue
+        sums.setdefault(str(name).split("@")[0], []).append(float(v))
+    return {k: sum(v) / len(v) for k, v in sums.items()}
+
+
+@dataclass(frozen=True, eq=False)
+class NotchSet:
+    """The notches of one bending direction, base to tip, with their mechanics.
+
+    Attributes
+    ----------
+    angle_deg : float
+        Direction (rotary angle of the notch centres).
+    index : (n,) int
+        Index of each notch in ``pattern.notches``.
+    x_mm, width_mm, arc_mm : (n,) float
+        Centre, axial width h and arc s, as cut (drawn + ``kerf_mm``).
+    arm_mm : (n,) float
+        Moment arm of the tendon about each backbone's neutral axis (times ``arm_scale``).
+    ybar_mm : (n,) float
+        Backbone centroid distance from the tube axis.
+    stiffness_nmm_per_rad : (n,) float
+        ``E I / h`` of each notch.
+    closure_rad : (n,) float
+        Angle at which each notch closes.
+    extreme_fibre_mm : (n,) float
+        Largest distance of backbone material from the neutral axis.
+    bending_length_mm : (n,) float
+        Length over which each backbone bends (h, or more with a hinge model).
+    """
+
+    angle_deg: float
+    index: np.ndarray
+    x_mm: np.ndarray
+    width_mm: np.ndarray
+    arc_mm: np.ndarray
+    arm_mm: np.ndarray
+    ybar_mm: np.ndarray
+    stiffness_nmm_per_rad: np.ndarray
+    closure_rad: np.ndarray
+    extreme_fibre_mm: np.ndarray
+    bending_length_mm: np.ndarray
+
+    def angles_at(self, tension_N: float, friction: float) -> np.ndarray:
+        """Per-notch angles (rad, base to tip) when the tendon enters the joint at ``tension_N``."""
+        out = np.empty(len(self.x_mm))
+        t = max(tension_N, 0.0)
+        for i in range(len(out)):
+            th = min(t * self.arm_mm[i] / self.stiffness_nmm_per_rad[i], self.closure_rad[i])
+            out[i] = th
+            t *= math.exp(-friction * th)
+        return out
+
+    def strain(self, angles_rad: np.ndarray) -> np.ndarray:
+        """Peak backbone strain of each notch at ``angles_rad``."""
+        return self.extreme_fibre_mm * np.asarray(angles_rad) / self.bending_length_mm
+
+
+def notch_set(tube, tendon_radius_mm: float, angle_deg: float, x_mm, width_mm, arc_mm,
+              mechanics: Mechanics = Mechanics(), index=None) -> NotchSet:
+    """A :class:`NotchSet` from per-notch arrays (base to tip): centres, widths h and arcs s (mm).
+
+    ``mechanics.kerf_mm`` widens each arc and width (as cut); the arcs are kept inside ``(0, 2 pi r_o)``.
+    """
+    e = mechanics.modulus_gpa(tube.material) * 1e3  # N/mm^2
+    circ = tube.circumference_mm
+    geos = [joint_geometry(tube.outer_radius_mm, tube.inner_radius_mm,
+                           min(max(float(s) + mechanics.kerf_mm, 1e-6), circ - 1e-6),
+                           max(float(h) + mechanics.kerf_mm, 1e-6), tendon_radius_mm)
+            for h, s in zip(width_mm, arc_mm)]
+    n = len(geos)
+    bend_len = np.array([g.notch_width_mm + hinge_extra_mm(g.outer_radius_mm, g.phi_rad, mechanics.hinge)
+                         for g in geos])
+    return NotchSet(
+        angle_deg=angle_deg,
+        index=np.arange(n) if index is None else np.asarray(index, int),
+        x_mm=np.asarray(x_mm, float),
+        width_mm=np.array([g.notch_width_mm for g in geos]),
+        arc_mm=np.array([g.arc_mm for g in geos]),
+        arm_mm=np.array([g.moment_arm_mm * mechanics.arm_scale for g in geos]),
+        ybar_mm=np.array([g.ybar_mm for g in geos]),
+        stiffness_nmm_per_rad=np.array([e * g.second_moment_mm4 for g in geos]) / bend_len,
+        closure_rad=np.array([g.closure_angle_rad for g in geos]),
+        extreme_fibre_mm=np.array([g.extreme_fibre_mm for g in geos]),
+        bending_length_mm=bend_len,
+    )
+
+
+def direction_notches(pattern: Pattern, mechanics: Mechanics = Mechanics()) -> list[NotchSet]:
+    """The pattern's notches grouped by direction (sorted by angle), each base to tip."""
+    index_of = {id(n): k for k, n in enumerate(pattern.notches)}
+    out = []
+    for ang, notches in notches_by_direction(pattern):
+        ns = sorted(notches, key=lambda n: -n.x_mm)
+        out.append(notch_set(pattern.tube, pattern.tendon.radius_mm, ang, [n.x_mm for n in ns],
+                             [n.width_mm for n in ns], [n.arc_mm for n in ns], mechanics,
+                             [index_of[id(n)] for n in ns]))
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class DirectionState:
+    """One tendon's state at its stroke.
+
+    Attributes
+    ----------
+    angle_deg : float
+        Bending direction.
+    stroke_mm : float
+        Motor-side tendon stroke.
+    force_N : float
+        Motor-side tendon force.
+    notch_angles_rad : (n,) float
+        Per-notch angles, base to tip (``notches.index`` maps them to the pattern).
+    strain : (n,) float
+        Per-notch peak backbone strain.
+    closed : (n,) bool
+        Notches that are closed (in contact).
+    notches : NotchSet
+    """
+
+    angle_deg: float
+    stroke_mm: float
+    force_N: float
+    notch_angles_rad: np.ndarray
+    strain: np.ndarray
+    closed: np.ndarray
+    notches: NotchSet
+
+    @property
+    def bend_deg(self) -> float:
+        """Sum of this direction's notch angles (deg)."""
+        return math.degrees(float(np.sum(self.notch_angles_rad)))
+
+    @property
+    def shares(self) -> np.ndarray:
+        """Each notch's share of the direction's bend, base to tip (sums to 1)."""
+        tot = float(np.sum(self.notch_angles_rad))
+        return self.notch_angles_rad / tot if tot > 0 else np.zeros_like(self.notch_angles_rad)
+
+
+@dataclass(frozen=True, eq=False)
+class JointState:
+    """The whole joint at a set of strokes.
+
+    Attributes
+    ----------
+    directions : tuple[DirectionState, ...]
+    notch_angles_rad : (n,) float
+        Angle of every notch of ``pattern.notches``, in pattern order.
+    tip_position_mm : (3,) float
+        Tip centre in the tube frame: origin at the base section (x = tube.length), ``z`` along the
+        straight tube towards the tip, rotary angle 0 along ``+x``.
+    tip_direction : (3,) float
+        Unit tangent of the tube at the tip.
+    centerline_mm : (m, 3) float
+        Points of the tube's axis from the base to the tip.
+    """
+
+    directions: tuple[DirectionState, ...]
+    notch_angles_rad: np.ndarray
+    tip_position_mm: np.ndarray
+    tip_direction: np.ndarray
+    centerline_mm: np.ndarray
+
+    @property
+    def tip_angle_deg(self) -> float:
+        """Angle between the tip direction and the straight tube's axis (deg)."""
+        return math.degrees(math.acos(max(-1.0, min(1.0, float(self.tip_direction[2])))))
+
+    @property
+    def tip_plane_deg(self) -> float:
+        """Azimuth of the tip direction (rotary angle towards which the tip points, deg in [0, 360))."""
+        return math.degrees(math.atan2(self.tip_direction[1], self.tip_direction[0])) % 360.0
+
+    @property
+    def max_strain(self) -> float:
+        return max((float(np.max(d.strain)) for d in self.directions if len(d.strain)), default=0.0)
+
+    def direction(self, angle_deg: float) -> DirectionState:
+        for d in self.directions:
+            if abs((d.angle_deg - angle_deg + 180.0) % 360.0 - 180.0) < 1e-6:
+                return d
+        raise KeyError(f"no notches at {angle_deg:g} deg")
+
+
+def _solve_force(ns: NotchSet, stroke_mm: float, pattern: Pattern, mech: Mechanics) -> float:
+    """Motor-side force (N) at which the modelled stroke equals ``stroke_mm`` (brentq on a monotone function)."""
+    from scipy.optimize import brentq
+
+    eff = stroke_mm - mech.slack_mm
+    if eff <= 0.0:
+        return 0.0
+    keep = 1.0 - mech.sheath_loss
+
+    def stroke_of(f: float) -> float:
+        th = ns.angles_at(f * keep, mech.mu(pattern))
+        return float(ns.arm_mm @ th) + mech.elongation_mm(f, pattern) - eff
+
+    hi = 1.0
+    while stroke_of(hi) < 0.0:
+        hi *= 2.0
+        if hi > 1e9:
+            raise CamtubeError("the joint cannot take up the stroke (no finite force found)")
+    return float(brentq(stroke_of, 0.0, hi, xtol=1e-12, rtol=1e-12, maxiter=200))
+
+
+def simulate(pattern: Pattern, strokes: float | Mapping[float, float],
+             mechanics: Mechanics = Mechanics()) -> JointState:
+    """The joint at the given tendon strokes.
+
+    Parameters
+    ----------
+    pattern : Pattern
+        At least one notch.
+    strokes : float or {angle_deg: stroke_mm}
+        Motor-side stroke of every tendon (one number: every direction), mm. Directions not
+        named are not pulled.
+    mechanics : Mechanics
+
+    Returns
+    -------
+    JointState
+    """
+    if not pattern.notches:
+        raise CamtubeError(f"{pattern.name}: the pattern has no notches; the joint does not bend")
+    sets = direction_notches(pattern, mechanics)
+    states = []
+    all_angles = np.zeros(len(pattern.notches))
+    for ns in sets:
+        if isinstance(strokes, Mapping):
+            stroke = next((float(v) for a, v in strokes.items()
+                           if abs((float(a) - ns.angle_deg + 180.0) % 360.0 - 180.0) < 1e-6), 0.0)
+        else:
+            stroke = float(strokes)
+        f = _solve_force(ns, stroke, pattern, mechanics)
+        th = ns.angles_at(f * (1.0 - mechanics.sheath_loss), mechanics.mu(pattern))
+        states.append(DirectionState(ns.angle_deg, stroke, f, th, ns.strain(th), th >= ns.closure_rad * (1 - 1e-9),
+                                     ns))
+        all_angles[ns.index] = th
+    pts, tip_dir = centerline(pattern, all_angles, mechanics)
+    return JointState(tuple(states), all_angles, pts[-1], tip_dir, pts)
+
+
+def _rot(axis: np.ndarray, angle: float) -> np.ndarray:
+    a = axis / np.linalg.norm(axis)
+    k = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
+
+
+def centerline(pattern: Pattern, notch_angles_rad: np.ndarray, mechanics: Mechanics = Mechanics(),
+               per_notch: int = 6) -> tuple[np.ndarray, np.ndarray]:
+    """Tube axis from the base to the tip for given notch angles.
+
+    Each notch bends by its angle about the neutral axis of its backbone (``ybar`` from the
+    axis, opposite the notch), spread over ``per_notch`` steps across its width; the tube is
+    straight elsewhere.
+
+    Returns
+    -------
+    points : (m, 3) float
+        Axis points (mm) in the tube frame of :class:`JointState`.
+    tip_direction : (3,) float
+    """
+    t = pattern.tube
+    notches = pattern.notches
+    order = sorted(range(len(notches)), key=lambda k: -notches[k].x_mm)
+    p = np.zeros(3)
+    r = np.eye(3)  # columns: local x, y (rotary frame), z (towards the tip)
+    pts = [p.copy()]
+    pos = t.length_mm  # current axial coordinate (x from the tip)
+    circ = t.circumference_mm
+    for k in order:
+        n = notches[k]
+        theta = float(notch_angles_rad[k])
+        start = n.x_mm + n.width_mm / 2.0
+        p = p + r[:, 2] * (pos - start)
+        pts.append(p.copy())
+        arc = min(max(n.arc_mm + mechanics.kerf_mm, 1e-6), circ - 1e-6)
+        g = joint_geometry(t.outer_radius_mm, t.inner_radius_mm, arc, n.width_mm + mechanics.kerf_mm,
+                           pattern.tendon.radius_mm)
+        a = math.radians(n.angle_deg)
+        towards = r[:, 0] * math.cos(a) + r[:, 1] * math.sin(a)  # notch side, in the local section
+        axis = np.cross(r[:, 2], towards)  # closing the notch turns the tip towards it
+        step_len = n.width_mm / per_notch
+        rot = _rot(axis, theta / per_notch)
+        for _ in range(per_notch):
+            q = p - towards * g.ybar_mm + r[:, 2] * (step_len / 2.0)  # neutral fibre, mid-step
+            r = rot @ r
+            towards = rot @ towards
+            p = q + r[:, 2] * (step_len / 2.0) + towards * g.ybar_mm
+            pts.append(p.copy())
+        pos = n.x_mm - n.width_mm / 2.0
+    p = p + r[:, 2] * pos
+    pts.append(p.copy())
+    return np.array(pts), r[:, 2].copy()
+
+
+def stroke_table(pattern: Pattern, stroke_mm: float, mechanics: Mechanics = Mechanics()) -> str:
+    """Text report of the joint at ``stroke_mm`` on every tendon, one tendon pulled at a time.
+
+    Per direction: force, bend, largest strain, closed notches, then every notch's angle and
+    strain; then the tip pose with all tendons at ``stroke_mm`` when there is one direction.
+    """
+    lines = [f"forward model at a tendon stroke of {stroke_mm:g} mm (notch by notch; friction mu "
+             f"{mechanics.mu(pattern):g}, hinge {mechanics.hinge}, tube E {mechanics.modulus_gpa(pattern.tube.material):g} GPa, "
+             f"mechanics: {mechanics.source}; notches cut {1000 * mechanics.kerf_mm:.0f} um wider than drawn)"]
+    sets = direction_notches(pattern, mechanics)
+    for ns in sets:
+        st = simulate(pattern, {ns.angle_deg: stroke_mm}, mechanics)
+        d = st.direction(ns.angle_deg)
+        lines.append(f"tendon at {d.angle_deg:g} deg: force {d.force_N:.3f} N, bend {d.bend_deg:.2f} deg, "
+                     f"largest strain {float(np.max(d.strain)):.4f}, {int(np.sum(d.closed))} of {len(d.closed)} "
+                     f"notches closed; tip at ({st.tip_position_mm[0]:.3f}, {st.tip_position_mm[1]:.3f}, "
+                     f"{st.tip_position_mm[2]:.3f}) mm pointing {st.tip_angle_deg:.2f} deg off the axis "
+                     f"towards {st.tip_plane_deg:.1f} deg")
+        lines.append("   notch     x mm   angle deg   share %   strain")
+        for j in range(len(ns.x_mm)):
+            lines.append(f"  {int(ns.index[j]):6d} {ns.x_mm[j]:8.3f} {math.degrees(d.notch_angles_rad[j]):11.3f} "
+                         f"{100 * d.shares[j]:9.2f} {d.strain[j]:8.4f}" + ("  closed" if d.closed[j] else ""))
+    return "\n".join(lines)

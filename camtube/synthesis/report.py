@@ -1,0 +1,175 @@
+"""What ``camtube synthesize`` prints and writes: the pattern YAML, target vs predicted, the
+active limit and the laser tolerance (bend change per 10 um of notch depth and of kerf).
+
+Writers return text; the command writes files.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from camtube.design.pattern import Pattern
+from camtube.joint.forward import simulate
+from camtube.synthesis.solve import Design
+
+#: Step of the tolerance figures (mm): 10 um.
+TOL_STEP_MM = 0.010
+
+
+def _num(v: float) -> str:
+    return f"{v:.6g}"
+
+
+def _list(vals) -> str:
+    return "[" + ", ".join(_num(v) for v in vals) + "]"
+
+
+def pattern_yaml(design: Design, process: object | None = None) -> str:
+    """The pattern YAML of ``design`` (per-notch lists from the tip; one anchor hole per direction)."""
+    g = design.goal
+    p = design.pattern
+    t, td, r = p.tube, p.tendon, p.rules
+    sec = design.notch_section
+    proc = g.process if process is None else process
+    lines = [
+        f"# Written by camtube synthesize from {g.source or 'a goal'}: per-notch values from the tip.",
+        "# Targets (bend at the tendon stroke, per direction): "
+        + "; ".join(f"{b.bend_deg:g} deg at {b.stroke_mm:g} mm towards {b.angle_deg:g} deg" for b in g.bends),
+        f"# Check: camtube design THIS.yaml --stroke {g.bends[0].stroke_mm:g} --overcut {design.mechanics.kerf_mm:g}"
+        + (f" --hinge {design.mechanics.hinge}" if design.mechanics.hinge != "beam" else "")
+        + (" --calibration FIT.json (the same fit)" if design.mechanics.source != "defaults" else ""),
+        f"name: {p.name}",
+        f"tube: {{outer_radius: {_num(t.outer_radius_mm)}, inner_radius: {_num(t.inner_radius_mm)}, "
+        f"length: {_num(t.length_mm)}, material: {t.material}}}",
+        "notch:",
+        "  layout: uan",
+        f"  count: {sec['count']}",
+        f"  first_offset: {_num(sec['first_offset'])}",
+        f"  widths: {_list(sec['widths'])}",
+        f"  arcs: {_list(sec['arcs'])}",
+    ]
+    if sec["count"] > 1:
+        lines.append(f"  spacings: {_list(sec['spacings'])}")
+    else:
+        lines.append("  spacing: 0.5")
+    lines.append(f"  angles_deg: {_list(sec['angles_deg'])}")
+    lines.append("holes:")
+    for h in p.holes:
+        lines.append(f"  - {{x: {_num(h.x_mm)}, size: {_num(h.width_mm)}, angle_deg: {_num(h.angle_deg)}}}")
+    lines.append(f"tendon: {{radius: {_num(td.radius_mm)}, length: {_num(td.length_mm)}, modulus_gpa: "
+                 f"{_num(td.modulus_gpa)}, material: {td.material}, friction: {_num(td.friction)}}}")
+    if isinstance(proc, dict):
+        import yaml
+
+        lines.append("process: " + yaml.safe_dump(proc, default_flow_style=True, sort_keys=False, width=10**6).strip())
+    else:
+        lines.append(f"process: {proc}")
+    lines.append(f"rules: {{min_backbone_arc: {_num(r.min_backbone_arc_mm)}, min_web: {_num(r.min_web_mm)}, "
+                 f"max_strain: {_num(r.max_strain)}, max_stroke: {_num(r.max_stroke_mm)}}}")
+    return "\n".join(lines) + "\n"
+
+
+@dataclass(frozen=True)
+class DirectionCheck:
+    """Forward-model figures of one direction of a pattern at its design stroke.
+
+    Attributes
+    ----------
+    angle_deg, target_deg, stroke_mm : float
+    predicted_deg : float
+        Bend the forward model predicts at ``stroke_mm``.
+    force_N, max_strain : float
+    share_error : float
+        Largest relative difference between a notch's share and its target share.
+    per_10um_depth_deg, per_10um_kerf_deg : float
+        Change of the bend at ``stroke_mm`` when every notch is cut 10 um deeper, or with 10 um more kerf
+        (arc and width each 10 um larger).
+    """
+
+    angle_deg: float
+    target_deg: float
+    stroke_mm: float
+    predicted_deg: float
+    force_N: float
+    max_strain: float
+    share_error: float
+    per_10um_depth_deg: float
+    per_10um_kerf_deg: float
+
+
+def _deeper_arc(s: float, ro: float, dd: float) -> float:
+    """Arc of a notch cut ``dd`` deeper (beam depth ``r_o (1 - cos(s / 2 r_o))``)."""
+    depth = ro * (1.0 - math.cos(s / (2.0 * ro))) + dd
+    return 2.0 * ro * math.acos(max(-1.0, 1.0 - depth / ro))
+
+
+def _perturbed(pattern: Pattern, arc, width) -> Pattern:
+    cuts = [replace(c, arc_mm=arc(c.arc_mm), width_mm=width(c.width_mm)) if c.kind == "notch" else c
+            for c in pattern.cuts]
+    return pattern.with_cuts(cuts)
+
+
+def check_design(design: Design, pattern: Pattern | None = None) -> tuple[DirectionCheck, ...]:
+    """Target vs forward model for each direction of ``pattern`` (default: the design's), with tolerances."""
+    p = pattern or design.pattern
+    mech = design.mechanics
+    ro = p.tube.outer_radius_mm
+    deeper = _perturbed(p, lambda s: _deeper_arc(s, ro, TOL_STEP_MM), lambda h: h)
+    kerfed = _perturbed(p, lambda s: s + TOL_STEP_MM, lambda h: h + TOL_STEP_MM)
+    out = []
+    for d in design.directions:
+        b = d.target
+        st = simulate(p, {b.angle_deg: b.stroke_mm}, mech).direction(b.angle_deg)
+        target_shares = list(d.shares[::-1])  # base to tip, like the state
+        err = max(abs(a - t) / t for a, t in zip(st.shares, target_shares))
+        bd = simulate(deeper, {b.angle_deg: b.stroke_mm}, mech).direction(b.angle_deg).bend_deg
+        bk = simulate(kerfed, {b.angle_deg: b.stroke_mm}, mech).direction(b.angle_deg).bend_deg
+        out.append(DirectionCheck(b.angle_deg, b.bend_deg, b.stroke_mm, st.bend_deg, st.force_N,
+                                  float(st.strain.max()), float(err), bd - st.bend_deg, bk - st.bend_deg))
+    return tuple(out)
+
+
+def active_limits(design: Design, checks) -> list[tuple[str, float]]:
+    """``(limit key, margin)`` per limit, smallest margin first (margin: fraction of the limit still free)."""
+    g = design.goal
+    lim = g.limits
+    p = design.pattern
+    circ = p.tube.circumference_mm
+    notches = p.notches
+    first, last = notches[0], notches[-1]
+    length = last.x_end_mm - first.x_start_mm
+    out = [
+        ("limits.max_strain", 1.0 - max(c.max_strain for c in checks) / lim.max_strain),
+        ("limits.max_force_N", 1.0 - max(c.force_N for c in checks) / lim.max_force_N),
+        ("limits.max_length", 1.0 - length / lim.max_length_mm),
+        ("limits.min_backbone_arc", (circ - max(n.arc_mm for n in notches)) / lim.min_backbone_arc_mm - 1.0
+         if lim.min_backbone_arc_mm > 0 else math.inf),
+        ("limits.min_feature", min(n.width_mm for n in notches) / lim.min_feature_mm - 1.0),
+    ]
+    return sorted(out, key=lambda kv: kv[1])
+
+
+def summary_text(design: Design, checks, seconds: float | None = None) -> str:
+    """Target against predicted per direction, the active limit and the laser tolerance."""
+    p = design.pattern
+    m = design.mechanics
+    lines = [f"{p.name}: {len(p.notches)} notches, joint {p.notches[-1].x_end_mm - p.notches[0].x_start_mm:.2f} mm, "
+             f"tube {p.tube.length_mm:g} mm; mechanics: {m.source}"
+             + (f" (not used: {', '.join(m.ignored)})" if m.ignored else "")
+             + (f"; solved in {seconds:.2f} s" if seconds is not None else "")]
+    if m.kerf_mm:
+        lines.append(f"notches drawn {1000 * m.kerf_mm:.0f} um narrower (arc and width) than they are to be cut: the "
+                     "expected overcut of a process without kerf compensation")
+    lines.append("direction  notches  stroke mm  target deg  predicted deg  force N  strain   shares err  "
+                 "deg/10um depth  deg/10um kerf")
+    for d, c in zip(design.directions, checks):
+        lines.append(f"{c.angle_deg:9g}  {d.count:7d}  {c.stroke_mm:9.3f}  {c.target_deg:10.2f}  {c.predicted_deg:13.2f}  "
+                     f"{c.force_N:7.3f}  {c.max_strain:.4f}  {100 * c.share_error:8.2f} %  {c.per_10um_depth_deg:+14.2f}  "
+                     f"{c.per_10um_kerf_deg:+13.2f}")
+    lim = active_limits(design, checks)
+    key, margin = lim[0]
+    lines.append(f"active limit: {key} ({100 * margin:.1f} % to spare); next: "
+                 + ", ".join(f"{k} {100 * v:.0f} %" for k, v in lim[1:3]))
+    lines.append("tolerance: a notch cut 10 um deeper, or 10 um more kerf (arc and width), changes the bend at the "
+                 "design stroke by the degrees shown")
+    return "\n".join(lines)

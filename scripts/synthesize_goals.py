@@ -1,0 +1,117 @@
+"""Solve goal files and check every written pattern three ways; print a Markdown table.
+
+    python scripts/synthesize_goals.py                       # the goals in examples/goals/
+    python scripts/synthesize_goals.py --heldout 20 --seed 2611   # a fresh batch of random goals
+
+Per goal: the solve time; the forward model's bend at the design stroke and the largest relative
+error of a notch's share; the independent re-simulation from the planned job's as-cut geometry
+(:mod:`camtube.synthesis.check`): its bend (error against the target), strain and force against
+the limits; and whether ``build`` (toolpath + CAD model + as-cut simulation) verifies the job.
+An infeasible goal shows its one-line message. The pattern is validated by the pattern loader
+from the YAML text exactly as ``camtube synthesize`` writes it.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from camtube.design.loader import load_text  # noqa: E402
+from camtube.synthesis.check import resimulate  # noqa: E402
+from camtube.synthesis.goal import build_goal, load_goal  # noqa: E402
+from camtube.synthesis.report import check_design, pattern_yaml  # noqa: E402
+from camtube.synthesis.solve import InfeasibleGoal, synthesize  # noqa: E402
+
+
+def build_verifies(loaded) -> bool:
+    from camtube.pipeline import BUILD, CadOptions, Request, outputs
+
+    files, job, est, cad = outputs(loaded, Request(what=BUILD, cad=CadOptions(step=False, pictures=False)))
+    return bool(cad.passed)
+
+
+def random_goals(n: int, seed: int):
+    """``n`` goals drawn from the three preset stocks, with 1 or 2 directions and the four distributions."""
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    stocks = [(0.75, 0.45, 1.0, 2.0, 3.0), (0.85, 0.55, 1.0, 2.5, 4.0), (1.25, 0.75, 2.0, 5.0, 8.0)]
+    out = []
+    for k in range(n):
+        ro, ri, s_lo, s_hi, fmax = stocks[rng.integers(3)]
+        dirs = 1 if rng.random() < 0.7 else 2
+        bends = []
+        for d in range(dirs):
+            stroke = float(np.round(rng.uniform(s_lo, s_hi), 2))
+            bend = float(np.round(rng.uniform(15.0, 70.0) * (1.0 if ro < 1 else 1.3), 1))
+            bends.append({"angle_deg": [180, 0][d] if dirs == 2 else float(rng.choice([0, 90, 180, 270])),
+                          "bend_deg": bend, "stroke_mm": stroke})
+        dist = str(rng.choice(["uniform", "tip_first", "base_first"]))
+        raw = {"tube": {"outer_radius": ro, "inner_radius": ri},
+               "tendon": {"friction": float(np.round(rng.choice([0.0, 0.1, 0.2]), 2))},
+               "goal": {"bends": bends, "distribution": dist, "tip_ratio": float(np.round(rng.uniform(1.5, 3), 2)),
+                        "layout": str(rng.choice(["alternate", "sequential"]))},
+               "limits": {"max_strain": float(np.round(rng.uniform(0.03, 0.05), 3)), "max_force_N": fmax,
+                          "max_length": 30.0}}
+        out.append((f"heldout-{seed}-{k:02d}", build_goal(raw, None, {}, name=f"heldout-{seed}-{k:02d}")))
+    return out
+
+
+def run(goals, build: bool) -> int:
+    print("| goal | notches | solve s | target deg @ mm | forward deg | share err % | independent deg (err %) "
+          "| strain / limit | force N / limit | build verifies |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    bad = 0
+    for name, goal in goals:
+        t0 = time.perf_counter()
+        try:
+            design = synthesize(goal)
+        except InfeasibleGoal as exc:
+            print(f"| {name} | infeasible | {time.perf_counter() - t0:.2f} | "
+                  + "; ".join(f"{b.bend_deg:g} @ {b.stroke_mm:g}" for b in goal.bends)
+                  + f" | - | - | - | - | - | {exc.limit}: nearest {exc.nearest} |")
+            continue
+        secs = time.perf_counter() - t0
+        loaded = load_text(pattern_yaml(design), ROOT / "examples" / "goals" / f"{name}.pattern.yaml")
+        p = loaded.pattern
+        checks = check_design(design, p)
+        res = resimulate(p, {b.angle_deg: b.stroke_mm for b in goal.bends})
+        lim = goal.limits
+        ok_build = build_verifies(loaded) if build else None
+        for i, (b, c, r) in enumerate(zip(goal.bends, checks, res)):
+            err = 100.0 * (r.bend_deg - b.bend_deg) / b.bend_deg
+            good = (abs(c.predicted_deg - b.bend_deg) <= 0.5 and c.share_error <= 0.02 and abs(err) <= 5.0
+                    and r.max_strain <= lim.max_strain and r.force_N <= lim.max_force_N and secs <= 10.0
+                    and ok_build is not False)
+            bad += not good
+            print(f"| {name if i == 0 else ''} | {len(p.notches) if i == 0 else ''} | {secs:.2f} | "
+                  f"{b.bend_deg:g} @ {b.stroke_mm:g} ({b.angle_deg:g} deg) | {c.predicted_deg:.2f} | "
+                  f"{100 * c.share_error:.2f} | {r.bend_deg:.2f} ({err:+.1f}) | {r.max_strain:.4f} / {lim.max_strain:g} | "
+                  f"{r.force_N:.2f} / {lim.max_force_N:g} | {'-' if ok_build is None else ('yes' if ok_build else 'NO')}"
+                  f"{'' if good else ' **FAIL**'} |")
+    print(f"\n{bad} direction(s) failing a check")
+    return 1 if bad else 0
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("goals", nargs="*", help="goal files (default: examples/goals/*.yaml)")
+    ap.add_argument("--heldout", type=int, default=0, metavar="N", help="draw N random goals instead")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--no-build", action="store_true", help="skip the build + verification")
+    a = ap.parse_args()
+    if a.heldout:
+        goals = random_goals(a.heldout, a.seed)
+    else:
+        files = [Path(g) for g in a.goals] or sorted((ROOT / "examples" / "goals").glob("*.yaml"))
+        goals = [(f.stem, load_goal(f)) for f in files]
+    return run(goals, not a.no_build)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

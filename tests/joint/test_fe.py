@@ -1,0 +1,28 @@
+"""The small FE case: the preset tube 1 notch by 3-D finite elements (scikit-fem) against the forward model.
+
+The full table (presets and the tip-first design) is ``scripts/fe_notch_table.py`` and docs/design.md.
+"""
+from __future__ import annotations
+
+import math
+
+import pytest
+
+pytest.importorskip("skfem")
+
+from camtube.design.geometry import joint_geometry  # noqa: E402
+from camtube.joint.fe import notch_fe  # noqa: E402
+from camtube.joint.forward import hinge_extra_mm  # noqa: E402
+
+
+def test_tube1_notch_stiffness_and_closure_against_fe():
+    r = notch_fe(0.75, 0.45, 2.83, 0.5, n_backbone=16, n_cut=8, n_lead=6, n_notch=3)
+    g = joint_geometry(0.75, 0.45, 2.83, 0.5)
+    # closure: the mouth closes when it has moved by h; the model rotates about the backbone centroid
+    assert r.model_closure_deg == pytest.approx(math.degrees(0.5 / (0.75 + g.ybar_mm)))
+    assert abs(r.closure_error) <= 0.10
+    # stiffness: the beam E I / h ignores the backbone's roots in the webs and is about twice too stiff ...
+    assert 1.5 < r.model_stiffness_nmm_per_rad / r.stiffness_nmm_per_rad < 3.0
+    # ... the fe_fit hinge (fitted to other notches, not this one) is within 10 %
+    k_fit = 2.5e3 * g.second_moment_mm4 / (0.5 + hinge_extra_mm(0.75, g.phi_rad, "fe_fit"))
+    assert k_fit == pytest.approx(r.stiffness_nmm_per_rad, rel=0.10)

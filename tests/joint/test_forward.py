@@ -1,0 +1,115 @@
+"""The notch-by-notch forward model against independent truth: the closed-form series model of
+``design.geometry`` (uniform, no friction), the capstan law, notch closure, the stroke balance,
+and a calibration JSON written by ``camtube model fit``."""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from camtube.design.geometry import bends_at_stroke, joint_geometry, pattern_geometry, tendon_compliance_mm_per_N
+from camtube.design.loader import load_pattern
+from camtube.joint import Mechanics, simulate
+from tests.conftest import PRESETS
+
+
+@pytest.mark.parametrize("name", PRESETS)
+@pytest.mark.parametrize("stroke", [0.3, 1.0, 2.0])
+def test_uniform_frictionless_matches_the_closed_form_series_model(name, stroke):
+    p = load_pattern(name)
+    d = bends_at_stroke(p, stroke)[0]
+    st = simulate(p, stroke).direction(180.0)
+    assert st.bend_deg == pytest.approx(math.degrees(d.bend_rad), rel=1e-9)
+    assert float(st.strain.max()) == pytest.approx(d.strain, rel=1e-9)
+    np.testing.assert_allclose(st.shares, 1.0 / len(st.shares), rtol=1e-9)
+
+
+def test_capstan_friction_lowers_the_tension_notch_by_notch():
+    p = replace(load_pattern("tube1"), tendon=replace(load_pattern("tube1").tendon, friction=0.3))
+    st = simulate(p, 1.5).direction(180.0)
+    th = st.notch_angles_rad  # base to tip
+    # uniform notches: the angle is proportional to the tension, which falls by exp(-mu theta) per notch
+    np.testing.assert_allclose(th[1:] / th[:-1], np.exp(-0.3 * th[:-1]), rtol=1e-9)
+    g = joint_geometry(0.75, 0.45, 2.83, 0.5)
+    c = tendon_compliance_mm_per_N(70.0, 28.0, 0.04)
+    # the stroke balance: kinematic shortening plus the tendon's stretch
+    assert g.moment_arm_mm * th.sum() + st.force_N * c == pytest.approx(1.5, rel=1e-9)
+    # the base notch sees the full force
+    k = 2.5e3 * g.second_moment_mm4 / 0.5
+    assert th[0] == pytest.approx(st.force_N * g.moment_arm_mm / k, rel=1e-9)
+    assert simulate(p, 1.5, Mechanics(friction=0.0)).direction(180.0).bend_deg > st.bend_deg
+
+
+def test_closed_notches_stop_bending_and_the_tendon_takes_the_rest():
+    p = load_pattern("tube3")
+    geo = pattern_geometry(p)
+    st = simulate(p, 150.0).direction(180.0)
+    assert st.closed.all()
+    assert math.radians(st.bend_deg) == pytest.approx(geo.total_closure_angle_rad, rel=1e-9)
+    c = tendon_compliance_mm_per_N(70.0, 28.0, 0.04)
+    arm = geo.first.moment_arm_mm
+    assert st.force_N == pytest.approx((150.0 - arm * geo.total_closure_angle_rad) / c, rel=1e-9)
+
+
+def test_tip_pose_points_towards_the_notches_and_keeps_the_straight_lengths():
+    p = load_pattern("tube1-bidirectional")
+    for ang in (0.0, 180.0):
+        st = simulate(p, {ang: 1.0})
+        d = st.direction(ang)
+        assert st.tip_angle_deg == pytest.approx(d.bend_deg, abs=1e-9)  # planar: angles add
+        assert st.tip_plane_deg == pytest.approx(ang, abs=1e-6)
+        lateral = st.tip_position_mm[0] * math.cos(math.radians(ang))
+        assert lateral > 0.5
+    straight = simulate(p, 0.0)
+    np.testing.assert_allclose(straight.tip_position_mm, [0, 0, p.tube.length_mm], atol=1e-12)
+    # the base segment before the first notch stays straight and keeps its length
+    bent = simulate(p, {180.0: 2.0})
+    first_edge = p.tube.length_mm - max(n.x_end_mm for n in p.notches)
+    assert np.linalg.norm(bent.centerline_mm[1] - bent.centerline_mm[0]) == pytest.approx(first_edge)
+
+
+def test_calibration_from_a_real_fit_json(tmp_path):
+    from camtube.model.core.fit import fit
+    from camtube.model.data import prepare
+    from camtube.model.core.predict import model_for_pattern, pattern_values
+    from camtube.model.report.fit import fit_json
+    from camtube.model.sim.synth import synthesize
+
+    p = load_pattern("tube2")
+    soft = replace(p, tendon=replace(p.tendon, modulus_gpa=14.0))
+    data = prepare(synthesize(soft, n_samples=1, n_cycles=3, seed=3), cycles="last", branch="loading")
+    r = fit(model_for_pattern(p), data, fit_params=("E_t",), fixed=pattern_values(p))
+    path = tmp_path / "fit.json"
+    path.write_text(fit_json(r))
+    mech = Mechanics.from_fit_json(path)
+    assert mech.tendon_modulus_gpa == pytest.approx(14.0, rel=0.05)
+    # closed form with the fitted E_t: stroke = arm theta + F C, F arm = K theta
+    g = joint_geometry(0.85, 0.55, 3.20, 0.5)
+    k = 2.5e3 * g.second_moment_mm4 / 0.5 / 10
+    c = tendon_compliance_mm_per_N(70.0, mech.tendon_modulus_gpa, 0.04)
+    theta = 2.0 / (g.moment_arm_mm + k * c / g.moment_arm_mm)
+    assert simulate(p, 2.0, mech).direction(180.0).bend_deg == pytest.approx(math.degrees(theta), rel=1e-6)
+
+
+def test_calibration_slack_and_bad_files(tmp_path):
+    from camtube.errors import CamtubeError
+
+    path = tmp_path / "d.json"
+    path.write_text(json.dumps({"schema": "camtube.diagnose/1", "final": {"params": {
+        "E_t": {"value": 28.0}, "slack.deadband_mm@1": {"value": 0.2}, "slack.deadband_mm@2": {"value": 0.4},
+        "creep.tau_s": {"value": 9.0}}}}))
+    mech = Mechanics.from_fit_json(path)
+    assert mech.slack_mm == pytest.approx(0.3) and mech.ignored == ("creep.tau_s",)
+    p = load_pattern("tube1")
+    assert simulate(p, 1.3, mech).direction(180.0).bend_deg == pytest.approx(
+        simulate(p, 1.0).direction(180.0).bend_deg, rel=1e-9)
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(CamtubeError, match="not JSON"):
+        Mechanics.from_fit_json(bad)
+    bad.write_text("{}")
+    with pytest.raises(CamtubeError, match="no fitted parameters"):
+        Mechanics.from_fit_json(bad)

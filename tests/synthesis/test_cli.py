@@ -1,0 +1,133 @@
+"""``camtube synthesize`` and ``camtube design --stroke`` as a user runs them: output, exit status,
+one-line errors naming file, line and key, nothing written on failure; the written pattern builds
+into a job that verifies; the independent re-simulation from the job's cut geometry agrees."""
+from __future__ import annotations
+
+import json
+import re
+
+import pytest
+
+from camtube.design.loader import load_pattern
+from camtube.joint import simulate
+from camtube.synthesis.check import as_cut_notches, resimulate
+from tests.conftest import ROOT
+from tests.test_cli_errors import assert_refused, camtube, listing
+
+GOALS = ROOT / "examples" / "goals"
+
+
+def test_synthesize_prints_target_predicted_limit_and_tolerance(tmp_path):
+    out = tmp_path / "p.yaml"
+    r = camtube("synthesize", str(GOALS / "04-tube1-tip-first.yaml"), "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    assert "target deg  predicted deg" in r.stdout and "active limit: limits." in r.stdout
+    assert "deg/10um depth" in r.stdout and "deg/10um kerf" in r.stdout
+    row = next(line for line in r.stdout.splitlines() if line.strip().startswith("180"))
+    nums = [float(x) for x in re.findall(r"[-+]?\d+\.\d+", row)]
+    target, predicted, depth, kerf = nums[1], nums[2], nums[-2], nums[-1]
+    assert target == 60.0 and abs(predicted - target) <= 0.5
+    assert depth > 0 and kerf > 0  # a deeper or wider notch is softer: more bend
+    # the kerf tolerance against the independent model: widen every as-cut notch by 10 um
+    p = load_pattern(out)
+    cut = as_cut_notches(p)
+    base = resimulate(p, {180.0: 1.5}, notches=cut)[0].bend_deg
+    wider = [type(n)(n.x_mm, n.angle_deg, n.width_mm + 0.01, n.arc_mm + 0.01) for n in cut]
+    assert resimulate(p, {180.0: 1.5}, notches=tuple(wider))[0].bend_deg - base == pytest.approx(kerf, rel=0.15)
+
+
+@pytest.mark.parametrize("goal,stroke", [("01-tube1-uniform-60", {180.0: 1.5}),
+                                         ("07-tube1-two-directions", {180.0: 1.5, 0.0: 1.2}),
+                                         ("10-tube3-curve-bell", {270.0: 3.0})])
+def test_written_pattern_builds_verifies_and_resimulates(goal, stroke, tmp_path):
+    out = tmp_path / "p.yaml"
+    assert camtube("synthesize", str(GOALS / f"{goal}.yaml"), "-o", str(out)).returncode == 0
+    b = camtube("build", str(out), "-o", str(tmp_path / "job"), "-q", "--no-step", "--no-pictures")
+    assert b.returncode == 0 and "verification: PASS" in b.stdout, b.stdout + b.stderr
+    assert any(p.suffix == ".ngc" for p in (tmp_path / "job").iterdir())
+    p = load_pattern(out)
+    targets = {180.0: 60.0} if goal.startswith("01") else ({180.0: 45.0, 0.0: 30.0} if goal.startswith("07")
+                                                            else {270.0: 43.125})
+    for r in resimulate(p, stroke):
+        assert abs(r.bend_deg - targets[r.angle_deg]) <= 0.05 * targets[r.angle_deg]
+        assert r.max_strain <= p.rules.max_strain
+
+
+def test_infeasible_goal_one_line_exit_2_nothing_written(tmp_path):
+    r = camtube("synthesize", str(GOALS / "12-infeasible-short-stroke.yaml"), "-o", str(tmp_path / "p.yaml"))
+    assert_refused(r, "12-infeasible-short-stroke.yaml", "infeasible", "nearest feasible target", "stroke")
+    assert listing(tmp_path) == []
+
+
+GOOD = """tube: {outer_radius: 0.75, inner_radius: 0.45}
+goal:
+  bends:
+    - {angle_deg: 180, bend_deg: 40, stroke_mm: 1.2}
+limits: {max_strain: 0.04}
+"""
+
+
+@pytest.mark.parametrize("edit,words", [
+    (("limits: {max_strain: 0.04}", "limits: {max_strian: 0.04}"), ["limits.max_strian", "did you mean 'max_strain'", ":5:"]),
+    (("bend_deg: 40", "bend_deg: -40"), ["goal.bends[0].bend_deg", "> 0", "-40"]),
+    (("stroke_mm: 1.2", "stroke_mm: 1.2mm"), ["goal.bends[0].stroke_mm", "expected a number"]),
+    (("inner_radius: 0.45", "inner_radius: 0.95"), ["tube.inner_radius", "smaller than the outer radius"]),
+    (("goal:", "goal:\n  distribution: tipfirst"), ["goal.distribution", "did you mean 'tip_first'"]),
+    (("goal:", "goal:\n  curve: [2, 4]\n  curve_length: 10"), ["goal.bends[0].bend_deg", "30.00"]),
+    (("limits:", "limit:"), ["did you mean 'limits'"]),
+])
+def test_goal_mistakes_one_line_each(tmp_path, edit, words):
+    g = tmp_path / "g.yaml"
+    g.write_text(GOOD.replace(*edit))
+    r = camtube("synthesize", str(g), "-o", str(tmp_path / "p.yaml"))
+    assert_refused(r, str(g), *words)
+    assert listing(tmp_path) == ["g.yaml"]
+
+
+def test_output_must_be_a_yaml_file(tmp_path):
+    g = tmp_path / "g.yaml"
+    g.write_text(GOOD)
+    assert_refused(camtube("synthesize", str(g), "-o", str(tmp_path / "p.dxf")), "p.dxf", "PATTERN.yaml")
+
+
+def test_calibration_changes_the_design_and_is_met_under_it(tmp_path):
+    fit = tmp_path / "fit.json"
+    fit.write_text(json.dumps({"schema": "camtube.fit/1", "params": {
+        "E_t": {"value": 14.0, "unit": "GPa"}, "slack.deadband_mm": {"value": 0.1, "unit": "mm"}}}))
+    plain, cal = tmp_path / "plain.yaml", tmp_path / "cal.yaml"
+    goal = str(GOALS / "01-tube1-uniform-60.yaml")
+    assert camtube("synthesize", goal, "-o", str(plain)).returncode == 0
+    r = camtube("synthesize", goal, "-o", str(cal), "--calibration", str(fit))
+    assert r.returncode == 0 and str(fit) in r.stdout
+    from camtube.joint import Mechanics
+
+    mech = Mechanics.from_fit_json(fit)
+    p_cal, p_plain = load_pattern(cal), load_pattern(plain)
+    k = 0.02  # the expected overcut both designs are drawn net of
+    from dataclasses import replace
+
+    got = simulate(p_cal, 1.5, replace(mech, kerf_mm=k)).direction(180.0).bend_deg
+    assert abs(got - 60.0) <= 0.5
+    assert abs(simulate(p_plain, 1.5, replace(mech, kerf_mm=k)).direction(180.0).bend_deg - 60.0) > 2.0
+
+
+def test_design_stroke_prints_the_forward_model(tmp_path):
+    r = camtube("design", "tube1", "--stroke", "1.5")
+    assert r.returncode == 0, r.stderr
+    assert "cut 20 um wider than drawn" in r.stdout  # the preset's process has no kerf compensation
+    from camtube.joint import Mechanics
+
+    st = simulate(load_pattern("tube1"), 1.5, Mechanics(kerf_mm=0.02)).direction(180.0)
+    assert f"bend {st.bend_deg:.2f} deg" in r.stdout and f"force {st.force_N:.3f} N" in r.stdout
+    r = camtube("design", "tube1", "--stroke", "1.5", "--overcut", "0")
+    st = simulate(load_pattern("tube1"), 1.5).direction(180.0)
+    assert f"bend {st.bend_deg:.2f} deg" in r.stdout and f"force {st.force_N:.3f} N" in r.stdout
+    assert r.stdout.count("\n       ") >= 10  # a row per notch
+    assert_refused(camtube("design", "tube1", "--stroke", "-1"), "--stroke", ">= 0")
+
+
+def test_missing_process_file_is_named(tmp_path):
+    g = tmp_path / "g.yaml"
+    g.write_text(GOOD + "process: nowhere.yaml\n")
+    assert_refused(camtube("synthesize", str(g), "-o", str(tmp_path / "p.yaml")), "process", "nowhere.yaml")
+    assert listing(tmp_path) == ["g.yaml"]
