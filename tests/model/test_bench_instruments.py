@@ -161,3 +161,15 @@ def test_the_report_opens_with_the_answer_then_the_pictures_then_the_table(tube2
     assert order == sorted(order)
     assert "answer: add slack" in page[:page.index("model.png")]
     assert (rep / "artefacts.png").stat().st_size > 1000
+
+
+def test_a_change_of_the_logging_rate_is_reported():
+    from camtube.model.data import Dataset
+
+    t = np.concatenate((np.arange(0.0, 40.0, 0.02), 40.0 + np.arange(0.0, 40.0, 0.04)))
+    x = 1.0 - np.cos(2 * np.pi * t / 8.0)
+    n = t.size
+    d = Dataset(np.full(n, "A", dtype=object), (t // 8).astype(int) + 1, t, x, 2.0 * x, 20.0 * x)
+    ins = check_instruments(d)
+    assert ins.rates_hz["A"] == pytest.approx(50.0)
+    assert any("sampling rate of sample A changes: 25 Hz from t = 40" in line for line in ins.lines())
