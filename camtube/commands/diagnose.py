@@ -6,6 +6,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import shlex
 from pathlib import Path
 
@@ -55,17 +56,26 @@ def register(model_sub) -> None:
     d.add_argument("--no-baseline", dest="baseline", action="store_false",
                    help="do not take the joint's rest angle (friction in the joint) into the baseline when the "
                         "data show it; it is then an ordinary candidate")
+    d.add_argument("--strict", action="store_true",
+                   help="refuse rows with a missing value (nan, empty) or a time stamp that goes backwards, naming "
+                        "the file and line (default: drop them and say how many)")
+    d.add_argument("--lag-ms", type=float, default=None, metavar="MS",
+                   help="lag of the angle channel behind stroke and force (ms) to correct (default: estimated "
+                        "from the data and corrected when resolved; 0 = none)")
     d.add_argument("--json", metavar="OUT.json", help="write the diagnosis as JSON")
     d.add_argument("--report", metavar="DIR", help="write an HTML report with PNG plots into DIR")
     d.set_defaults(func=cmd_diagnose)
 
 
-def fit_command_prefix(args: argparse.Namespace) -> str:
-    """The ``camtube model fit`` command selecting the same rows and files as this diagnosis."""
+def fit_command_prefix(args: argparse.Namespace, instruments=None) -> str:
+    """The ``camtube model fit`` command selecting the same rows and files as this diagnosis (with the rows
+    the instruments' check set aside, and its lag, when it found any)."""
     parts = ["camtube", "model", "fit", args.data, "--pattern", args.pattern]
     for o in args.overrides:
         parts += ["--set", o]
     parts += ["--cycles", args.cycles, "--branch", "both", "--no-deadband"]
+    if instruments is not None and (instruments.n_aside or instruments.n_dropped or instruments.lag.applied_ms):
+        parts += ["--set-aside", "--lag-ms", f"{instruments.lag.applied_ms:.6g}"]
     for f in args.effect_file:
         parts += ["--effect-file", f]
     for f in args.fix:
@@ -79,8 +89,9 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     from camtube.io import write_atomic
     from camtube.model.core.build import build_registry, check_suffix, fitted_and_held, parse_assignments, split_names
     from camtube.model.core.predict import model_for_pattern, pattern_values
-    from camtube.model.data import load_csv, select_cycles
+    from camtube.model.data import read_measurements, select_cycles
     from camtube.model.diagnose import diagnose
+    from camtube.model.diagnose.instruments import check_instruments
     from camtube.model.report.diagnosis import diagnosis_json, diagnosis_text, write_report
 
     check_suffix(args.json, (".json",), "--json")
@@ -91,8 +102,11 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     pattern = load_from_args(args).pattern
     reg, _ = build_registry(args.effect_file)
     model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects)])
-    raw = load_csv(args.data)
-    rows = select_cycles(raw, args.cycles)
+    meas = read_measurements(args.data, strict=args.strict)
+    rows = select_cycles(meas.data, args.cycles)
+    ins = check_instruments(rows, lag_ms=args.lag_ms, dropped=meas.summary(),
+                            n_dropped=int(meas.missing_lines.size + meas.backward_lines.size))
+    rows = ins.data
     fit_names, held = fitted_and_held(model, args.fit_params, args.fix, with_effects=False)
     fixed = pattern_values(pattern)
     fixed.update(held)
@@ -108,7 +122,8 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
                  stop_ratio=1.15 if args.stop_rule else None, modulus_range_gpa=(lo, hi),
                  per_sample=args.per_sample, init=parse_assignments(args.init, "--init"),
                  baseline=None if args.baseline else ())
-    prefix = fit_command_prefix(args)
+    d = dataclasses.replace(d, instruments=ins)
+    prefix = fit_command_prefix(args, ins)
     title = f"{pattern.name}: {args.data} ({len(rows)} rows, cycles {args.cycles}, both directions, deadband kept)"
     print(diagnosis_text(d, prefix, title))
     meta = {"pattern": pattern.name, "data": str(args.data), "cycles": args.cycles}

@@ -60,6 +60,11 @@ def register(sub) -> None:
     f.add_argument("--starts", type=int, default=0, metavar="N",
                    help="multi-start: also start from the best points of an N-per-parameter grid over each "
                         "effect parameter's declared range (log-spaced for scales); default 0 (one start)")
+    f.add_argument("--set-aside", action="store_true",
+                   help="read the file as model diagnose does: drop rows with a missing value or a backward time "
+                        "stamp, set aside spikes and repeated stamps, and correct the angle's lag (--lag-ms)")
+    f.add_argument("--lag-ms", type=float, default=0.0, metavar="MS",
+                   help="with --set-aside: lag of the angle channel to correct (ms; default 0)")
     f.add_argument("--json", metavar="OUT.json", help="write the summary as JSON")
     f.add_argument("--plot", metavar="OUT.png", help="write angle and residual vs stroke (PNG)")
     f.set_defaults(func=cmd_fit)
@@ -129,6 +134,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from camtube.model.core.fit import FitError, fit
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import check_fittable, find_slack, load_csv, prepare, remove_deadband, select_cycles
+    from camtube.errors import DataError
     from camtube.model.report.fit import fit_json, fit_text
 
     check_suffix(args.json, (".json",), "--json")
@@ -136,8 +142,22 @@ def cmd_fit(args: argparse.Namespace) -> int:
     pattern = load_from_args(args).pattern
     reg, _ = build_registry(args.effect_file)
     model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects)])
-    raw = load_csv(args.data)
-    rows = prepare(raw, args.cycles, args.branch, args.deadband, args.deadband_threshold)
+    if args.set_aside:
+        from camtube.model.data import read_measurements
+        from camtube.model.diagnose.instruments import check_instruments
+
+        meas = read_measurements(args.data)
+        if meas.summary():
+            print(meas.summary())
+        ins = check_instruments(select_cycles(meas.data, args.cycles), lag_ms=args.lag_ms or 0.0)
+        print("; ".join(ins.lines()[:1] + ins.lines()[-1:]))
+        raw = ins.data
+        rows = prepare(raw, "all", args.branch, args.deadband, args.deadband_threshold)
+    else:
+        if args.lag_ms:
+            raise DataError("--lag-ms needs --set-aside (the instruments' check that corrects it)")
+        raw = load_csv(args.data)
+        rows = prepare(raw, args.cycles, args.branch, args.deadband, args.deadband_threshold)
     check_fittable(rows, f"{args.data} (cycles {args.cycles}, {args.branch} branch)")
     names, held = fitted_and_held(model, args.fit_params, args.fix)
     fixed = pattern_values(pattern)

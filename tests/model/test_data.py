@@ -1,6 +1,8 @@
 """Measurement CSV: round trip, validation errors with line numbers, selection, deadband removal."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -205,3 +207,24 @@ def test_prepare_unloading_and_both_partition_the_rows(tube2):
     assert up.stroke_mm.max() > 2.3 and down.stroke_mm.max() > 2.3
     with pytest.raises(DataError, match="branch"):
         prepare(d, branch="sideways")
+
+
+def test_derived_data_is_cached_on_the_dataset_not_in_module_tables():
+    # issue 20: caches are objects owned by what they cache; no module-level WeakKeyDictionary tables
+    import ast
+    import dataclasses
+
+    from camtube.model.data.dataset import Cache, Dataset
+
+    root = Path(__file__).resolve().parents[2] / "camtube"
+    for path in root.rglob("*.py"):
+        tree = ast.parse(path.read_text(), str(path))
+        for node in tree.body:
+            if isinstance(node, (ast.Assign, ast.AnnAssign)) and node.value is not None:
+                assert "WeakKeyDictionary" not in ast.unparse(node.value), f"{path}: module-level cache"
+    d = Dataset(np.array(["A"] * 4, dtype=object), np.ones(4, int), np.arange(4.0), np.array([0.0, 1, 2, 1]),
+                np.zeros(4), np.zeros(4))
+    assert list(d.direction) == [1, 1, 1, -1] and "dataset.direction" in d.cache
+    sub = d.take(np.array([True, True, True, False]))
+    assert isinstance(sub.cache, Cache) and len(sub.cache) == 0 and sub.cache is not d.cache
+    assert dataclasses.replace(d, stroke_mm=np.arange(4.0)).cache is not d.cache

@@ -39,7 +39,6 @@ runs each sample with its own values (every effect already runs per sample).
 from __future__ import annotations
 
 import math
-import weakref
 from dataclasses import dataclass, field, replace
 from typing import Callable, Mapping, Sequence
 
@@ -453,16 +452,15 @@ class JointModel:
         return angle
 
 
-# speed: per-sample views of a Dataset, cached (per-sample parameters run the model sample by sample)
-_VIEWS: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
+# speed: per-sample views of a Dataset, cached on it (per-sample parameters run the model sample by sample)
 
 
 def _sample_views(data: Dataset) -> list:
     """``(sample, slice, sub-dataset)`` of each sample, cached per Dataset (fits evaluate the same rows often)."""
-    hit = _VIEWS.get(data)
+    hit = data.cache.get("model.sample_views")
     if hit is None:
         hit = [(smp, sl, data.take(np.arange(sl.start, sl.stop))) for smp, sl in data.sample_slices()]
-        _VIEWS[data] = hit
+        data.cache.set("model.sample_views", hit)
     return hit
 
 

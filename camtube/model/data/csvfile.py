@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import difflib
 import io
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -26,7 +27,10 @@ def _err(source: str, line: int | None, msg: str, fix: str = "") -> DataError:
 
 
 def _to_float(col: tuple, name: str, lines: np.ndarray, source: str, finite: bool = True) -> np.ndarray:
-    """Column of strings -> (n,) float; the first bad cell raises with its line."""
+    """Column of strings -> (n,) float; the first bad cell raises with its line (``finite=False``: empty
+    cells, NaN and inf become NaN)."""
+    if not finite:
+        col = tuple(c if c.strip() else "nan" for c in col)
     try:
         arr = np.array(col, dtype=float)
     except ValueError:
@@ -56,6 +60,38 @@ def _check_separator(header: list[str], source: str, line: int) -> None:
             raise _err(source, line, f"the columns are separated by {name}, not commas",
                        "save the file as comma-separated values with a decimal point (not a decimal comma)")
 
+@dataclass(frozen=True, eq=False)
+class Measurements:
+    """A measurement file read leniently (:func:`read_measurements`).
+
+    Attributes
+    ----------
+    data : Dataset
+        The rows kept.
+    missing_lines : (k,) int
+        File lines dropped because a measurement cell was empty, NaN or infinite.
+    backward_lines : (m,) int
+        File lines dropped because their time stamp went backwards within the sample.
+    source : str
+    """
+
+    data: Dataset
+    missing_lines: np.ndarray
+    backward_lines: np.ndarray
+    source: str = "<csv>"
+
+    def summary(self) -> str:
+        """One line: how many rows were dropped and why (empty when none)."""
+        out = []
+        if self.missing_lines.size:
+            ln = ", ".join(str(int(v)) for v in self.missing_lines[:3]) + (", ..." if self.missing_lines.size > 3 else "")
+            out.append(f"{self.missing_lines.size} row(s) with a missing value (nan/empty) dropped (lines {ln})")
+        if self.backward_lines.size:
+            ln = ", ".join(str(int(v)) for v in self.backward_lines[:3]) + (", ..." if self.backward_lines.size > 3 else "")
+            out.append(f"{self.backward_lines.size} row(s) whose time stamp goes backwards dropped (lines {ln})")
+        return f"{self.source}: " + "; ".join(out) if out else ""
+
+
 def parse_csv(text: str, source: str = "<csv>") -> Dataset:
     """Parse measurement CSV text into a :class:`Dataset` (see the module docstring).
 
@@ -71,6 +107,12 @@ def parse_csv(text: str, source: str = "<csv>") -> Dataset:
     DataError
         Naming ``source:line`` and the column.
     """
+    return _parse(text, source, strict=True).data
+
+
+def _parse(text: str, source: str, strict: bool) -> Measurements:
+    """Parse ``text``; ``strict=False`` drops rows with a missing measurement or a backward time stamp
+    (returned in :class:`Measurements`) instead of refusing them."""
     reader = csv.reader(io.StringIO(text))
     header: list[str] | None = None
     header_line = 0
@@ -131,7 +173,19 @@ def parse_csv(text: str, source: str = "<csv>") -> Dataset:
         k = int(bad[0])
         raise _err(source, int(ln[k]), f"column 'cycle' must be a whole number >= 1, got {cols['cycle'][k].strip()!r}",
                    "number the cycles 1, 2, 3, ...")
-    num = {c: _to_float(cols[c], c, ln, source) for c in _FLOAT_COLS}
+    num = {c: _to_float(cols[c], c, ln, source, finite=strict) for c in _FLOAT_COLS}
+    missing_lines = np.zeros(0, np.int64)
+    if not strict:
+        bad = ~np.all([np.isfinite(v) for v in num.values()], axis=0)
+        if bad.any():
+            missing_lines = ln[bad]
+            keep = ~bad
+            if not keep.any():
+                raise _err(source, int(ln[0]), "every row has a missing value (nan/empty)",
+                           "check the file: no row holds all of time_s, stroke_mm, force_N, angle_deg")
+            sample, ln, cyc_f = sample[keep], ln[keep], cyc_f[keep]
+            num = {c: v[keep] for c, v in num.items()}
+            cols = {c: tuple(np.asarray(v, dtype=object)[keep]) for c, v in cols.items()}
     extra: dict[str, np.ndarray] = {}
     for c in header:
         if c in COLUMNS:
@@ -152,6 +206,22 @@ def parse_csv(text: str, source: str = "<csv>") -> Dataset:
         cyc_f = cyc_f[order]
         num = {c: v[order] for c, v in num.items()}
         extra = {c: v[order] for c, v in extra.items()}
+    backward_lines = np.zeros(0, np.int64)
+    if not strict:
+        # a stamp below the latest one before it (same sample) is set aside; the rest stays in order
+        t = num["time_s"]
+        back = np.zeros(t.size, bool)
+        starts = np.flatnonzero(np.concatenate(([True], sample[1:] != sample[:-1])))
+        ends = np.concatenate((starts[1:], [t.size]))
+        for a, b in zip(starts, ends):
+            seg = t[a:b]
+            back[a + 1:b] = seg[1:] < np.maximum.accumulate(seg)[:-1]
+        if back.any():
+            keep = ~back
+            backward_lines = ln[back]
+            sample, ln, cyc_f = sample[keep], ln[keep], cyc_f[keep]
+            num = {c: v[keep] for c, v in num.items()}
+            extra = {c: v[keep] for c, v in extra.items()}
     same = sample[1:] == sample[:-1]
     for name, arr, fix in (("time_s", num["time_s"], "sort each sample's rows by time"),
                            ("cycle", cyc_f, "cycles must not decrease with time within a sample")):
@@ -161,13 +231,30 @@ def parse_csv(text: str, source: str = "<csv>") -> Dataset:
             raise _err(source, int(ln[k]),
                        f"column {name!r} goes backwards within sample {sample[k]!r}: {arr[k]:g} after "
                        f"{arr[k - 1]:g} (line {int(ln[k - 1])})", fix)
-    return Dataset(sample, cyc_f.astype(np.int64), num["time_s"], num["stroke_mm"], num["force_N"],
+    data = Dataset(sample, cyc_f.astype(np.int64), num["time_s"], num["stroke_mm"], num["force_N"],
                    num["angle_deg"], extra)
+    return Measurements(data, missing_lines, backward_lines, source)
 
 
 def load_csv(path: str | Path) -> Dataset:
     """Load and validate a measurement CSV file (see :func:`parse_csv`)."""
-    path = Path(path)
+    return _parse(_read_text(Path(path)), str(path), strict=True).data
+
+
+def read_measurements(path: str | Path, strict: bool = False) -> Measurements:
+    """Load a measurement CSV file, dropping (``strict=False``) or refusing (``strict=True``) rows with a
+    missing value (nan, empty) or a time stamp that goes backwards; :meth:`Measurements.summary` says how
+    many and which lines.
+
+    Raises
+    ------
+    DataError
+        As :func:`load_csv`; with ``strict``, naming the first such line and the column.
+    """
+    return _parse(_read_text(Path(path)), str(path), strict=strict)
+
+
+def _read_text(path: Path) -> str:
     try:
         text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
@@ -181,7 +268,7 @@ def load_csv(path: str | Path) -> Dataset:
     except UnicodeDecodeError as exc:
         raise DataError(f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start}); fix: give the "
                         "measurement CSV (save it as UTF-8 text)") from None
-    return parse_csv(text, str(path))
+    return text
 
 
 def check_fittable(data: Dataset, what: str = "the selected rows") -> None:

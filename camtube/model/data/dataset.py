@@ -5,15 +5,52 @@ module only holds the value type every model function takes.
 """
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass, field
+from typing import Any, Callable
 
 import numpy as np
 
-# speed: the direction of motion is derived data, cached per Dataset object (fits evaluate the model
-# hundreds of times on the same rows); see scripts/bench_diagnose.py
-_DIRECTION: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-_SLICES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+class Cache:
+    """Derived data of one value, computed once and kept with it (the way trimesh's ``caching.Cache`` sits on a
+    mesh): the direction of motion, sample slices, monotone runs, windows, per-sample views ...
+
+    The value that owns it is immutable (a :class:`Dataset`'s arrays are not modified after construction), so
+    nothing is ever invalidated: a new value (``take``, ``with_angle``) gets a new, empty cache. Keys are
+    strings named by the module that computes the entry (``"history.segments"``).
+    """
+
+    __slots__ = ("_data",)
+
+    def __init__(self) -> None:
+        self._data: dict[str, Any] = {}
+
+    def get(self, key: str, default: Any = None) -> Any:
+        return self._data.get(key, default)
+
+    def set(self, key: str, value: Any) -> Any:
+        """Store ``value`` under ``key``; returns it."""
+        self._data[key] = value
+        return value
+
+    def get_or(self, key: str, compute: Callable[[], Any]) -> Any:
+        """The entry under ``key``, computed by ``compute()`` and stored the first time."""
+        try:
+            return self._data[key]
+        except KeyError:
+            return self.set(key, compute())
+
+    def __contains__(self, key: str) -> bool:
+        return key in self._data
+
+    def __len__(self) -> int:
+        return len(self._data)
+
+    def clear(self) -> None:
+        self._data.clear()
+
+    def __repr__(self) -> str:
+        return f"Cache({sorted(self._data)})"
 
 
 @dataclass(frozen=True, eq=False)
@@ -38,6 +75,9 @@ class Dataset:
         Measured joint angle, deg.
     extra : dict[str, (n,) array]
         Extra CSV columns, kept as read.
+    cache : Cache
+        Derived data computed once per Dataset (speed: fits evaluate the model hundreds of times on the same
+        rows); not part of the value (not compared, not passed on by ``take`` or ``dataclasses.replace``).
     """
 
     sample: np.ndarray
@@ -47,6 +87,7 @@ class Dataset:
     force_N: np.ndarray
     angle_deg: np.ndarray
     extra: dict = field(default_factory=dict)
+    cache: Cache = field(default_factory=Cache, init=False, compare=False, repr=False)
 
     def __len__(self) -> int:
         return int(self.stroke_mm.shape[0])
@@ -60,7 +101,7 @@ class Dataset:
     def sample_slices(self) -> list[tuple[str, slice]]:
         """``(sample, slice)`` of each sample's contiguous rows, in order (computed once per Dataset; a new list
         each call)."""
-        hit = _SLICES.get(self)
+        hit = self.cache.get("dataset.slices")
         if hit is not None:
             return list(hit)
         out = []
@@ -71,7 +112,7 @@ class Dataset:
             ends = np.concatenate((change, [n]))
             for s, e in zip(starts, ends):
                 out.append((str(self.sample[s]), slice(int(s), int(e))))
-        _SLICES[self] = tuple(out)
+        self.cache.set("dataset.slices", tuple(out))
         return out
 
     @property
@@ -83,13 +124,12 @@ class Dataset:
         Computed once per Dataset (the arrays are not modified after construction;
         the cached copy is read-only).
         """
-        hit = _DIRECTION.get(self)
+        hit = self.cache.get("dataset.direction")
         if hit is not None:
             return hit
         d = self._direction()
         d.setflags(write=False)
-        _DIRECTION[self] = d
-        return d
+        return self.cache.set("dataset.direction", d)
 
     def _direction(self) -> np.ndarray:
         d = np.zeros(len(self), dtype=int)

@@ -34,7 +34,6 @@ the stroke (one NumPy call per stroke reversal); the linear filter of
 from __future__ import annotations
 
 import math
-import weakref
 from typing import Callable
 
 import numpy as np
@@ -266,19 +265,17 @@ def local_force_N(ctx: Context) -> np.ndarray:
 
     f = np.asarray(ctx.force_N, float)
     # speed: a fit evaluates the model many times with the same force array (no force-stage effect)
-    hit = _LOCAL_FORCE.get(ctx.data)
+    hit = ctx.data.cache.get("builtin.local_force")
     if hit is not None and hit[0] is ctx.force_N:
         return hit[1]
     out = f.copy()
     for sl, rows, _ in _force_windows(ctx.data):
         if rows > 1:
             out[sl] = uniform_filter1d(f[sl], rows, mode="nearest")
-    _LOCAL_FORCE[ctx.data] = (ctx.force_N, out)
+    ctx.data.cache.set("builtin.local_force", (ctx.force_N, out))
     return out
 
 
-_LOCAL_FORCE: "weakref.WeakKeyDictionary[Dataset, tuple]" = weakref.WeakKeyDictionary()
-_WINDOWS: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
 
 
 def _white_noise_sd(x: np.ndarray) -> float:
@@ -294,7 +291,7 @@ def _white_noise_sd(x: np.ndarray) -> float:
 def _force_windows(data: Dataset) -> list:
     """Cached per Dataset: ``(slice, rows, sd_N)`` of each sample: the odd window of :func:`local_force_N` and
     the standard deviation of the noise left on the averaged force (white noise / sqrt(rows))."""
-    hit = _WINDOWS.get(data)
+    hit = data.cache.get("builtin.force_windows")
     if hit is None:
         t = np.asarray(data.time_s, float)
         f = np.asarray(data.force_N, float)
@@ -307,7 +304,7 @@ def _force_windows(data: Dataset) -> list:
                 rows = int(round(window_s / dt)) if dt > 0 else 1
                 rows = max(rows - (1 - rows % 2), 1)  # odd: centred
             hit.append((sl, rows, _white_noise_sd(f[sl]) / math.sqrt(rows)))
-        _WINDOWS[data] = hit
+        data.cache.set("builtin.force_windows", hit)
     return hit
 
 
@@ -339,14 +336,13 @@ def _toe_table(shape: float, x_min: float) -> tuple[np.ndarray, np.ndarray]:
     return hit
 
 
-_TOE_FORCES: "weakref.WeakKeyDictionary[Dataset, tuple]" = weakref.WeakKeyDictionary()
 
 
 def _toe_forces(ctx: Context) -> tuple[np.ndarray, np.ndarray]:
     """``(forces, low)``: the averaged force of every row (clipped at zero), then :data:`TOE_NODES` quantile
     nodes of the tension's posterior for each row of ``low`` (the rows near zero force). Cached per Dataset and
     force array: they depend on the data only, and a fit evaluates the law many times."""
-    hit = _TOE_FORCES.get(ctx.data)
+    hit = ctx.data.cache.get("builtin.toe_forces")
     if hit is not None and hit[0] is ctx.force_N:
         return hit[1], hit[2]
     fa = local_force_N(ctx)
@@ -361,7 +357,7 @@ def _toe_forces(ctx: Context) -> tuple[np.ndarray, np.ndarray]:
         u = (np.arange(TOE_NODES) + 0.5) / TOE_NODES
         fq = mu[:, None] + s[:, None] * ndtri(np.minimum(p0 + u[None, :] * (1.0 - p0), 1.0 - 1e-12))
         f = np.concatenate([f, np.maximum(fq, 0.0).ravel()])
-    _TOE_FORCES[ctx.data] = (ctx.force_N, f, low)
+    ctx.data.cache.set("builtin.toe_forces", (ctx.force_N, f, low))
     return f, low
 
 

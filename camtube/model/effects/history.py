@@ -7,16 +7,12 @@
 from __future__ import annotations
 
 import math
-import weakref
 
 import numpy as np
 
 from camtube.model.data.dataset import Dataset
 
 # speed: derived per-Dataset data, cached (fits evaluate the model hundreds of times on the same rows)
-_SEGMENTS: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
-_SEG_ARRAYS: "weakref.WeakKeyDictionary[Dataset, tuple]" = weakref.WeakKeyDictionary()
-_SAMPLING: "weakref.WeakKeyDictionary[Dataset, list]" = weakref.WeakKeyDictionary()
 
 
 def monotone_segments(data: Dataset) -> list[tuple[int, int, int, bool]]:
@@ -24,7 +20,7 @@ def monotone_segments(data: Dataset) -> list[tuple[int, int, int, bool]]:
 
     Cached per :class:`Dataset` object (the fit evaluates the model many times on the same rows).
     """
-    hit = _SEGMENTS.get(data)
+    hit = data.cache.get("history.segments")
     if hit is not None:
         return hit
     d = data.direction
@@ -36,13 +32,13 @@ def monotone_segments(data: Dataset) -> list[tuple[int, int, int, bool]]:
         stops = np.concatenate((cut, [dd.size]))
         for k, (a, b) in enumerate(zip(starts, stops)):
             out.append((sl.start + int(a), sl.start + int(b), int(dd[a]), k == 0))
-    _SEGMENTS[data] = out
+    data.cache.set("history.segments", out)
     return out
 
 
 def _segment_arrays(data: Dataset) -> tuple:
     """Cached ``(starts, stops, dirs, firsts, lengths, row_dir)`` of :func:`monotone_segments` as arrays/lists."""
-    hit = _SEG_ARRAYS.get(data)
+    hit = data.cache.get("history.segment_arrays")
     if hit is None:
         segs = monotone_segments(data)
         starts = np.array([s[0] for s in segs], np.int64)
@@ -50,7 +46,7 @@ def _segment_arrays(data: Dataset) -> tuple:
         dirs = [s[2] for s in segs]
         firsts = [s[3] for s in segs]
         hit = (starts, stops, dirs, firsts, stops - starts, np.repeat(np.array(dirs, np.int64), stops - starts))
-        _SEG_ARRAYS[data] = hit
+        data.cache.set("history.segment_arrays", hit)
     return hit
 
 
@@ -85,7 +81,7 @@ def play_operator(data: Dataset, x: np.ndarray, width_mm: float) -> np.ndarray:
 
 def _sampling(data: Dataset) -> list:
     """Cached per sample: ``(slice, h, uniform, dt)`` (median step, whether the sampling is uniform)."""
-    hit = _SAMPLING.get(data)
+    hit = data.cache.get("history.sampling")
     if hit is None:
         t = np.asarray(data.time_s, float)
         hit = []
@@ -94,14 +90,14 @@ def _sampling(data: Dataset) -> list:
             h = float(np.median(dt)) if dt.size else 0.0
             uniform = bool(dt.size and h > 0 and np.all(np.abs(dt - h) <= 1e-6 * h + 1e-12))
             hit.append((sl, h, uniform, dt))
-        _SAMPLING[data] = hit
+        data.cache.set("history.sampling", hit)
     return hit
 
 
 def first_order_lag(data: Dataset, u: np.ndarray, tau_s: float) -> np.ndarray:
     """``v`` with ``tau dv/dt = u - v`` per sample (exact for piecewise-constant ``u``), ``v_0 = u_0``.
 
-    Uniform sampling uses :func:`scipy.signal.lfilter`; otherwise a loop.
+    Uniform sampling uses :func:`scipy.signal.lfilter`; otherwise :func:`_lag_nonuniform` (blocks of NumPy calls).
     """
     from scipy.signal import lfilter
 
@@ -118,12 +114,40 @@ def first_order_lag(data: Dataset, u: np.ndarray, tau_s: float) -> np.ndarray:
             a = math.exp(-h / tau)
             v[sl], _ = lfilter([1.0 - a], [1.0, -a], us, zi=[a * us[0]])
         else:
-            a = np.exp(-np.maximum(dt, 0.0) / tau)
-            out = np.empty_like(us)
-            out[0] = us[0]
-            acc = float(us[0])
-            for k in range(1, us.size):
-                acc = a[k - 1] * acc + (1.0 - a[k - 1]) * float(us[k])
-                out[k] = acc
-            v[sl] = out
+            v[sl] = _lag_nonuniform(us, dt, tau)
     return v
+
+
+#: Decay (in units of tau) spanned by one block of :func:`_lag_nonuniform`: exp(30) keeps the scaled sums far
+#: from overflow and their rounding at ~1e-14 relative.
+_LAG_BLOCK = 30.0
+
+
+def _lag_nonuniform(u: np.ndarray, dt: np.ndarray, tau: float) -> np.ndarray:
+    """``v_k = a_k v_(k-1) + (1 - a_k) u_k``, ``a_k = exp(-dt_k / tau)``, ``v_0 = u_0``, for uneven steps ``dt``
+    ((n - 1,) s), in blocks of NumPy calls (speed: a logger's jittered stamps made this a Python loop over every
+    row). Within a block ``v_k = A_k (v_start + sum_j b_j / A_j)``, ``A_k`` the product of the ``a`` so far,
+    computed through the cumulative sum of ``dt / tau``; a block ends once that sum has grown by
+    :data:`_LAG_BLOCK`. Agrees with the row-by-row recursion to ~1e-14 relative."""
+    decay = np.maximum(dt, 0.0) / tau                    # -log a_k, k = 1 .. n-1
+    b = -np.expm1(-decay) * u[1:]                        # (1 - a_k) u_k
+    cum = np.cumsum(decay)
+    out = np.empty_like(u)
+    out[0] = u[0]
+    prev, s, m = float(u[0]), 0, decay.size
+    if m and cum[-1] > _LAG_BLOCK * m / 50.0:  # tau within a few steps: blocks of a row or two; the loop is faster
+        a = np.exp(-decay)
+        for k in range(m):
+            prev = a[k] * prev + b[k]
+            out[k + 1] = prev
+        return out
+    while s < m:
+        base = cum[s - 1] if s else 0.0
+        e = max(int(np.searchsorted(cum, base + _LAG_BLOCK, side="right")), s + 1)
+        log_a = -(cum[s:e] - base)                       # log A_k within the block
+        scaled = np.cumsum(np.exp(-log_a) * b[s:e])
+        block = np.exp(log_a) * (prev + scaled)
+        out[s + 1:e + 1] = block
+        prev = float(block[-1])
+        s = e
+    return out

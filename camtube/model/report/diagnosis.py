@@ -160,6 +160,15 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
     out["candidates"] = [_candidate_dict(d, c) for c in d.candidates]
     out["rounds"] = [[_candidate_dict(d, c) for c in r] for r in d.rounds]
     out["recommended"] = list(d.recommended)
+    out["explanation"] = d.explanation or None
+    ins = d.instruments
+    if ins is not None:
+        out["instruments"] = {
+            "rows_read": len(ins.raw), "rows_dropped": int(ins.n_dropped), "dropped": ins.dropped or None,
+            "rows_set_aside": {k: int(len(v)) for k, v in ins.aside.items()},
+            "rates_hz": {k: _num(v) for k, v in ins.rates_hz.items()}, "rate_changes": list(ins.rate_changes),
+            "lag_ms": _num(ins.lag.lag_ms), "lag_se_ms": _num(ins.lag.se_ms), "lag_given": bool(ins.lag.given),
+            "lag_applied_ms": _num(ins.lag.applied_ms)}
     out["replaced"] = [{"effects": list(old), "by": new} for old, new in d.replaced]
     out["dropped"] = list(d.dropped)
     out["waterfall"] = [{"effects": list(s.effects), "rmse_deg": _num(s.rmse_deg),
@@ -202,6 +211,85 @@ def baseline_lines(d: Diagnosis) -> list[str]:
     return out
 
 
+#: Where each built-in effect sits on the bench, and what the data cannot tell it from (with the measurement
+#: that would).
+SIDES = {
+    "slack": "tendon or drive: the data cannot tell slack in the tendon from lost motion between the motor and "
+             "the carriage (both take up stroke before the load cell sees tension); a displacement gauge on the "
+             "carriage would (lost motion in the drive also opens only after an unloading, so the first pull "
+             "differs)",
+    "play": "drive (lost motion between the motor and the carriage) or a tendon that slips at the guide; a "
+            "displacement gauge on the carriage would tell",
+    "toe": "tendon (its fibres straighten one after another)",
+    "toe_shape": "tendon (its fibres straighten one after another)",
+    "creep": "tendon (it lengthens under load); a drifting load-cell zero also grows with time: re-zero the load "
+             "cell with the tendon unloaded after the test, or hold a long dwell at zero stroke, to tell",
+    "viscoelastic": "tendon (delayed compliance); the joint's own relaxation does not show here (the measured "
+                    "force carries it)",
+    "friction": "tendon (friction at the guide or in a sheath)",
+    "series": "tendon or sheath (a compliance in series: the same as a softer tendon)",
+    "force_zero": "instruments (the load cell's zero)",
+    "angle_bias": "instruments (the tracker's offset), or a joint that rests bent",
+    "rest_angle": "joint (friction or a permanent set)",
+    "hardstop": "joint (the notches close)",
+    "kerf": "joint geometry", "flat_walls": "joint geometry", "chords": "joint geometry",
+}
+
+
+def answer_lines(d: Diagnosis) -> list[str]:
+    """The answer first: what to add in order with the error before and after each step, what is left and what
+    it follows, per sample, and the instruments' findings (rows set aside, lag)."""
+    floor = d.noise_floor_deg
+    steps = d.waterfall
+    out = []
+    if d.recommended:
+        label = f" ({d.explanation} explanation)" if d.explanation else ""
+        out.append(f"answer: add {', then '.join(d.recommended)}{label}")
+        out.append(f"  current model: RMSE {steps[0].rmse_deg:.3f} deg ({_times(steps[0].rmse_deg, floor)} the noise "
+                   f"floor {floor:.3f} deg)")
+        for k, name in enumerate(d.recommended, 1):
+            side = SIDES.get(name)
+            out.append(f"  {k}. + {name}: {steps[k - 1].rmse_deg:.3f} -> {steps[k].rmse_deg:.3f} deg "
+                       f"({_times(steps[k].rmse_deg, floor)} the floor)" + (f"; sits in the {side}" if side else ""))
+        if d.per_sample and len(steps) > len(d.recommended) + 1:
+            out.append(f"  {len(d.recommended) + 1}. per sample ({', '.join(d.per_sample)}): "
+                       f"{steps[-2].rmse_deg:.3f} -> {steps[-1].rmse_deg:.3f} deg")
+        samples = list(steps[0].rmse_per_sample)
+        if len(samples) > 1:
+            for smp in samples:
+                gains = [f"{name} {steps[k - 1].rmse_per_sample[smp]:.2f} -> {steps[k].rmse_per_sample[smp]:.2f}"
+                         for k, name in enumerate(d.recommended, 1)]
+                out.append(f"  sample {smp}: " + "; ".join(gains) + " deg")
+    elif d.partial:
+        out.append("answer: nothing the library has explains the misfit; the built-ins that lower it ("
+                   + ", ".join(d.partial) + f") leave {_times(d.partial_steps[-1].rmse_deg, floor)} the noise floor "
+                   "and are not recommended (see 'partial' and 'unexplained')")
+    else:
+        out.append(f"answer: nothing to add: the model is at {_times(steps[0].rmse_deg, floor)} the noise floor "
+                   f"({steps[0].rmse_deg:.3f} vs {floor:.3f} deg)")
+    u = unexplained_report.of_diagnosis(d)
+    if u is not None and (d.recommended or d.partial):
+        follows = ", ".join(u["follows"][:2]) if u.get("follows") else "nothing in particular (noise-like)"
+        out.append(f"  left: {100 * u['share']:.0f} % of the final error is above the noise floor; it follows "
+                   f"{follows}; carried by sample(s) {', '.join(u.get('samples') or []) or 'alike'}")
+    elif d.recommended:
+        out.append("  left: nothing structured (the error is at the noise floor)")
+    ins = d.instruments
+    if ins is not None:
+        from camtube.model.diagnose.instruments import with_aside
+
+        out.append("instruments:")
+        out += [f"  {line}" for line in ins.lines()]
+        if ins.n_aside:
+            r0, a0, _ = with_aside(ins, steps[0].predicted, floor)
+            r1, a1, _ = with_aside(ins, steps[-1].predicted, floor)
+            out.append(f"  with the {ins.n_aside} rows set aside counted: RMSE {r0:.3f} -> {r1:.3f} deg; the data allow "
+                       f"{a1:.3f} deg (noise floor and artefacts): {r1 / a1:.2f} x; without them: "
+                       f"{steps[0].rmse_deg:.3f} -> {steps[-1].rmse_deg:.3f} deg, floor {floor:.3f} deg: "
+                       f"{steps[-1].rmse_deg / floor:.2f} x")
+    return out
+
+
 def diagnosis_json(d: Diagnosis, command: str = "", meta: dict | None = None) -> str:
     """:func:`diagnosis_dict` as indented JSON with a final newline (deterministic)."""
     return json.dumps(diagnosis_dict(d, command, meta), indent=2, allow_nan=False) + "\n"
@@ -212,6 +300,8 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
     floor = d.noise_floor_deg
     base = d.waterfall[0]
     lines = [title] if title else []
+    lines += answer_lines(d)
+    lines.append("")
     given = d.given or base
     cur = ", ".join(given.effects) or "none"
     parts = d.noise_floor_parts_deg
@@ -237,7 +327,7 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
                          f"{c.delta_bic:9.1f}  {verdict}")
     lines.append("")
     if d.recommended:
-        lines.append("recommended, in order:")
+        lines.append("recommended, in order" + (f" ({d.explanation} explanation)" if d.explanation else "") + ":")
         prev = base
         # the values are those of the whole chain (what the command below gives before any per-sample step):
         # a step's own refit can differ a lot (play alone takes up a toe's slack)
@@ -335,13 +425,47 @@ def model_png(d: Diagnosis, max_samples: int = 4) -> bytes:
                 label="current model" + (f" + {', '.join(d.baseline)} (baseline)" if d.baseline else ""))
         if final is not base:
             ax.plot(st, final.predicted[s], "-", lw=0.7, color="black",
-                    label="+ " + ", ".join(d.recommended))
+                    label="+ " + ", ".join(d.recommended) + (f" ({d.explanation})" if d.explanation else ""))
+        elif d.partial and d.partial_steps:
+            ax.plot(st, d.partial_steps[-1].predicted[s], "--", lw=0.7, color="tab:blue",
+                    label="+ " + ", ".join(d.partial) + " (partial, not recommended)")
         ax.set_title(f"sample {smp}: RMSE {base.rmse_per_sample[smp]:.2f} -> {final.rmse_per_sample[smp]:.2f} deg",
                      fontsize=9)
         ax.set_xlabel("stroke (mm)")
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("joint angle (deg)")
     axes[0].legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    return _png(fig)
+
+
+def artefacts_png(d: Diagnosis, max_samples: int = 4) -> bytes | None:
+    """Angle against time per sample as read, with the rows the instruments' check set aside marked (``None``
+    without an instruments' check)."""
+    ins = d.instruments
+    if ins is None:
+        return None
+    raw = ins.raw
+    sl = raw.sample_slices()[:max_samples]
+    fig = _figure(13.0, 2.4 * len(sl) + 0.6)
+    axes = np.atleast_1d(fig.subplots(len(sl), 1, squeeze=False)[:, 0])
+    marks = {"angle spike": ("x", "tab:red"), "force spike": ("+", "tab:purple"),
+             "repeated time stamp": ("|", "tab:orange")}
+    for ax, (smp, s) in zip(axes, sl):
+        t = raw.time_s[s]
+        ax.plot(t, raw.angle_deg[s], "-", lw=0.4, color="0.55", label="angle as read", rasterized=True)
+        for why, rows in ins.aside.items():
+            r = rows[(rows >= s.start) & (rows < s.stop)]
+            if r.size:
+                m, c = marks.get(why, ("o", "black"))
+                ax.plot(raw.time_s[r], raw.angle_deg[r], m, ms=6, color=c, label=f"{why} ({r.size}), set aside")
+        ax.set_ylabel(f"{smp}: angle (deg)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper right")
+    axes[-1].set_xlabel("time (s)")
+    lag = ins.lag
+    axes[0].set_title(f"rows read {len(raw)}; set aside {ins.n_aside}; dropped before (missing values, backward "
+                      f"stamps) {ins.n_dropped}; angle lag corrected {lag.applied_ms:.3g} ms", fontsize=9)
     fig.tight_layout()
     return _png(fig)
 
@@ -426,6 +550,9 @@ def report_files(d: Diagnosis, command: str = "", title: str = "camtube diagnosi
     """``{file name: bytes}`` of the report: four PNGs and ``index.html`` (self-contained, offline)."""
     files = {"model.png": model_png(d), "atlas.png": atlas_png(d), "ranking.png": ranking_png(d),
              "waterfall.png": waterfall_png(d)}
+    art = artefacts_png(d)
+    if art is not None:
+        files["artefacts.png"] = art
     esc = html.escape
     rows = []
     for k, c in enumerate(d.candidates, 1):
@@ -442,18 +569,24 @@ def report_files(d: Diagnosis, command: str = "", title: str = "camtube diagnosi
 white-space:pre-wrap}}table{{border-collapse:collapse;font-size:90%}}td,th{{border:1px solid #ccc;padding:2px 6px}}
 img{{max-width:100%}}</style></head><body>
 <h1>{esc(title)}</h1>
-<pre>{esc(diagnosis_text(d, command))}</pre>
-{unexplained_report.html_section(d)}<h2>Model vs measurement</h2><img src="model.png" alt="angle vs stroke">
-<h2>Residual atlas</h2>
-<p>Residual (measured - model) against each variable; lines are binned medians, the band the quartiles of the
-current model; dashed/dotted: loading/unloading.</p><img src="atlas.png" alt="residual atlas">
-<h2>Candidate ranking</h2><img src="ranking.png" alt="ranking">
+<h2>Answer</h2>
+<pre>{esc(chr(10).join(answer_lines(d)))}</pre>
+{("<p>Add them: <code>" + esc(add_command(d, command)) + "</code></p>") if d.recommended and add_command(d, command) else ""}
+<h2>Model vs measurement</h2><p>Measured angle, the current model and the model with the recommended effects
+(or, when nothing is recommended, the partial effects, dashed).</p><img src="model.png" alt="angle vs stroke">
+<h2>Waterfall</h2><p>RMSE as the recommended effects are added, refitted on all rows.</p>
+<img src="waterfall.png" alt="waterfall">
+{'<h2>Instruments</h2><p>The angle as read; the rows set aside before fitting are marked.</p><img src="artefacts.png" alt="artefacts">' if art is not None else ""}
+{unexplained_report.html_section(d)}<h2>Candidates</h2><img src="ranking.png" alt="ranking">
 <table><tr><th>#</th><th>effect</th><th>held-out RMSE deg</th><th>RMSE deg</th><th>delta BIC</th>
 <th>parameters</th><th>verdict</th></tr>
 {chr(10).join(rows)}
 </table>
-<h2>Waterfall</h2><p>RMSE as the recommended effects are added, refitted on all rows.</p>
-<img src="waterfall.png" alt="waterfall">
+<h2>Residual atlas</h2>
+<p>Residual (measured - model) against each variable; lines are binned medians, the band the quartiles of the
+current model; dashed/dotted: loading/unloading.</p><img src="atlas.png" alt="residual atlas">
+<h2>The diagnosis in full</h2>
+<pre>{esc(diagnosis_text(d, command))}</pre>
 </body></html>
 """
     files["index.html"] = page.encode("utf-8")

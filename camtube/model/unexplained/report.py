@@ -1,17 +1,15 @@
 """The ``unexplained`` section of a diagnosis report (text, JSON, HTML), from a :class:`Diagnosis`.
 
 The diagnosis report (:mod:`camtube.model.report.diagnosis`) calls these three hooks;
-the analysis runs once per diagnosis (memoised on the object).
+the analysis runs once per diagnosis (kept in the diagnosis's own cache).
 """
 from __future__ import annotations
 
 import html
 import math
-import weakref
 
 from camtube.model.unexplained.analysis import analyse, describe, variables_of
 
-_MEMO: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 #: A name for the starter effect, by what the residual follows.
 NAMES = {("stroke", True): "drive_error", ("time", True): "tendon_oscillation", ("angle", False): "arm_change",
          ("first_cycle", False): "first_cycle_set", ("cycle", False): "cycle_drift", ("time", False): "drift",
@@ -21,19 +19,16 @@ NAMES = {("stroke", True): "drive_error", ("time", True): "tendon_oscillation", 
 
 def of_diagnosis(d) -> dict | None:
     """``unexplained`` of the diagnosis's final (or partial) model (``None`` when within 1.15 x the noise floor)."""
-    try:
-        return _MEMO[d]
-    except (KeyError, TypeError):
-        pass
+    cache = getattr(d, "cache", None)
+    if cache is not None and "unexplained" in cache:
+        return cache.get("unexplained")
     # the misfit no fitted effect explains: after the partial effects when there are some (they are fitted,
     # but not recommended because the error stays above the floor), else after the recommended ones
     steps = getattr(d, "partial_steps", ())
     residual = steps[-1].residuals if getattr(d, "partial", ()) and steps else d.final.residuals
     u = analyse(residual, variables_of(d.data), d.noise_floor_deg)
-    try:
-        _MEMO[d] = u
-    except TypeError:
-        pass
+    if cache is not None:
+        cache.set("unexplained", u)
     return u
 
 
@@ -66,7 +61,10 @@ def text_lines(d, json_path: str = "DIAG.json") -> list[str]:
     if u is None:
         return []
     lines = describe(u)
-    if d.recommended:  # not reached by the diagnosis (a recommended chain is within 1.15 x the floor)
+    if d.recommended and getattr(d, "explanation", "") == "partial":
+        lines.append(f"  this is what is left with the recommended effects ({', '.join(d.recommended)}): they explain "
+                     f"most of the misfit, the error stays at {d.final.rmse_deg / d.noise_floor_deg:.2f} x the floor")
+    elif d.recommended:  # not reached by the diagnosis (a recommended chain is within 1.15 x the floor)
         lines.append(f"  note: with {', '.join(d.recommended)} the error stays at "
                      f"{d.final.rmse_deg / d.noise_floor_deg:.2f} x the floor; the recommended effect(s) may stand in "
                      f"for the physics above: try the starter effect without them")

@@ -1,0 +1,435 @@
+"""The instruments before the physics: artefacts set aside, the logger's rates, the lag between channels.
+
+``check_instruments(data, lag_ms=None) -> Instruments``
+
+A diagnosis of the joint must not be a diagnosis of the sensors. Before any physics is fitted:
+
+* **Spikes** (interference in the tracker or the load cell): a row outside the range of its two neighbours
+  either side (same sample) by more than :data:`SPIKE_Z` noise scales; the scale is the median absolute
+  row-to-row change (x 1.4826 / sqrt 2, robust to the spikes themselves). Turning points and kinks of the
+  motion stay within their neighbours' range, so only isolated jumps qualify.
+* **Repeated time stamps**: a row whose stamp equals the previous row's (the logger wrote one instant
+  twice) is set aside. Rows whose stamp goes backwards, and rows with a missing value, are dropped when
+  the file is read (:func:`camtube.model.data.read_measurements`), and counted there.
+* **Rate changes**: the sampling interval's median over blocks of 200 rows; a block more than 20 % off the
+  sample's median is reported (the rate is stated, nothing is set aside).
+* **Lag of the angle channel** against the force (both see the same tendon tension; the drive, the tendon's
+  slack, toe and creep sit upstream of both, so they do not shift one against the other). For a trial lag
+  ``tau`` (whole rows: interpolating between rows averages the noise and favours half-row shifts) the
+  angle is read ``tau`` later and regressed, per sample, on the force (smoothed by a centred running mean):
+  a cubic, a step and a hysteresis proportional to the force that flip with the direction of motion
+  (friction in the joint, at the guide), and the force minus its low-passed copies with time constants of
+  2, 8 and 32 s (a slow relaxation of the joint's backbone makes the angle follow the force's history: not
+  a delay). The step also absorbs what a delay does at constant speed, so the lag is resolved by the parts
+  of the record where the speed changes (ramps that start and stop smoothly, reversals, dwells); on a
+  constant-speed triangle it is usually not resolved and not corrected. The lag minimising the residual
+  is refined by a parabola through the best three shifts. Its standard error is the spread of the same
+  estimate over blocks of
+  cycles (``sd / sqrt(blocks)``). It is a property of the instruments: it is corrected (the angle read
+  ``lag`` later) when it exceeds three standard errors and a quarter of the sampling interval, is a minimum inside
+  the range tried (+-250 ms) and lowers the regression's residual RMS by :data:`MIN_FALL` (2 %), or when the
+  user gives ``--lag-ms``, and it is never offered as an effect of the joint.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from camtube.model.data.dataset import Dataset
+
+#: A row this many robust scales from its running median is a spike.
+SPIKE_Z = 8.0
+#: Neighbours either side whose range a row is compared with.
+NEIGHBOURS = 2
+#: A lag is corrected only when it lowers the residual RMS of the lag regression by this fraction.
+MIN_FALL = 0.02
+#: A sampling interval this far off the sample's median is a rate change.
+RATE_CHANGE = 0.2
+
+
+@dataclass(frozen=True, eq=False)
+class Lag:
+    """Lag of the angle channel behind the force channel.
+
+    Attributes
+    ----------
+    lag_ms, se_ms : float
+        Estimate and its standard error (ms); positive: the angle is late.
+    given : bool
+        The user gave the lag (``--lag-ms``): no estimate.
+    applied_ms : float
+        The lag corrected (0 when none was).
+    fall : float
+        Relative fall of the residual RMS of the lag regression from no lag to the estimate.
+    """
+
+    lag_ms: float
+    se_ms: float
+    given: bool = False
+    applied_ms: float = 0.0
+    fall: float = 0.0
+
+
+@dataclass(frozen=True, eq=False)
+class Instruments:
+    """What the instruments did (:func:`check_instruments`).
+
+    Attributes
+    ----------
+    data : Dataset
+        The rows kept, the angle corrected for the lag.
+    raw : Dataset
+        The rows as read.
+    aside : dict[str, (k,) int]
+        Rows of ``raw`` set aside, by reason (``"angle spike"``, ``"force spike"``, ``"repeated time stamp"``).
+    kept : (n_raw,) bool
+        Rows of ``raw`` kept in ``data``.
+    rates_hz : dict[str, float]
+        Each sample's median sampling rate.
+    rate_changes : tuple[str, ...]
+        Sentences on blocks sampled at another rate.
+    lag : Lag
+    dropped : str
+        The reader's line on rows dropped (missing values, backward stamps), or ``""``.
+    n_dropped : int
+    """
+
+    data: Dataset
+    raw: Dataset
+    aside: dict
+    kept: np.ndarray
+    rates_hz: dict
+    rate_changes: tuple
+    lag: Lag
+    dropped: str = ""
+    n_dropped: int = 0
+
+    @property
+    def n_aside(self) -> int:
+        return int((~self.kept).sum())
+
+    def lines(self) -> list[str]:
+        """The instruments' findings, one sentence each."""
+        out = []
+        if self.dropped:
+            out.append(self.dropped)
+        parts = [f"{len(v)} {k}{'s' if len(v) != 1 else ''}" for k, v in self.aside.items() if len(v)]
+        n_raw = len(self.raw)
+        if parts:
+            out.append(f"set aside before fitting: {self.n_aside} of {n_raw} rows ({', '.join(parts)})")
+        else:
+            out.append(f"set aside before fitting: none of {n_raw} rows (no spikes, no repeated time stamps)")
+        out.append("sampling: " + ", ".join(f"{s} {r:.4g} Hz" for s, r in self.rates_hz.items()))
+        out.extend(self.rate_changes)
+        lg = self.lag
+        if lg.given:
+            out.append(f"angle lag: {lg.lag_ms:.4g} ms as given (--lag-ms); the angle is read {lg.applied_ms:.4g} ms "
+                       "later (whole rows)")
+        elif lg.applied_ms:
+            out.append(f"angle lag: the tracker lags the load cell by {lg.lag_ms:.3g} +- {lg.se_ms:.2g} ms "
+                       f"(an instrument property, not the joint's); corrected: the angle is read {lg.applied_ms:.3g}"
+                       " ms later (whole rows; --lag-ms 0 to keep it)")
+        else:
+            out.append(f"angle lag: {lg.lag_ms:.2g} +- {lg.se_ms:.2g} ms against the load cell: none to correct"
+                       if math.isfinite(lg.se_ms) else "angle lag: not resolved by these data (no minimum within "
+                       "+-250 ms): none corrected; give --lag-ms if it is known")
+        return out
+
+
+def _spikes(x: np.ndarray, slices: list) -> np.ndarray:
+    """Rows of ``x`` (n,) outside the range of their neighbours (:data:`NEIGHBOURS` rows either side, same
+    sample) by more than :data:`SPIKE_Z` noise scales; the scale is ``1.4826 MAD(diff x) / sqrt(2)`` (robust
+    to the spikes). A turning point or a kink of the motion stays within its neighbours' range (within a
+    row's change), so only isolated jumps qualify."""
+    out = np.zeros(x.size, bool)
+    h = NEIGHBOURS
+    for _, sl in slices:
+        v = x[sl]
+        if v.size < 10 * h:
+            continue
+        scale = 1.4826 * float(np.median(np.abs(np.diff(v)))) / math.sqrt(2.0)
+        if scale <= 0.0:
+            continue
+        pad = np.concatenate((np.full(h, v[0]), v, np.full(h, v[-1])))
+        win = np.delete(np.lib.stride_tricks.sliding_window_view(pad, 2 * h + 1), h, axis=1)
+        out[sl] = (v > win.max(axis=1) + SPIKE_Z * scale) | (v < win.min(axis=1) - SPIKE_Z * scale)
+    return out
+
+
+def _rates(data: Dataset) -> tuple[dict, tuple]:
+    rates, notes = {}, []
+    for s, sl in data.sample_slices():
+        dt = np.diff(data.time_s[sl])
+        dt = dt[dt > 0]
+        if not dt.size:
+            continue
+        med = float(np.median(dt))
+        rates[s] = 1.0 / med
+        nb = dt.size // 200
+        if nb >= 2:
+            blk = np.median(dt[: nb * 200].reshape(nb, 200), axis=1)
+            off = np.flatnonzero(np.abs(blk / med - 1.0) > RATE_CHANGE)
+            if off.size:
+                t0 = float(data.time_s[sl][off[0] * 200])
+                notes.append(f"sampling rate of sample {s} changes: {1.0 / blk[off[0]]:.4g} Hz from t = {t0:.4g} s "
+                             f"({off.size} of {nb} blocks of 200 rows off the median {1.0 / med:.4g} Hz)")
+    return rates, tuple(notes)
+
+
+#: Time constants (s) of the low-passed force regressors that absorb a slow relaxation of the joint.
+RELAX_TAUS_S = (2.0, 8.0, 32.0)
+#: Widths (fractions of the force's range) of the play operators that absorb friction in the joint (it holds
+#: the angle while the force reverses, which a delay would otherwise be fitted to).
+STICK_WIDTHS = (0.01, 0.03)
+#: Width (s) of the centred running mean of the force in the lag regression (short against the motion: a
+#: wide one flattens the force's turning points, which a shift of the angle then mimics).
+SMOOTH_S = 0.1
+
+
+def _play(x: np.ndarray, width: float) -> np.ndarray:
+    """Play (backlash) operator of ``x`` (n,) with full width ``width``: the output follows ``x`` only once
+    ``x`` has moved ``width`` from where it last pushed it."""
+    out = np.empty_like(x)
+    y = float(x[0])
+    h = 0.5 * width
+    for i, v in enumerate(x.tolist()):
+        if v > y + h:
+            y = v - h
+        elif v < y - h:
+            y = v + h
+        out[i] = y
+    return out
+
+
+def _lag_design(data: Dataset) -> list:
+    """Per sample: ``(slice, basis)`` with the force regressors of :func:`_lag_sse`: a cubic of the force per
+    direction of motion, and the force low-passed with :data:`RELAX_TAUS_S` (a relaxation of the joint
+    makes the angle follow the force's history, not a delay)."""
+    from scipy.signal import lfilter
+
+    out = []
+    direction = data.direction
+    for _, sl in data.sample_slices():
+        f = data.force_N[sl]
+        dt = float(np.median(np.diff(data.time_s[sl]))) if f.size > 1 else 1.0
+        k = 2 * int(SMOOTH_S / max(dt, 1e-9) / 2) + 1
+        if 1 < k < f.size:  # a centred running mean: less force noise in the regressors, no shift in time
+            f = np.convolve(np.pad(f, k // 2, mode="edge"), np.ones(k) / k, "valid")
+        x = (f - f.mean()) / (f.std() or 1.0)
+        # a cubic of the force, a step (friction in the joint) and a hysteresis proportional to the force
+        # (friction at the guide: the cell reads a tension that differs from the joint's by a ratio) that flip
+        # with the direction of motion
+        dirn = direction[sl].astype(float)
+        cols = [np.ones_like(x), x, x * x, x ** 3, dirn * x, dirn]
+        for w in STICK_WIDTHS:  # friction that holds the joint while the force reverses: a play of the force
+            cols.append(_play(x, w * float(np.ptp(x))) - x)
+        for tau in RELAX_TAUS_S:
+            a = math.exp(-dt / tau)
+            lp = lfilter([1.0 - a], [1.0, -a], x, zi=[a * x[0]])[0]
+            cols.append(x - lp)
+        out.append((sl, np.stack(cols, axis=1)))
+    return out
+
+
+def _lag_sse(data: Dataset, design: list, shift: int, rows: np.ndarray) -> float:
+    """Residual sum of squares of the angle ``shift`` rows later, regressed on the force regressors
+    (:func:`_lag_design`), over ``rows`` (index array)."""
+    sse = 0.0
+    for sl, basis in design:
+        idx = rows[(rows >= sl.start + max(0, -shift)) & (rows < sl.stop - max(0, shift))]
+        if idx.size < 40:
+            continue
+        a = data.angle_deg[idx + shift]
+        x = basis[idx - sl.start]
+        coef, *_ = np.linalg.lstsq(x, a, rcond=None)
+        r = a - x @ coef
+        sse += float(r @ r)
+    return sse
+
+
+def _lag_of(data: Dataset, design: list, rows: np.ndarray, lo: int, hi: int) -> float:
+    """Lag (rows) minimising :func:`_lag_sse` over whole-row shifts ``lo .. hi``, refined by a parabola through
+    the best three (whole rows: interpolating between rows would average the noise and favour half-row
+    shifts)."""
+    return _lag_scan(data, design, rows, lo, hi)[0]
+
+
+def _lag_scan(data: Dataset, design: list, rows: np.ndarray, lo: int, hi: int) -> tuple[float, bool, float]:
+    """``(lag in rows, interior minimum?, relative fall of the residual RMS from no shift to the best)``."""
+    shifts = np.arange(lo, hi + 1)
+    sse = np.array([_lag_sse(data, design, int(k), rows) for k in shifts])
+    k = int(np.argmin(sse))
+    zero = sse[shifts == 0][0] if (shifts == 0).any() else sse[k]
+    fall = 1.0 - math.sqrt(sse[k] / zero) if zero > 0 else 0.0
+    if 0 < k < sse.size - 1:
+        y0, y1, y2 = sse[k - 1], sse[k], sse[k + 1]
+        den = y0 - 2 * y1 + y2
+        return float(shifts[k] + (0.5 * (y0 - y2) / den if den > 0 else 0.0)), True, fall
+    return float(shifts[k]), False, fall
+
+
+def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_ms: float = 250.0) -> Lag:
+    """Lag of the angle behind the force (ms) with its standard error (see the module docstring).
+
+    Parameters
+    ----------
+    data : Dataset
+        Rows free of artefacts.
+    max_rows : int
+        Rows used (evenly thinned in time).
+    blocks : int
+        Blocks of cycles per sample for the standard error.
+    max_lag_ms : float
+        Largest lag tried either way.
+    """
+    n = len(data)
+    dt = float(np.median(np.diff(data.time_s))) if n > 1 else 1.0
+    dt = dt if dt > 0 else 1.0
+    max_shift = max(3, int(round(max_lag_ms * 1e-3 / dt)))
+    step = max(1, n // max_rows)
+    rows = np.arange(0, n, step)
+    design = _lag_design(data)
+    est, interior, fall = _lag_scan(data, design, rows, -max_shift, max_shift)
+    near = int(round(est))
+    per = []
+    cyc = data.cycle
+    for _, sl in data.sample_slices():
+        c = cyc[sl]
+        edges = np.linspace(c.min(), c.max() + 1, blocks + 1)
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            r = rows[(rows >= sl.start) & (rows < sl.stop)]
+            r = r[(cyc[r] >= lo) & (cyc[r] < hi)]
+            if r.size >= 100:
+                per.append(_lag_of(data, design, r, near - 3, near + 3))
+    se = float(np.std(per, ddof=1) / math.sqrt(len(per))) if len(per) > 1 else float("inf")
+    if not interior:  # no minimum inside the range tried: not a delay the data resolve
+        se = float("inf")
+    return Lag(est * dt * 1e3, se * dt * 1e3, fall=fall)
+
+
+def shift_angle(data: Dataset, lag_ms: float) -> tuple[Dataset, np.ndarray, float]:
+    """``data`` with the angle read ``lag_ms`` later, by whole rows of each sample (interpolating between rows
+    would average the tracker's noise and hide it from the noise floor); the rows at the end whose later angle
+    is past the record are dropped.
+
+    Returns
+    -------
+    data : Dataset
+    kept : (n,) bool
+        Rows of the input kept.
+    applied_ms : float
+        The shift applied: whole rows times the median sampling interval (within half a row of ``lag_ms``).
+    """
+    if lag_ms == 0.0:
+        return data, np.ones(len(data), bool), 0.0
+    ang = data.angle_deg.copy()
+    keep = np.ones(len(data), bool)
+    applied = []
+    for _, sl in data.sample_slices():
+        t = data.time_s[sl]
+        dt = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+        k = int(round(lag_ms * 1e-3 / dt)) if dt > 0 else 0
+        applied.append(k * dt * 1e3)
+        if k == 0:
+            continue
+        idx = np.arange(sl.start, sl.stop)
+        src = np.clip(idx + k, sl.start, sl.stop - 1)
+        ang[idx] = data.angle_deg[src]
+        keep[idx] = (idx + k >= sl.start) & (idx + k < sl.stop)
+    return data.with_angle(ang).take(keep), keep, float(np.mean(applied))
+
+
+def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str = "", n_dropped: int = 0,
+                      ) -> Instruments:
+    """Find the instruments' artefacts, set them aside, estimate (or apply) the angle's lag.
+
+    Parameters
+    ----------
+    data : Dataset
+        The rows as read (``n`` rows).
+    lag_ms : float, optional
+        The angle channel's lag (ms) to correct; ``None``: estimate it and correct it when it is resolved.
+    dropped, n_dropped : str, int
+        The reader's line on dropped rows and their count (stated in the findings).
+
+    Returns
+    -------
+    Instruments
+    """
+    slices = data.sample_slices()
+    aside: dict[str, np.ndarray] = {}
+    rep = np.zeros(len(data), bool)
+    for _, sl in slices:
+        t = data.time_s[sl]
+        rep[sl.start + 1:sl.stop] = np.diff(t) <= 0.0
+    aside["repeated time stamp"] = np.flatnonzero(rep)
+    sa = _spikes(data.angle_deg, slices) & ~rep
+    sf = _spikes(data.force_N, slices) & ~rep & ~sa
+    aside["angle spike"] = np.flatnonzero(sa)
+    aside["force spike"] = np.flatnonzero(sf)
+    kept = ~(rep | sa | sf)
+    clean = data.take(kept)
+    rates, notes = _rates(clean)
+    if lag_ms is not None:
+        lag = Lag(float(lag_ms), 0.0, given=True, applied_ms=float(lag_ms))  # whole rows below
+    else:
+        lag = estimate_lag(clean)
+        dt_ms = 1e3 / max(np.median(list(rates.values())) if rates else 1.0, 1e-9)
+        if abs(lag.lag_ms) > 3.0 * lag.se_ms and abs(lag.lag_ms) > 0.25 * dt_ms and lag.fall >= MIN_FALL:
+            lag = Lag(lag.lag_ms, lag.se_ms, applied_ms=lag.lag_ms, fall=lag.fall)
+    shifted, k2, applied = shift_angle(clean, lag.applied_ms)
+    if lag.applied_ms:
+        lag = Lag(lag.lag_ms, lag.se_ms, lag.given, applied, lag.fall)
+    idx = np.flatnonzero(kept)
+    kept[idx[~k2]] = False
+    if (~k2).any():
+        aside["end of record after the lag shift"] = idx[~k2]
+    return Instruments(shifted, data, aside, kept, rates, notes, lag, dropped, n_dropped)
+
+
+def with_aside(ins: Instruments, predicted_deg: np.ndarray, floor_deg: float) -> tuple[float, float, int]:
+    """Errors over the rows kept *and* the rows set aside (spikes, repeated stamps).
+
+    The model's prediction at a row set aside is interpolated in time from the rows kept around it (the
+    model is smooth in time), at the instant the angle was seen (``t - lag``).
+
+    Parameters
+    ----------
+    ins : Instruments
+    predicted_deg : (n,) float
+        A model's prediction on ``ins.data`` (the rows kept).
+    floor_deg : float
+        The noise floor estimated on the rows kept.
+
+    Returns
+    -------
+    rmse_deg : float
+        RMSE over the rows kept and set aside.
+    allowed_deg : float
+        What the data allow over the same rows: the floor on the rows kept, the artefacts' own size on the rows
+        set aside (a perfect model misses a spike by the spike).
+    n_aside : int
+        Rows set aside that were counted (those inside a sample's record).
+    """
+    clean = ins.data
+    resid = clean.angle_deg - predicted_deg
+    sse, n = float(resid @ resid), resid.size
+    extra = 0.0
+    aside = np.flatnonzero(~ins.kept)
+    raw = ins.raw
+    lag_s = ins.lag.applied_ms * 1e-3
+    counted = 0
+    for smp, sl in clean.sample_slices():
+        a = aside[raw.sample[aside] == smp]
+        if not a.size:
+            continue
+        t = raw.time_s[a] - lag_s
+        inside = (t >= clean.time_s[sl][0]) & (t <= clean.time_s[sl][-1])
+        r = raw.angle_deg[a][inside] - np.interp(t[inside], clean.time_s[sl], predicted_deg[sl])
+        extra += float(r @ r)
+        counted += int(inside.sum())
+    rmse = math.sqrt((sse + extra) / max(n + counted, 1))
+    allowed = math.sqrt((n * floor_deg ** 2 + extra) / max(n + counted, 1))
+    return rmse, allowed, counted

@@ -1,0 +1,212 @@
+"""Diagnosis of whole-bench files (issue 19): :mod:`camtube.model.sim.bench`, several mechanisms at once.
+
+Each file: two samples, 25-100 Hz, about 60,000 rows, 50 cycles with dwells and rests, the first cycle
+dwelling longer, tracker spikes, dropouts (nan), stamp jitter and repeated stamps; one mechanism dominant,
+others present. The file is written as CSV and read back as a user's would be (rows with a missing value
+dropped and counted), the instruments are checked (spikes set aside, the angle's lag estimated and
+corrected), then ``diagnose`` runs on the rows kept.
+
+Run: ``python scripts/bench_diagnose.py --batch bench`` (the sets the method was tuned on) or
+``--batch bench-heldout`` (drawn once the method was settled, from a seed not used before; see
+docs/diagnose.md for when it was run); or ``python scripts/bench_real.py bench bench-heldout``.
+Each prints, per file, what was recommended, the RMSE before/after against the true floor, the noise-floor
+estimate against the truth, the lag, the rows set aside, and the seconds (instruments + diagnosis); then the
+count right and the seconds per 60,000-row file.
+"""
+from __future__ import annotations
+
+import tempfile
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+from benchutil import ROOT
+
+from camtube.design.loader import load_pattern
+from camtube.model.core.predict import model_for_pattern, pattern_values
+from camtube.model.data import format_csv, read_measurements
+from camtube.model.diagnose import diagnose
+from camtube.model.diagnose.instruments import check_instruments
+from camtube.model.sim.bench import (
+    Backbone, Clock, Drive, Guide, LoadCell, Protocol, SampleBench, Tendon, Tracker, simulate_bench,
+)
+
+TOES = {"toe", "toe_shape"}
+#: Mechanisms by family: the effects of the library that are the right answer (empty: none is; the answer is
+#: nothing recommended, and what is left follows ``follows``).
+FAMILIES = {
+    "control": (set(), None),
+    "toe": (TOES, None),
+    "slack": ({"slack"}, None),
+    "lost motion": ({"slack", "play"}, None),
+    "creep": ({"creep", "viscoelastic"}, None),  # a slow viscoelastic element and creep: known equivalents
+    "backbone": (set(), None),
+    "zero drift": (set(), "time"),
+    "lag": (set(), None),
+    "friction": ({"friction"}, None),
+}
+
+
+def protocol_for(rate_hz: float, rows: int = 60_000, n_cycles: int = 50) -> Protocol:
+    """Cycle timing giving about ``rows`` rows over two samples at ``rate_hz``."""
+    cycle_s = rows / 2.0 / rate_hz / n_cycles
+    return Protocol(n_cycles=n_cycles, ramp_s=0.3 * cycle_s, dwell_s=0.2 * cycle_s, rest_s=0.2 * cycle_s,
+                    first_dwell_s=0.2 * cycle_s)
+
+
+def _mild(rng: np.random.Generator) -> SampleBench:
+    """A bench with small secondary mechanisms on (as any real one has)."""
+    return SampleBench(
+        drive=Drive(backlash_mm=float(rng.uniform(0.0, 0.005)), rail_friction_N=0.05),
+        guide=Guide(mu=float(rng.uniform(0.0, 0.002))),
+        tendon=Tendon(crimp_mm=float(rng.uniform(0.0, 0.01)), creep_A_mm_per_s=float(rng.uniform(0, 1e-6))),
+        backbone=Backbone(relax=((float(rng.uniform(0.02, 0.1)), 3.0),)),
+        tracker=Tracker(noise_deg=float(rng.uniform(0.1, 0.25))),
+    )
+
+
+def dominant(kind: str, base: SampleBench, rng: np.random.Generator, strength: float = 1.0) -> SampleBench:
+    """``base`` with ``kind`` made the dominant mechanism."""
+    u = lambda lo, hi: float(rng.uniform(lo, hi)) * strength  # noqa: E731
+    if kind == "toe":
+        return replace(base, tendon=replace(base.tendon, crimp_mm=u(0.15, 0.4), crimp_shape=float(rng.uniform(1.5, 4))))
+    if kind == "slack":
+        return replace(base, tendon=replace(base.tendon, slack_mm=u(0.08, 0.2)))
+    if kind == "lost motion":
+        return replace(base, drive=Drive(backlash_mm=u(0.1, 0.25), rail_friction_N=float(rng.uniform(0.05, 0.2))))
+    if kind == "creep":
+        return replace(base, tendon=replace(base.tendon, creep_A_mm_per_s=u(2e-4, 6e-4), creep_n=2.0,
+                                            creep_sat_mm=float(rng.uniform(0.05, 0.15))))
+    if kind == "backbone":
+        return replace(base, backbone=Backbone(relax=((u(0.2, 0.4), float(rng.uniform(1, 4))),
+                                                      (u(0.1, 0.3), float(rng.uniform(15, 40)))),
+                                               yield_nmm=float(rng.uniform(3, 6)), set_rate_per_s=u(0.02, 0.05)))
+    if kind == "zero drift":
+        return replace(base, load_cell=LoadCell(drift_N_per_h=u(0.2, 0.5), walk_N_per_sqrt_h=0.05))
+    if kind == "lag":
+        return replace(base, tracker=replace(base.tracker, lag_ms=u(25, 80)))
+    if kind == "friction":
+        return replace(base, guide=Guide(mu=u(0.1, 0.2)))
+    if kind == "control":  # the paper's physics: nothing else (the instruments' artefacts stay)
+        return SampleBench(tracker=base.tracker)
+    raise ValueError(kind)
+
+
+def draw_batch(seed: int, kinds: list) -> list:
+    """``[(name, tube, rate_hz, (SampleBench, SampleBench), (kind1, kind2), sim_seed)]`` drawn from ``seed``."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for i, kind in enumerate(kinds):
+        k1, k2 = kind if isinstance(kind, tuple) else (kind, kind)
+        tube = str(rng.choice(["tube1", "tube2"]))
+        rate = float(rng.choice([25.0, 40.0, 50.0, 100.0]))
+        b1 = dominant(k1, _mild(rng), rng)
+        b2 = dominant(k2, _mild(rng), rng, strength=float(rng.uniform(0.7, 1.3)))
+        if k1 == "lag" == k2:  # one tracker for both samples
+            b2 = replace(b2, tracker=replace(b2.tracker, lag_ms=b1.tracker.lag_ms))
+        name = k1 if k1 == k2 else f"{k1} / {k2}"
+        out.append((name, tube, rate, (b1, b2), (k1, k2), seed * 100 + i))
+    return out
+
+
+TUNE_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
+              ("toe", "creep"), "friction"]
+#: The fresh held-out batch: drawn once the method was settled (commit after the search object), from a seed
+#: not used before, with another pair of mechanisms in one file; run once, reported separately.
+HELDOUT_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
+                 ("slack", "toe"), "friction"]
+BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS)}
+
+
+def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
+    """Simulate, write, read back, check the instruments and diagnose one file; a dict of the figures."""
+    name, tube, rate, benches, kinds, seed = spec
+    pattern = load_pattern(ROOT / "patterns" / f"{tube}.yaml")
+    rec = simulate_bench(pattern, benches, protocol_for(rate), Clock(rate_hz=rate), seed=seed)
+    path = workdir / f"bench_{seed}.csv"
+    path.write_text(format_csv(rec.data))
+    t0 = time.perf_counter()
+    meas = read_measurements(path)
+    ins = check_instruments(meas.data, dropped=meas.summary(), n_dropped=meas.missing_lines.size)
+    t1 = time.perf_counter()
+    model = model_for_pattern(pattern)
+    d = diagnose(model, ins.data, ["E_t"], pattern_values(pattern))
+    t2 = time.perf_counter()
+    rec_list = list(d.recommended)
+    final = d.final.rmse_deg
+    floor_true = rec.floor_deg
+    lag_true = benches[0].tracker.lag_ms
+    right = set()
+    for k in kinds:
+        right |= FAMILIES[k][0]
+    first = rec_list[0] if rec_list else "-"
+    if kinds[0] == "lag":
+        # an instrument property: found and corrected (within 3 standard errors or 20 %), never offered as a
+        # joint effect; the secondary mechanisms may still be explained, to the floor
+        lag_ok = (ins.lag.applied_ms > 0 and abs(ins.lag.applied_ms - benches[0].tracker.lag_ms)
+                  <= max(3.0 * ins.lag.se_ms, 0.2 * benches[0].tracker.lag_ms))
+        ok = lag_ok and (not rec_list or final <= 1.15 * floor_true)
+    elif not right:
+        ok = not rec_list
+    else:
+        ok = bool(rec_list) and rec_list[0] in right and final <= 1.15 * floor_true
+        if kinds[0] != kinds[1]:
+            ok = bool(rec_list) and set(rec_list) >= {next(iter(FAMILIES[k][0] & set(rec_list)), None) or "?" for k in kinds}
+    floor_ok = abs(d.noise_floor_deg / floor_true - 1.0) <= 0.2
+    from camtube.model.unexplained import report as unexplained_report
+
+    u = unexplained_report.of_diagnosis(d)
+    left = (u.get("follows") or ["-"])[0] if u else "-"
+    want = FAMILIES[kinds[0]][1]
+    if want is not None:  # the library lacks it: nothing of a wrong family, and what is left follows `want`
+        ok = ok and left == want
+    out = dict(name=name, tube=tube, rate=rate, rows=len(rec.data), first=first, recommended=rec_list,
+               partial=list(d.partial), explanation=d.explanation, base=d.waterfall[0].rmse_deg, final=final, floor_est=d.noise_floor_deg,
+               floor_true=floor_true, floor_ok=floor_ok, left=left, lag_true=lag_true, lag_est=ins.lag.lag_ms,
+               lag_se=ins.lag.se_ms, lag_applied=ins.lag.applied_ms, n_aside=ins.n_aside,
+               n_dropped=meas.missing_lines.size, spikes_true=len(rec.spike_rows), ok=ok,
+               s_instruments=t1 - t0, s_diagnose=t2 - t1)
+    if verbose:
+        print(f"{name:18s} {tube} {rate:4.0f} Hz {len(rec.data):6d} rows | first {first:11s} rec {','.join(rec_list) or '-':24s}"
+              f" {d.explanation or '-':8s} partial {','.join(d.partial) or '-':18s} RMSE {out['base']:.3f} -> {final:.3f} deg ({final / floor_true:.2f} x true floor; partial chain "
+              f"{(d.partial_steps[-1].rmse_deg / floor_true) if d.partial else float('nan'):.2f} x) | floor est "
+              f"{d.noise_floor_deg:.3f} true {floor_true:.3f} ({'ok' if floor_ok else 'OFF'}) | lag {lag_true:.0f} -> "
+              f"{ins.lag.lag_ms:.1f}+-{ins.lag.se_ms:.1f} ms (applied {ins.lag.applied_ms:.1f}) | left follows {left} | aside {ins.n_aside} "
+              f"(spikes {len(rec.spike_rows)}), dropped {meas.missing_lines.size} | {'RIGHT' if ok else 'wrong'} | "
+              f"{t1 - t0:.1f}+{t2 - t1:.1f} s", flush=True)
+    return out
+
+
+def run_batch(name: str) -> list:
+    seed, kinds = BATCHES[name]
+    with tempfile.TemporaryDirectory() as tmp:
+        res = [run_file(s, Path(tmp)) for s in draw_batch(seed, kinds)]
+    n_ok = sum(r["ok"] for r in res)
+    n_floor = sum(r["floor_ok"] for r in res)
+    per_60k = [(r["s_instruments"] + r["s_diagnose"]) * 60_000 / r["rows"] for r in res]
+    print(f"{name}: {n_ok} of {len(res)} right; noise floor within 20 % of the true one in {n_floor} of {len(res)}; "
+          f"seconds per 60,000-row file: median {np.median(per_60k):.1f}, max {max(per_60k):.1f}")
+    return res
+
+
+def write_file(batch: str, kind: str, path: str) -> None:
+    """Write the file of ``kind`` (its name in the batch's table) of ``batch`` as CSV, as a lab would have it."""
+    seed, kinds = BATCHES[batch]
+    spec = next(s for s in draw_batch(seed, kinds) if s[0] == kind)
+    name, tube, rate, benches, _, sim_seed = spec
+    pattern = load_pattern(ROOT / "patterns" / f"{tube}.yaml")
+    rec = simulate_bench(pattern, benches, protocol_for(rate), Clock(rate_hz=rate), seed=sim_seed)
+    Path(path).write_text(format_csv(rec.data))
+    print(f"wrote {path}: {name}, {tube}, {rate:g} Hz, {len(rec.data)} rows; true floor {rec.floor_deg:.3f} deg, "
+          f"spikes {len(rec.spike_rows)}, missing angles {len(rec.dropout_rows)}")
+
+
+if __name__ == "__main__":
+    import sys
+
+    if sys.argv[1:2] == ["--write"]:  # --write BATCH KIND OUT.csv
+        write_file(*sys.argv[2:5])
+    else:
+        for b in sys.argv[1:] or ["bench"]:
+            run_batch(b)
