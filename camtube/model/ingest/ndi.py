@@ -22,8 +22,6 @@ the file, line and column.
 """
 from __future__ import annotations
 
-import csv
-import io
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from camtube.errors import DataError
+from camtube.model.ingest.table import read_table
 
 #: NDI's marker for a value that could not be measured; anything below ``-3e28`` is treated as missing.
 BAD_FLOAT_LIMIT = -3.0e28
@@ -192,25 +191,10 @@ def parse_ndi(text: str, source: str = "<ndi>", *, unit: str = "mm", rate_hz: fl
     """
     if unit not in ("mm", "m"):
         raise _err(source, None, f"tracker unit {unit!r} is not known", "use mm (NDI's default) or m")
-    reader = csv.reader(io.StringIO(text))
-    header: list[str] | None = None
-    hline = 0
-    rows: list[list[str]] = []
-    lines: list[int] = []
-    try:
-        for rec in reader:
-            if not rec or not any(c.strip() for c in rec):
-                continue
-            if header is None:
-                header = [c.strip() for c in rec]
-                hline = reader.line_num
-                continue
-            rows.append(rec)
-            lines.append(reader.line_num)
-    except csv.Error as exc:
-        raise _err(source, reader.line_num, f"not valid CSV ({exc})") from None
-    if header is None:
+    table = read_table(text, source)
+    if table is None:
         raise _err(source, None, "the file is empty", "export the tracking data from NDI Track as CSV")
+    header, hline, rows, lines = table.header, table.header_line, table.rows, table.lines
     starts = _group_starts(header)
     if not starts:
         raise _err(source, hline, "no tool column group (a header cell starting with 'Port')",

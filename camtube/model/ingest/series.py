@@ -16,15 +16,14 @@ Unknown keys are errors with a "did you mean" hint.
 """
 from __future__ import annotations
 
-import csv
 import difflib
-import io
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
 
 from camtube.errors import DataError
+from camtube.model.ingest.table import read_table
 
 #: Seconds per unit of a time column.
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "min": 60.0}
@@ -299,25 +298,10 @@ def parse_series(text: str, source: str, time: str, time_unit: str, value: str, 
         A missing column (with a "did you mean" and the map key to change), a non-numeric or empty cell
         (file, line and column), a time that does not increase.
     """
-    reader = csv.reader(io.StringIO(text))
-    header = None
-    hline = 0
-    rows: list[list[str]] = []
-    lines: list[int] = []
-    try:
-        for rec in reader:
-            if not rec or not any(c.strip() for c in rec) or rec[0].lstrip().startswith("#"):
-                continue
-            if header is None:
-                header = [c.strip() for c in rec]
-                hline = reader.line_num
-                continue
-            rows.append(rec)
-            lines.append(reader.line_num)
-    except csv.Error as exc:
-        raise DataError(f"{source}:{reader.line_num}: not valid CSV ({exc})") from None
-    if header is None:
+    table = read_table(text, source, comments=True)
+    if table is None:
         raise DataError(f"{source}: the file is empty")
+    header, hline, rows, lines = table.header, table.header_line, table.rows, table.lines
     if len(header) == 1 and (";" in header[0] or "\t" in header[0]):
         raise DataError(f"{source}:{hline}: the columns are not separated by commas; fix: save the log as "
                         "comma-separated values with a decimal point")
