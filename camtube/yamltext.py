@@ -9,7 +9,7 @@ import difflib
 import os
 import re
 from pathlib import Path
-from typing import Iterable
+from typing import Callable, Iterable
 
 import yaml
 
@@ -51,7 +51,7 @@ def parse_yaml(text: str):
     return yaml.load(text, Loader=StrictLoader)  # noqa: S506 (a SafeLoader subclass)
 
 
-def read_yaml_file(path: str | os.PathLike, what: str, fix: str) -> tuple[object, str]:
+def read_yaml_file(path: str | os.PathLike, what: str, fix: str | Callable[[], str]) -> tuple[object, str]:
     """Parse a YAML file; ``(data, text)``. Every failure is a one-line :class:`PatternError`.
 
     Parameters
@@ -60,15 +60,15 @@ def read_yaml_file(path: str | os.PathLike, what: str, fix: str) -> tuple[object
         The file.
     what : str
         What the file should be, in words (``pattern``, ``machine profile``), for the message.
-    fix : str
-        What to do when the file cannot be read at all.
+    fix : str or callable returning str
+        What to do when the file cannot be read at all (a callable is asked only then).
     """
     file = str(path)
     try:
         data = Path(path).read_bytes()
     except OSError as exc:
-        raise PatternError([Issue("file", f"cannot read {what}: {exc.strerror}", file, f"a readable YAML file",
-                                  fix)]) from None
+        raise PatternError([Issue("file", f"cannot read {what}: {exc.strerror}", file, "a readable YAML file",
+                                  fix() if callable(fix) else fix)]) from None
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

@@ -229,8 +229,8 @@ def _section(reader: _Reader, raw: dict, name: str) -> dict:
 def read_yaml(path: str | os.PathLike) -> tuple[dict, dict[str, int], str]:
     """Read a YAML mapping; returns ``(raw, line_map, file)``; every failure names the file and line."""
     file = str(path)
-    raw, text = read_yaml_file(path, "pattern", "check the path, or give a preset name (" +
-                               ", ".join(preset_names()) + ")")
+    raw, text = read_yaml_file(path, "pattern",
+                               lambda: f"check the path, or give a preset name ({', '.join(preset_names())})")
     if raw is None:
         raw = {}
     if not isinstance(raw, dict):
