@@ -338,27 +338,51 @@ def _toe_table(shape: float, x_min: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 
-def _toe_forces(ctx: Context) -> tuple[np.ndarray, np.ndarray]:
-    """``(forces, low)``: the averaged force of every row (clipped at zero), then :data:`TOE_NODES` quantile
-    nodes of the tension's posterior for each row of ``low`` (the rows near zero force). Cached per Dataset and
-    force array: they depend on the data only, and a fit evaluates the law many times."""
+#: Points of the per-sample grid of averaged forces on which the posterior mean of a toe law is computed (the
+#: rows near zero force interpolate in it: the posterior depends on the averaged force only, per sample).
+TOE_POSTERIOR_GRID = 256
+
+
+def _toe_forces(ctx: Context) -> tuple[np.ndarray, np.ndarray, tuple]:
+    """``(forces, low, (index, weight))``: the averaged force of every row (clipped at zero), then
+    :data:`TOE_NODES` quantile nodes of the tension's posterior at each point of a per-sample grid of averaged
+    forces (:data:`TOE_POSTERIOR_GRID` points spanning the rows of ``low``, those near zero force), and each low
+    row's place in that grid (linear interpolation). Cached per Dataset and force array: they depend on the
+    data only, and a fit evaluates the law many times."""
     hit = ctx.data.cache.get("builtin.toe_forces")
     if hit is not None and hit[0] is ctx.force_N:
-        return hit[1], hit[2]
+        return hit[1], hit[2], hit[3]
     fa = local_force_N(ctx)
     f = np.maximum(fa, 0.0)
     sd = local_force_sd_N(ctx.data)
     low = np.flatnonzero(fa < TOE_LOW_SD * sd)
+    index = np.zeros(low.size, np.intp)
+    weight = np.zeros(low.size)
     if low.size:
         from scipy.special import ndtr, ndtri
 
-        mu, s = fa[low], sd[low]
-        p0 = ndtr(-mu / s)[:, None]
         u = (np.arange(TOE_NODES) + 0.5) / TOE_NODES
-        fq = mu[:, None] + s[:, None] * ndtri(np.minimum(p0 + u[None, :] * (1.0 - p0), 1.0 - 1e-12))
-        f = np.concatenate([f, np.maximum(fq, 0.0).ravel()])
-    ctx.data.cache.set("builtin.toe_forces", (ctx.force_N, f, low))
-    return f, low
+        grids = []
+        offset = 0
+        for _, sl in ctx.data.sample_slices():
+            mine = (low >= sl.start) & (low < sl.stop)
+            if not mine.any():
+                continue
+            mu = fa[low[mine]]
+            s = float(sd[low[mine]][0])
+            lo_mu, hi_mu = float(mu.min()), float(mu.max())
+            g = np.linspace(lo_mu, hi_mu if hi_mu > lo_mu else lo_mu + 1e-12, TOE_POSTERIOR_GRID)
+            pos = (mu - lo_mu) / (g[1] - g[0])
+            i = np.minimum(pos.astype(np.intp), TOE_POSTERIOR_GRID - 2)
+            index[mine] = i + offset
+            weight[mine] = pos - i
+            p0 = ndtr(-g / s)[:, None]
+            fq = g[:, None] + s * ndtri(np.minimum(p0 + u[None, :] * (1.0 - p0), 1.0 - 1e-12))
+            grids.append(np.maximum(fq, 0.0).ravel())
+            offset += TOE_POSTERIOR_GRID
+        f = np.concatenate([f, *grids])
+    ctx.data.cache.set("builtin.toe_forces", (ctx.force_N, f, low, (index, weight)))
+    return f, low, (index, weight)
 
 
 def toe_elongation(ctx: Context, elong: np.ndarray, extra: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
@@ -367,14 +391,17 @@ def toe_elongation(ctx: Context, elong: np.ndarray, extra: Callable[[np.ndarray]
     The law is evaluated at :func:`local_force_N`; near zero force, where it is steep, it is averaged
     over the tension's posterior given the averaged force (a normal of the remaining noise's size,
     :func:`local_force_sd_N`, truncated at zero: a tendon cannot push), by :data:`TOE_NODES` quantile
-    nodes. Where the elongation would exceed the stroke the tendon is slack and the joint straight.
+    nodes, on a grid of averaged forces per sample (:data:`TOE_POSTERIOR_GRID` points, interpolated:
+    the law is evaluated at a few thousand nodes instead of sixteen per low row). Where the elongation
+    would exceed the stroke the tendon is slack and the joint straight.
     """
-    f, low = _toe_forces(ctx)
+    f, low, (index, weight) = _toe_forces(ctx)
     toe = extra(f)
     n = elong.size
     if low.size:
         rows = toe[:n].copy()
-        rows[low] = toe[n:].reshape(low.size, TOE_NODES).mean(axis=1)
+        mean = toe[n:].reshape(-1, TOE_NODES).mean(axis=1)
+        rows[low] = mean[index] * (1.0 - weight) + mean[index + 1] * weight
         toe = rows
     return np.minimum(elong + toe, np.maximum(ctx.stroke_mm, elong))
 
