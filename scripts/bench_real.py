@@ -40,7 +40,7 @@ FAMILIES = {
     "toe": (TOES, None),
     "slack": ({"slack"}, None),
     "lost motion": ({"slack", "play"}, None),
-    "creep": ({"creep", "viscoelastic"}, None),  # a slow viscoelastic element and creep: known equivalents
+    "creep": ({"creep", "creep_load", "viscoelastic"}, None),  # a slow viscoelastic element and creep: known equivalents
     "backbone": (set(), None),
     "zero drift": (set(), "time"),
     "lag": (set(), None),

@@ -10,6 +10,8 @@ name           stage       physics (parameters)
 slack          stroke      tendon slack: a deadband at low stroke (deadband_mm)
 play           stroke      lost motion in the drive, direction dependent (play_mm)
 creep          stroke      tendon creep / drift over time (creep_mm, tau_s)
+creep_load     stroke      tendon creep under load: Findley's power law in the load-time integral
+                           (creep_mm, exponent)
 friction       elongation  tendon-sheath friction: mean tension differs from the
                            load cell by a fraction, sign of motion (mu)
 toe            elongation  toe region of the tendon (quadratic, then linear) (toe_mm)
@@ -125,6 +127,7 @@ SLACK = Effect(
     meaning="tendon slack: the first part of the stroke only takes up the slack, the joint does not move",
     signature="at low stroke the joint stays straight while the base model already bends it "
               "(negative residual at small stroke, then a constant offset)",
+    off={"deadband_mm": 0.0},
 )
 
 
@@ -143,6 +146,7 @@ PLAY = Effect(
     signature="the residual flips sign with the direction of motion, with a constant size: "
               "loading lags, unloading leads (a parallelogram loop)",
     history=True,
+    off={"play_mm": 0.0},
 )
 
 
@@ -164,6 +168,52 @@ CREEP = Effect(
             "bend less for the same stroke; it settles with a time constant",
     signature="the residual trends with cycle number and time: early cycles differ from late ones",
     history=True,
+    off={"creep_mm": 0.0},
+)
+
+
+#: Load-time integral (N s) at which ``creep_load.creep_mm`` is the creep reached (1 N carried for 1000 s).
+LOAD_TIME_REF_NS = 1000.0
+
+
+def load_time_Ns(ctx: Context) -> np.ndarray:
+    """(n,) the tension carried so far, integrated over time per sample (trapezoids of the measured force,
+    clipped at zero: a slack tendon carries none), in N s. Cached per Dataset and force array."""
+    hit = ctx.data.cache.get("builtin.load_time")
+    if hit is not None and hit[0] is ctx.force_N:
+        return hit[1]
+    t = np.asarray(ctx.data.time_s, float)
+    f = np.maximum(np.asarray(ctx.force_N, float), 0.0)
+    out = np.zeros(t.size)
+    for _, sl in ctx.data.sample_slices():
+        ts, fs = t[sl], f[sl]
+        if ts.size > 1:
+            out[sl] = np.concatenate(([0.0], np.cumsum(0.5 * (fs[1:] + fs[:-1]) * np.diff(ts))))
+    ctx.data.cache.set("builtin.load_time", (ctx.force_N, out))
+    return out
+
+
+def _creep_load(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
+    w = load_time_Ns(ctx) / LOAD_TIME_REF_NS
+    # a tendon longer than the stroke is slack: the joint stays straight
+    return np.maximum(stroke - p["creep_mm"] * w ** p["exponent"], 0.0)
+
+
+CREEP_LOAD = Effect(
+    name="creep_load", stage="stroke",
+    params=(Param("creep_mm", "mm", 0.0, 5.0, lambda d, c: 0.01 * _stroke_span(d),
+                  f"tendon lengthening after {LOAD_TIME_REF_NS:g} N s of load (1 N carried for {LOAD_TIME_REF_NS:g} s)",
+                  kind="length"),
+            Param("exponent", "", 0.05, 3.0, 0.4,
+                  "power of the load-time integral (Findley's creep law: below 1 the creep slows down)",
+                  log=True, starts=(0.2, 0.5, 1.0))),
+    apply=_creep_load,
+    meaning="creep under load (Findley's power law in the load carried over time): the tendon lengthens "
+            "only while it carries tension, fast at first and then slower, and does not recover at rest",
+    signature="the residual trends with the load carried so far: early cycles differ from late ones, "
+              "and more after long dwells under load than after rests",
+    history=True,
+    off={"creep_mm": 0.0},
 )
 
 
@@ -182,6 +232,7 @@ FRICTION = Effect(
     meaning="tendon-sheath friction between the load cell and the joint: the tendon's mean tension is "
             "lower than measured while pulling and higher while releasing (friction hysteresis)",
     signature="the residual flips sign with the direction of motion and grows with force",
+    off={"mu": 0.0},
 )
 
 
@@ -209,6 +260,7 @@ TOE = Effect(
             "force (force grows with elongation squared) and reaches its linear stiffness after toe_mm",
     signature="the residual is curved against force: it moves quickly at low force and is constant at "
               "high force (the tendon stretches more than linear at the start)",
+    off={"toe_mm": 0.0},
 )
 
 
@@ -452,6 +504,7 @@ TOE_SHAPE = Effect(
     signature="the residual is curved against force: it moves quickly at low force and is constant at "
               "high force (the tendon stretches more than linear at the start)",
     family="toe",
+    off={"offset_mm": 1e-3},
 )
 
 
@@ -468,6 +521,7 @@ VISCOELASTIC = Effect(
     signature="the residual follows the force history: a loop against force (hysteresis) that depends "
               "on the loading rate",
     history=True,
+    off={"ratio": 0.0},
 )
 
 
@@ -620,7 +674,7 @@ FORCE_ZERO = Effect(
 )
 
 #: The built-in effects, in their documented order.
-BUILTIN_EFFECTS = (SLACK, PLAY, CREEP, FRICTION, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
+BUILTIN_EFFECTS = (SLACK, PLAY, CREEP, CREEP_LOAD, FRICTION, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
                    HARDSTOP, REST_ANGLE, ANGLE_BIAS, FORCE_ZERO)
 #: Built-in effect names in that order.
 BUILTINS = tuple(e.name for e in BUILTIN_EFFECTS)
