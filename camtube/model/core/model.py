@@ -171,6 +171,10 @@ class Effect:
         viscoelasticity): it needs whole cycles in both directions to be identified.
     source : str
         The file that defined it (empty for built-ins); named in error messages.
+    off : dict
+        Parameter values (short names) at which the effect does nothing, e.g. ``{"creep_mm": 0.0}``. With
+        them the diagnosis can fit the effect in some samples only (held off in the others); empty: it
+        cannot.
     """
 
     name: str
@@ -182,6 +186,7 @@ class Effect:
     family: str = ""
     history: bool = False
     source: str = ""
+    off: Mapping = field(default_factory=dict, compare=False)
 
     def __post_init__(self):
         for st in self.stages:
@@ -194,6 +199,9 @@ class Effect:
         elif len(self.stages) > 1:
             raise ValueError(f"effect {self.name!r} acts on {len(self.stages)} stages: give apply as "
                              "{stage: function}")
+        unknown = [k for k in self.off if k not in {p.name for p in self.params}]
+        if unknown:
+            raise ValueError(f"effect {self.name!r}: off names unknown parameter(s) {', '.join(unknown)}")
 
     @property
     def stages(self) -> tuple[str, ...]:
@@ -395,6 +403,11 @@ class JointModel:
             out = Parameters.of(list(out.items) + [replace(p, name=n, sample=smp, vary=True)])
         for src in (fixed, initial):
             out = out.with_values({k: v for k, v in src.items() if k in out and "@" in k})
+        # a per-sample copy given in ``fixed`` is held there (an effect off in that sample), unless it is
+        # named in ``fit``
+        for k in fixed:
+            if "@" in k and k in out and k not in fit:
+                out = out.set(k, vary=False)
         for name, (lo, hi) in bounds.items():
             if name in out:
                 out = out.set(name, lo=float(lo), hi=float(hi))

@@ -154,6 +154,9 @@ class Candidate:
     replaces : tuple[str, ...]
         Effects chosen earlier that this candidate takes the place of: with it in the model their
         parameters went to a bound (it explains what they did), so it is also tried without them.
+    held : dict
+        Per-sample copies of the effect held at its ``off`` values (``name@S -> value``): the effect is
+        fitted in the other samples only (in sample S its copies were not resolved).
     """
 
     effect: str
@@ -172,6 +175,7 @@ class Candidate:
     block_mse: np.ndarray | None = None
     per_sample: tuple = ()
     replaces: tuple = ()
+    held: dict = field(default_factory=dict)
 
     @property
     def label(self) -> str:
@@ -286,6 +290,7 @@ class Diagnosis:
     dropped: tuple = ()
     explanation: str = ""
     instruments: object = None
+    held: dict = field(default_factory=dict)
     cache: Cache = field(default_factory=Cache, init=False, compare=False, repr=False)
 
     @property
@@ -457,7 +462,9 @@ def refit_all_rows(model: JointModel, data: Dataset, names: Sequence[str], fixed
 
     ``init`` is rounded to :data:`INIT_DIGITS` significant digits first, as the printed command has it.
     """
-    params = model.make_params(data, names, fixed, initial=_rounded(init), per_sample=per_sample)
+    held = {k for k in fixed if "@" in k}
+    params = model.make_params(data, names, fixed, initial=_rounded({k: v for k, v in init.items() if k not in held}),
+                               per_sample=per_sample)
     return fit(model, data, params=params, grid=grid)
 
 
@@ -471,7 +478,7 @@ def _search_fit(model: JointModel, data: Dataset, names: Sequence[str], values: 
     per_sample = fit_options.pop("per_sample", ())
     starts = fit_options.pop("starts", ())
     params = model.make_params(data, names, fixed, per_sample=per_sample)
-    params = params.with_values({k: v for k, v in values.items() if k in params})
+    params = params.with_values({k: v for k, v in values.items() if k in params and not ("@" in k and k in fixed)})
     starts = [{k: v for k, v in st.items() if k in params} for st in starts]
     options = {"max_nfev": 100, "keep": 1, "tol": 1e-8, **fit_options}
     return fit(model, data, params=params, starts=[st for st in starts if st], **options)
@@ -685,6 +692,9 @@ class Search:
         self.clock = {"start": time.perf_counter()}
         self.settings = settings
         self.fixed = dict(settings.fixed)
+        #: per-sample copies held off (an effect fitted in some samples only): ``name@S -> value``
+        self.held: dict = {}
+        self.cand_held: dict = {}
         self.given_model = model
         self.data = data
         self.registry = registry if registry is not None else builtin_registry()
@@ -719,6 +729,15 @@ class Search:
         self.retry_pool: list[Effect] = []
         self.stop = ""
 
+    def _fx(self, model: JointModel, held: Mapping[str, float] | None = None) -> dict:
+        """The held values for a fit of ``model``: the user's ``fixed``, plus the per-sample copies held off
+        (the chain's and ``held``) of the effects ``model`` has."""
+        specs = model.param_specs
+        out = dict(self.fixed)
+        for src in (self.held, held or {}):
+            out.update({k: v for k, v in src.items() if k.split("@")[0] in specs})
+        return out
+
     # ------------------------------------------------------------------ the model as given
     def fit_base(self) -> "Search":
         """Fit the model as given on every row, estimate the noise floor, thin the search rows, cut the blocks."""
@@ -743,7 +762,7 @@ class Search:
 
     def _refit_search(self, values: Mapping[str, float]) -> None:
         ch = self.chain
-        ch.fit = _search_fit(ch.current, self.search, ch.names, values, self.fixed, per_sample=ch.per_sample)
+        ch.fit = _search_fit(ch.current, self.search, ch.names, values, self._fx(ch.current), per_sample=ch.per_sample)
 
     # ------------------------------------------------------------------ baseline
     def try_baseline(self) -> None:
@@ -776,7 +795,7 @@ class Search:
         chain = ch.current.with_effects(list(ch.current.effects) + [eff])
         names = ch.names + tuple(eff.full_names())
         init = {k: v for k, v in c.values.items() if k.split("@")[0] in names}
-        r = refit_all_rows(chain, data, names, self.fixed, init, s.grid, per_sample=ch.per_sample)
+        r = refit_all_rows(chain, data, names, self._fx(chain), init, s.grid, per_sample=ch.per_sample)
         if not r.rmse < ch.all_rows.rmse or _resolution_problems(chain, list(r.fitted), r.params, r.stderr,
                                                                  r.at_bound, data, s.modulus_range_gpa):
             return None
@@ -796,7 +815,7 @@ class Search:
             mi = start.with_effects(list(start.effects) + list(effects[:i]))
             ni = _names_for(mi, self.settings.fit_params)
             psi = [n for n in per_sample if n.split("@")[0] in ni]
-            ri = refit_all_rows(mi, self.data, ni, self.fixed,
+            ri = refit_all_rows(mi, self.data, ni, self._fx(mi),
                                 {k: v for k, v in values.items() if k.split("@")[0] in ni}, self.settings.grid,
                                 per_sample=psi)
             out.append(_step(ri, psi))
@@ -822,11 +841,37 @@ class Search:
                                  self.chain.heldout_rmse_deg, s.min_gain, s.bic_threshold)
 
     def _fit_one(self, m: JointModel, names: tuple, start: Mapping[str, float], per_sample: Sequence[str],
-                 **opts) -> tuple[FitResult, float, np.ndarray]:
+                 held: Mapping[str, float] | None = None, **opts) -> tuple[FitResult, float, np.ndarray]:
         """``m`` fitted on the search rows and cross-validated: ``(fit, held-out RMSE, block MSE)``."""
-        f = _search_fit(m, self.search, names, start, self.fixed, per_sample=per_sample, **opts)
-        ho, mse = _cv(m, self.search, names, f.params, self.fixed, self.fold, self.block, per_sample=per_sample)
+        fx = self._fx(m, held)
+        f = _search_fit(m, self.search, names, start, fx, per_sample=per_sample, **opts)
+        ho, mse = _cv(m, self.search, names, f.params, fx, self.fold, self.block, per_sample=per_sample)
         return f, ho, mse
+
+    def _absent(self, eff: Effect, m: JointModel, f: FitResult) -> dict:
+        """Per-sample copies of ``eff`` to hold off: in each sample where a copy of ``f`` (a per-sample fit) is
+        not resolved (on a bound, infinite standard error, a time outside the record), every copy of that
+        sample, the amplitude at ``eff.off`` and the others where they are; empty when there is no such sample,
+        when ``eff`` has no ``off`` values, or when it would be off in every sample."""
+        if not eff.off:
+            return {}
+        samples = list(self.search.samples)
+        bad = []
+        for smp in samples:
+            mine = [f"{n}@{smp}" for n in eff.full_names() if f"{n}@{smp}" in f.fitted]
+            # bounds and ranges only: one sample's unresolved copies make every standard error infinite
+            if mine and _resolution_problems(m, mine, f.params, {n: 1.0 for n in mine},
+                                             [n for n in f.at_bound if n in mine], self.data,
+                                             self.settings.modulus_range_gpa):
+                bad.append(smp)
+        if not bad or len(bad) == len(samples):
+            return {}
+        out = {}
+        for smp in bad:
+            for p in eff.params:
+                nm = f"{eff.name}.{p.name}@{smp}"
+                out[nm] = float(eff.off[p.name]) if p.name in eff.off else float(f.params[nm])
+        return out
 
     def _instead(self, eff: Effect, old: Effect, values: Mapping[str, float], initial: bool) -> list:
         """``eff`` fitted in place of ``old`` (a swap): a row of :meth:`_fit_candidates`."""
@@ -839,11 +884,24 @@ class Search:
         kept = {k: v for k, v in values.items() if k.split("@")[0] not in gone}
         start = m2.initial_values(self.search, base=kept) if initial else kept
         f2, ho2, mse2 = self._fit_one(m2, names2, start, ps2, grid=grid, grid_names=new)
-        return [eff, m2, new, f2, ho2, mse2, (), (old.name,)]
+        row = [eff, m2, new, f2, ho2, mse2, (), (old.name,)]
+        if any(n.split("@")[0] in gone for n in ch.per_sample) and eff.off:
+            # the effect replaced was fitted per sample: so is its replacement, off where a sample does not show it
+            ps3 = list(ps2) + list(new)
+            f3, ho3, mse3 = self._fit_one(m2, names2, f2.params, ps3)
+            held = self._absent(eff, m2, f3)
+            if held:
+                kept3 = [f"{n}@{smp}" for n in new for smp in self.search.samples if f"{n}@{smp}" not in held]
+                f3, ho3, mse3 = self._fit_one(m2, names2, f3.params, ps3, held=held, grid=grid, grid_names=kept3)
+            if ho3 < ho2:
+                row = [eff, m2, new, f3, ho3, mse3, tuple(new), (old.name,)]
+                self.cand_held[(eff.name, (old.name,))] = held
+        return row
 
     def _fit_candidates(self, pool, try_per_sample, init, swappable, swap_all) -> list:
         """Rows ``[effect, model, new names, fit, held-out RMSE, block MSE, per-sample names(, replaces)]``."""
         ch, s = self.chain, self.settings
+        self.cand_held = {}
         fits = []
         for eff in (pool if swap_all else ()):
             # instead of each effect of swappable only (the stop ratio is reached: nothing is to be added)
@@ -860,6 +918,18 @@ class Search:
                 eff, m, new, f, ho, mse, _ = row
                 ps = list(ch.per_sample) + list(new)
                 f2, ho2, mse2 = self._fit_one(m, ch.names + new, f.params, ps)
+                # in a sample that does not show the effect its copies are not resolved (a time constant on a
+                # bound, a stand-in for another effect): the effect fitted in the other samples only
+                held = self._absent(eff, m, f2)
+                if held:
+                    kept = [f"{n}@{smp}" for n in new for smp in self.search.samples if f"{n}@{smp}" not in held]
+                    f3, ho3, mse3 = self._fit_one(m, ch.names + new, f2.params, ps, held=held, grid=s.grid,
+                                                  grid_names=kept)
+                    dm, se = _gain(mse, mse3, self.strata)
+                    if dm > s.z * se and f3.bic < f.bic - s.bic_threshold:
+                        row[3:7] = [f3, ho3, mse3, tuple(new)]
+                        self.cand_held[(eff.name, ())] = held
+                        continue
                 dm, se = _gain(mse, mse2, self.strata)
                 if dm > s.z * se and f2.bic < f.bic - s.bic_threshold:
                     row[3:7] = [f2, ho2, mse2, tuple(new)]
@@ -902,10 +972,11 @@ class Search:
         if new and not why:
             why += _resolution_problems(m, list(f.fitted), f.params, f.stderr, f.at_bound, self.data,
                                         s.modulus_range_gpa)
+        held = dict(self.cand_held.get((eff.name, tuple(swap[0]) if swap else ()), {})) if eff_ps else {}
         return Candidate(eff.name, tuple(e.name for e in m.effects), f.rmse, ho, dbic, params,
                          confounded=tuple(conf), significant=not why, why="; ".join(why),
                          predicted=f.predicted, values=dict(f.params), gain_z=gz, block_mse=mse,
-                         per_sample=eff_ps, replaces=tuple(swap[0]) if swap else ())
+                         per_sample=eff_ps, replaces=tuple(swap[0]) if swap else (), held=held)
 
     # ------------------------------------------------------------------ the all-rows check and the chain
     def check_all_rows(self, c: Candidate, eff: Effect):
@@ -920,7 +991,7 @@ class Search:
         ps += list(c.per_sample)
         init = {k: v for k, v in c.values.items() if k.split("@")[0] in names}
         self.round_init = init
-        r = refit_all_rows(m, data, names, self.fixed, init, s.grid, per_sample=ps)
+        r = refit_all_rows(m, data, names, self._fx(m, c.held), init, s.grid, per_sample=ps)
         problems = []
         if not r.rmse < ch.all_rows.rmse:
             problems.append(f"its refit on all rows does not lower the RMSE ({ch.all_rows.rmse:.3f} -> "
@@ -941,7 +1012,16 @@ class Search:
             # the waterfall without the replaced effects: every step must still lower the RMSE
             inter = self.chain_steps(ch.model, keep, range(1, len(keep) + 1), r.params, ps)
             if not _each_lower([ch.steps[0].rmse_deg] + [x.rmse_deg for x in inter] + [r.rmse]):
-                problems.append(f"without {', '.join(c.replaces)} a step of the chain does not lower the RMSE")
+                # the replacement in the place of the effect it replaces (it does what that one did there)
+                at = min(i for i, e in enumerate(ch.chosen) if e.name in c.replaces)
+                order = [e for e in ch.chosen[:at] if e.name not in c.replaces] + [eff] + \
+                    [e for e in ch.chosen[at:] if e.name not in c.replaces]
+                if order[-1] is not eff:
+                    inter = self.chain_steps(ch.model, order, range(1, len(order)), r.params, ps)
+                    if _each_lower([ch.steps[0].rmse_deg] + [x.rmse_deg for x in inter] + [r.rmse]):
+                        keep = order
+                if eff not in keep:
+                    problems.append(f"without {', '.join(c.replaces)} a step of the chain does not lower the RMSE")
         if problems:
             return problems
         return (c, eff, m, names, r, {k: v for k, v in init.items() if k in r.fitted}, ps, keep, inter,
@@ -971,13 +1051,16 @@ class Search:
         self.floor, self.floor_se, self.floor_parts = f_c, se_c, parts_c
         ch.per_sample = ps
         self.rejected = [(rc, w) for rc, w in self.rejected if rc.effect != eff.name]
+        self.held = {k: v for k, v in self.held.items() if k.split(".")[0] not in set(c.replaces) | {eff.name}}
+        self.held.update(c.held)
         if c.replaces:
             self.replaced.append((tuple(c.replaces), eff.name))
             ch.chosen = keep
             self.recommended = [e.name for e in keep]
             ch.steps = ch.steps[:1] + inter
-        self.recommended.append(eff.name)
-        ch.chosen.append(eff)
+        if eff not in ch.chosen:  # a replacement may take the replaced effect's place in the chain
+            self.recommended.append(eff.name)
+            ch.chosen.append(eff)
         self.chosen_round[eff.name] = len(self.rounds) - 1
         ch.current, ch.names, ch.all_rows = m, names, r
         ch.steps.append(_step(r, ch.per_sample, init))
@@ -1002,6 +1085,7 @@ class Search:
         old, ch.current, ch.names, ch.per_sample, ch.all_rows, ch.steps, ch.fit, ch.heldout_rmse_deg, \
             ch.block_mse = got
         self.dropped.append(old.name)
+        self.held = {k: v for k, v in self.held.items() if k.split(".")[0] != old.name}
         ch.chosen = [e for e in ch.chosen if e.name != old.name]
         self.recommended = [e.name for e in ch.chosen]
         self.swaps_tried = False
@@ -1025,7 +1109,7 @@ class Search:
                           mse))
         for held_out_ok, ho, old, m, names, ps, f, mse in sorted(tries, key=lambda t: (not t[0], t[1], t[2].name)):
             init = {k: v for k, v in f.params.items() if k in names or k.split("@")[0] in names}
-            r = refit_all_rows(m, data, names, self.fixed, init, s.grid, per_sample=ps)
+            r = refit_all_rows(m, data, names, self._fx(m), init, s.grid, per_sample=ps)
             # the thinned search rows see a coarser history (a play operator that misses the stroke's peaks):
             # an effect that helps only there is not needed either when every row does without it (BIC)
             if not held_out_ok and r.bic - ch.all_rows.bic >= s.bic_threshold:
@@ -1163,7 +1247,7 @@ class Search:
         r = ch.all_rows
         if changed:
             init = {k: v for k, v in base_fit.params.items() if k in base_fit.fitted}
-            r = refit_all_rows(ch.current, data, ch.names, self.fixed, init, s.grid, per_sample=ps)
+            r = refit_all_rows(ch.current, data, ch.names, self._fx(ch.current), init, s.grid, per_sample=ps)
             if not r.rmse < ch.all_rows.rmse or r.rmse < self.floor - 2.0 * self.floor_se:
                 notes.append("per-sample parameters were better on held-out cycles but not on all rows: kept as "
                              "before")
@@ -1227,7 +1311,8 @@ class Search:
                          self.floor_se, tuple({rc.label: w for rc, w in self.rejected}.items()), tuple(ps_names),
                          tuple(notes), s.grid, partial, partial_steps, self.floor_parts, tuple(self.replaced),
                          {k: self.chosen_round[k] for k in recommended or partial if k in self.chosen_round},
-                         self.given, tuple(self.baseline_added), self.baseline_gain, tuple(self.dropped), label)
+                         self.given, tuple(self.baseline_added), self.baseline_gain, tuple(self.dropped), label,
+                         held={k: v for k, v in self.held.items() if k.split(".")[0] in set(recommended)})
 
 
 def _sample_notes(model: JointModel, r: FitResult, samples: Sequence[str], ps: Sequence[str]) -> list[str]:

@@ -19,6 +19,7 @@ report directory with an index is complete).
      "replaced": [{"effects", "by"}], "dropped": [effect, ...],   # stepwise: swapped or dropped before the end
      "partial": [{"effect", "rmse_before_deg", "rmse_deg", "floor_ratio", "params"}],  # lower it, not a fix
      "waterfall": [{"effects", "rmse_deg", "per_sample"}],
+     "per_sample": [name, ...], "held": {"name@S": value},   # per-sample copies held off (absent in S)
      "final": {"effects", "rmse_deg", "params"}, "stop_reason", "command",
      "unexplained": null | {"share", "follows", "periodic": [{"variable", "period", "unit", "amplitude_deg"}],
                             "shape", "samples", ...}}   # camtube.model.unexplained
@@ -111,6 +112,8 @@ def add_command(d: Diagnosis, prefix: str) -> str:
         cmd += f" --fit {','.join(fit_names(d, effects)) or 'none'}"
     if d.final.per_sample:
         cmd += f" --per-sample {','.join(d.final.per_sample)}"
+    for k, v in d.held.items():  # an effect held off in the samples that do not show it
+        cmd += " --fix " + shlex.quote(f"{k}={v:.6g}")
     for k, v in d.final.init.items():
         cmd += " --init " + shlex.quote(f"{k}={v:.6g}")
     cmd += f" --starts {d.grid}"
@@ -183,6 +186,7 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
     out["partial"] = _partial_dicts(d)
     out["rejected"] = [{"effect": e, "why": w} for e, w in d.rejected]
     out["per_sample"] = list(d.per_sample)
+    out["held"] = {k: _num(v) for k, v in d.held.items()}
     out["sample_notes"] = list(d.sample_notes)
     out["stop_reason"] = d.stop_reason
     out["command"] = add_command(d, command)
@@ -224,6 +228,9 @@ SIDES = {
     "toe_shape": "tendon (its fibres straighten one after another)",
     "creep": "tendon (it lengthens under load); a drifting load-cell zero also grows with time: re-zero the load "
              "cell with the tendon unloaded after the test, or hold a long dwell at zero stroke, to tell",
+    "creep_load": "tendon (it lengthens while it carries load, and does not recover at rest); a drifting "
+                  "load-cell zero grows with time instead: re-zero the load cell with the tendon unloaded after "
+                  "the test, or hold a long dwell at zero stroke, to tell",
     "viscoelastic": "tendon (delayed compliance); the joint's own relaxation does not show here (the measured "
                     "force carries it)",
     "friction": "tendon (friction at the guide or in a sheath)",
@@ -260,6 +267,12 @@ def answer_lines(d: Diagnosis) -> list[str]:
                 gains = [f"{name} {steps[k - 1].rmse_per_sample[smp]:.2f} -> {steps[k].rmse_per_sample[smp]:.2f}"
                          for k, name in enumerate(d.recommended, 1)]
                 out.append(f"  sample {smp}: " + "; ".join(gains) + " deg")
+            for name in d.recommended:
+                off = sorted({k.split("@")[1] for k in d.held if k.split(".")[0] == name})
+                if off:
+                    on = [smp for smp in samples if smp not in off]
+                    out.append(f"  {name}: in sample(s) {', '.join(on)} only; held off in {', '.join(off)} "
+                               "(that sample does not show it: fitted there, its values were not resolved)")
     elif d.partial:
         out.append("answer: nothing the library has explains the misfit; the built-ins that lower it ("
                    + ", ".join(d.partial) + f") leave {_times(d.partial_steps[-1].rmse_deg, floor)} the noise floor "
