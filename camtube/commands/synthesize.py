@@ -48,7 +48,7 @@ def cmd_synthesize(args: argparse.Namespace) -> int:
     loaded = load_text(text, out)  # camtube's own rules, before anything is written
     checks = check_design(design, loaded.pattern)
     path = write_atomic(out, text)
-    print(summary_text(design, checks, seconds))
+    print(summary_text(design, checks, seconds, loaded.pattern))
     for w in loaded.warnings:
         print(f"warning: {w}", file=sys.stderr)
     print(f"wrote {path}")

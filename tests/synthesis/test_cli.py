@@ -131,3 +131,30 @@ def test_missing_process_file_is_named(tmp_path):
     g.write_text(GOOD + "process: nowhere.yaml\n")
     assert_refused(camtube("synthesize", str(g), "-o", str(tmp_path / "p.yaml")), "process", "nowhere.yaml")
     assert listing(tmp_path) == ["g.yaml"]
+
+
+@pytest.mark.parametrize("hinge,other", [("beam", "fe_fit"), ("fe_fit", "beam")])
+def test_synthesize_prints_the_bend_under_the_other_stiffness_model(tmp_path, hinge, other):
+    """The stiffness line: the written pattern re-simulated with the other hinge, as the forward model gives it.
+    Softer notches (fe_fit) need less force for the same kinematic travel, so the tendon stretches less and
+    the joint bends more at the same stroke; stiffer ones (beam) bend less."""
+    from dataclasses import replace
+
+    from camtube.joint import Mechanics
+
+    g = tmp_path / "g.yaml"
+    g.write_text(GOOD.replace("tube: {outer_radius: 0.75, inner_radius: 0.45}",
+                              f"tube: {{outer_radius: 0.75, inner_radius: 0.45, hinge: {hinge}}}"))
+    out = tmp_path / "p.yaml"
+    r = camtube("synthesize", str(g), "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    line = next(x for x in r.stdout.splitlines() if x.startswith("stiffness:"))
+    assert f"designed with the {hinge} hinge; with the {other} hinge" in line
+    m = re.search(r"notches ([\d.]+)(?: to ([\d.]+))? x as stiff", line)
+    lo, hi = float(m.group(1)), float(m.group(2) or m.group(1))
+    assert (hi < 1.0) if other == "fe_fit" else (lo > 1.0)
+    bend, delta = map(float, re.search(r"would be ([\d.]+) deg \(([-+][\d.]+)\) towards 180 deg", line).groups())
+    want = simulate(load_pattern(out), {180.0: 1.2}, Mechanics(kerf_mm=0.02, hinge=other)).direction(180.0).bend_deg
+    assert bend == pytest.approx(want, abs=0.006)
+    assert delta == pytest.approx(bend - 40.0, abs=0.02)  # the design meets 40 deg under its own hinge
+    assert (delta > 2.0) if other == "fe_fit" else (delta < -2.0)
