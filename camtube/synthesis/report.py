@@ -185,6 +185,14 @@ def summary_text(design: Design, checks, seconds: float | None = None, pattern: 
     lines.append("tolerance: a notch cut 10 um deeper, or 10 um more kerf (arc and width), changes the bend at the "
                  "design stroke by the degrees shown")
     lines.append(stiffness_line(design, checks, pattern))
+    if design.goal.centerline:
+        from camtube.synthesis.centerline import follow
+
+        f = follow(design.goal, p, m)
+        lines.append(f"centre line (every tendon at its stroke): tip at ({f.model_tip_mm[0]:.3f}, {f.model_tip_mm[1]:.3f}, "
+                     f"{f.model_tip_mm[2]:.3f}) mm, target ({f.target_tip_mm[0]:.3f}, {f.target_tip_mm[1]:.3f}, "
+                     f"{f.target_tip_mm[2]:.3f}) mm; farthest from the target's centre line {1000 * f.max_deviation_mm:.0f} um "
+                     f"over {f.length_mm:.2f} mm; tip direction off by {f.tip_direction_error_deg:.2f} deg")
     return "\n".join(lines)
 
 
