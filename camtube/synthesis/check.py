@@ -15,6 +15,8 @@ mistake in one is not repeated in the other:
   ``R (1 - cos(theta/2)) + a cos(theta/2)`` about the fibre's middle, and ``theta = M h / (E I)`` is
   solved notch by notch (``brentq``) with capstan friction over each notch's wrap;
 * the motor-side force follows from ``stroke = slack + sum (h - chord) + F C``.
+* the tip direction of a several-direction (3-D) pattern composes every notch's turn with scipy's
+  ``Rotation`` (:func:`tip_direction`).
 """
 from __future__ import annotations
 

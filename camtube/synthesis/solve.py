@@ -15,6 +15,10 @@ Per bending direction, for a notch count ``n``:
    ``scipy.optimize.least_squares`` on the forward model itself (``n + 1`` residuals: every notch's
    angle and the stroke).
 
+A 3-D ``goal.centerline`` is solved piece by piece: each piece is one direction's constant-curvature curve over
+its own length (as a planar ``goal.curve``), its pitch lengthened by the axis's shortening
+(:func:`_axis_pitch`), the pieces laid out one after the other from the base (:mod:`camtube.synthesis.centerline`).
+
 The notch count is tried from ``ceil(bend / max_notch_bend_deg)`` outwards; the first count that
 keeps every limit wins. A goal no count meets raises :class:`InfeasibleGoal` naming the limit and the
 nearest feasible target (found by bisection on the bend or the stroke, whichever the limit calls for).
@@ -27,7 +31,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from camtube.design.geometry import joint_geometry
-from camtube.design.pattern import Pattern, Process, Rules, Tube, hole, notch, sort_cuts
+from camtube.design.pattern import Pattern, Process, Rules, Tube, hole, sort_cuts
 from camtube.errors import CamtubeError
 from camtube.joint.forward import Mechanics, hinge_extra_mm, notch_set
 from camtube.synthesis.goal import BendTarget, Goal, shares_from_tip
