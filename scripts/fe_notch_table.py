@@ -74,7 +74,7 @@ def main() -> int:
     from camtube.joint.fe import notch_fe
 
     print(f"| notch | r_o / r_i mm | s mm | h mm | web mm | FE K alone | FE K in row of {ROW} | beam E I/h (err) "
-          "| fe_fit (err) | FE closure deg (row) | model closure deg (err) | s |")
+          "| fe_fit (err) | FE closure deg (row) | model closure deg (err) | seconds |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     worst = {"beam": 0.0, "fe_fit": 0.0, "fe_fit_alone": 0.0, "closure": 0.0}
     for name, ro, ri, s, h, web in cases():
