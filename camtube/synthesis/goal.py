@@ -41,8 +41,9 @@ GOAL_SCHEMA: dict = {
         "material": Field("choice", "", "tube material", "polyimide",
                           choices=("polyimide", "pebax", "nitinol", "other")),
         "modulus_gpa": Field("float", "GPa", "Young's modulus of the tube (default: 2.5 for polyimide)", None, **POS),
-        "hinge": Field("choice", "", "notch stiffness: beam (E I / h, the paper's) or fe_fit (h plus the root "
-                       "length a finite-element model shows; see docs/design.md)", "beam", choices=("beam", "fe_fit")),
+        "hinge": Field("choice", "", "notch stiffness: beam (E I / h, the paper's; too stiff) or fe_fit (h plus the "
+                       "root length a finite-element model of a lone notch shows; too soft in a row); see docs/design.md",
+                       "beam", choices=("beam", "fe_fit")),
     },
     "tendon": {
         "radius": Field("float", "mm", "tendon radius r_t", 0.04, **POS),
