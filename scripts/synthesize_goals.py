@@ -2,11 +2,14 @@
 
     python scripts/synthesize_goals.py                       # the goals in examples/goals/
     python scripts/synthesize_goals.py --heldout 20 --seed 2611   # a fresh batch of random goals
+    python scripts/synthesize_goals.py --fresh 6 --seed 2222     # random goals of forms unlike examples/goals
 
 Per goal: the solve time; the forward model's bend at the design stroke and the largest relative
 error of a notch's share; the independent re-simulation from the planned job's as-cut geometry
 (:mod:`camtube.synthesis.check`): its bend (error against the target), strain and force against
 the limits; and whether ``build`` (toolpath + CAD model + as-cut simulation) verifies the job.
+For a 3-D goal: how far the forward model's centre line is from the goal's, and the tip direction of the
+independent re-simulation's notch angles (composed with scipy rotations) against the goal's.
 An infeasible goal shows its one-line message. The pattern is validated by the pattern loader
 from the YAML text exactly as ``camtube synthesize`` writes it.
 """
@@ -20,6 +23,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+
+import numpy as np  # noqa: E402
 
 from camtube.design.loader import load_text  # noqa: E402
 from camtube.synthesis.check import resimulate  # noqa: E402
@@ -62,11 +67,59 @@ def random_goals(n: int, seed: int):
     return out
 
 
+def fresh_goals(n: int, seed: int):
+    """``n`` goals of forms the examples do not have: stocks other than the presets (and tube 3), other tendons
+    (steel, nitinol, aramid), three directions, 3-D centre lines, tip first. The stroke is drawn around the
+    kinematic travel ``(r_i + r_o / 2) * bend`` so most are plausible; nothing is tuned to make them feasible."""
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    stocks = [(1.0, 0.8), (0.6, 0.4), (1.5, 1.0), (1.25, 0.75)]
+    tendons = [{}, {"radius": 0.05, "length": 120.0, "modulus_gpa": 200.0, "material": "steel"},
+               {"radius": 0.04, "length": 90.0, "modulus_gpa": 60.0, "material": "nitinol"},
+               {"radius": 0.06, "length": 80.0, "modulus_gpa": 70.0, "material": "aramid"}]
+    forms = ["three_directions", "centerline", "tip_first", "centerline", "three_directions", "tip_first"]
+    out = []
+    for k in range(n):
+        ro, ri = stocks[rng.integers(len(stocks))]
+        td = dict(tendons[rng.integers(len(tendons))], friction=float(np.round(rng.choice([0.0, 0.1, 0.2]), 2)))
+        form = forms[int(rng.integers(len(forms)))]
+        arm = ri + ro / 2.0
+
+        def stroke(bend: float) -> float:
+            return float(np.round(arm * np.radians(bend) * rng.uniform(1.1, 1.6), 2))
+
+        goal: dict = {}
+        if form == "three_directions":
+            bends = [float(np.round(rng.uniform(15.0, 45.0), 1)) for _ in range(3)]
+            goal = {"bends": [{"angle_deg": a, "bend_deg": b, "stroke_mm": stroke(b)} for a, b in zip((0, 120, 240), bends)],
+                    "layout": str(rng.choice(["alternate", "sequential"]))}
+        elif form == "centerline":
+            m = int(rng.integers(2, 4))
+            dirs = rng.permutation([0, 60, 90, 150, 180, 240, 270, 330])[:m]
+            goal = {"centerline": []}
+            for a in dirs:
+                b = float(np.round(rng.uniform(20.0, 50.0), 1))
+                goal["centerline"].append({"length_mm": float(np.round(rng.uniform(4.0, 9.0) * ro / 0.75, 1)),
+                                           "bend_deg": b, "towards_deg": float(a), "stroke_mm": stroke(b)})
+        else:
+            b = float(np.round(rng.uniform(30.0, 80.0), 1))
+            goal = {"bends": [{"angle_deg": float(rng.choice([0, 90, 180, 270])), "bend_deg": b, "stroke_mm": stroke(b)}],
+                    "distribution": "tip_first", "tip_ratio": float(np.round(rng.uniform(1.5, 4.0), 2))}
+        raw = {"tube": {"outer_radius": ro, "inner_radius": ri}, "tendon": td, "goal": goal,
+               "limits": {"max_strain": float(np.round(rng.uniform(0.03, 0.05), 3)),
+                          "max_force_N": float(np.round(4.0 * (ro / 0.75) ** 3, 1)), "max_length": 40.0}}
+        name = f"fresh-{seed}-{k:02d}-{form}"
+        out.append((name, build_goal(raw, None, {}, name=name)))
+    return out
+
+
 def run(goals, build: bool) -> int:
     print("| goal | notches | solve s | target deg @ mm | forward deg | share err % | independent deg (err %) "
           "| strain / limit | force N / limit | build verifies |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     bad = 0
+    paths = []
     for name, goal in goals:
         t0 = time.perf_counter()
         try:
@@ -83,6 +136,18 @@ def run(goals, build: bool) -> int:
         res = resimulate(p, {b.angle_deg: b.stroke_mm for b in goal.bends})
         lim = goal.limits
         ok_build = build_verifies(loaded) if build else None
+        if goal.centerline:
+            from camtube.synthesis.centerline import follow
+
+            from camtube.synthesis.centerline import target_points
+            from camtube.synthesis.check import tip_direction
+
+            f = follow(goal, p, design.mechanics)
+            tgt = target_points(goal, p)
+            want = (tgt[-1] - tgt[-2]) / np.linalg.norm(tgt[-1] - tgt[-2])
+            ind = float(np.degrees(np.arccos(np.clip(tip_direction(p, res) @ want, -1.0, 1.0))))
+            paths.append((name, f, ind))
+            bad += not (f.max_deviation_mm <= 0.05 and f.tip_direction_error_deg <= 0.5 and ind <= 2.0)
         for i, (b, c, r) in enumerate(zip(goal.bends, checks, res)):
             err = 100.0 * (r.bend_deg - b.bend_deg) / b.bend_deg
             good = (abs(c.predicted_deg - b.bend_deg) <= 0.5 and c.share_error <= 0.02 and abs(err) <= 5.0
@@ -94,7 +159,14 @@ def run(goals, build: bool) -> int:
                   f"{100 * c.share_error:.2f} | {r.bend_deg:.2f} ({err:+.1f}) | {r.max_strain:.4f} / {lim.max_strain:g} | "
                   f"{r.force_N:.2f} / {lim.max_force_N:g} | {'-' if ok_build is None else ('yes' if ok_build else 'NO')}"
                   f"{'' if good else ' **FAIL**'} |")
-    print(f"\n{bad} direction(s) failing a check")
+    if paths:
+        print("\n| 3-D goal | centre line mm | farthest from target um | tip error um | tip direction error deg "
+              "| independent tip direction error deg |")
+        print("|---|---|---|---|---|---|")
+        for name, f, ind in paths:
+            print(f"| {name} | {f.length_mm:.2f} | {1000 * f.max_deviation_mm:.0f} | {1000 * f.tip_error_mm:.0f} | "
+                  f"{f.tip_direction_error_deg:.3f} | {ind:.3f} |")
+    print(f"\n{bad} direction(s) or centre line(s) failing a check")
     return 1 if bad else 0
 
 
@@ -102,10 +174,13 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("goals", nargs="*", help="goal files (default: examples/goals/*.yaml)")
     ap.add_argument("--heldout", type=int, default=0, metavar="N", help="draw N random goals instead")
+    ap.add_argument("--fresh", type=int, default=0, metavar="N", help="draw N random goals of new forms instead")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--no-build", action="store_true", help="skip the build + verification")
     a = ap.parse_args()
-    if a.heldout:
+    if a.fresh:
+        goals = fresh_goals(a.fresh, a.seed)
+    elif a.heldout:
         goals = random_goals(a.heldout, a.seed)
     else:
         files = [Path(g) for g in a.goals] or sorted((ROOT / "examples" / "goals").glob("*.yaml"))

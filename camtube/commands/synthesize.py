@@ -13,9 +13,11 @@ def register(sub) -> None:
     p = sub.add_parser(
         "synthesize", help="design the notch pattern that meets a goal (bend at a stroke, limits)",
         description="Read a goal YAML (stock, tendon, goal.bends: bend_deg at stroke_mm per direction, "
-                    "distribution or curve, limits), choose every notch's width and arc with the notch-by-notch "
-                    "forward model, write a pattern YAML that camtube's rules accept, and print target vs "
-                    "predicted, the active limit and the bend change per 10 um of notch depth and of kerf. "
+                    "distribution, a planar curve or a 3-D goal.centerline, limits), choose every notch's width and "
+                    "arc with the notch-by-notch forward model, write a pattern YAML that camtube's rules accept, and "
+                    "print target vs predicted, the active limit, the bend change per 10 um of notch depth and of "
+                    "kerf, the bend under the other notch-stiffness model (beam vs fe_fit) and, for a 3-D goal, how "
+                    "closely the centre line is followed. "
                     "An infeasible goal: one line naming the limit and the nearest feasible target, exit 2. "
                     "Lengths mm, angles deg, forces N.")
     p.add_argument("goal", metavar="GOAL.yaml", help="goal file (see examples/goals/ and docs/design.md)")
@@ -48,7 +50,7 @@ def cmd_synthesize(args: argparse.Namespace) -> int:
     loaded = load_text(text, out)  # camtube's own rules, before anything is written
     checks = check_design(design, loaded.pattern)
     path = write_atomic(out, text)
-    print(summary_text(design, checks, seconds))
+    print(summary_text(design, checks, seconds, loaded.pattern))
     for w in loaded.warnings:
         print(f"warning: {w}", file=sys.stderr)
     print(f"wrote {path}")

@@ -68,7 +68,8 @@ def _axis(lo: float, hi: float, n: int) -> np.ndarray:
 
 def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm: float, width_mm: float,
              modulus_gpa: float = 2.5, poisson: float = 0.34, *, n_r: int = 2, n_backbone: int = 20,
-             n_cut: int = 12, n_lead: int = 8, n_notch: int = 4, lead_mm: float | None = None) -> NotchFE:
+             n_cut: int = 12, n_lead: int = 8, n_notch: int = 4, lead_mm: float | None = None,
+             count: int = 1, web_mm: float = 0.5, n_web: int = 3) -> NotchFE:
     """Bending stiffness and closure angle of one notch by 3-D finite elements (see the module docstring).
 
     Parameters
@@ -81,6 +82,10 @@ def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm: float, widt
         Grid cells through the wall, around the backbone, around the cut, along each lead and along the notch.
     lead_mm : float, optional
         Plain tube on each side of the notch (default ``2 r_o``).
+    count, web_mm, n_web : int, float, int
+        A row of ``count`` equal notches ``web_mm`` apart (edge to edge, ``n_web`` cells per web), as in a
+        pattern: the stiffness and closure are then per notch (the row's rotation over ``count``), so the
+        webs' share of the compliance (which a single notch between long leads does not see) is counted.
     """
     import skfem
     from skfem.helpers import ddot, sym_grad, trace
@@ -95,14 +100,21 @@ def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm: float, widt
         _axis(-math.pi, -math.pi + half, max(2, n_cut // 2)),
         _axis(-math.pi + half, math.pi - half, n_backbone),
         _axis(math.pi - half, math.pi, max(2, n_cut // 2))]))
-    length = 2.0 * lead + h
-    z_nodes = np.unique(np.concatenate([_axis(0.0, lead, n_lead), _axis(lead, lead + h, n_notch),
-                                        _axis(lead + h, length, n_lead)]))
+    starts = [lead + k * (h + web_mm) for k in range(count)]  # z of each notch's base-side edge
+    length = 2.0 * lead + count * h + (count - 1) * web_mm
+    z_parts = [_axis(0.0, lead, n_lead), _axis(starts[-1] + h, length, n_lead)]
+    for k, z0 in enumerate(starts):
+        z_parts.append(_axis(z0, z0 + h, n_notch))
+        if k + 1 < count:
+            z_parts.append(_axis(z0 + h, z0 + h + web_mm, n_web))
+    z_nodes = np.unique(np.round(np.concatenate(z_parts), 9))  # no near-duplicate planes where parts meet
     box = skfem.MeshTet.init_tensor(r_nodes, t_nodes, z_nodes)
     p, t = box.p.copy(), box.t.copy()
     # cells of the notch: z inside the notch and angle within the cut (near +-pi)
     c = p[:, t].mean(axis=1)
-    in_notch = (c[2] > lead) & (c[2] < lead + h) & (np.abs(c[1]) > math.pi - half)
+    in_notch = np.zeros(t.shape[1], bool)
+    for z0 in starts:
+        in_notch |= (c[2] > z0) & (c[2] < z0 + h) & (np.abs(c[1]) > math.pi - half)
     t = t[:, ~in_notch]
     # close the seam: nodes at angle +pi are the nodes at -pi
     seam = np.isclose(p[1], math.pi)
@@ -148,11 +160,11 @@ def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm: float, widt
     g = np.c_[np.ones(on_far.sum()), pts[0, on_far], pts[1, on_far]]
     coef = np.linalg.lstsq(g, uz[on_far], rcond=None)[0]
     phi = coef[1]  # du_z/dx: rotation of the far face about y (rad)
-    theta_n = phi - moment * (length - h) / (e * i_tube)
+    theta_n = (phi - moment * (length - count * h) / (e * i_tube)) / count  # per notch
     mouth = np.isclose(np.hypot(pts[0], pts[1]), ro) & np.isclose(np.abs(np.arctan2(pts[1], pts[0])), math.pi, atol=1e-9)
-    lo = mouth & np.isclose(pts[2], lead)
-    hi = mouth & np.isclose(pts[2], lead + h)
-    d_gap = float(uz[lo].mean() - uz[hi].mean())  # the gap shrinks by this much
+    # each gap shrinks by this much (mean over the row's notches)
+    d_gap = float(np.mean([uz[mouth & np.isclose(pts[2], z0)].mean() - uz[mouth & np.isclose(pts[2], z0 + h)].mean()
+                           for z0 in starts]))
     g_model = joint_geometry(ro, ri, s, h)
     return NotchFE(ro, ri, s, h, moment / theta_n, e * g_model.second_moment_mm4 / h,
                    math.degrees(h * theta_n / d_gap), math.degrees(g_model.closure_angle_rad),

@@ -42,7 +42,10 @@ FALLBACK_MODULUS_GPA = 2.5
 #: ``hinge="fe_fit"``: the backbone bends over ``h + r_o * poly(phi)`` instead of ``h``. The cubic (highest
 #: power first) was fitted to ten finite-element runs of :mod:`camtube.joint.fe` (tubes r_o/r_i 0.75/0.45,
 #: 0.85/0.55, 1.25/0.75; phi 1.1-4.3 rad; h 0.3-0.8 mm), none of them a preset notch: the extra length hardly
-#: depends on h, and peaks near phi = 3 (a half-tube backbone) at about one outer radius.
+#: depends on h, and peaks near phi = 3 (a half-tube backbone) at about one outer radius. Those runs were of a notch
+#: *alone*; in a pattern the webs are shorter than that root length and a notch in its row is 16-55 % stiffer, so
+#: ``fe_fit`` is 16-35 % too soft there, and it ignores the wall ratio (17-21 % too stiff on thin walls): the FE of a
+#: notch in a row lies between ``beam`` and ``fe_fit`` (docs/design.md), which is why ``beam`` stays the default.
 HINGE_FE_POLY = (-0.0737, 0.5155, -0.8976, 1.0071)
 HINGES = ("beam", "fe_fit")
 

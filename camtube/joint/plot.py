@@ -56,7 +56,65 @@ def bend_png(pattern: Pattern, strokes_mm, angle_deg: float | None = None,
     ax.legend(fontsize=7, loc="lower left")
     ax.grid(alpha=0.3)
     buf = io.BytesIO()
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.07, 1, 0.97))
+    fig.savefig(buf, format="png")
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def centerline_png(pattern: Pattern, strokes, mechanics: Mechanics = Mechanics(), target: np.ndarray | None = None,
+                   title: str = "") -> bytes:
+    """PNG of the tube's centre line in 3-D (perspective view and its three projections), one line per set of strokes.
+
+    Parameters
+    ----------
+    strokes : sequence of {angle_deg: stroke_mm}
+        Each entry pulls every named tendon to its stroke (mm) at once.
+    target : (m, 3) float, optional
+        A goal's centre line (mm, the frame of :class:`camtube.joint.forward.JointState`), drawn dashed.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(8.0, 7.6), dpi=120)
+    ax3 = fig.add_subplot(2, 2, 1, projection="3d")
+    views = [fig.add_subplot(2, 2, k) for k in (2, 3, 4)]
+    names = (("x", 0), ("y", 1), ("z", 2))
+    pairs = ((0, 2), (1, 2), (0, 1))
+    colours = plt.cm.viridis(np.linspace(0.1, 0.85, len(strokes)))
+    lines = []
+    for s, col in zip(strokes, colours):
+        st = simulate(pattern, s, mechanics)
+        pts = st.centerline_mm
+        label = "strokes " + ", ".join(f"{v:g} mm at {a:g} deg" for a, v in s.items()) + f": tip {st.tip_angle_deg:.1f} deg"
+        lines.append((pts, col, "-", label))
+    if target is not None:
+        lines.append((np.asarray(target), "crimson", "--", "goal's centre line"))
+    for pts, col, ls, label in lines:
+        ax3.plot(pts[:, 0], pts[:, 1], pts[:, 2], color=col, ls=ls, lw=1.5, label=label)
+        for ax, (i, j) in zip(views, pairs):
+            ax.plot(pts[:, i], pts[:, j], color=col, ls=ls, lw=1.2)
+    every = np.vstack([pts for pts, *_ in lines])
+    mid, half = (every.max(axis=0) + every.min(axis=0)) / 2.0, max(float(np.ptp(every, axis=0).max()) / 2.0, 1e-3)
+    ax3.set_xlim(mid[0] - half, mid[0] + half)  # a cube: equal scales on the three axes
+    ax3.set_ylim(mid[1] - half, mid[1] + half)
+    ax3.set_zlim(mid[2] - half, mid[2] + half)
+    ax3.set_box_aspect((1, 1, 1))
+    ax3.set_xlabel("x (mm)")
+    ax3.set_ylabel("y (mm)")
+    ax3.set_zlabel("z, from the base (mm)")
+    fig.legend(*ax3.get_legend_handles_labels(), fontsize=7, loc="lower center", ncol=2)
+    for ax, (i, j) in zip(views, pairs):
+        ax.set_aspect("equal", adjustable="box")
+        ax.set_xlabel(f"{names[i][0]} (mm)", fontsize=7, labelpad=1)
+        ax.set_ylabel(f"{names[j][0]} (mm)", fontsize=7, labelpad=1)
+        ax.tick_params(labelsize=6)
+        ax.grid(alpha=0.3)
+    fig.suptitle(title or f"{pattern.name}: predicted centre line (notch-by-notch model)", fontsize=10)
+    buf = io.BytesIO()
+    fig.tight_layout(rect=(0, 0.07, 1, 0.97))
     fig.savefig(buf, format="png")
     plt.close(fig)
     return buf.getvalue()

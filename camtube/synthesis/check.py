@@ -15,6 +15,8 @@ mistake in one is not repeated in the other:
   ``R (1 - cos(theta/2)) + a cos(theta/2)`` about the fibre's middle, and ``theta = M h / (E I)`` is
   solved notch by notch (``brentq``) with capstan friction over each notch's wrap;
 * the motor-side force follows from ``stroke = slack + sum (h - chord) + F C``.
+* the tip direction of a several-direction (3-D) pattern composes every notch's turn with scipy's
+  ``Rotation`` (:func:`tip_direction`).
 """
 from __future__ import annotations
 
@@ -198,3 +200,26 @@ def resimulate(pattern: Pattern, strokes: dict[float, float], *, friction: float
         strain = max(s.extreme_fibre_mm * x / hk for s, x, hk in zip(secs, th, h))
         out.append(Resimulated(ang, stroke, math.degrees(float(th.sum())), f, float(strain), np.degrees(th)))
     return tuple(out)
+
+
+def tip_direction(pattern: Pattern, results: tuple[Resimulated, ...],
+                  notches: tuple[AsCutNotch, ...] | None = None) -> np.ndarray:
+    """Unit tip direction (tube frame: ``z`` along the straight tube from the base) of the re-simulated notch angles.
+
+    Every notch, base to tip, turns the tube's own frame about ``z x u`` (``u`` the notch's side in that frame) by
+    its angle; the rotations are composed with ``scipy.spatial.transform.Rotation`` (not the forward model's
+    chain). Directions not in ``results`` do not bend.
+    """
+    from scipy.spatial.transform import Rotation
+
+    cut = as_cut_notches(pattern) if notches is None else notches
+    turns = []
+    for r in results:
+        mine = sorted((n for n in cut if abs((n.angle_deg - r.angle_deg + 180.0) % 360.0 - 180.0) < 1e-6),
+                      key=lambda n: -n.x_mm)
+        turns += [(n.x_mm, n.angle_deg, th) for n, th in zip(mine, r.notch_angles_deg)]
+    rot = Rotation.identity()
+    for _, ang, th in sorted(turns, key=lambda t: -t[0]):
+        a = math.radians(ang)
+        rot = rot * Rotation.from_rotvec(np.array([-math.sin(a), math.cos(a), 0.0]) * math.radians(th))
+    return rot.apply([0.0, 0.0, 1.0])

@@ -23,6 +23,15 @@ _BEND_ROW = (
     ("stroke_mm", Field("float", "mm", "tendon stroke (motor side) at which the bend is reached", ..., **POS)),
 )
 
+_ARC_ROW = (
+    ("length_mm", Field("float", "mm", "arc length of this piece of the centre line", ..., **POS)),
+    ("bend_deg", Field("float", "deg", "turn of the tangent over the piece (constant curvature)", ..., 0.0, 360.0,
+                       True)),
+    ("towards_deg", Field("float", "deg", "rotary angle (in the tube's own frame) the piece bends towards: its "
+                          "notches' angle and its tendon's side", ..., -360.0, 720.0)),
+    ("stroke_mm", Field("float", "mm", "stroke of this piece's tendon at which the shape is reached", ..., **POS)),
+)
+
 #: Every key of a goal file.
 GOAL_SCHEMA: dict = {
     "name": Field("str", "", "name of the written pattern (defaults to the goal file's name)", None),
@@ -32,8 +41,9 @@ GOAL_SCHEMA: dict = {
         "material": Field("choice", "", "tube material", "polyimide",
                           choices=("polyimide", "pebax", "nitinol", "other")),
         "modulus_gpa": Field("float", "GPa", "Young's modulus of the tube (default: 2.5 for polyimide)", None, **POS),
-        "hinge": Field("choice", "", "notch stiffness: beam (E I / h, the paper's) or fe_fit (h plus the root "
-                       "length a finite-element model shows; see docs/design.md)", "beam", choices=("beam", "fe_fit")),
+        "hinge": Field("choice", "", "notch stiffness: beam (E I / h, the paper's; too stiff) or fe_fit (h plus the "
+                       "root length a finite-element model of a lone notch shows; too soft in a row); see docs/design.md",
+                       "beam", choices=("beam", "fe_fit")),
     },
     "tendon": {
         "radius": Field("float", "mm", "tendon radius r_t", 0.04, **POS),
@@ -43,7 +53,10 @@ GOAL_SCHEMA: dict = {
         "friction": Field("float", "", "capstan friction coefficient on the notch edges", 0.0, 0.0, 2.0),
     },
     "goal": {
-        "bends": Field("rows", "", "one target per bending direction", ..., row=_BEND_ROW),
+        "bends": Field("rows", "", "one target per bending direction (required unless goal.centerline)", (),
+                       row=_BEND_ROW),
+        "centerline": Field("rows", "", "3-D centre line from the base: circular pieces, each in its own plane with its "
+                            "own tendon (one piece per direction)", (), row=_ARC_ROW),
         "distribution": Field("str", "", "how the bend is shared by the notches: uniform, tip_first, base_first, "
                               "or a list of per-notch shares from the tip", "uniform"),
         "tip_ratio": Field("float", "", "tip_first/base_first: bend of the end notch over the other end's", 3.0,
@@ -89,6 +102,22 @@ class BendTarget:
 
 
 @dataclass(frozen=True)
+class Arc:
+    """One piece of a 3-D centre-line goal: ``length_mm`` of constant curvature turning the tangent by
+    ``bend_deg`` towards the rotary angle ``towards_deg`` of the tube's own frame, reached at ``stroke_mm``
+    of its tendon."""
+
+    length_mm: float
+    bend_deg: float
+    towards_deg: float
+    stroke_mm: float
+
+    @property
+    def target(self) -> BendTarget:
+        return BendTarget(self.towards_deg % 360.0, self.bend_deg, self.stroke_mm)
+
+
+@dataclass(frozen=True)
 class Limits:
     """Limits the design must keep (mm, N)."""
 
@@ -117,6 +146,8 @@ class Goal:
     tip_ratio : float
     curve_deg_per_mm : tuple[float, ...]
         Curvature samples from the tip (empty: no curve).
+    centerline : tuple[Arc, ...]
+        3-D centre line from the base (empty: none); ``bends`` then holds one target per piece.
     curve_length_mm : float or None
     notches : int or None
         Notches per direction (None: automatic).
@@ -145,6 +176,7 @@ class Goal:
     limits: Limits = field(default_factory=Limits)
     process: object = "femto-polyimide.yaml"
     hinge: str = "beam"
+    centerline: tuple["Arc", ...] = ()
     name: str = "goal"
     source: str | None = None
 
@@ -192,11 +224,16 @@ def build_goal(raw: dict, file: str | None = None, lines: dict[str, int] | None 
         r.issue("tube.inner_radius", "inner radius must be smaller than the outer radius", tube["inner_radius"],
                 f"< tube.outer_radius = {tube['outer_radius']:g} mm", "check r_i and r_o (radii, not diameters)")
     bends = goal["bends"] or ()
-    if not bends:
+    arcs = goal["centerline"] or ()
+    if arcs:
+        _check_centerline(r, goal, arcs, bends)
+        bends = tuple({"angle_deg": a["towards_deg"], "bend_deg": a["bend_deg"], "stroke_mm": a["stroke_mm"]}
+                      for a in arcs)
+    elif not bends:
         r.issue("goal.bends", "needs at least one target", None, "a list of {angle_deg, bend_deg, stroke_mm}",
-                "add e.g. '- {angle_deg: 180, bend_deg: 60, stroke_mm: 1.5}'")
+                "add e.g. '- {angle_deg: 180, bend_deg: 60, stroke_mm: 1.5}' (or a 3-D goal.centerline)")
     seen: dict[float, int] = {}
-    for i, b in enumerate(bends):
+    for i, b in enumerate(() if arcs else bends):
         a = round(b["angle_deg"] % 360.0, 6)
         if a in seen:
             r.issue(f"goal.bends[{i}].angle_deg", f"direction {b['angle_deg']:g} deg is already goal.bends[{seen[a]}]",
@@ -217,7 +254,7 @@ def build_goal(raw: dict, file: str | None = None, lines: dict[str, int] | None 
             r.issue("goal.notches", f"disagrees with the {len(dist)} shares of goal.distribution", goal["notches"],
                     f"{len(dist)} or auto", "remove goal.notches (the list sets the count)")
     curve = goal["curve"]
-    if curve:
+    if curve and not arcs:  # with a centre line: one issue, from _check_centerline
         if len(bends) > 1:
             r.issue("goal.curve", "a planar curve needs a single bend", None, "one entry in goal.bends",
                     "remove the other bends")
@@ -254,7 +291,31 @@ def build_goal(raw: dict, file: str | None = None, lines: dict[str, int] | None 
         base_length_mm=goal["base_length"],
         limits=Limits(lim["max_strain"], lim["max_force_N"], lim["max_length"], lim["min_web"],
                       lim["min_backbone_arc"], lim["min_feature"]),
-        process=process, hinge=tube["hinge"], name=raw.get("name") or name or "goal", source=file)
+        process=process, hinge=tube["hinge"],
+        centerline=tuple(Arc(a["length_mm"], a["bend_deg"], a["towards_deg"] % 360.0, a["stroke_mm"]) for a in arcs),
+        name=raw.get("name") or name or "goal", source=file)
+
+
+def _check_centerline(r: Reader, goal: dict, arcs, bends) -> None:
+    """The 3-D centre line's own rules (each problem: one issue naming the key and the fix)."""
+    if bends:
+        r.issue("goal.bends", "goal.centerline sets the bends (one per piece)", None, "goal.bends or goal.centerline",
+                "remove goal.bends (each piece's towards_deg, bend_deg and stroke_mm are its target)")
+    if goal["curve"]:
+        r.issue("goal.curve", "a planar curve and a 3-D centre line cannot both be followed", None,
+                "goal.curve or goal.centerline", "remove goal.curve (a planar piece is one goal.centerline row)")
+    dist = goal["distribution"]
+    if isinstance(dist, tuple) or dist != "uniform":
+        r.issue("goal.distribution", "each piece of goal.centerline has constant curvature", dist,
+                "uniform (or leave it out)", "remove goal.distribution; split a piece to vary its curvature")
+    seen: dict[float, int] = {}
+    for i, a in enumerate(arcs):
+        d = round(a["towards_deg"] % 360.0, 6)
+        if d in seen:
+            r.issue(f"goal.centerline[{i}].towards_deg", f"direction {a['towards_deg']:g} deg is already "
+                    f"goal.centerline[{seen[d]}] (each piece has its own tendon)", a["towards_deg"],
+                    "a different rotary angle for every piece", "merge the two pieces or turn one of them")
+        seen[d] = i
 
 
 def load_goal(path: str | os.PathLike) -> Goal:

@@ -8,8 +8,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from camtube.design.pattern import Pattern
-from camtube.joint.forward import simulate
+from camtube.joint.forward import HINGES, simulate
 from camtube.synthesis.solve import Design
 
 #: Step of the tolerance figures (mm): 10 um.
@@ -84,6 +86,11 @@ class DirectionCheck:
     per_10um_depth_deg, per_10um_kerf_deg : float
         Change of the bend at ``stroke_mm`` when every notch is cut 10 um deeper, or with 10 um more kerf
         (arc and width each 10 um larger).
+    other_hinge : str
+        The notch-stiffness model the design was *not* made with (``beam`` or ``fe_fit``).
+    other_hinge_deg : float
+        Bend at ``stroke_mm`` of the same pattern under ``other_hinge``: the stiffness uncertainty (the FE of a
+        notch in a row lies between the two models, docs/design.md).
     """
 
     angle_deg: float
@@ -95,6 +102,8 @@ class DirectionCheck:
     share_error: float
     per_10um_depth_deg: float
     per_10um_kerf_deg: float
+    other_hinge: str = ""
+    other_hinge_deg: float = math.nan
 
 
 def _deeper_arc(s: float, ro: float, dd: float) -> float:
@@ -116,16 +125,19 @@ def check_design(design: Design, pattern: Pattern | None = None) -> tuple[Direct
     ro = p.tube.outer_radius_mm
     deeper = _perturbed(p, lambda s: _deeper_arc(s, ro, TOL_STEP_MM), lambda h: h)
     kerfed = _perturbed(p, lambda s: s + TOL_STEP_MM, lambda h: h + TOL_STEP_MM)
+    other = next(h for h in HINGES if h != mech.hinge)
+    mech_other = replace(mech, hinge=other)
     out = []
     for d in design.directions:
         b = d.target
         st = simulate(p, {b.angle_deg: b.stroke_mm}, mech).direction(b.angle_deg)
+        bo = simulate(p, {b.angle_deg: b.stroke_mm}, mech_other).direction(b.angle_deg).bend_deg
         target_shares = list(d.shares[::-1])  # base to tip, like the state
         err = max(abs(a - t) / t for a, t in zip(st.shares, target_shares))
         bd = simulate(deeper, {b.angle_deg: b.stroke_mm}, mech).direction(b.angle_deg).bend_deg
         bk = simulate(kerfed, {b.angle_deg: b.stroke_mm}, mech).direction(b.angle_deg).bend_deg
         out.append(DirectionCheck(b.angle_deg, b.bend_deg, b.stroke_mm, st.bend_deg, st.force_N,
-                                  float(st.strain.max()), float(err), bd - st.bend_deg, bk - st.bend_deg))
+                                  float(st.strain.max()), float(err), bd - st.bend_deg, bk - st.bend_deg, other, bo))
     return tuple(out)
 
 
@@ -149,9 +161,9 @@ def active_limits(design: Design, checks) -> list[tuple[str, float]]:
     return sorted(out, key=lambda kv: kv[1])
 
 
-def summary_text(design: Design, checks, seconds: float | None = None) -> str:
-    """Target against predicted per direction, the active limit and the laser tolerance."""
-    p = design.pattern
+def summary_text(design: Design, checks, seconds: float | None = None, pattern: Pattern | None = None) -> str:
+    """Target against predicted per direction, the active limit, the laser tolerance and the stiffness spread."""
+    p = pattern or design.pattern
     m = design.mechanics
     lines = [f"{p.name}: {len(p.notches)} notches, joint {p.notches[-1].x_end_mm - p.notches[0].x_start_mm:.2f} mm, "
              f"tube {p.tube.length_mm:g} mm; mechanics: {m.source}"
@@ -172,4 +184,32 @@ def summary_text(design: Design, checks, seconds: float | None = None) -> str:
                  + ", ".join(f"{k} {100 * v:.0f} %" for k, v in lim[1:3]))
     lines.append("tolerance: a notch cut 10 um deeper, or 10 um more kerf (arc and width), changes the bend at the "
                  "design stroke by the degrees shown")
+    lines.append(stiffness_line(design, checks, pattern))
+    if design.goal.centerline:
+        from camtube.synthesis.centerline import follow
+
+        f = follow(design.goal, p, m)
+        lines.append(f"centre line (every tendon at its stroke): tip at ({f.model_tip_mm[0]:.3f}, {f.model_tip_mm[1]:.3f}, "
+                     f"{f.model_tip_mm[2]:.3f}) mm, target ({f.target_tip_mm[0]:.3f}, {f.target_tip_mm[1]:.3f}, "
+                     f"{f.target_tip_mm[2]:.3f}) mm; farthest from the target's centre line {1000 * f.max_deviation_mm:.0f} um "
+                     f"over {f.length_mm:.2f} mm; tip direction off by {f.tip_direction_error_deg:.2f} deg")
     return "\n".join(lines)
+
+
+def stiffness_line(design: Design, checks, pattern: Pattern | None = None) -> str:
+    """The bend at the design stroke under the other notch-stiffness model, per direction (one line)."""
+    from camtube.joint.forward import direction_notches
+
+    p = pattern or design.pattern
+    m = design.mechanics
+    other = checks[0].other_hinge
+    k_own = np.concatenate([ns.stiffness_nmm_per_rad for ns in direction_notches(p, m)])
+    k_other = np.concatenate([ns.stiffness_nmm_per_rad for ns in direction_notches(p, replace(m, hinge=other))])
+    ratio = k_other / k_own
+    lo, hi = float(ratio.min()), float(ratio.max())
+    span = f"{lo:.2f}" if abs(hi - lo) < 0.005 else f"{lo:.2f} to {hi:.2f}"
+    parts = [f"{c.other_hinge_deg:.2f} deg ({c.other_hinge_deg - c.predicted_deg:+.2f}) towards {c.angle_deg:g} deg"
+             for c in checks]
+    return (f"stiffness: designed with the {m.hinge} hinge; with the {other} hinge (this pattern's notches {span} x as "
+            f"stiff) the bend at the design stroke would be " + "; ".join(parts)
+            + " (the FE of a notch in a row lies between the two: docs/design.md)")

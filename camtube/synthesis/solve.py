@@ -15,6 +15,10 @@ Per bending direction, for a notch count ``n``:
    ``scipy.optimize.least_squares`` on the forward model itself (``n + 1`` residuals: every notch's
    angle and the stroke).
 
+A 3-D ``goal.centerline`` is solved piece by piece: each piece is one direction's constant-curvature curve over
+its own length (as a planar ``goal.curve``), its pitch lengthened by the axis's shortening
+(:func:`_axis_pitch`), the pieces laid out one after the other from the base (:mod:`camtube.synthesis.centerline`).
+
 The notch count is tried from ``ceil(bend / max_notch_bend_deg)`` outwards; the first count that
 keeps every limit wins. A goal no count meets raises :class:`InfeasibleGoal` naming the limit and the
 nearest feasible target (found by bisection on the bend or the stroke, whichever the limit calls for).
@@ -27,7 +31,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from camtube.design.geometry import joint_geometry
-from camtube.design.pattern import Pattern, Process, Rules, Tube, hole, notch, sort_cuts
+from camtube.design.pattern import Pattern, Process, Rules, Tube, hole, sort_cuts
 from camtube.errors import CamtubeError
 from camtube.joint.forward import Mechanics, hinge_extra_mm, notch_set
 from camtube.synthesis.goal import BendTarget, Goal, shares_from_tip
@@ -339,52 +343,105 @@ def _solve_direction(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarge
     return first
 
 
+def _piece_goal(goal: Goal, i: int) -> tuple[Goal, float]:
+    """The goal one direction is solved for, and its length budget (mm): a 3-D centre line's piece ``i`` is a
+    constant-curvature curve over its own length; otherwise the goal itself within ``limits.max_length``."""
+    if not goal.centerline:
+        return goal, goal.limits.max_length_mm
+    b, length = goal.bends[i], goal.centerline[i].length_mm
+    k = b.bend_deg / length
+    return replace(goal, curve_deg_per_mm=(k, k), curve_length_mm=length, bends=(b,)), length
+
+
+def _axis_pitch(goal: Goal, mech: Mechanics, d: DirectionDesign, length_mm: float) -> DirectionDesign:
+    """A centre-line piece's pitch such that the tube's *axis* is ``length_mm`` long once bent.
+
+    Each notch bends about its backbone's neutral fibre, ``ybar`` from the axis on the backbone side, so over
+    a notch bending by ``theta`` the axis is ``ybar theta`` shorter than the straight tube: the cells are
+    lengthened by that much (positions do not enter the angles, so nothing else changes).
+    """
+    t = goal.tube
+    k = mech.kerf_mm
+    th = np.radians(d.target.bend_deg) * np.asarray(d.shares)
+    ybar = np.array([joint_geometry(t.outer_radius_mm, t.inner_radius_mm, a + k, w + k).ybar_mm
+                     for w, a in zip(d.widths_mm, d.arcs_mm)])
+    return replace(d, pitch_mm=(length_mm + float(ybar @ th)) / d.count)
+
+
 def _solve_all(goal: Goal, mech: Mechanics, grid: _Grid,
                deadline: float = math.inf) -> tuple[DirectionDesign, ...] | tuple[int, _Fail]:
     out = []
     for i, b in enumerate(goal.bends):
-        r = _solve_direction(goal, mech, grid, b, goal.limits.max_length_mm, deadline)
+        g, budget = _piece_goal(goal, i)
+        r = _solve_direction(g, mech, grid, b, budget, deadline)
         if isinstance(r, _Fail):
+            if goal.centerline and r.limit == "goal.curve_length":
+                r = replace(r, limit=f"goal.centerline[{i}].length_mm",
+                            why=r.why.replace("goal.curve_length", f"goal.centerline[{i}].length_mm"))
             return i, r
+        if goal.centerline:
+            r = _axis_pitch(goal, mech, r, goal.centerline[i].length_mm)
         out.append(r)
     total = _layout_length(goal, out)
     if total > goal.limits.max_length_mm + 1e-9:
         return 0, _Fail("limits.max_length", f"the {len(out)} directions together make a joint of {total:.2f} mm, "
                         f"more than {goal.limits.max_length_mm:g} mm", "bend")
+    if goal.centerline:
+        rows = _layout_rows(goal, out)
+        for j in range(len(rows) - 1):
+            web = (rows[j][3] + rows[j + 1][3]) / 2.0 - (rows[j][0] + rows[j + 1][0]) / 2.0
+            if web < goal.limits.min_web_mm - 1e-9:
+                return 0, _Fail("limits.min_web", f"two pieces of the centre line meet with a web of {web:.3f} mm, "
+                                f"thinner than limits.min_web = {goal.limits.min_web_mm:g} mm", "bend")
     return tuple(out)
 
 
-def _layout(goal: Goal, dirs) -> list[tuple[float, float, float]]:
-    """``(width, arc, angle)`` of every notch from the tip, interleaved or one direction after the other."""
+def _layout_rows(goal: Goal, dirs) -> list[tuple[float, float, float, float | None]]:
+    """``(width, arc, angle, pitch)`` of every notch from the tip, interleaved or one direction after the other
+    (a 3-D centre line: its pieces from the tip, the last piece first); ``pitch`` is the notch's cell on a curve
+    (uniform within a piece), else None."""
     rows = []
+    if goal.centerline:
+        for d in reversed(dirs):
+            rows += [(w, a, d.target.angle_deg, d.pitch_mm) for w, a in zip(d.widths_mm, d.arcs_mm)]
+        return rows
     if goal.layout == "sequential" or len(dirs) == 1:
         for d in dirs:
-            rows += [(w, a, d.target.angle_deg) for w, a in zip(d.widths_mm, d.arcs_mm)]
+            rows += [(w, a, d.target.angle_deg, d.pitch_mm) for w, a in zip(d.widths_mm, d.arcs_mm)]
         return rows
     k = max(d.count for d in dirs)
     for i in range(k):
         for d in dirs:
             if i < d.count:
-                rows.append((d.widths_mm[i], d.arcs_mm[i], d.target.angle_deg))
+                rows.append((d.widths_mm[i], d.arcs_mm[i], d.target.angle_deg, None))
     return rows
 
 
+def _layout(goal: Goal, dirs) -> list[tuple[float, float, float]]:
+    """``(width, arc, angle)`` of every notch from the tip (see :func:`_layout_rows`)."""
+    return [r[:3] for r in _layout_rows(goal, dirs)]
+
+
+def _webs(goal: Goal, rows) -> list[float]:
+    """Web before each next notch (mm): cells of a curve's pitch touch, otherwise ``goal.web``."""
+    out = []
+    for a, b in zip(rows, rows[1:]):
+        if a[3] is not None and b[3] is not None:
+            out.append((a[3] + b[3]) / 2.0 - (a[0] + b[0]) / 2.0)
+        else:
+            out.append(goal.web_mm)
+    return out
+
+
 def _layout_length(goal: Goal, dirs) -> float:
-    if len(dirs) == 1 and dirs[0].pitch_mm is not None:
-        d = dirs[0]
-        return d.pitch_mm * (d.count - 1) + (d.widths_mm[0] + d.widths_mm[-1]) / 2.0
-    rows = _layout(goal, dirs)
-    return sum(r[0] for r in rows) + goal.web_mm * (len(rows) - 1)
+    rows = _layout_rows(goal, dirs)
+    return sum(r[0] for r in rows) + sum(_webs(goal, rows))
 
 
 def _assemble(goal: Goal, dirs: tuple[DirectionDesign, ...], mech: Mechanics, process=None) -> Design:
-    rows = _layout(goal, dirs)
+    rows = _layout_rows(goal, dirs)
     widths = [r[0] for r in rows]
-    if len(dirs) == 1 and dirs[0].pitch_mm is not None:
-        p = dirs[0].pitch_mm
-        webs = [round(p - (widths[i] + widths[i + 1]) / 2.0, 4) for i in range(len(rows) - 1)]
-    else:
-        webs = [goal.web_mm] * (len(rows) - 1)
+    webs = [round(w, 4) for w in _webs(goal, rows)]
     section = {
         "layout": "uan", "count": len(rows), "first_offset": goal.first_offset_mm,
         "widths": [round(w, 4) for w in widths], "arcs": [round(r[1], 4) for r in rows],
@@ -431,7 +488,8 @@ def synthesize(goal: Goal, calibration: Mechanics | None = None, time_limit_s: f
     nearest = _nearest(goal, mech, grid, fail.knob, deadline)
     b = goal.bends[i]
     where = f"{goal.source}: " if goal.source else ""
-    raise InfeasibleGoal(f"{where}goal.bends[{i}] ({b.bend_deg:g} deg at {b.stroke_mm:g} mm towards {b.angle_deg:g} deg) "
+    what = f"goal.centerline[{i}]" if goal.centerline else f"goal.bends[{i}]"
+    raise InfeasibleGoal(f"{where}{what} ({b.bend_deg:g} deg at {b.stroke_mm:g} mm towards {b.angle_deg:g} deg) "
                          f"is infeasible: {fail.limit}: {fail.why}; nearest feasible target: {nearest}; fix: "
                          + (f"lower bend_deg to the nearest target, or give more stroke or relax {fail.limit}"
                             if fail.knob == "bend" else

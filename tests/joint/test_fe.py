@@ -26,3 +26,17 @@ def test_tube1_notch_stiffness_and_closure_against_fe():
     # ... the fe_fit hinge (fitted to other notches, not this one) is within 10 %
     k_fit = 2.5e3 * g.second_moment_mm4 / (0.5 + hinge_extra_mm(0.75, g.phi_rad, "fe_fit"))
     assert k_fit == pytest.approx(r.stiffness_nmm_per_rad, rel=0.10)
+
+
+def test_a_notch_in_a_row_is_stiffer_than_alone_and_between_the_two_hinges():
+    """In a pattern the webs (here 0.3 mm, the goal default) are shorter than the span over which a lone notch's
+    backbone bends into the plain tube, so per notch a row is stiffer than one notch alone; the two hinge models
+    bracket it (what ``synthesize``'s stiffness line tells the user), and the closure angle still holds."""
+    mesh = dict(n_backbone=16, n_cut=8, n_lead=6, n_notch=3)
+    alone = notch_fe(0.75, 0.45, 2.83, 0.5, **mesh)
+    row = notch_fe(0.75, 0.45, 2.83, 0.5, count=3, web_mm=0.3, **mesh)
+    assert row.stiffness_nmm_per_rad > 1.15 * alone.stiffness_nmm_per_rad
+    g = joint_geometry(0.75, 0.45, 2.83, 0.5)
+    k_fit = 2.5e3 * g.second_moment_mm4 / (0.5 + hinge_extra_mm(0.75, g.phi_rad, "fe_fit"))
+    assert k_fit < row.stiffness_nmm_per_rad < row.model_stiffness_nmm_per_rad
+    assert abs(row.closure_error) <= 0.10

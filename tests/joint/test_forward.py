@@ -113,3 +113,19 @@ def test_calibration_slack_and_bad_files(tmp_path):
     bad.write_text("{}")
     with pytest.raises(CamtubeError, match="no fitted parameters"):
         Mechanics.from_fit_json(bad)
+
+
+def test_centerline_png_draws_the_3d_shape():
+    """The 3-D picture is a PNG that reads back, of the size asked for."""
+    import io
+
+    import matplotlib.pyplot as plt
+
+    from camtube.design.loader import load_pattern
+    from camtube.joint.plot import centerline_png
+
+    p = load_pattern("tube1-bidirectional")
+    png = centerline_png(p, [{180.0: 0.8, 0.0: 0.4}, {180.0: 1.5, 0.0: 0.8}])
+    img = plt.imread(io.BytesIO(png), format="png")
+    assert img.shape[:2] == (912, 960)
+    assert (img[..., :3] < 0.9).any()  # something drawn

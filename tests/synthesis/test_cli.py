@@ -38,7 +38,8 @@ def test_synthesize_prints_target_predicted_limit_and_tolerance(tmp_path):
 
 @pytest.mark.parametrize("goal,stroke", [("01-tube1-uniform-60", {180.0: 1.5}),
                                          ("07-tube1-two-directions", {180.0: 1.5, 0.0: 1.2}),
-                                         ("10-tube3-curve-bell", {270.0: 3.0})])
+                                         ("10-tube3-curve-bell", {270.0: 3.0}),
+                                         ("13-tube1-3d-hook", {180.0: 1.2, 90.0: 1.2})])
 def test_written_pattern_builds_verifies_and_resimulates(goal, stroke, tmp_path):
     out = tmp_path / "p.yaml"
     assert camtube("synthesize", str(GOALS / f"{goal}.yaml"), "-o", str(out)).returncode == 0
@@ -46,8 +47,8 @@ def test_written_pattern_builds_verifies_and_resimulates(goal, stroke, tmp_path)
     assert b.returncode == 0 and "verification: PASS" in b.stdout, b.stdout + b.stderr
     assert any(p.suffix == ".ngc" for p in (tmp_path / "job").iterdir())
     p = load_pattern(out)
-    targets = {180.0: 60.0} if goal.startswith("01") else ({180.0: 45.0, 0.0: 30.0} if goal.startswith("07")
-                                                            else {270.0: 43.125})
+    targets = {"01": {180.0: 60.0}, "07": {180.0: 45.0, 0.0: 30.0}, "10": {270.0: 43.125},
+               "13": {180.0: 45.0, 90.0: 45.0}}[goal[:2]]
     for r in resimulate(p, stroke):
         assert abs(r.bend_deg - targets[r.angle_deg]) <= 0.05 * targets[r.angle_deg]
         assert r.max_strain <= p.rules.max_strain
@@ -130,4 +131,66 @@ def test_missing_process_file_is_named(tmp_path):
     g = tmp_path / "g.yaml"
     g.write_text(GOOD + "process: nowhere.yaml\n")
     assert_refused(camtube("synthesize", str(g), "-o", str(tmp_path / "p.yaml")), "process", "nowhere.yaml")
+    assert listing(tmp_path) == ["g.yaml"]
+
+
+@pytest.mark.parametrize("hinge,other", [("beam", "fe_fit"), ("fe_fit", "beam")])
+def test_synthesize_prints_the_bend_under_the_other_stiffness_model(tmp_path, hinge, other):
+    """The stiffness line: the written pattern re-simulated with the other hinge, as the forward model gives it.
+    Softer notches (fe_fit) need less force for the same kinematic travel, so the tendon stretches less and
+    the joint bends more at the same stroke; stiffer ones (beam) bend less."""
+    from dataclasses import replace
+
+    from camtube.joint import Mechanics
+
+    g = tmp_path / "g.yaml"
+    g.write_text(GOOD.replace("tube: {outer_radius: 0.75, inner_radius: 0.45}",
+                              f"tube: {{outer_radius: 0.75, inner_radius: 0.45, hinge: {hinge}}}"))
+    out = tmp_path / "p.yaml"
+    r = camtube("synthesize", str(g), "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    line = next(x for x in r.stdout.splitlines() if x.startswith("stiffness:"))
+    assert f"designed with the {hinge} hinge; with the {other} hinge" in line
+    m = re.search(r"notches ([\d.]+)(?: to ([\d.]+))? x as stiff", line)
+    lo, hi = float(m.group(1)), float(m.group(2) or m.group(1))
+    assert (hi < 1.0) if other == "fe_fit" else (lo > 1.0)
+    bend, delta = map(float, re.search(r"would be ([\d.]+) deg \(([-+][\d.]+)\) towards 180 deg", line).groups())
+    want = simulate(load_pattern(out), {180.0: 1.2}, Mechanics(kerf_mm=0.02, hinge=other)).direction(180.0).bend_deg
+    assert bend == pytest.approx(want, abs=0.006)
+    assert delta == pytest.approx(bend - 40.0, abs=0.02)  # the design meets 40 deg under its own hinge
+    assert (delta > 2.0) if other == "fe_fit" else (delta < -2.0)
+
+
+CURVE3D = """tube: {outer_radius: 0.75, inner_radius: 0.45}
+goal:
+  centerline:
+    - {length_mm: 6, bend_deg: 45, towards_deg: 180, stroke_mm: 1.2}
+    - {length_mm: 6, bend_deg: 45, towards_deg: 90, stroke_mm: 1.2}
+limits: {max_strain: 0.04, max_force_N: 3, max_length: 16}
+"""
+
+
+@pytest.mark.parametrize("edit,words", [
+    (("towards_deg: 90", "towards_deg: 180"), ["goal.centerline[1].towards_deg", "own tendon", "turn one"]),
+    (("towards_deg: 90", "towards_deg: -180"), ["goal.centerline[1].towards_deg", "already goal.centerline[0]"]),
+    (("length_mm: 6, bend_deg: 45, towards_deg: 90", "bend_deg: 45, towards_deg: 90"),
+     ["goal.centerline[1].length_mm", "required"]),
+    (("length_mm: 6, bend_deg: 45, towards_deg: 90", "length_mm: -6, bend_deg: 45, towards_deg: 90"),
+     ["goal.centerline[1].length_mm", "> 0"]),
+    (("towards_deg: 90, stroke_mm: 1.2}", "towards_deg: 90, stroke_mm: 1.2, twist: 3}"),
+     ["goal.centerline[1].twist", "unknown"]),
+    (("goal:", "goal:\n  bends:\n    - {angle_deg: 180, bend_deg: 40, stroke_mm: 1.2}"),
+     ["goal.bends", "remove goal.bends"]),
+    (("goal:", "goal:\n  distribution: tip_first"), ["goal.distribution", "constant curvature"]),
+    (("goal:", "goal:\n  curve: [2, 4]\n  curve_length: 10"), ["goal.curve", "remove goal.curve"]),
+    (("centerline:", "centreline:"), ["goal.centreline", "did you mean 'centerline'"]),
+    (("length_mm: 6, bend_deg: 45, towards_deg: 90", "length_mm: 2, bend_deg: 45, towards_deg: 90"),
+     ["goal.centerline[1]", "infeasible", "nearest feasible target"]),
+])
+def test_3d_centerline_mistakes_one_line_each(tmp_path, edit, words):
+    g = tmp_path / "g.yaml"
+    assert edit[0] in CURVE3D
+    g.write_text(CURVE3D.replace(*edit, 1))
+    r = camtube("synthesize", str(g), "-o", str(tmp_path / "p.yaml"))
+    assert_refused(r, str(g), *words)
     assert listing(tmp_path) == ["g.yaml"]

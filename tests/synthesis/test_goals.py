@@ -36,9 +36,10 @@ def expected_shares(goal, n: int) -> np.ndarray:
     return w / w.sum()
 
 
-def test_there_are_twelve_goals_of_every_kind():
+def test_there_are_fourteen_goals_of_every_kind():
     kinds = [load_goal(g) for g in GOALS]
-    assert len(GOALS) == 12
+    assert len(GOALS) == 14
+    assert sum(bool(g.centerline) for g in kinds) == 2
     assert any(g.distribution == "tip_first" for g in kinds)
     assert any(len(g.bends) == 2 for g in kinds)
     assert any(g.curve_deg_per_mm for g in kinds)
@@ -149,3 +150,48 @@ def test_a_hopeless_goal_is_refused_within_the_time_limit():
         synthesize(build_goal(raw, "g.yaml", {}))
     assert time.perf_counter() - t0 < 10.0
     assert "\n" not in str(ei.value) and ei.value.limit == "limits.max_length"
+
+
+def _tip_direction(arcs) -> np.ndarray:
+    """The goal's tip direction by composing the pieces' rotations with scipy (independent of the solver's code):
+    each piece turns the tube's own frame about ``z x towards`` in that frame."""
+    from scipy.spatial.transform import Rotation
+
+    r = Rotation.identity()
+    for a in arcs:
+        t = np.radians(a.towards_deg)
+        axis = np.cross([0.0, 0.0, 1.0], [np.cos(t), np.sin(t), 0.0])  # in the piece's own (body) frame
+        r = r * Rotation.from_rotvec(axis * np.radians(a.bend_deg))
+    return r.apply([0.0, 0.0, 1.0])
+
+
+@pytest.mark.parametrize("name", ["13-tube1-3d-hook", "14-tube2-3d-three-planes"])
+def test_3d_centerline_is_followed(name, tmp_path):
+    """The forward model's centre line with every tendon at its stroke stays within 50 um of the goal's and its tip
+    points within 0.5 deg of the goal's tip direction (1 deg for the independent re-simulation); the shape is out
+    of any one plane."""
+    from camtube.synthesis.centerline import follow, target_points
+
+    goal = load_goal(ROOT / "examples" / "goals" / f"{name}.yaml")
+    design = synthesize(goal)
+    p = load_text(pattern_yaml(design), tmp_path / "p.yaml").pattern
+    # one direction per piece, each with its notches at a uniform pitch, pieces one after the other from the base
+    for arc in goal.centerline:
+        xs = sorted(n.x_mm for n in p.notches if abs(n.angle_deg - arc.towards_deg) < 1e-6)
+        assert len(xs) >= 4
+        np.testing.assert_allclose(np.diff(xs), np.diff(xs)[0], atol=2e-4)
+    f = follow(goal, p, design.mechanics)
+    assert f.max_deviation_mm <= 0.05 and f.tip_error_mm <= 0.05
+    st = simulate(p, {b.angle_deg: b.stroke_mm for b in goal.bends}, design.mechanics)
+    want = _tip_direction(goal.centerline)
+    assert np.degrees(np.arccos(np.clip(st.tip_direction @ want, -1, 1))) <= 0.5
+    # the independent re-simulation from the job's cut geometry, its notch angles composed apart: within 1 deg
+    from camtube.synthesis.check import resimulate, tip_direction
+
+    res = resimulate(p, {b.angle_deg: b.stroke_mm for b in goal.bends})
+    assert np.degrees(np.arccos(np.clip(tip_direction(p, res) @ want, -1, 1))) <= 1.0
+    # the target itself: its length is the pieces' plus the plain tube, and it is not planar
+    tgt = target_points(goal, p)
+    assert np.linalg.norm(np.diff(tgt, axis=0), axis=1).sum() > sum(a.length_mm for a in goal.centerline)
+    centred = tgt - tgt.mean(axis=0)
+    assert np.linalg.svd(centred, compute_uv=False)[2] > 0.1  # third singular value: out of plane
