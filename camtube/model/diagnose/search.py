@@ -118,6 +118,9 @@ PARTIAL_RATIO = 1.5
 #: Candidates (best held-out first) also tried with per-sample parameters in each round: samples that differ
 #: a lot make the shared version of the right effect rank low (two slacks 4x apart), so more than the top two.
 PER_SAMPLE_TRIES = 4
+#: Solver steps (per start) a candidate's refit on all rows may take: one that needs more has a direction the
+#: data barely resolve (an effect that trades with E_t); the refits of accepted candidates take 4-20.
+CHECK_MAX_NFEV = 60
 #: Before stopping, this many of the first round's best candidates are tried in place of each chosen effect.
 SWAP_TRIES = 3
 #: Significant digits of the start values printed with ``--init`` (and used by the diagnosis itself).
@@ -457,15 +460,18 @@ def _rounded(values: Mapping[str, float]) -> dict[str, float]:
 
 
 def refit_all_rows(model: JointModel, data: Dataset, names: Sequence[str], fixed: Mapping[str, float],
-                   init: Mapping[str, float], grid: int, per_sample: Sequence[str] = ()) -> FitResult:
+                   init: Mapping[str, float], grid: int, per_sample: Sequence[str] = (),
+                   max_nfev: int | None = None) -> FitResult:
     """The fit ``camtube model fit ... --init NAME=VALUE ... --starts GRID [--per-sample ...]`` makes.
 
     ``init`` is rounded to :data:`INIT_DIGITS` significant digits first, as the printed command has it.
+    ``max_nfev`` caps each start's solver (a candidate's check: a fit that has not converged by then is
+    refused, so an accepted one is the command's fit).
     """
     held = {k for k in fixed if "@" in k}
     params = model.make_params(data, names, fixed, initial=_rounded({k: v for k, v in init.items() if k not in held}),
                                per_sample=per_sample)
-    return fit(model, data, params=params, grid=grid)
+    return fit(model, data, params=params, grid=grid, max_nfev=max_nfev)
 
 
 def _search_fit(model: JointModel, data: Dataset, names: Sequence[str], values: Mapping[str, float],
@@ -991,8 +997,11 @@ class Search:
         ps += list(c.per_sample)
         init = {k: v for k, v in c.values.items() if k.split("@")[0] in names}
         self.round_init = init
-        r = refit_all_rows(m, data, names, self._fx(m, c.held), init, s.grid, per_sample=ps)
+        r = refit_all_rows(m, data, names, self._fx(m, c.held), init, s.grid, per_sample=ps, max_nfev=CHECK_MAX_NFEV)
         problems = []
+        if r.nfev >= CHECK_MAX_NFEV:
+            problems.append(f"its refit on all rows had not converged after {CHECK_MAX_NFEV} steps (a direction the "
+                            "data barely resolve)")
         if not r.rmse < ch.all_rows.rmse:
             problems.append(f"its refit on all rows does not lower the RMSE ({ch.all_rows.rmse:.3f} -> "
                             f"{r.rmse:.3f} deg)")
