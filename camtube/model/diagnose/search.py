@@ -53,7 +53,13 @@ Method
    effect's parameters are tried per sample; they are kept when the held-out
    error falls significantly. The output says which samples differ (values
    more than three combined standard errors apart) and names any sample the
-   final model leaves worse than the current one.
+   final model leaves worse than the current one. Where a sample's copies are not
+   resolved (on a bound: that sample does not show the effect, or the effect stands in
+   for another one there), they are held at the effect's ``off`` values and the effect
+   is fitted in the other samples only (``Candidate.held``, ``Diagnosis.held``); a
+   per-sample version with unresolved copies never replaces the shared one. A
+   replacement of an effect fitted per sample is fitted per sample too, and may take the
+   replaced effect's place in the chain.
    The next round retries only the candidates whose held-out RMSE fell by ``min_gain`` in this one.
 7. The search stops when the held-out RMSE is within ``stop_ratio`` of the
    noise floor (the held-out RMSE at full resolution: the all-rows RMSE times the
@@ -856,9 +862,9 @@ class Search:
 
     def _absent(self, eff: Effect, m: JointModel, f: FitResult) -> dict:
         """Per-sample copies of ``eff`` to hold off: in each sample where a copy of ``f`` (a per-sample fit) is
-        not resolved (on a bound, infinite standard error, a time outside the record), every copy of that
-        sample, the amplitude at ``eff.off`` and the others where they are; empty when there is no such sample,
-        when ``eff`` has no ``off`` values, or when it would be off in every sample."""
+        not resolved (on a bound, a time or length outside what the record resolves), every copy of that
+        sample, those named in ``eff.off`` at their off values and the others where they are; empty when there
+        is no such sample, when ``eff`` has no ``off`` values, or when it would be off in every sample."""
         if not eff.off:
             return {}
         samples = list(self.search.samples)
@@ -935,7 +941,8 @@ class Search:
                     if dm > s.z * se and f3.bic < f.bic - s.bic_threshold:
                         row[3:7] = [f3, ho3, mse3, tuple(new)]
                         self.cand_held[(eff.name, ())] = held
-                        continue
+                    # a per-sample version with unresolved copies does not replace the shared one
+                    continue
                 dm, se = _gain(mse, mse2, self.strata)
                 if dm > s.z * se and f2.bic < f.bic - s.bic_threshold:
                     row[3:7] = [f2, ho2, mse2, tuple(new)]
