@@ -159,3 +159,27 @@ def test_python_snippets_of_docs_model_md_run(tmp_path):
                              timeout=120)
         assert run.returncode == 0, run.stderr
     assert np.isfinite(float(run.stdout.split()[0]))
+
+
+@pytest.mark.parametrize("tail,words", [
+    # holding one sample's copy of a parameter that is not fitted per sample would be silently ignored
+    (["--fix", "creep_load.creep_mm@1=0"], ("creep_load.creep_mm@1", "--per-sample creep_load")),
+    # a sample the data do not have
+    (["--per-sample", "creep_load", "--fix", "creep_load.creep_mm@S9=0"], ("S9", "samples: 1, 2")),
+])
+def test_fix_of_one_samples_copy_is_checked(data_csv, capsys, tail, words):
+    _fails_cleanly(["model", "fit", str(data_csv), "--pattern", TUBE2, "--effects", "creep_load", "-q", *tail],
+                   capsys, *words)
+
+
+def test_fix_of_one_samples_copy_holds_it(data_csv, capsys):
+    # the synthetic data have a 0.05 mm slack in both samples: sample 1's copy held at 0.02, sample 2's fitted
+    # (E_t is shared, so it moves a little with the held value)
+    out = data_csv.parent / "held.json"
+    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "--effects", "slack", "--cycles", "all",
+                 "--branch", "both", "--no-deadband", "--per-sample", "slack", "--fix", "slack.deadband_mm@1=0.02",
+                 "-q", "--json", str(out)]) == 0
+    import json
+    params = json.loads(out.read_text())["params"]
+    assert params["slack.deadband_mm@1"]["value"] == 0.02
+    assert 0.04 < params["slack.deadband_mm@2"]["value"] < 0.08

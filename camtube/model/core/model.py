@@ -406,7 +406,11 @@ class JointModel:
         # a per-sample copy given in ``fixed`` is held there (an effect off in that sample), unless it is
         # named in ``fit``
         for k in fixed:
-            if "@" in k and k in out and k not in fit:
+            if "@" in k and k not in out:
+                base = split_name(k)[0]
+                raise FitError(f"parameter {k!r} is held for one sample, but {base!r} is not fitted per sample: add "
+                               f"--per-sample {base.split('.')[0]} (or hold it for every sample with --fix {base}=VALUE)")
+            if "@" in k and k not in fit:
                 out = out.set(k, vary=False)
         for name, (lo, hi) in bounds.items():
             if name in out:
