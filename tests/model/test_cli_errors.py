@@ -173,13 +173,19 @@ def test_fix_of_one_samples_copy_is_checked(data_csv, capsys, tail, words):
 
 
 def test_fix_of_one_samples_copy_holds_it(data_csv, capsys):
-    # the synthetic data have a 0.05 mm slack in both samples: sample 1's copy held at 0.02, sample 2's fitted
-    # (E_t is shared, so it moves a little with the held value)
-    out = data_csv.parent / "held.json"
-    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "--effects", "slack", "--cycles", "all",
-                 "--branch", "both", "--no-deadband", "--per-sample", "slack", "--fix", "slack.deadband_mm@1=0.02",
-                 "-q", "--json", str(out)]) == 0
+    # the synthetic data have a 0.05 mm slack in both samples: holding sample 1's copy at a wrong 0.02 keeps it
+    # there (sample 2's stays fitted) and costs error against the fit with both free
     import json
-    params = json.loads(out.read_text())["params"]
-    assert params["slack.deadband_mm@1"]["value"] == 0.02
-    assert 0.04 < params["slack.deadband_mm@2"]["value"] < 0.08
+
+    def run(*fix):
+        out = data_csv.parent / f"held{len(fix)}.json"
+        assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "--effects", "slack", "--cycles", "all",
+                     "--branch", "both", "--no-deadband", "--per-sample", "slack", *fix, "-q",
+                     "--json", str(out)]) == 0
+        return json.loads(out.read_text())
+
+    free, held = run(), run("--fix", "slack.deadband_mm@1=0.02")
+    assert held["params"]["slack.deadband_mm@1"]["value"] == 0.02
+    assert abs(free["params"]["slack.deadband_mm@1"]["value"] - 0.05) < 0.005
+    assert held["params"]["slack.deadband_mm@2"]["value"] != 0.02
+    assert held["rmse_deg"] > 1.05 * free["rmse_deg"]
