@@ -52,3 +52,28 @@ def test_broken_effect_names_file_line_and_effect(tmp_path, capsys, data_csv, bo
     assert f"{f}:{want}" in err and "'broken'" in err, err
     for w in words:
         assert w in err, err
+
+
+@pytest.mark.parametrize("kw,words", [
+    ('off={"gian": 0.0}', ["gian", "off"]),
+    ('stage="strok"', ["strok", "stage"]),
+])
+def test_a_bad_effect_definition_names_its_line_also_from_a_relative_path(tmp_path, capsys, monkeypatch, kw, words):
+    # an Effect(...) the constructor refuses (a ValueError raised inside camtube): the line of the file, not
+    # the message for a file that is not Python text
+    src = HEAD + "    return x\n\n\nBAD = Effect(name=\"bad\", stage=\"stroke\", params=(Param(\"gain\", \"\", 0.0, 2.0, 1.0, " \
+        "\"gain\"),), apply=_apply)\n"
+    src = src.replace('stage="stroke"', kw) if kw.startswith("stage") else src.replace("apply=_apply)", f"apply=_apply, {kw})")
+    (tmp_path / "bad.py").write_text(src)
+    monkeypatch.chdir(tmp_path)
+    data = tmp_path / "d.csv"
+    assert main(["model", "synth", "--pattern", TUBE2, "-o", str(data), "--cycles", "2", "-q"]) == 0
+    capsys.readouterr()
+    assert main(["model", "fit", str(data), "--pattern", TUBE2, "--effect-file", "bad.py", "--effects", "bad"]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and err.count("\n") == 1
+    line = src.splitlines().index(next(ln for ln in src.splitlines() if ln.startswith("BAD = "))) + 1
+    assert f"bad.py:{line}:" in err, err
+    for w in words:
+        assert w in err, err
+    assert "give a Python source file" not in err

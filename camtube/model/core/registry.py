@@ -126,13 +126,14 @@ def load_effect_file(path: str | Path) -> tuple[Effect, ...]:
                               "(UTF-8 text; see docs/diagnose.md)") from None
         raise EffectError(f"{path}:{exc.lineno}: cannot load the effect file: {exc.msg}; fix: correct the Python "
                           "at that line") from None
-    except ValueError as exc:  # the source is not text (null bytes)
-        raise EffectError(f"{path}: cannot load the effect file: {exc}; fix: give a Python source file "
-                          "(UTF-8 text; see docs/diagnose.md)") from None
     except Exception as exc:  # noqa: BLE001 - a user's file may raise anything; report it with its line
         import traceback
 
-        tb = [f for f in traceback.extract_tb(exc.__traceback__) if f.filename == str(path)]
+        here = path.resolve()
+        tb = [f for f in traceback.extract_tb(exc.__traceback__) if Path(f.filename).resolve() == here]
+        if isinstance(exc, ValueError) and not tb:  # the source is not text (null bytes): no line of it ran
+            raise EffectError(f"{path}: cannot load the effect file: {exc}; fix: give a Python source file "
+                              "(UTF-8 text; see docs/diagnose.md)") from None
         line = f":{tb[-1].lineno}" if tb else ""
         raise EffectError(f"{path}{line}: cannot load the effect file: {type(exc).__name__}: {exc}") from None
     finally:
