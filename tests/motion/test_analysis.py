@@ -21,14 +21,19 @@ def job():
 
 
 def trace(job, speed_mm_s, period_s, shift_mm=(0.0, 0.0), pause_s=0.0):
-    """Sampled beam path: every pass at ``speed`` with the gate open, a closed-gate pause between passes."""
+    """Sampled beam path: every pass at ``speed`` with the gate open, a closed-gate pause between passes.
+
+    As LinuxCNC records it: the machine rests at a pass's start with the gate closed; the gate is set
+    at each sample the stage moves to with the beam on (the first step's sample on), closed again at
+    the sample of the next move's first step (here the jump to the next pass's start)."""
     ro = job.outer_radius_mm
     xs, ys, zs, gs = [], [], [], []
     for p in job.passes:
         pts = np.asarray(p.contour.points + p.contour.points[:1], float) + shift_mm
+        xs.append(pts[:1, 0]), ys.append(pts[:1, 1]), zs.append([-p.focus_offset_mm]), gs.append(np.zeros(1, bool))
         for a, b in zip(pts[:-1], pts[1:]):
             n = max(1, int(round(math.dist(a, b) / (speed_mm_s * period_s))))
-            t = np.arange(n) / n
+            t = np.arange(1, n + 1) / n
             seg = a + (b - a) * t[:, None]
             xs.append(seg[:, 0]), ys.append(seg[:, 1]), zs.append(np.full(n, -p.focus_offset_mm))
             gs.append(np.ones(n, bool))
