@@ -2,10 +2,13 @@
 
 The beam model: LinuxCNC's motion controller writes the commanded position and
 the outputs (gate, pulse rate) of a servo cycle together, and the stage moves to
-that position while they are in force: the beam is on while the stage moves from
-sample ``k - 1`` to sample ``k`` exactly when the gate is set at sample ``k`` (the
-gate opens in the cycle of a cut's first step and closes in the cycle of the next
-move's first step, so the beam-on path is exactly the cutting moves). Kept samples
+that position while they are in force (causality: no drive moves towards a position
+not yet written): the beam is on while the stage moves from sample ``k - 1`` to
+sample ``k`` exactly when the gate is set at sample ``k``. From rest (every gate
+switch under exact stop) the gate opens in the cycle of a cut's first step and closes
+in the cycle of the next move's first step, so the beam-on path is exactly the
+cutting moves; switched at speed (over-travel), LinuxCNC switches it with the step
+that reaches the move's start, one step early. Kept samples
 are joined by straight lines: the recorder drops only cycles on straight,
 constant-speed stretches with a steady gate. All lengths are on the outer
 surface of the tube (``y = radians(A) r_o`` for a rotary stage), mm.

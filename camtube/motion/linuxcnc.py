@@ -78,8 +78,8 @@ class Recording:
         focus (mm) axes, in the profile's axis order.
     gate : (n,) bool
         ``motion.digital-out-NN``: the beam gate, set in the same cycle as the positions: the
-        gate of sample ``k`` is in force while the stage moves from sample ``k - 1`` to ``k`` (LinuxCNC
-        opens it in the cycle of a cut's first step, closes it in the cycle of the next move's).
+        gate of sample ``k`` is in force while the stage moves from sample ``k - 1`` to ``k`` (from rest,
+        LinuxCNC opens it in the cycle of a cut's first step, closes it in the cycle of the next move's).
     period_s : float
         Servo period (s).
     wall_s : float
@@ -210,9 +210,9 @@ def dose_hal(profile) -> list[str]:
 
     A position-synchronised output fires by position: the pulses of a servo cycle are the path
     length the stage moves in it times the pulses per mm. LinuxCNC's motion controller writes, in
-    one servo cycle, the commanded position ``p_k`` and the motion-synchronised outputs (the gate
-    opens in the cycle of a cut's first step and closes in the cycle of the next move's first
-    step); the stage moves from ``p_(k-1)`` to ``p_k`` while they are in force. So, with stock
+    one servo cycle, the commanded position ``p_k`` and the motion-synchronised outputs (from rest
+    the gate opens in the cycle of a cut's first step and closes in the cycle of the next move's
+    first step); the stage moves from ``p_(k-1)`` to ``p_k`` while they are in force. So, with stock
     components only (as LinuxCNC's ``laserpower`` scales the power to the speed), run after
     ``motion-controller`` in the same thread: ``ddt`` turns each commanded axis position
     (``axis.L.pos-cmd``) into ``(p_k - p_(k-1)) / T``, the step of this cycle per second (no
