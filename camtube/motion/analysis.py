@@ -1,10 +1,16 @@
 """What a recorded run did, measured against the job it was made from.
 
-The beam model: the gate and the commanded positions are set in the same servo
-cycle, so the beam is on while the stage moves from sample ``k`` to sample
-``k + 1`` exactly when the gate is set at sample ``k`` (kept samples are
-joined by straight lines: the recorder drops only cycles on straight,
-constant-speed stretches with a steady gate). All lengths are on the outer
+The beam model: LinuxCNC's motion controller writes the commanded position and
+the outputs (gate, pulse rate) of a servo cycle together, and the stage moves to
+that position while they are in force (causality: no drive moves towards a position
+not yet written): the beam is on while the stage moves from sample ``k - 1`` to
+sample ``k`` exactly when the gate is set at sample ``k``. From rest (every gate
+switch under exact stop) the gate opens in the cycle of a cut's first step and closes
+in the cycle of the next move's first step, so the beam-on path is exactly the
+cutting moves; switched at speed (over-travel), LinuxCNC switches it with the step
+that reaches the move's start, one step early. Kept samples
+are joined by straight lines: the recorder drops only cycles on straight,
+constant-speed stretches with a steady gate. All lengths are on the outer
 surface of the tube (``y = radians(A) r_o`` for a rotary stage), mm.
 
 Figures (:class:`MotionReport`):
@@ -14,7 +20,7 @@ Figures (:class:`MotionReport`):
 - share of the beam-on path run within +-5 % of the scan speed;
 - dose: share of the beam-on path that gets within +-5 % of the nominal pulses per mm
   (``1000 frequency_khz / scan_speed``): from the recorded pulse rate of a distance-gated
-  profile (the rate commanded at sample ``k`` is in force from ``k`` to ``k + 1``), or, for a
+  profile (the rate commanded at sample ``k`` is in force from ``k - 1`` to ``k``), or, for a
   time-gated one, the set frequency over the recorded speed;
 - farthest beam-on position outside the design cut regions (the tube is periodic in y);
 - largest distance from a drawn corner (every vertex of a pass path that is a true corner of the
@@ -254,8 +260,9 @@ def _own_pass_mm(rec_x, rec_y, gate, geom) -> tuple[float, float]:
     path), mm: the k-th stretch of samples with the gate open is the k-th pass (NaN if the counts differ)."""
     import shapely
 
-    edges = np.flatnonzero(np.diff(np.concatenate(([0], gate.astype(np.int8), [0]))))
-    starts, ends = edges[::2], edges[1::2]  # the beam is on from sample s to sample e (gate set at s .. e - 1)
+    g = gate[1:].astype(np.int8)  # the gate of sample k + 1 is that of the step k -> k + 1
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], g, [0]))))
+    starts, ends = edges[::2], edges[1::2]  # the beam is on from sample s to sample e (gate set at s + 1 .. e)
     if len(starts) != len(geom.pass_paths) or not geom.pass_paths:
         return math.nan, math.nan
     dev = miss = 0.0
@@ -287,7 +294,7 @@ def analyse(rec, geom: JobGeometry, profile, estimate_s: float | None = None) ->
     ro = geom.outer_radius_mm
     circ = 2.0 * math.pi * ro if profile.rotary else math.inf
     x, y, z = _surface(rec, ro, profile.rotary)
-    on = rec.gate[:-1]
+    on = rec.gate[1:]  # step k -> k + 1 runs with the gate (and pulse rate) of sample k + 1
     dx, dy = np.diff(x), np.diff(y)
     seg = np.hypot(dx, dy)
     dt = np.diff(rec.cycle) * rec.period_s
@@ -321,7 +328,7 @@ def analyse(rec, geom: JobGeometry, profile, estimate_s: float | None = None) ->
     rate = getattr(rec, "rate_khz", None)
     with np.errstate(divide="ignore", invalid="ignore"):
         if rate is not None:  # pulses fired over each beam-on interval per mm moved
-            ppmm = 1000.0 * rate[:-1][on] * dt[on] / lo
+            ppmm = 1000.0 * rate[1:][on] * dt[on] / lo
         else:  # time gating: the set frequency, whatever the speed
             ppmm = 1000.0 * geom.frequency_khz / speed
     good = np.abs(ppmm / nominal - 1.0) <= SPEED_BAND

@@ -77,14 +77,17 @@ class Recording:
         ``axis.<L>.pos-cmd`` of the axial (mm), circumferential (deg if rotary, else mm) and
         focus (mm) axes, in the profile's axis order.
     gate : (n,) bool
-        ``motion.digital-out-NN``: the beam gate, set in the same cycle as the positions.
+        ``motion.digital-out-NN``: the beam gate, set in the same cycle as the positions: the
+        gate of sample ``k`` is in force while the stage moves from sample ``k - 1`` to ``k`` (from rest,
+        LinuxCNC opens it in the cycle of a cut's first step, closes it in the cycle of the next move's).
     period_s : float
         Servo period (s).
     wall_s : float
         Real time the run took (s).
     rate_khz : (n,) float or None
         Distance gating (:func:`dose_hal`): the laser's pulse rate (kHz) the HAL commands at each
-        sample, in force until the next; None for a time-gated profile.
+        sample, in force with that sample's gate while the stage moves to that sample's position
+        (from the previous one); None for a time-gated profile.
     """
 
     cycle: np.ndarray
@@ -203,40 +206,40 @@ def config_texts(profile, workdir: str | os.PathLike, driver: str) -> dict[str, 
 
 
 def dose_hal(profile) -> list[str]:
-    """HAL lines of distance gating: the laser's pulse rate (kHz) follows the surface speed.
+    """HAL lines of distance gating: the pulses of each servo cycle follow the distance commanded in that cycle.
 
-    Stock components only, as LinuxCNC's ``laserpower`` scales the power to the speed:
-    ``ddt`` differentiates the commanded axis positions (``axis.L.pos-cmd``) into velocities
-    and, once more, into accelerations; ``sum2`` extrapolates each velocity one servo cycle
-    ahead (``v + a T``: the rate set in a cycle is in force during the next one, when the stage
-    has already moved on); for a rotary axis ``mult2`` and ``scale`` turn deg/s into surface
-    mm/s (``x radius_output x pi/180``); ``hypot`` gives the surface speed; ``mult2`` times the
-    pulses per mm (analog output ``dose_output``) and the gate (``conv_bit_float``), ``scale``
-    x 0.001 gives kHz on the signal ``laser-rate-khz`` (wire it to the laser's external
-    pulse-rate or trigger input). The pulses per mm then stay at the nominal value however
-    the stage slows down into a corner.
+    A position-synchronised output fires by position: the pulses of a servo cycle are the path
+    length the stage moves in it times the pulses per mm. LinuxCNC's motion controller writes, in
+    one servo cycle, the commanded position ``p_k`` and the motion-synchronised outputs (from rest
+    the gate opens in the cycle of a cut's first step and closes in the cycle of the next move's
+    first step); the stage moves from ``p_(k-1)`` to ``p_k`` while they are in force. So, with stock
+    components only (as LinuxCNC's ``laserpower`` scales the power to the speed), run after
+    ``motion-controller`` in the same thread: ``ddt`` turns each commanded axis position
+    (``axis.L.pos-cmd``) into ``(p_k - p_(k-1)) / T``, the step of this cycle per second (no
+    extrapolation: the step is known, not estimated); for a rotary axis ``mult2`` and ``scale``
+    turn deg/s into surface mm/s (``x radius_output x pi/180``); ``hypot`` gives the path length
+    of the step per second; ``mult2`` times the pulses per mm (analog output ``dose_output``) and
+    the gate (``conv_bit_float``), ``scale`` x 0.001 gives kHz on the signal ``laser-rate-khz``
+    (wire it to the laser's external pulse-rate or trigger input): rate x T is the pulses of the
+    cycle, the step's length x the pulses per mm however the stage accelerates or stops.
     """
     ax, ac = profile.axes[0].lower(), profile.axes[1].lower()
-    T = profile.servo_period_s
-    hal = ["loadrt ddt count=4", "loadrt sum2 count=2", "loadrt mult2 count=3", "loadrt scale count=2",
-           "loadrt hypot count=1", "loadrt conv_bit_float count=1"]
-    for f in ("ddt.0", "ddt.1", "ddt.2", "ddt.3", "sum2.0", "sum2.1", "mult2.0", "scale.0", "hypot.0", "mult2.1",
-              "conv-bit-float.0", "mult2.2", "scale.1"):
+    hal = ["loadrt ddt count=2", "loadrt mult2 count=3", "loadrt scale count=2", "loadrt hypot count=1",
+           "loadrt conv_bit_float count=1"]
+    for f in ("ddt.0", "ddt.1", "mult2.0", "scale.0", "hypot.0", "mult2.1", "conv-bit-float.0", "mult2.2",
+              "scale.1"):
         hal.append(f"addf {f} servo-thread")
     hal += [
         f"net rec-{ax} ddt.0.in", f"net rec-{ac} ddt.1.in",  # the recorder's nets of axis.L.pos-cmd
-        "net dose-vel-ax ddt.0.out => ddt.2.in sum2.0.in0", "net dose-acc-ax ddt.2.out => sum2.0.in1",
-        "net dose-vel-c ddt.1.out => ddt.3.in sum2.1.in0", "net dose-acc-c ddt.3.out => sum2.1.in1",
-        f"setp sum2.0.gain1 {T!r}", f"setp sum2.1.gain1 {T!r}",
-        "net dose-v-ax sum2.0.out => hypot.0.in0",
+        "net dose-v-ax ddt.0.out => hypot.0.in0",
     ]
     if profile.rotary:
-        hal += ["net dose-v-c-deg sum2.1.out => mult2.0.in0",
+        hal += ["net dose-v-c-deg ddt.1.out => mult2.0.in0",
                 f"net dose-radius motion.analog-out-{profile.radius_output:02d} => mult2.0.in1",
                 "net dose-v-c-rad mult2.0.out => scale.0.in", f"setp scale.0.gain {math.pi / 180.0!r}",
                 "net dose-v-c scale.0.out => hypot.0.in1"]
     else:
-        hal += ["net dose-v-c sum2.1.out => hypot.0.in1"]
+        hal += ["net dose-v-c ddt.1.out => hypot.0.in1"]
     hal += [
         "net surface-speed hypot.0.out => mult2.1.in0",
         f"net dose-ppmm motion.analog-out-{profile.dose_output:02d} => mult2.1.in1",

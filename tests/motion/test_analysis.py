@@ -21,14 +21,19 @@ def job():
 
 
 def trace(job, speed_mm_s, period_s, shift_mm=(0.0, 0.0), pause_s=0.0):
-    """Sampled beam path: every pass at ``speed`` with the gate open, a closed-gate pause between passes."""
+    """Sampled beam path: every pass at ``speed`` with the gate open, a closed-gate pause between passes.
+
+    As LinuxCNC records it: the machine rests at a pass's start with the gate closed; the gate is set
+    at each sample the stage moves to with the beam on (the first step's sample on), closed again at
+    the sample of the next move's first step (here the jump to the next pass's start)."""
     ro = job.outer_radius_mm
     xs, ys, zs, gs = [], [], [], []
     for p in job.passes:
         pts = np.asarray(p.contour.points + p.contour.points[:1], float) + shift_mm
+        xs.append(pts[:1, 0]), ys.append(pts[:1, 1]), zs.append([-p.focus_offset_mm]), gs.append(np.zeros(1, bool))
         for a, b in zip(pts[:-1], pts[1:]):
             n = max(1, int(round(math.dist(a, b) / (speed_mm_s * period_s))))
-            t = np.arange(n) / n
+            t = np.arange(1, n + 1) / n
             seg = a + (b - a) * t[:, None]
             xs.append(seg[:, 0]), ys.append(seg[:, 1]), zs.append(np.full(n, -p.focus_offset_mm))
             gs.append(np.ones(n, bool))
@@ -62,3 +67,24 @@ def test_idle_pauses_are_not_run_time(job):
     moving = (len(rec) - 1) * 1e-4
     idle = 0.05 * (len(job.passes) - 1)  # the last pause comes after the last motion
     assert rec.run_time_s == pytest.approx(moving - idle - 0.05, abs=5e-4)
+
+
+def test_the_dose_counts_each_cycles_pulses_over_the_step_to_its_position(job):
+    """The rate of sample k is in force while the stage moves from sample k - 1 to k (with the gate of k): a
+    rate that follows each step exactly scores 100 %; the same rates paired one step late do not."""
+    prof = load_profile("linuxcnc-rotary")
+    base = trace(job, 10.0, 1e-4)
+    # uneven steps (1, 2, 3, 2 base steps per cycle): the speed changes every cycle, as at a chord's turn
+    idx = np.cumsum(np.resize([1, 2, 3, 2], len(base)))
+    idx = np.concatenate(([0], idx[idx < len(base)]))
+    cut = Recording(np.arange(len(idx)), base.axial[idx], base.circ[idx], base.focus[idx], base.gate[idx], 1e-4, 0.0)
+    geom = JobGeometry.from_job(job)
+    ppmm = 1000.0 * geom.frequency_khz / geom.scan_speed_mm_s
+    y = np.radians(cut.circ) * job.outer_radius_mm
+    step = np.concatenate(([0.0], np.hypot(np.diff(cut.axial), np.diff(y))))  # the step to each sample's position
+    rate = ppmm * step / 1e-4 * cut.gate / 1000.0  # kHz
+    own = Recording(cut.cycle, cut.axial, cut.circ, cut.focus, cut.gate, 1e-4, 0.0, rate)
+    assert analyse(own, geom, prof).dose_share == pytest.approx(1.0, abs=1e-9)
+    late = Recording(cut.cycle, cut.axial, cut.circ, cut.focus, cut.gate, 1e-4, 0.0,
+                     np.concatenate(([0.0], rate[:-1])))
+    assert analyse(late, geom, prof).dose_share < 0.5
