@@ -2,17 +2,17 @@
 
     python scripts/fe_notch_table.py            # the three presets and the tip-first example design
     python scripts/fe_notch_table.py --heldout  # also six isolated notches of new geometry (the fe_fit check)
-    python scripts/fe_notch_table.py --fine     # also one refined mesh (convergence)
+    python scripts/fe_notch_table.py --fine     # also one refined mesh and rows of 3 and 7 (convergence)
 
 Every notch is modelled with :func:`camtube.joint.fe.notch_fe` (scikit-fem, quadratic tetrahedra, pure
-moment) twice: alone between two leads of plain tube (``FE K alone``), and as the middle of a row of
-``ROW`` equal notches at the pattern's own web (``FE K in row``: the row's rotation per notch, as the joint
-model counts it; the webs between the notches are shorter than the span over which an isolated notch's
-backbone bends into the plain tube, so a notch in a row is stiffer). The model's stiffness is shown twice:
-the beam ``E I / h`` (the paper's, the default) and ``hinge="fe_fit"`` (h plus the root length of
-:data:`camtube.joint.forward.HINGE_FE_POLY`, fitted to ten isolated-notch FE runs with h 0.3 and 0.8 mm,
-none of them a notch in this table). Errors are against the row. The tip-first design's notches are taken
-as cut (drawn + the 20 um overcut it was designed for) at its 0.3 mm web.
+moment) twice: alone between two leads of plain tube (``FE K alone``), and in its row (``FE K in its row``:
+the notch's own rotation between the middle sections of the webs on either side): a preset's notch as the
+middle and as the end notch of a row of ``ROW`` equal notches at the pattern's own web, the tip-first design's
+tip, middle and base notch in the design's whole row as cut (drawn + the 20 um overcut it was designed for, at
+its 0.28 mm web as cut). The model's stiffness is shown three times: the beam ``E I / h`` (the paper's),
+``hinge="fe_fit"`` (h plus a lone notch's root length, :data:`camtube.joint.forward.HINGE_FE_POLY`) and
+``hinge="fe_row"`` (the default: the root shortened by the webs to the neighbours, :data:`HINGE_ROW`, fitted to
+the row runs of ``scripts/fe_row_runs.py``, none of them a notch of this table). Errors are against the row.
 """
 from __future__ import annotations
 
@@ -36,7 +36,8 @@ HELDOUT = ((1.0, 0.7, 2.0, 0.4), (0.6, 0.45, 3.5, 0.25), (1.5, 0.9, 2.5, 0.6), (
 def cases():
     """``(label, r_o, r_i, s, widths, web, k)`` of the table's rows: the notch ``k`` of a row of notches of
     ``widths`` (base to tip, mm) at ``web`` (mm, edge to edge): a preset's middle notch and end notch in a row of
-    ``ROW``; the tip-first design's tip, middle and base notch in the design's own row (as cut)."""
+    ``ROW``; the tip-first design's tip, middle and base notch in the design's own row (as cut; ``s`` is then each
+    notch's arc)."""
     from camtube.design.loader import load_pattern, load_text
     from camtube.synthesis.goal import load_goal
     from camtube.synthesis.report import pattern_yaml
@@ -55,9 +56,9 @@ def cases():
     k = d.mechanics.kerf_mm
     ns = sorted(p.notches, key=lambda n: -n.x_mm)  # base to tip
     row = tuple(n.width_mm + k for n in ns)
-    arc = sum(n.arc_mm for n in ns) / len(ns) + k  # the arcs differ by < 1 um
+    arcs = tuple(n.arc_mm + k for n in ns)
     for label, i in (("base", 0), ("middle", len(ns) // 2), ("tip", len(ns) - 1)):
-        yield f"tip-first ({d.mechanics.hinge}), {label} notch", 0.75, 0.45, arc, row, goal.web_mm - k, i
+        yield f"tip-first ({d.mechanics.hinge}), {label} notch", 0.75, 0.45, arcs, row, goal.web_mm - k, i
 
 
 def model_stiffness(ro: float, ri: float, s: float, h: float, hinge: str, webs=(math.inf, math.inf),
@@ -89,10 +90,11 @@ def main() -> int:
     for name, ro, ri, s, widths, web, i in cases():
         t0 = time.perf_counter()
         h = widths[i]
+        arcs, s = (s, s[i]) if isinstance(s, tuple) else ((s,) * len(widths), s)
         one = notch_fe(ro, ri, s, h)
-        key = (ro, ri, s, widths, web)
+        key = (ro, ri, arcs, widths, web)
         if key not in rows:
-            rows[key] = notch_fe(ro, ri, s, widths, web_mm=web)
+            rows[key] = notch_fe(ro, ri, arcs, widths, web_mm=web)
         row = rows[key]
         webs = (web if i > 0 else math.inf, web if i < len(widths) - 1 else math.inf)
         k_row = row.per_notch_nmm_per_rad[i]
@@ -113,25 +115,29 @@ def main() -> int:
           f"{100 * worst['fe_fit']:.0f} %, fe_row {100 * worst['fe_row']:.1f} %, closure {100 * worst['closure']:.1f} %")
     if a.heldout:
         print("\nheld-out isolated notches (geometry not used for HINGE_FE_POLY nor above):\n")
-        print("| r_o / r_i mm | phi rad | s mm | h mm | FE K alone | beam (err) | fe_fit (err) | FE closure deg "
-              "| model closure deg (err) |")
-        print("|---|---|---|---|---|---|---|---|---|")
+        print("| r_o / r_i mm | phi rad | s mm | h mm | FE K alone | beam (err) | fe_fit (err) | fe_row alone (err) "
+              "| FE closure deg | model closure deg (err) |")
+        print("|---|---|---|---|---|---|---|---|---|---|")
         for ro, ri, phi, h in HELDOUT:
             s = ro * (2.0 * math.pi - phi)
             r = notch_fe(ro, ri, s, h)
             k_fit = model_stiffness(ro, ri, s, h, "fe_fit")
+            k_row = model_stiffness(ro, ri, s, h, "fe_row")
             print(f"| {ro:g} / {ri:g} | {phi:.2f} | {s:.3f} | {h:.3f} | {r.stiffness_nmm_per_rad:.2f} | "
                   f"{r.model_stiffness_nmm_per_rad:.2f} ({pct(r.model_stiffness_nmm_per_rad, r.stiffness_nmm_per_rad)}) | "
-                  f"{k_fit:.2f} ({100 * (k_fit / r.stiffness_nmm_per_rad - 1):+.1f} %) | {r.closure_deg:.2f} | "
+                  f"{k_fit:.2f} ({100 * (k_fit / r.stiffness_nmm_per_rad - 1):+.1f} %) | "
+                  f"{k_row:.2f} ({100 * (k_row / r.stiffness_nmm_per_rad - 1):+.1f} %) | {r.closure_deg:.2f} | "
                   f"{r.model_closure_deg:.2f} ({100 * r.closure_error:+.1f} %) |", flush=True)
     if a.fine:
         c = notch_fe(0.75, 0.45, 2.83, 0.5, count=3)
         f = notch_fe(0.75, 0.45, 2.83, 0.5, count=3, n_r=3, n_backbone=28, n_cut=16, n_lead=10, n_notch=6, n_web=6)
-        print(f"\nmesh: tube1 row of 3, per notch K {c.stiffness_nmm_per_rad:.2f} ({c.dofs} dofs) -> "
-              f"{f.stiffness_nmm_per_rad:.2f} ({f.dofs} dofs), closure {c.closure_deg:.2f} -> {f.closure_deg:.2f} deg")
+        print(f"\nmesh: tube1 row of 3, middle notch K {c.middle_nmm_per_rad:.2f} ({c.dofs} dofs) -> "
+              f"{f.middle_nmm_per_rad:.2f} ({f.dofs} dofs), end notch {c.per_notch_nmm_per_rad[-1]:.2f} -> "
+              f"{f.per_notch_nmm_per_rad[-1]:.2f}, closure {c.closure_deg:.2f} -> {f.closure_deg:.2f} deg")
         for n in (3, 7):
             r = notch_fe(0.75, 0.45, 2.83, 0.5, count=n)
-            print(f"row length: tube1, {n} notches: per notch K {r.stiffness_nmm_per_rad:.2f}")
+            print(f"row length: tube1, {n} notches: middle notch K {r.middle_nmm_per_rad:.2f}, end notch "
+                  f"{r.per_notch_nmm_per_rad[-1]:.2f}, row mean {r.stiffness_nmm_per_rad:.2f}")
     return 0
 
 

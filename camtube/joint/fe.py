@@ -86,7 +86,7 @@ def _axis(lo: float, hi: float, n: int) -> np.ndarray:
     return np.linspace(lo, hi, max(int(n), 1) + 1)
 
 
-def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm: float, width_mm,
+def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm, width_mm,
              modulus_gpa: float = 2.5, poisson: float = 0.34, *, n_r: int = 2, n_backbone: int = 20,
              n_cut: int = 12, n_lead: int = 8, n_notch: int = 4, lead_mm: float | None = None,
              count: int = 1, web_mm: float = 0.5, n_web: int = 4) -> NotchFE:
@@ -94,8 +94,10 @@ def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm: float, widt
 
     Parameters
     ----------
-    outer_radius_mm, inner_radius_mm, arc_mm : float
-        Tube and notch (arc on the outer surface).
+    outer_radius_mm, inner_radius_mm : float
+        Tube.
+    arc_mm : float or sequence of float
+        The notch's arc on the outer surface, or each notch's (base to far end, as many as ``width_mm``'s).
     width_mm : float or sequence of float
         Axial width h of the notch, or of each notch of the row (base to far end; its length sets ``count``).
     modulus_gpa, poisson : float
@@ -114,7 +116,7 @@ def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm: float, widt
     from skfem.helpers import ddot, sym_grad, trace
     from skfem.models.elasticity import lame_parameters
 
-    ro, ri, s = outer_radius_mm, inner_radius_mm, arc_mm
+    ro, ri = outer_radius_mm, inner_radius_mm
     if np.ndim(width_mm):
         hs = [float(x) for x in width_mm]
         count = len(hs)
@@ -122,13 +124,21 @@ def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm: float, widt
         hs = [float(width_mm)] * count
     h = float(np.mean(hs))
     lead = 2.0 * ro if lead_mm is None else lead_mm
-    half = s / (2.0 * ro)  # half-angle of the cut, centred on pi
+    arcs = [float(x) for x in arc_mm] if np.ndim(arc_mm) else [float(arc_mm)] * count
+    if len(arcs) != count:
+        raise ValueError(f"{len(arcs)} arcs for {count} notches")
+    halves = []  # half-angle of each cut, centred on pi; cuts within 5 mrad share one (no sliver cells)
+    for a in arcs:
+        hf = a / (2.0 * ro)
+        halves.append(next((x for x in halves if abs(x - hf) < 5e-3), hf))
+    half = max(halves)
     e = modulus_gpa * 1e3
     r_nodes = _axis(ri, ro, n_r)
     t_nodes = np.unique(np.concatenate([
         _axis(-math.pi, -math.pi + half, max(2, n_cut // 2)),
         _axis(-math.pi + half, math.pi - half, n_backbone),
-        _axis(math.pi - half, math.pi, max(2, n_cut // 2))]))
+        _axis(math.pi - half, math.pi, max(2, n_cut // 2)),
+        [math.pi - x for x in halves], [x - math.pi for x in halves]]))  # a grid line on every cut's edge
     starts = list(lead + np.concatenate([[0.0], np.cumsum(np.array(hs[:-1]) + web_mm)]))  # base-side edges
     length = 2.0 * lead + sum(hs) + (count - 1) * web_mm
     z_parts = [_axis(0.0, lead, n_lead), _axis(starts[-1] + hs[-1], length, n_lead)]
@@ -146,8 +156,8 @@ def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm: float, widt
     # cells of the notch: z inside the notch and angle within the cut (near +-pi)
     c = p[:, t].mean(axis=1)
     in_notch = np.zeros(t.shape[1], bool)
-    for z0, hk in zip(starts, hs):
-        in_notch |= (c[2] > z0) & (c[2] < z0 + hk) & (np.abs(c[1]) > math.pi - half)
+    for z0, hk, hf in zip(starts, hs, halves):
+        in_notch |= (c[2] > z0) & (c[2] < z0 + hk) & (np.abs(c[1]) > math.pi - hf)
     t = t[:, ~in_notch]
     # close the seam: nodes at angle +pi are the nodes at -pi
     seam = np.isclose(p[1], math.pi)
@@ -209,7 +219,7 @@ def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm: float, widt
                      for z0, hk, kk in zip(starts, hs, per_notch))
     mid = count // 2
     hm = hs[mid]
-    g_model = joint_geometry(ro, ri, s, hm)
-    return NotchFE(ro, ri, s, hm, moment / theta_n, e * g_model.second_moment_mm4 / hm,
+    g_model = joint_geometry(ro, ri, arcs[mid], hm)
+    return NotchFE(ro, ri, arcs[mid], hm, moment / theta_n, e * g_model.second_moment_mm4 / hm,
                    closures[mid], math.degrees(g_model.closure_angle_rad),
                    int(basis.N), per_notch, tuple(hs), closures)

@@ -42,8 +42,8 @@ GOAL_SCHEMA: dict = {
                           choices=("polyimide", "pebax", "nitinol", "other")),
         "modulus_gpa": Field("float", "GPa", "Young's modulus of the tube (default: 2.5 for polyimide)", None, **POS),
         "hinge": Field("choice", "", "notch stiffness: fe_row (h plus a root length that shrinks with the webs to "
-                       "the neighbours, fitted to FE runs of notches in rows: within 6 % of the FE), beam (E I / h, the "
-                       "paper's: 1.2-2.5 x too stiff) or fe_fit (h plus a lone notch's root length: 10-45 % too soft in "
+                       "the neighbours, fitted to FE runs of notches in rows: within 7 % of the FE), beam (E I / h, the "
+                       "paper's: 1.3-4.6 x too stiff) or fe_fit (h plus a lone notch's root length: 11-45 % too soft in "
                        "a row); see docs/design.md", "fe_row", choices=("fe_row", "beam", "fe_fit")),
     },
     "tendon": {

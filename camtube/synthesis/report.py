@@ -217,4 +217,4 @@ def stiffness_line(design: Design, checks, pattern: Pattern | None = None) -> st
              for c in checks]
     return (f"stiffness: designed with the {m.hinge} hinge; with the {other} hinge (this pattern's notches {span} x as "
             f"stiff) the bend at the design stroke would be " + "; ".join(parts)
-            + " (fe_row is within 6 % of the FE of a notch in its row, beam 1.2 to 2.5 x too stiff: docs/design.md)")
+            + " (fe_row is within 7 % of the FE of a notch in its row, beam 1.3 to 4.6 x too stiff: docs/design.md)")
