@@ -209,20 +209,21 @@ def _solve_count(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget, n
         return _solve_count_at(goal, mech, grid, target, n, budget_mm, None)
     widths = (goal.curve_length_mm / n / 2.0 if goal.curve_deg_per_mm else 0.5,) * n
     gaps = gaps_fn(widths)
-    for _ in range(6):
-        r = _solve_count_at(goal, mech, grid, target, n, budget_mm, _pairs(gaps))
-        if not isinstance(r, DirectionDesign):
-            return r
-        new = gaps_fn(r.widths_mm)
-        if max(abs(a - b) for a, b in zip(new, gaps)) < 1e-5:
-            return r
-        gaps = new
-    return r
+    for _ in range(30):  # the widths (first pass, before the polish) and the webs they leave, until they settle
+        w = _solve_count_at(goal, mech, grid, target, n, budget_mm, _pairs(gaps), widths_only=True)
+        if not isinstance(w, tuple):
+            return w
+        new = gaps_fn(w)
+        if max(abs(a - b) for a, b in zip(new, gaps)) < 1.5e-3:  # widths are rounded to 1 um
+            break
+        gaps = [(a + b) / 2.0 for a, b in zip(gaps, new)]  # damped: a wider notch leaves a shorter web
+    return _solve_count_at(goal, mech, grid, target, n, budget_mm, _pairs(gaps))
 
 
 def _solve_count_at(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget, n: int,
-                    budget_mm: float, webs) -> DirectionDesign | _Fail:
-    """:func:`_solve_count` at given webs (per notch base to tip, as cut; None: the goal's web inside the row)."""
+                    budget_mm: float, webs, widths_only: bool = False) -> DirectionDesign | _Fail | tuple:
+    """:func:`_solve_count` at given webs (per notch base to tip, as cut; None: the goal's web inside the row);
+    ``widths_only``: just the drawn widths from the tip (the first pass: the polish keeps them)."""
     from scipy.optimize import brentq, least_squares
 
     if webs is None:
@@ -285,6 +286,8 @@ def _solve_count_at(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget
     k = grid.kerf  # drawn = as cut - k
     widths = np.ceil((h[np.arange(n), idx] - k) / WIDTH_STEP_MM - 1e-9) * WIDTH_STEP_MM
     widths = np.maximum(widths, lim.min_feature_mm)
+    if widths_only:
+        return tuple(float(w) for w in widths[::-1])
     arcs0 = grid.s[idx] - k
 
     x = np.zeros(n)  # positions do not enter the angles (the webs are given)
@@ -442,7 +445,10 @@ def _solve_all(goal: Goal, mech: Mechanics, grid: _Grid,
             for _ in range(4 if mech.hinge == "fe_row" else 0):
                 # the webs follow the lengthened pitch: solve again with it until the pitch settles
                 add = r.pitch_mm - g.curve_length_mm / r.count
-                r2 = _solve_direction(g, mech, grid, b, budget, deadline, _gaps_fn(goal, g, mech, b, [None], 0, add))
+                gaps = _gaps_fn(goal, g, mech, b, [None], 0, add)
+                r2 = _solve_count(g, mech, grid, b, r.count, budget, gaps)  # the same count first (fast)
+                if isinstance(r2, _Fail):
+                    r2 = _solve_direction(g, mech, grid, b, budget, deadline, gaps)
                 if isinstance(r2, _Fail):
                     return i, r2
                 r2 = _axis_pitch(goal, mech, r2, goal.centerline[i].length_mm)
