@@ -208,12 +208,12 @@ def _solve_count(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget, n
     if mech.hinge != "fe_row" or gaps_fn is None or n < 2:
         return _solve_count_at(goal, mech, grid, target, n, budget_mm, None)
     widths = (goal.curve_length_mm / n / 2.0 if goal.curve_deg_per_mm else 0.5,) * n
-    gaps = gaps_fn(widths)
+    gaps = [max(x, 0.0) for x in gaps_fn(widths)]  # overlapping notches: no web, no root (and no design)
     for _ in range(30):  # the widths (first pass, before the polish) and the webs they leave, until they settle
         w = _solve_count_at(goal, mech, grid, target, n, budget_mm, _pairs(gaps), widths_only=True)
         if not isinstance(w, tuple):
             return w
-        new = gaps_fn(w)
+        new = [max(x, 0.0) for x in gaps_fn(w)]
         if max(abs(a - b) for a, b in zip(new, gaps)) < 1.5e-3:  # widths are rounded to 1 um
             break
         gaps = [(a + b) / 2.0 for a, b in zip(gaps, new)]  # damped: a wider notch leaves a shorter web
