@@ -3,6 +3,7 @@
     python scripts/fe_notch_table.py            # the three presets and the tip-first example design
     python scripts/fe_notch_table.py --heldout  # also six isolated notches of new geometry (the fe_fit check)
     python scripts/fe_notch_table.py --fine     # also one refined mesh and rows of 3 and 7 (convergence)
+    python scripts/fe_notch_table.py --alternating  # also a row of notches on alternate sides (example 07's kind)
 
 Every notch is modelled with :func:`camtube.joint.fe.notch_fe` (scikit-fem, quadratic tetrahedra, pure
 moment) twice: alone between two leads of plain tube (``FE K alone``), and in its row (``FE K in its row``:
@@ -79,6 +80,7 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--fine", action="store_true")
     ap.add_argument("--heldout", action="store_true")
+    ap.add_argument("--alternating", action="store_true")
     a = ap.parse_args()
     from camtube.joint.fe import notch_fe
 
@@ -128,6 +130,18 @@ def main() -> int:
                   f"{k_fit:.2f} ({100 * (k_fit / r.stiffness_nmm_per_rad - 1):+.1f} %) | "
                   f"{k_row:.2f} ({100 * (k_row / r.stiffness_nmm_per_rad - 1):+.1f} %) | {r.closure_deg:.2f} | "
                   f"{r.model_closure_deg:.2f} ({100 * r.closure_error:+.1f} %) |", flush=True)
+    if a.alternating:
+        # tube 1, phi 2.0 rad, h 0.45, web 0.28 mm as cut: about example 07's notches (two directions alternating)
+        ro, ri, s, h, w = 0.75, 0.45, 3.21, 0.45, 0.28
+        same = notch_fe(ro, ri, s, h, count=ROW, web_mm=w)
+        alt = notch_fe(ro, ri, s, h, count=ROW, web_mm=w, angles_deg=[180 if k % 2 == 0 else 0 for k in range(ROW)])
+        far = 2 * w + h  # to the next notch of the same direction, across the other direction's
+        print(f"\nalternating sides (tube 1, s {s} mm, h {h} mm, web {w} mm): middle notch K {alt.middle_nmm_per_rad:.2f} "
+              f"(each: {', '.join(f'{x:.2f}' for x in alt.per_notch_nmm_per_rad)}); all on one side "
+              f"{same.middle_nmm_per_rad:.2f}; lone {notch_fe(ro, ri, s, h).stiffness_nmm_per_rad:.2f}; fe_row "
+              f"{model_stiffness(ro, ri, s, h, 'fe_row', (far, far)):.2f} (webs to its own direction's notches, "
+              f"{far:.2f} mm), {model_stiffness(ro, ri, s, h, 'fe_row', (w, w)):.2f} (to the nearest notch); beam "
+              f"{model_stiffness(ro, ri, s, h, 'beam'):.2f}")
     if a.fine:
         c = notch_fe(0.75, 0.45, 2.83, 0.5, count=3)
         f = notch_fe(0.75, 0.45, 2.83, 0.5, count=3, n_r=3, n_backbone=28, n_cut=16, n_lead=10, n_notch=6, n_web=6)

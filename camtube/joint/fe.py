@@ -89,7 +89,7 @@ def _axis(lo: float, hi: float, n: int) -> np.ndarray:
 def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm, width_mm,
              modulus_gpa: float = 2.5, poisson: float = 0.34, *, n_r: int = 2, n_backbone: int = 20,
              n_cut: int = 12, n_lead: int = 8, n_notch: int = 4, lead_mm: float | None = None,
-             count: int = 1, web_mm: float = 0.5, n_web: int = 4) -> NotchFE:
+             count: int = 1, web_mm: float = 0.5, n_web: int = 4, angles_deg=None) -> NotchFE:
     """Bending stiffness and closure angle of one notch by 3-D finite elements (see the module docstring).
 
     Parameters
@@ -111,6 +111,10 @@ def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm, width_mm,
         pattern: the stiffness and closure are then per notch (the row's rotation over ``count``), so the
         webs' share of the compliance (which a single notch between long leads does not see) is counted;
         ``per_notch_nmm_per_rad`` holds each notch's own (the web's middle always gets a grid plane).
+    angles_deg : sequence of 180 or 0, optional
+        Each notch's side (default all 180: the notches the moment closes); a notch at 0 is cut on the backbone
+        side of the others (an alternating two-direction pattern; the moment opens it: the same stiffness, no
+        closure angle, nan).
     """
     import skfem
     from skfem.helpers import ddot, sym_grad, trace
@@ -132,13 +136,19 @@ def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm, width_mm,
         hf = a / (2.0 * ro)
         halves.append(next((x for x in halves if abs(x - hf) < 5e-3), hf))
     half = max(halves)
+    sides = [180.0] * count if angles_deg is None else [float(a) % 360.0 for a in angles_deg]
+    if len(sides) != count or any(a not in (0.0, 180.0) for a in sides):
+        raise ValueError("angles_deg: one 0 or 180 per notch")
+    back = [x for x, a in zip(halves, sides) if a == 0.0]  # cuts centred on angle 0
     e = modulus_gpa * 1e3
     r_nodes = _axis(ri, ro, n_r)
     t_nodes = np.unique(np.concatenate([
         _axis(-math.pi, -math.pi + half, max(2, n_cut // 2)),
         _axis(-math.pi + half, math.pi - half, n_backbone),
         _axis(math.pi - half, math.pi, max(2, n_cut // 2)),
-        [math.pi - x for x in halves], [x - math.pi for x in halves]]))  # a grid line on every cut's edge
+        [math.pi - x for x, a in zip(halves, sides) if a == 180.0],
+        [x - math.pi for x, a in zip(halves, sides) if a == 180.0],
+        _axis(-max(back), max(back), n_cut) if back else [], back, [-x for x in back]]))  # lines on the cuts' edges
     starts = list(lead + np.concatenate([[0.0], np.cumsum(np.array(hs[:-1]) + web_mm)]))  # base-side edges
     length = 2.0 * lead + sum(hs) + (count - 1) * web_mm
     z_parts = [_axis(0.0, lead, n_lead), _axis(starts[-1] + hs[-1], length, n_lead)]
@@ -156,8 +166,9 @@ def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm, width_mm,
     # cells of the notch: z inside the notch and angle within the cut (near +-pi)
     c = p[:, t].mean(axis=1)
     in_notch = np.zeros(t.shape[1], bool)
-    for z0, hk, hf in zip(starts, hs, halves):
-        in_notch |= (c[2] > z0) & (c[2] < z0 + hk) & (np.abs(c[1]) > math.pi - hf)
+    for z0, hk, hf, a in zip(starts, hs, halves, sides):
+        across = (np.abs(c[1]) > math.pi - hf) if a == 180.0 else (np.abs(c[1]) < hf)
+        in_notch |= (c[2] > z0) & (c[2] < z0 + hk) & across
     t = t[:, ~in_notch]
     # close the seam: nodes at angle +pi are the nodes at -pi
     seam = np.isclose(p[1], math.pi)
@@ -216,7 +227,7 @@ def notch_fe(outer_radius_mm: float, inner_radius_mm: float, arc_mm, width_mm,
     # closure of each notch: h times its own rotation over its gap's shrinkage at the mouth
     closures = tuple(math.degrees(hk * (moment / kk) / (uz[mouth & np.isclose(pts[2], z0)].mean()
                                                         - uz[mouth & np.isclose(pts[2], z0 + hk)].mean()))
-                     for z0, hk, kk in zip(starts, hs, per_notch))
+                     if a == 180.0 else math.nan for z0, hk, kk, a in zip(starts, hs, per_notch, sides))
     mid = count // 2
     hm = hs[mid]
     g_model = joint_geometry(ro, ri, arcs[mid], hm)

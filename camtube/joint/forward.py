@@ -58,6 +58,8 @@ HINGE_FE_POLY = (-0.0737, 0.5155, -0.8976, 1.0071)
 #: unbounded root's). Fitted by ``python scripts/fe_row_runs.py fit`` to the 20 training runs of
 #: scripts/data/fe_row_train.json (rows of five, a Latin hypercube over r_o, r_i / r_o, phi, h and the web; the
 #: middle and the far-end notch of each); checked against the FE table's notches and held-out rows (docs/design.md).
+#: Not for notches on alternate sides (two directions interleaved): there the FE row is several times softer than
+#: this (or any) hinge says (``scripts/fe_notch_table.py --alternating``).
 HINGE_ROW = {"a": (0.151, 0.113, 0.689), "b": 1.32}
 HINGES = ("beam", "fe_fit", "fe_row")
 

@@ -64,3 +64,17 @@ def test_fe_row_hinge_follows_each_notch_of_a_row():
     mixed = notch_fe(0.75, 0.45, 2.83, (0.4, 0.8, 0.4), web_mm=0.3, **mesh)
     assert mixed.per_notch_nmm_per_rad[1] < 0.75 * middle
     assert abs(mixed.closure_error) <= 0.10
+
+
+def test_notches_on_alternate_sides_make_a_far_softer_row():
+    """Notches cut on alternate sides (two directions interleaved, as example 07) at a short web: the moment must
+    go round the web's ring from one backbone to the next, so a notch between two opposite ones is far softer than
+    a lone notch, and softer still than one in a row on one side; no hinge model counts this (docs/design.md)."""
+    mesh = dict(n_backbone=16, n_cut=8, n_lead=6, n_notch=3)
+    one = notch_fe(0.75, 0.45, 3.21, 0.45, **mesh)
+    alt = notch_fe(0.75, 0.45, 3.21, 0.45, count=3, web_mm=0.28, angles_deg=(0, 180, 0), **mesh)
+    assert alt.middle_nmm_per_rad < 0.5 * one.stiffness_nmm_per_rad
+    assert alt.per_notch_closure_deg[0] != alt.per_notch_closure_deg[0]  # nan: the moment opens a notch at 0 deg
+    assert 0.0 < alt.closure_deg < alt.model_closure_deg  # it rotates with the ring: its mouth closes sooner
+    with pytest.raises(ValueError):
+        notch_fe(0.75, 0.45, 3.21, 0.45, count=3, angles_deg=(0, 90, 0), **mesh)
