@@ -19,9 +19,10 @@ def register(sub) -> None:
                         "and strain, tendon force, tip position and direction, one tendon pulled at a time")
     p.add_argument("--calibration", metavar="FIT.json",
                    help="with --stroke: use the parameters of a 'camtube model fit/diagnose --json' file")
-    p.add_argument("--hinge", choices=("beam", "fe_fit"), default="beam",
-                   help="with --stroke: notch stiffness E I / h (beam, default) or with the root length a "
-                        "finite-element model shows (fe_fit; see docs/design.md)")
+    p.add_argument("--hinge", choices=("fe_row", "beam", "fe_fit"), default="fe_row",
+                   help="with --stroke: notch stiffness: E I over h plus a root length that shrinks with the webs "
+                        "to the neighbours (fe_row, default, fitted to FE runs of notches in rows), E I / h (beam, "
+                        "the paper's) or with a lone notch's root length (fe_fit); see docs/design.md")
     p.add_argument("--overcut", type=float, metavar="MM",
                    help="with --stroke: how much wider than drawn each notch is cut, mm (default: 0 with kerf "
                         "compensation, else the calibration's kerf or the 0.02 mm the CAD verification assumes; "

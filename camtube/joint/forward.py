@@ -15,8 +15,10 @@ Along one tendon, notches are taken from the base (large ``x``) to the tip:
 * the stroke is ``slack + sum_i arm_i theta_i + elongation(F)``, with the elastic elongation
   ``F L0 / (E_t pi r_t^2)`` (plus a toe region and a series compliance when calibrated).
 
-``Mechanics(hinge="fe_fit")`` lengthens each backbone beam by the root length a finite-element model of
-the notch shows (:data:`HINGE_FE_POLY`, :mod:`camtube.joint.fe`); the default ``beam`` is the paper's ``h``.
+Each backbone beam is longer than ``h`` by the root length the finite-element model of a notch in its row
+shows (:mod:`camtube.joint.fe`): the default hinge ``fe_row`` (:data:`HINGE_ROW`) shortens a lone notch's root by
+the webs to its neighbours (the notches of its own direction); ``beam`` is the paper's ``h`` and ``fe_fit`` a lone
+notch's root (:data:`HINGE_FE_POLY`).
 For a given stroke the motor-side force ``F`` is the root of that (monotone) stroke equation.
 The tip pose follows by chaining the notch rotations, each about its backbone's neutral axis.
 """
@@ -45,18 +47,73 @@ FALLBACK_MODULUS_GPA = 2.5
 #: depends on h, and peaks near phi = 3 (a half-tube backbone) at about one outer radius. Those runs were of a notch
 #: *alone*; in a pattern the webs are shorter than that root length and a notch in its row is 16-55 % stiffer, so
 #: ``fe_fit`` is 16-35 % too soft there, and it ignores the wall ratio (17-21 % too stiff on thin walls): the FE of a
-#: notch in a row lies between ``beam`` and ``fe_fit`` (docs/design.md), which is why ``beam`` stays the default.
+#: notch in a row lies between ``beam`` and ``fe_fit`` (docs/design.md); ``fe_row`` (below) is the default.
 HINGE_FE_POLY = (-0.0737, 0.5155, -0.8976, 1.0071)
-HINGES = ("beam", "fe_fit")
+
+#: ``hinge="fe_row"``: the backbone bends over ``h + r_o A (tanh(w_1 / (B r_o)) + tanh(w_2 / (B r_o))) / 2``,
+#: ``w_1, w_2`` the webs (edge to edge, as cut) to the neighbouring notches on either side (a side without a
+#: neighbour: plain tube, tanh = 1), ``A = a0 + a1 phi + a2 r_i / r_o`` the root length of a lone notch
+#: over r_o and ``B r_o`` the decay length of a root into the tube (a shear-lag root whose far end is the web's
+#: middle, the plane of symmetry between two notches: its compliance is ``tanh(w / 2 lambda)`` of the
+#: unbounded root's). Fitted by ``python scripts/fe_row_runs.py fit`` to the 20 training runs of
+#: scripts/data/fe_row_train.json (rows of five, a Latin hypercube over r_o, r_i / r_o, phi, h and the web; the
+#: middle and the far-end notch of each); checked against the FE table's notches and held-out rows (docs/design.md).
+#: Not for notches on alternate sides (two directions interleaved): there the FE row is several times softer than
+#: this (or any) hinge says (``scripts/fe_notch_table.py --alternating``).
+HINGE_ROW = {"a": (0.151, 0.113, 0.689), "b": 1.32}
+HINGES = ("beam", "fe_fit", "fe_row")
 
 
-def hinge_extra_mm(outer_radius_mm: float, phi_rad: float, hinge: str = "beam") -> float:
-    """Extra bending length (mm) of a notch's backbone beyond its width h (0 for the plain beam model)."""
+def hinge_extra_mm(outer_radius_mm: float, phi_rad: float, hinge: str = "beam", *,
+                   inner_radius_mm: float | None = None, webs_mm=(math.inf, math.inf)) -> float:
+    """Extra bending length (mm) of a notch's backbone beyond its width h (0 for the plain beam model).
+
+    ``fe_row`` needs ``inner_radius_mm`` and the webs (mm, edge to edge, as cut) to the neighbouring notches on
+    either side (``math.inf``: plain tube on that side; the default, a lone notch).
+    """
+    return hinge_root_mm(outer_radius_mm, phi_rad, hinge, inner_radius_mm) * hinge_side_factor(
+        outer_radius_mm, webs_mm, hinge)
+
+
+def hinge_root_mm(outer_radius_mm: float, phi_rad: float, hinge: str = "beam",
+                  inner_radius_mm: float | None = None) -> float:
+    """The extra bending length (mm) of a lone notch (plain tube on both sides)."""
     if hinge == "beam":
         return 0.0
-    if hinge != "fe_fit":
+    if hinge == "fe_fit":
+        return outer_radius_mm * max(float(np.polyval(HINGE_FE_POLY, phi_rad)), 0.0)
+    if hinge != "fe_row":
         raise ValueError(f"unknown hinge model {hinge!r}; one of {', '.join(HINGES)}")
-    return outer_radius_mm * max(float(np.polyval(HINGE_FE_POLY, phi_rad)), 0.0)
+    if inner_radius_mm is None:
+        raise ValueError("the fe_row hinge needs the inner radius")
+    return row_extra_mm(outer_radius_mm, inner_radius_mm, phi_rad, (math.inf, math.inf), HINGE_ROW["a"],
+                        HINGE_ROW["b"])
+
+
+def hinge_side_factor(outer_radius_mm: float, webs_mm, hinge: str = "beam") -> float:
+    """The share (0..1] of the lone notch's root length left by the webs to its neighbours (1 but for ``fe_row``)."""
+    if hinge != "fe_row":
+        return 1.0
+    return _sides(outer_radius_mm, webs_mm, HINGE_ROW["b"])
+
+
+def _sides(outer_radius_mm: float, webs_mm, b: float) -> float:
+    sides = [math.tanh(max(w, 0.0) / (b * outer_radius_mm)) if math.isfinite(w) else 1.0 for w in webs_mm]
+    return sum(sides) / len(sides)
+
+
+def row_extra_mm(outer_radius_mm: float, inner_radius_mm: float, phi_rad: float, webs_mm, a, b: float) -> float:
+    """The ``fe_row`` root length (mm) with coefficients ``a = (a0, a1, a2)`` and ``b`` (see :data:`HINGE_ROW`)."""
+    root = a[0] + a[1] * phi_rad + a[2] * inner_radius_mm / outer_radius_mm
+    return outer_radius_mm * max(root, 0.0) * _sides(outer_radius_mm, webs_mm, b)
+
+
+def row_webs_mm(x_mm, width_mm) -> list[tuple[float, float]]:
+    """Per notch (in the order given, along the tube) the webs (mm, edge to edge) to the previous and the next
+    notch of the row; ``math.inf`` at the row's ends."""
+    x, h = np.asarray(x_mm, float), np.asarray(width_mm, float)
+    gaps = [abs(x[i + 1] - x[i]) - (h[i] + h[i + 1]) / 2.0 for i in range(len(x) - 1)]
+    return [(gaps[i - 1] if i > 0 else math.inf, gaps[i] if i < len(gaps) else math.inf) for i in range(len(x))]
 
 
 @dataclass(frozen=True)
@@ -85,10 +142,10 @@ class Mechanics:
         (a job planned without kerf compensation cuts its first pass on the design line).
     sheath_loss : float
         Fraction of the motor-side force lost before the joint (tendon-sheath friction while pulling).
-    hinge : {"beam", "fe_fit"}
-        How long a beam the backbone is: ``beam`` (the paper's and ``design``'s: the notch width h) or
-        ``fe_fit`` (h plus the root length that a finite-element model of the notch shows,
-        :data:`HINGE_FE_POLY`).
+    hinge : {"fe_row", "beam", "fe_fit"}
+        How long a beam the backbone is: ``fe_row`` (the default: h plus a root length that shrinks with the
+        webs to the neighbouring notches, :data:`HINGE_ROW`), ``beam`` (the paper's: the notch width h) or
+        ``fe_fit`` (h plus the root length of a lone notch, :data:`HINGE_FE_POLY`).
     source : str
         Where the values came from (``defaults`` or a fit file).
     ignored : tuple[str, ...]
@@ -105,7 +162,7 @@ class Mechanics:
     arm_scale: float = 1.0
     kerf_mm: float = 0.0
     sheath_loss: float = 0.0
-    hinge: str = "beam"
+    hinge: str = "fe_row"
     source: str = "defaults"
     ignored: tuple[str, ...] = ()
 
@@ -210,7 +267,7 @@ class NotchSet:
     ybar_mm : (n,) float
         Backbone centroid distance from the tube axis.
     stiffness_nmm_per_rad : (n,) float
-        ``E I / h`` of each notch.
+        ``E I / L`` of each notch (``L`` its bending length).
     closure_rad : (n,) float
         Angle at which each notch closes.
     extreme_fibre_mm : (n,) float
@@ -247,10 +304,12 @@ class NotchSet:
 
 
 def notch_set(tube, tendon_radius_mm: float, angle_deg: float, x_mm, width_mm, arc_mm,
-              mechanics: Mechanics = Mechanics(), index=None) -> NotchSet:
+              mechanics: Mechanics = Mechanics(), index=None, webs_mm=None) -> NotchSet:
     """A :class:`NotchSet` from per-notch arrays (base to tip): centres, widths h and arcs s (mm).
 
     ``mechanics.kerf_mm`` widens each arc and width (as cut); the arcs are kept inside ``(0, 2 pi r_o)``.
+    ``webs_mm`` (the ``fe_row`` hinge): per notch the two webs (as cut) to its neighbours; by default from the
+    centres and the as-cut widths of these notches (:func:`row_webs_mm`).
     """
     e = mechanics.modulus_gpa(tube.material) * 1e3  # N/mm^2
     circ = tube.circumference_mm
@@ -259,8 +318,11 @@ def notch_set(tube, tendon_radius_mm: float, angle_deg: float, x_mm, width_mm, a
                            max(float(h) + mechanics.kerf_mm, 1e-6), tendon_radius_mm)
             for h, s in zip(width_mm, arc_mm)]
     n = len(geos)
-    bend_len = np.array([g.notch_width_mm + hinge_extra_mm(g.outer_radius_mm, g.phi_rad, mechanics.hinge)
-                         for g in geos])
+    if webs_mm is None:
+        webs_mm = row_webs_mm(x_mm, [g.notch_width_mm for g in geos])
+    bend_len = np.array([g.notch_width_mm + hinge_extra_mm(g.outer_radius_mm, g.phi_rad, mechanics.hinge,
+                                                           inner_radius_mm=g.inner_radius_mm, webs_mm=w)
+                         for g, w in zip(geos, webs_mm)])
     return NotchSet(
         angle_deg=angle_deg,
         index=np.arange(n) if index is None else np.asarray(index, int),

@@ -12,8 +12,10 @@ mistake in one is not repeated in the other:
 * **mechanics with exact chord geometry**: the notch's neutral fibre bends into an arc of radius
   ``R = h / theta``; the tendon, ``a`` from it on the notch side, crosses the notch as a straight chord
   of length ``2 (R - a) sin(theta / 2)``; the tendon force along that chord has the moment arm
-  ``R (1 - cos(theta/2)) + a cos(theta/2)`` about the fibre's middle, and ``theta = M h / (E I)`` is
-  solved notch by notch (``brentq``) with capstan friction over each notch's wrap;
+  ``R (1 - cos(theta/2)) + a cos(theta/2)`` about the fibre's middle, and ``theta = M L / (E I)`` is
+  solved notch by notch (``brentq``) with capstan friction over each notch's wrap; the bending length ``L`` is
+  the hinge model's (``h`` for ``beam``; ``h`` plus the root length of :func:`camtube.joint.forward.hinge_extra_mm`
+  for ``fe_fit`` and ``fe_row``, with this module's own backbone angle and as-cut webs): the one formula shared;
 * the motor-side force follows from ``stroke = slack + sum (h - chord) + F C``.
 * the tip direction of a several-direction (3-D) pattern composes every notch's turn with scipy's
   ``Rotation`` (:func:`tip_direction`).
@@ -126,8 +128,9 @@ class Resimulated:
     notch_angles_deg: np.ndarray
 
 
-def _notch_angle(tension: float, h: float, a: float, ei: float) -> float:
-    """theta with theta E I / h = T (R (1 - cos(theta/2)) + a cos(theta/2)), R = h / theta."""
+def _notch_angle(tension: float, h: float, a: float, ei: float, length: float | None = None) -> float:
+    """theta with theta E I / L = T (R (1 - cos(theta/2)) + a cos(theta/2)), R = h / theta (L: the bending
+    length, h by default)."""
     from scipy.optimize import brentq
 
     if tension <= 0.0:
@@ -136,7 +139,7 @@ def _notch_angle(tension: float, h: float, a: float, ei: float) -> float:
     def f(th: float) -> float:
         r = h / th
         arm = r * (1.0 - math.cos(th / 2.0)) + a * math.cos(th / 2.0)
-        return th * ei / h - tension * arm
+        return th * ei / (h if length is None else length) - tension * arm
 
     hi = 0.5
     while f(hi) < 0.0 and hi < 3.0:
@@ -146,7 +149,7 @@ def _notch_angle(tension: float, h: float, a: float, ei: float) -> float:
 
 def resimulate(pattern: Pattern, strokes: dict[float, float], *, friction: float | None = None,
                tube_modulus_gpa: float | None = None, kerf_mm: float | None = None,
-               notches: tuple[AsCutNotch, ...] | None = None) -> tuple[Resimulated, ...]:
+               notches: tuple[AsCutNotch, ...] | None = None, hinge: str | None = None) -> tuple[Resimulated, ...]:
     """Re-simulate each pulled direction of ``pattern`` from its as-cut notches (see the module docstring).
 
     Parameters
@@ -160,8 +163,12 @@ def resimulate(pattern: Pattern, strokes: dict[float, float], *, friction: float
         Beam kerf of the simulation (default: the process's, or the simulation's default).
     notches : optional
         As-cut notches (default: :func:`as_cut_notches`).
+    hinge : str, optional
+        The hinge model of the bending length (default: the forward model's default, ``Mechanics().hinge``).
     """
     from scipy.optimize import brentq
+
+    from camtube.joint.forward import Mechanics, hinge_extra_mm
 
     t = pattern.tube
     td = pattern.tendon
@@ -177,11 +184,16 @@ def resimulate(pattern: Pattern, strokes: dict[float, float], *, friction: float
         a = [s.centroid_mm + t.inner_radius_mm - td.radius_mm for s in secs]
         ei = [e * s.second_moment_mm4 for s in secs]
         h = [n.width_mm for n in mine]
+        gaps = [abs(p.x_mm - q.x_mm) - (p.width_mm + q.width_mm) / 2.0 for p, q in zip(mine, mine[1:])]
+        webs = [(gaps[k - 1] if k else math.inf, gaps[k] if k < len(gaps) else math.inf) for k in range(len(mine))]
+        ln = [hk + hinge_extra_mm(t.outer_radius_mm, 2.0 * math.pi - n.arc_mm / t.outer_radius_mm,
+                                  hinge or Mechanics().hinge, inner_radius_mm=t.inner_radius_mm, webs_mm=w)
+              for hk, n, w in zip(h, mine, webs)]
 
         def angles(force: float) -> list[float]:
             tension, res = force, []
             for k in range(len(mine)):
-                th = _notch_angle(tension, h[k], a[k], ei[k])
+                th = _notch_angle(tension, h[k], a[k], ei[k], ln[k])
                 res.append(th)
                 tension *= math.exp(-mu * th)
             return res
@@ -197,7 +209,7 @@ def resimulate(pattern: Pattern, strokes: dict[float, float], *, friction: float
             hi *= 2.0
         f = float(brentq(travel, 0.0, hi, xtol=1e-12))
         th = np.array(angles(f))
-        strain = max(s.extreme_fibre_mm * x / hk for s, x, hk in zip(secs, th, h))
+        strain = max(s.extreme_fibre_mm * x / lk for s, x, lk in zip(secs, th, ln))
         out.append(Resimulated(ang, stroke, math.degrees(float(th.sum())), f, float(strain), np.degrees(th)))
     return tuple(out)
 

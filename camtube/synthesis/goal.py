@@ -41,9 +41,10 @@ GOAL_SCHEMA: dict = {
         "material": Field("choice", "", "tube material", "polyimide",
                           choices=("polyimide", "pebax", "nitinol", "other")),
         "modulus_gpa": Field("float", "GPa", "Young's modulus of the tube (default: 2.5 for polyimide)", None, **POS),
-        "hinge": Field("choice", "", "notch stiffness: beam (E I / h, the paper's; too stiff) or fe_fit (h plus the "
-                       "root length a finite-element model of a lone notch shows; too soft in a row); see docs/design.md",
-                       "beam", choices=("beam", "fe_fit")),
+        "hinge": Field("choice", "", "notch stiffness: fe_row (h plus a root length that shrinks with the webs to "
+                       "the neighbours, fitted to FE runs of notches in rows: within 7 % of the FE), beam (E I / h, the "
+                       "paper's: 1.3-4.6 x too stiff) or fe_fit (h plus a lone notch's root length: 11-45 % too soft in "
+                       "a row); see docs/design.md", "fe_row", choices=("fe_row", "beam", "fe_fit")),
     },
     "tendon": {
         "radius": Field("float", "mm", "tendon radius r_t", 0.04, **POS),
@@ -175,7 +176,7 @@ class Goal:
     base_length_mm: float = 1.5
     limits: Limits = field(default_factory=Limits)
     process: object = "femto-polyimide.yaml"
-    hinge: str = "beam"
+    hinge: str = "fe_row"
     centerline: tuple["Arc", ...] = ()
     name: str = "goal"
     source: str | None = None

@@ -33,7 +33,7 @@ import numpy as np
 from camtube.design.geometry import joint_geometry
 from camtube.design.pattern import Pattern, Process, Rules, Tube, hole, sort_cuts
 from camtube.errors import CamtubeError
-from camtube.joint.forward import Mechanics, hinge_extra_mm, notch_set
+from camtube.joint.forward import Mechanics, hinge_root_mm, hinge_side_factor, notch_set
 from camtube.synthesis.goal import BendTarget, Goal, shares_from_tip
 
 #: Backbone strain aimed at, as a fraction of ``limits.max_strain`` (room for the laser's tolerance).
@@ -168,7 +168,8 @@ class _Grid:
         self.arm = np.array([g.moment_arm_mm for g in geos]) * mech.arm_scale
         self.e = np.array([g.extreme_fibre_mm for g in geos])
         self.ybar = np.array([g.ybar_mm for g in geos])
-        self.extra = np.array([hinge_extra_mm(ro, g.phi_rad, mech.hinge) for g in geos])  # beyond h
+        # beyond h: a lone notch's root length (times each notch's side factor, 1 but for the fe_row hinge)
+        self.extra = np.array([hinge_root_mm(ro, g.phi_rad, mech.hinge, ri) for g in geos])
         self.ro = ro
 
 
@@ -177,22 +178,57 @@ def _elongation(goal: Goal, mech: Mechanics, f: float) -> float:
     return mech.elongation_mm(f, probe)
 
 
-def _choose(grid: _Grid, goal: Goal, th: np.ndarray, tension: np.ndarray):
-    """Per notch (base to tip) the grid index of the largest arc that keeps the limits, or -1; and h there."""
+def _choose(grid: _Grid, goal: Goal, th: np.ndarray, tension: np.ndarray, side: np.ndarray):
+    """Per notch (base to tip) the grid index of the largest arc that keeps the limits, or -1; and h there.
+    ``side``: per notch the share of the root length its webs leave (:func:`hinge_side_factor`)."""
     lim = goal.limits
     m = tension[:, None] * grid.arm[None, :]  # (n, m) moment N mm
     strain = m * grid.e[None, :] / grid.ei[None, :]
-    h = th[:, None] * grid.ei[None, :] / np.maximum(m, 1e-300) - grid.extra[None, :]  # as-cut width
+    h = th[:, None] * grid.ei[None, :] / np.maximum(m, 1e-300) - grid.extra[None, :] * side[:, None]  # as cut
     h_close = th[:, None] * (grid.ro + grid.ybar[None, :]) / CLOSE_MARGIN
     ok = (strain <= STRAIN_DESIGN * lim.max_strain) & (h >= lim.min_feature_mm + grid.kerf) & (h >= h_close)
     idx = np.where(ok.any(axis=1), ok.shape[1] - 1 - np.argmax(ok[:, ::-1], axis=1), -1)
     return idx, h, strain, h_close
 
 
+def _pairs(gaps) -> list[tuple[float, float]]:
+    """Per notch (base to tip) its webs to the previous and the next notch from the gaps between them."""
+    n = len(gaps) + 1
+    return [(gaps[i - 1] if i > 0 else math.inf, gaps[i] if i < n - 1 else math.inf) for i in range(n)]
+
+
 def _solve_count(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget, n: int,
-                 budget_mm: float) -> DirectionDesign | _Fail:
-    """The design of one direction with ``n`` notches, or why there is none."""
+                 budget_mm: float, gaps_fn=None) -> DirectionDesign | _Fail:
+    """The design of one direction with ``n`` notches, or why there is none.
+
+    With the ``fe_row`` hinge a notch's stiffness depends on the webs to its neighbours (as cut), which
+    ``gaps_fn(widths from the tip)`` gives (base to tip) in the pattern's layout: on a curve they depend on the
+    widths, so the solve is repeated with the webs of the widths found until they no longer change.
+    """
+    if mech.hinge != "fe_row" or gaps_fn is None or n < 2:
+        return _solve_count_at(goal, mech, grid, target, n, budget_mm, None)
+    widths = (goal.curve_length_mm / n / 2.0 if goal.curve_deg_per_mm else 0.5,) * n
+    gaps = [max(x, 0.0) for x in gaps_fn(widths)]  # overlapping notches: no web, no root (and no design)
+    for _ in range(30):  # the widths (first pass, before the polish) and the webs they leave, until they settle
+        w = _solve_count_at(goal, mech, grid, target, n, budget_mm, _pairs(gaps), widths_only=True)
+        if not isinstance(w, tuple):
+            return w
+        new = [max(x, 0.0) for x in gaps_fn(w)]
+        if max(abs(a - b) for a, b in zip(new, gaps)) < 1.5e-3:  # widths are rounded to 1 um
+            break
+        gaps = [(a + b) / 2.0 for a, b in zip(gaps, new)]  # damped: a wider notch leaves a shorter web
+    return _solve_count_at(goal, mech, grid, target, n, budget_mm, _pairs(gaps))
+
+
+def _solve_count_at(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget, n: int,
+                    budget_mm: float, webs, widths_only: bool = False) -> DirectionDesign | _Fail | tuple:
+    """:func:`_solve_count` at given webs (per notch base to tip, as cut; None: the goal's web inside the row);
+    ``widths_only``: just the drawn widths from the tip (the first pass: the polish keeps them)."""
     from scipy.optimize import brentq, least_squares
+
+    if webs is None:
+        webs = _pairs([goal.web_mm - mech.kerf_mm] * (n - 1)) if n > 1 else [(math.inf, math.inf)]
+    side = np.array([hinge_side_factor(goal.tube.outer_radius_mm, w, mech.hinge) for w in webs])
 
     lim = goal.limits
     shares = np.array(shares_from_tip(goal, n))
@@ -206,7 +242,7 @@ def _solve_count(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget, n
                      f"{mech.slack_mm:g} mm", "bend")
 
     def state(f: float):
-        idx, h, strain, h_close = _choose(grid, goal, th, f * keep)
+        idx, h, strain, h_close = _choose(grid, goal, th, f * keep, side)
         if (idx < 0).any():
             return None, idx, h, strain, h_close
         kin = float(np.sum(grid.arm[idx] * th))
@@ -250,13 +286,15 @@ def _solve_count(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget, n
     k = grid.kerf  # drawn = as cut - k
     widths = np.ceil((h[np.arange(n), idx] - k) / WIDTH_STEP_MM - 1e-9) * WIDTH_STEP_MM
     widths = np.maximum(widths, lim.min_feature_mm)
+    if widths_only:
+        return tuple(float(w) for w in widths[::-1])
     arcs0 = grid.s[idx] - k
 
-    x = np.zeros(n)  # positions do not enter the angles
+    x = np.zeros(n)  # positions do not enter the angles (the webs are given)
     probe = Pattern("goal", goal.tube, (), tendon=goal.tendon)
 
     def residuals(v: np.ndarray) -> np.ndarray:
-        ns = notch_set(goal.tube, goal.tendon.radius_mm, target.angle_deg, x, widths, v[:n], mech)
+        ns = notch_set(goal.tube, goal.tendon.radius_mm, target.angle_deg, x, widths, v[:n], mech, webs_mm=webs)
         ang = ns.angles_at(v[n] * (1.0 - mech.sheath_loss), mu)
         st = float(ns.arm_mm @ ang) + mech.elongation_mm(v[n], probe) - stroke
         return np.concatenate([(ang - th) * 1e3, [st * 1e2]])
@@ -274,7 +312,7 @@ def _solve_count(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget, n
     if force > lim.max_force_N:
         return _Fail("limits.max_force_N", f"the tendon force at {target.stroke_mm:g} mm of stroke would be "
                      f"{force:.2f} N, more than limits.max_force_N = {lim.max_force_N:g} N", "stroke")
-    ns = notch_set(goal.tube, goal.tendon.radius_mm, target.angle_deg, x, widths, arcs, mech)
+    ns = notch_set(goal.tube, goal.tendon.radius_mm, target.angle_deg, x, widths, arcs, mech, webs_mm=webs)
     strain_now = ns.strain(ns.angles_at(force * (1.0 - mech.sheath_loss), mu))
     if float(np.max(strain_now)) > lim.max_strain:
         return _Fail("limits.max_strain", f"the backbone strain would be {float(np.max(strain_now)):.4f}, above "
@@ -323,7 +361,7 @@ def _counts(goal: Goal, target: BendTarget) -> list[int]:
 
 
 def _solve_direction(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget,
-                     budget_mm: float, deadline: float = math.inf) -> DirectionDesign | _Fail:
+                     budget_mm: float, deadline: float = math.inf, gaps_fn=None) -> DirectionDesign | _Fail:
     import time
 
     first: _Fail | None = None
@@ -331,7 +369,7 @@ def _solve_direction(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarge
     for n in _counts(goal, target):
         if first is not None and time.perf_counter() > deadline:
             break
-        r = _solve_count(goal, mech, grid, target, n, budget_mm)
+        r = _solve_count(goal, mech, grid, target, n, budget_mm, gaps_fn)
         if isinstance(r, DirectionDesign):
             return r
         first = first or r
@@ -368,12 +406,35 @@ def _axis_pitch(goal: Goal, mech: Mechanics, d: DirectionDesign, length_mm: floa
     return replace(d, pitch_mm=(length_mm + float(ybar @ th)) / d.count)
 
 
+def _gaps_fn(goal: Goal, piece: Goal, mech: Mechanics, target: BendTarget, dirs: list, i: int,
+             pitch_add_mm: float = 0.0):
+    """``widths from the tip -> webs as cut (base to tip)`` between the notches of direction ``i`` (its notches of
+    ``widths``, the others as in ``dirs``) in the goal's layout: what the forward model will see (a notch's
+    neighbours are the notches of its own direction, its tendon's). ``pitch_add_mm``: a centre-line piece's
+    lengthening of the pitch (:func:`_axis_pitch`)."""
+    def f(widths) -> list[float]:
+        n = len(widths)
+        pitch = piece.curve_length_mm / n + pitch_add_mm if piece.curve_deg_per_mm else None
+        cand = DirectionDesign(target, tuple(float(w) for w in widths), (0.0,) * n, (), 0.0, pitch)
+        ds = list(dirs)
+        ds[i] = cand
+        rows = _layout_rows(goal, ds)
+        webs = _webs(goal, rows)
+        x, pos = [], 0.0
+        for j, r in enumerate(rows):
+            pos += (rows[j - 1][0] / 2.0 + webs[j - 1] if j else 0.0) + r[0] / 2.0
+            x.append(pos)
+        mine = sorted(((xx, r[0]) for xx, r in zip(x, rows) if r[2] == target.angle_deg), key=lambda t: -t[0])
+        return [abs(a[0] - b[0]) - (a[1] + b[1]) / 2.0 - mech.kerf_mm for a, b in zip(mine, mine[1:])]
+    return f
+
+
 def _solve_all(goal: Goal, mech: Mechanics, grid: _Grid,
                deadline: float = math.inf) -> tuple[DirectionDesign, ...] | tuple[int, _Fail]:
     out = []
     for i, b in enumerate(goal.bends):
         g, budget = _piece_goal(goal, i)
-        r = _solve_direction(g, mech, grid, b, budget, deadline)
+        r = _solve_direction(g, mech, grid, b, budget, deadline, _gaps_fn(goal, g, mech, b, [None], 0))
         if isinstance(r, _Fail):
             if goal.centerline and r.limit == "goal.curve_length":
                 r = replace(r, limit=f"goal.centerline[{i}].length_mm",
@@ -381,7 +442,34 @@ def _solve_all(goal: Goal, mech: Mechanics, grid: _Grid,
             return i, r
         if goal.centerline:
             r = _axis_pitch(goal, mech, r, goal.centerline[i].length_mm)
+            for _ in range(4 if mech.hinge == "fe_row" else 0):
+                # the webs follow the lengthened pitch: solve again with it until the pitch settles
+                add = r.pitch_mm - g.curve_length_mm / r.count
+                gaps = _gaps_fn(goal, g, mech, b, [None], 0, add)
+                r2 = _solve_count(g, mech, grid, b, r.count, budget, gaps)  # the same count first (fast)
+                if isinstance(r2, _Fail):
+                    r2 = _solve_direction(g, mech, grid, b, budget, deadline, gaps)
+                if isinstance(r2, _Fail):
+                    return i, r2
+                r2 = _axis_pitch(goal, mech, r2, goal.centerline[i].length_mm)
+                settled = r2.count == r.count and abs(r2.pitch_mm - r.pitch_mm) < 1e-7
+                r = r2
+                if settled:
+                    break
         out.append(r)
+    for _ in range(4 if (mech.hinge == "fe_row" and len(out) > 1 and not goal.centerline
+                         and goal.layout != "sequential") else 0):
+        # interleaved directions: a notch's own direction's neighbours are two cells away, across another
+        # direction's notch: solve again with the others' widths as the last pass found them, until they settle
+        last = list(out)
+        for i, b in enumerate(goal.bends):
+            g, budget = _piece_goal(goal, i)
+            r = _solve_direction(g, mech, grid, b, budget, deadline, _gaps_fn(goal, g, mech, b, last, i))
+            if isinstance(r, _Fail):
+                return i, r
+            out[i] = r
+        if all(a.widths_mm == b.widths_mm for a, b in zip(last, out)):
+            break
     total = _layout_length(goal, out)
     if total > goal.limits.max_length_mm + 1e-9:
         return 0, _Fail("limits.max_length", f"the {len(out)} directions together make a joint of {total:.2f} mm, "

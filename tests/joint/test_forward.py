@@ -15,13 +15,16 @@ from camtube.design.loader import load_pattern
 from camtube.joint import Mechanics, simulate
 from tests.conftest import PRESETS
 
+#: The paper's hinge (E I / h), which the closed-form series model of design.geometry is.
+BEAM = Mechanics(hinge="beam")
+
 
 @pytest.mark.parametrize("name", PRESETS)
 @pytest.mark.parametrize("stroke", [0.3, 1.0, 2.0])
 def test_uniform_frictionless_matches_the_closed_form_series_model(name, stroke):
     p = load_pattern(name)
     d = bends_at_stroke(p, stroke)[0]
-    st = simulate(p, stroke).direction(180.0)
+    st = simulate(p, stroke, BEAM).direction(180.0)
     assert st.bend_deg == pytest.approx(math.degrees(d.bend_rad), rel=1e-9)
     assert float(st.strain.max()) == pytest.approx(d.strain, rel=1e-9)
     np.testing.assert_allclose(st.shares, 1.0 / len(st.shares), rtol=1e-9)
@@ -29,7 +32,7 @@ def test_uniform_frictionless_matches_the_closed_form_series_model(name, stroke)
 
 def test_capstan_friction_lowers_the_tension_notch_by_notch():
     p = replace(load_pattern("tube1"), tendon=replace(load_pattern("tube1").tendon, friction=0.3))
-    st = simulate(p, 1.5).direction(180.0)
+    st = simulate(p, 1.5, BEAM).direction(180.0)
     th = st.notch_angles_rad  # base to tip
     # uniform notches: the angle is proportional to the tension, which falls by exp(-mu theta) per notch
     np.testing.assert_allclose(th[1:] / th[:-1], np.exp(-0.3 * th[:-1]), rtol=1e-9)
@@ -40,7 +43,38 @@ def test_capstan_friction_lowers_the_tension_notch_by_notch():
     # the base notch sees the full force
     k = 2.5e3 * g.second_moment_mm4 / 0.5
     assert th[0] == pytest.approx(st.force_N * g.moment_arm_mm / k, rel=1e-9)
-    assert simulate(p, 1.5, Mechanics(friction=0.0)).direction(180.0).bend_deg > st.bend_deg
+    assert simulate(p, 1.5, Mechanics(friction=0.0, hinge="beam")).direction(180.0).bend_deg > st.bend_deg
+
+
+def test_fe_row_hinge_counts_the_webs_to_the_neighbours():
+    """The default hinge: each backbone bends over h plus a root length r_o A (tanh(w_1 / B r_o) + tanh(w_2 / B r_o))
+    / 2, w the webs (as cut) to the neighbouring notches; an end notch has plain tube on one side (tanh = 1), so it
+    is softer than the notches inside the row, which are equal; all are softer than the beam E I / h."""
+    from camtube.joint.forward import HINGE_ROW, direction_notches
+
+    assert Mechanics().hinge == "fe_row"
+    p = load_pattern("tube1")  # uniform: h 0.5, s 2.83, web 0.5 mm
+    kerf = 0.02
+    ns = direction_notches(p, Mechanics(kerf_mm=kerf))[0]
+    g = joint_geometry(0.75, 0.45, 2.83 + kerf, 0.5 + kerf)
+    (a0, a1, a2), b = HINGE_ROW["a"], HINGE_ROW["b"]
+    root = 0.75 * (a0 + a1 * g.phi_rad + a2 * 0.45 / 0.75)
+    web = 0.5 - kerf  # the cut widens each notch by the kerf: the web between two is that much shorter
+    inside = 0.52 + root * math.tanh(web / (b * 0.75))
+    end = 0.52 + root * (math.tanh(web / (b * 0.75)) + 1.0) / 2.0
+    np.testing.assert_allclose(ns.bending_length_mm[1:-1], inside, rtol=1e-12)
+    np.testing.assert_allclose(ns.bending_length_mm[[0, -1]], end, rtol=1e-12)
+    ei = 2.5e3 * g.second_moment_mm4
+    np.testing.assert_allclose(ns.stiffness_nmm_per_rad, ei / ns.bending_length_mm, rtol=1e-12)
+    assert ns.stiffness_nmm_per_rad[0] < ns.stiffness_nmm_per_rad[1] < ei / 0.52
+    # a lone notch (plain tube on both sides) has the whole root; a web of nothing leaves none
+    from camtube.joint.forward import hinge_extra_mm
+
+    assert hinge_extra_mm(0.75, g.phi_rad, "fe_row", inner_radius_mm=0.45) == pytest.approx(root, rel=1e-12)
+    assert hinge_extra_mm(0.75, g.phi_rad, "fe_row", inner_radius_mm=0.45, webs_mm=(0.0, 0.0)) == 0.0
+    # the stroke balance holds with the softer notches, and they bend more at the same stroke
+    st = simulate(p, 1.5, Mechanics(kerf_mm=kerf)).direction(180.0)
+    assert st.bend_deg > simulate(p, 1.5, replace(Mechanics(kerf_mm=kerf), hinge="beam")).direction(180.0).bend_deg
 
 
 def test_closed_notches_stop_bending_and_the_tendon_takes_the_rest():
@@ -84,7 +118,7 @@ def test_calibration_from_a_real_fit_json(tmp_path):
     r = fit(model_for_pattern(p), data, fit_params=("E_t",), fixed=pattern_values(p))
     path = tmp_path / "fit.json"
     path.write_text(fit_json(r))
-    mech = Mechanics.from_fit_json(path)
+    mech = replace(Mechanics.from_fit_json(path), hinge="beam")  # the closed form below is the beam's
     assert mech.tendon_modulus_gpa == pytest.approx(14.0, rel=0.05)
     # closed form with the fitted E_t: stroke = arm theta + F C, F arm = K theta
     g = joint_geometry(0.85, 0.55, 3.20, 0.5)
