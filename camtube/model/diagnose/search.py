@@ -90,6 +90,7 @@ others are ratios of errors or multiples of standard errors.
 """
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from dataclasses import dataclass, field, replace
@@ -98,7 +99,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from camtube.model.core.fit import FitResult, fit
-from camtube.model.core.model import Effect, JointModel
+from camtube.model.core.model import Effect, FitError, JointModel
 from camtube.model.core.registry import Registry, builtin_registry
 from camtube.model.data.csvfile import check_fittable
 from camtube.model.data.dataset import Cache, Dataset
@@ -1236,8 +1237,82 @@ class Search:
             self.fit_base()
         while self.step():
             pass
+        self.try_sample_wise()
         self.clock["search"] = time.perf_counter()
         return self.result()
+
+    def try_sample_wise(self) -> bool:
+        """When the chain leaves the error above :data:`REACH_RATIO` x the floor and there are several samples:
+        diagnose each sample alone; when they show different effects, fit the union with each effect held off
+        (at its ``off`` values) in the samples that do not show it, and take it as the chain when it lowers the
+        all-rows error and BIC with every parameter resolved and a waterfall that lowers at every step. Two
+        samples that each need a different first effect defeat the joint greedy search (a stand-in that
+        serves both wins its first round); one sample at a time does not. True when the chain changed."""
+        ch, s, data = self.chain, self.settings, self.data
+        samples = list(data.samples)
+        if not s.per_sample or len(samples) < 2 or ch.all_rows.rmse <= REACH_RATIO * self.floor:
+            return False
+        sub_settings = replace(s, per_sample=False)
+        chains: dict[str, list[str]] = {}
+        inits: dict[str, dict] = {}
+        for smp in samples:
+            sub = data.take(np.asarray(data.sample) == smp)
+            try:
+                d_s = Search(self.given_model, sub, sub_settings, candidates=list(self.all_pool),
+                             registry=self.registry).run()
+            except FitError:
+                return False
+            chains[smp] = list(d_s.recommended) or list(d_s.partial)
+            inits[smp] = d_s.final.params if d_s.recommended else (d_s.partial_steps[-1].params if d_s.partial
+                                                                   else {})
+        union = list(dict.fromkeys(e for smp in samples for e in chains[smp]))
+        if not union or all(chains[smp] == chains[samples[0]] for smp in samples):
+            return False
+        effects = [self.registry[e] for e in union if e not in {x.name for x in ch.model.effects}]
+        if not effects:
+            return False
+        m = ch.model.with_effects(list(ch.model.effects) + effects)
+        names = _names_for(m, s.fit_params)
+        ps = [n for e in effects for n in e.full_names()]
+        start = m.initial_values(data)
+        held = {}
+        for e in effects:
+            for smp in samples:
+                if e.name not in chains[smp] and e.off:
+                    for p in e.params:
+                        nm = f"{e.name}.{p.name}"
+                        held[f"{nm}@{smp}"] = float(e.off[p.name]) if p.name in e.off else float(start[nm])
+        init = {k: v for k, v in ch.all_rows.params.items() if k.split("@")[0] in names and "@" not in k}
+        for smp in samples:
+            init.update({f"{k}@{smp}": v for k, v in inits[smp].items()
+                         if "@" not in k and k in ps and f"{k}@{smp}" not in held})
+        fixed = {**self.fixed, **held}
+        r = refit_all_rows(m, data, names, fixed, init, s.grid, per_sample=ps, max_nfev=CHECK_MAX_NFEV)
+        if (r.nfev >= CHECK_MAX_NFEV or not r.rmse < ch.all_rows.rmse
+                or not r.bic < ch.all_rows.bic - s.bic_threshold
+                or _resolution_problems(m, list(r.fitted), r.params, r.stderr, r.at_bound, data, s.modulus_range_gpa)):
+            return False
+        old_held, self.held = self.held, held
+        order = None
+        for perm in itertools.permutations(effects):
+            inter = self.chain_steps(ch.model, list(perm), range(1, len(perm)), r.params, ps)
+            if _each_lower([ch.steps[0].rmse_deg] + [x.rmse_deg for x in inter] + [r.rmse]):
+                order = list(perm)
+                break
+        if order is None:
+            self.held = old_held
+            return False
+        m = ch.model.with_effects(list(ch.model.effects) + order)
+        r2 = refit_all_rows(m, data, names, fixed, {k: v for k, v in r.params.items() if k in r.fitted}, s.grid,
+                            per_sample=ps)
+        ch.current, ch.names, ch.per_sample, ch.all_rows, ch.chosen = m, names, ps, r2, order
+        ch.steps = ch.steps[:1] + inter + [_step(r2, ps, {k: v for k, v in r.params.items() if k in r.fitted})]
+        self.recommended = [e.name for e in order]
+        self._refit_search(r2.params)
+        shows = "; ".join(f"{smp} shows {', '.join(chains[smp]) or 'nothing'}" for smp in samples)
+        self.notes_late.append(f"each sample diagnosed alone: {shows}; fitted so, each effect held off in the "
+                               "samples that do not show it")
+        return True
 
     # ------------------------------------------------------------------ per sample and the result
     def try_per_sample(self) -> tuple[list[str], list[str], Step | None]:

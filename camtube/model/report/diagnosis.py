@@ -272,7 +272,7 @@ def answer_lines(d: Diagnosis) -> list[str]:
                 if off:
                     on = [smp for smp in samples if smp not in off]
                     out.append(f"  {name}: in sample(s) {', '.join(on)} only; held off in {', '.join(off)} "
-                               "(that sample does not show it: fitted there, its values were not resolved)")
+                               "(that sample does not show it)")
     elif d.partial:
         out.append("answer: nothing the library has explains the misfit; the built-ins that lower it ("
                    + ", ".join(d.partial) + f") leave {_times(d.partial_steps[-1].rmse_deg, floor)} the noise floor "
