@@ -126,7 +126,10 @@ HELDOUT2_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", 
 HELDOUT3_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
                   ("toe", "slack"), ("creep", "slack"), "friction"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
-           "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS)}
+           "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
+           # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
+           # batch's composition, a seed not used before; run once
+           "bench-heldout4": (20261226, HELDOUT3_KINDS)}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
