@@ -15,6 +15,20 @@ from tests.conftest import PATTERNS
 
 TOE_FAMILY = {"toe", "toe_shape", "slack"}
 CREEP_FAMILY = {"creep", "creep_load", "viscoelastic"}
+CREEPING = Tendon(creep_A_mm_per_s=4e-4, creep_n=2.0, creep_sat_mm=0.1)
+
+
+def _two_samples(first: Tendon, second: Tendon):
+    """A 12,000-row bench file of tube 2 (30 cycles at 25 Hz, no spikes or dropouts) whose two samples have the
+    tendons given (and the paper's physics otherwise): ``(pattern, record, diagnosis)``."""
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    trk = Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0)
+    cycle_s = 12000 / 2 / 25.0 / 30
+    prot = Protocol(n_cycles=30, ramp_s=0.3 * cycle_s, dwell_s=0.2 * cycle_s, rest_s=0.2 * cycle_s,
+                    first_dwell_s=0.2 * cycle_s)
+    rec = simulate_bench(p, (SampleBench(tendon=first, tracker=trk), SampleBench(tendon=second, tracker=trk)), prot,
+                         Clock(rate_hz=25.0), seed=5)
+    return p, rec, diagnose(model_for_pattern(p), rec.data, ("E_t",), pattern_values(p))
 
 
 def test_make_params_holds_a_per_sample_copy_given_in_fixed():
@@ -34,15 +48,7 @@ def test_make_params_holds_a_per_sample_copy_given_in_fixed():
 def test_two_samples_with_different_mechanisms_get_each_its_own():
     # sample 1: a braided tendon with a long toe; sample 2: a tendon that creeps under load. Each effect is
     # fitted where its sample shows it and held off in the other; the printed command reproduces the error
-    p = load_pattern(PATTERNS / "tube2.yaml")
-    trk = Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0)
-    toe = SampleBench(tendon=Tendon(crimp_mm=0.3, crimp_shape=2.5), tracker=trk)
-    creep = SampleBench(tendon=Tendon(creep_A_mm_per_s=4e-4, creep_n=2.0, creep_sat_mm=0.1), tracker=trk)
-    cycle_s = 12000 / 2 / 25.0 / 30
-    prot = Protocol(n_cycles=30, ramp_s=0.3 * cycle_s, dwell_s=0.2 * cycle_s, rest_s=0.2 * cycle_s,
-                    first_dwell_s=0.2 * cycle_s)
-    rec = simulate_bench(p, (toe, creep), prot, Clock(rate_hz=25.0), seed=5)
-    d = diagnose(model_for_pattern(p), rec.data, ("E_t",), pattern_values(p))
+    p, rec, d = _two_samples(Tendon(crimp_mm=0.3, crimp_shape=2.5), CREEPING)
     chain = set(d.recommended)
     assert chain & TOE_FAMILY and chain & CREEP_FAMILY, d.recommended
     assert d.final.rmse_deg <= 1.15 * rec.floor_deg
@@ -70,15 +76,7 @@ def test_samples_that_each_need_a_different_first_effect_are_diagnosed_one_at_a_
     # sample 1: a slack tendon; sample 2: a tendon that creeps under load. Searched together, a stand-in that
     # serves both samples wins the first round; each sample diagnosed alone shows its own effect, and the
     # union, each effect held off where its sample does not show it, is the answer
-    p = load_pattern(PATTERNS / "tube2.yaml")
-    trk = Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0)
-    slack = SampleBench(tendon=Tendon(slack_mm=0.15), tracker=trk)
-    creep = SampleBench(tendon=Tendon(creep_A_mm_per_s=4e-4, creep_n=2.0, creep_sat_mm=0.1), tracker=trk)
-    cycle_s = 12000 / 2 / 25.0 / 30
-    prot = Protocol(n_cycles=30, ramp_s=0.3 * cycle_s, dwell_s=0.2 * cycle_s, rest_s=0.2 * cycle_s,
-                    first_dwell_s=0.2 * cycle_s)
-    rec = simulate_bench(p, (slack, creep), prot, Clock(rate_hz=25.0), seed=5)
-    d = diagnose(model_for_pattern(p), rec.data, ("E_t",), pattern_values(p))
+    _, rec, d = _two_samples(Tendon(slack_mm=0.15), CREEPING)
     assert "slack" in d.recommended and set(d.recommended) & CREEP_FAMILY, d.recommended
     assert d.final.rmse_deg <= 1.15 * rec.floor_deg
     assert d.held.get("slack.deadband_mm@S2") == 0.0
