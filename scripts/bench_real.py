@@ -129,7 +129,10 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
            # batch's composition, a seed not used before; run once
-           "bench-heldout4": (20261226, HELDOUT3_KINDS)}
+           "bench-heldout4": (20261226, HELDOUT3_KINDS),
+           # drawn once each sample diagnosed alone was restricted to samples each explained alone (a test of
+           # an effect the library lacks caught the looser rule): the same composition, a seed not used before
+           "bench-heldout5": (20261227, HELDOUT3_KINDS)}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:

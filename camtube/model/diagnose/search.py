@@ -1243,7 +1243,8 @@ class Search:
 
     def try_sample_wise(self) -> bool:
         """When the chain leaves the error above :data:`REACH_RATIO` x the floor and there are several samples:
-        diagnose each sample alone; when they show different effects, fit the union with each effect held off
+        diagnose each sample alone; when each is explained (something recommended, or nothing to add) and they
+        show different effects, fit the union with each effect held off
         (at its ``off`` values) in the samples that do not show it, and take it as the chain when it lowers the
         all-rows error and BIC with every parameter resolved and a waterfall that lowers at every step. Two
         samples that each need a different first effect defeat the joint greedy search (a stand-in that
@@ -1262,9 +1263,10 @@ class Search:
                              registry=self.registry).run()
             except FitError:
                 return False
-            chains[smp] = list(d_s.recommended) or list(d_s.partial)
-            inits[smp] = d_s.final.params if d_s.recommended else (d_s.partial_steps[-1].params if d_s.partial
-                                                                   else {})
+            if d_s.partial:  # stand-ins that leave that sample unexplained: no answer to combine
+                return False
+            chains[smp] = list(d_s.recommended)
+            inits[smp] = d_s.final.params if d_s.recommended else {}
         union = list(dict.fromkeys(e for smp in samples for e in chains[smp]))
         if not union or all(chains[smp] == chains[samples[0]] for smp in samples):
             return False
