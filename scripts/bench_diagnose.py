@@ -588,17 +588,16 @@ def variants() -> None:
 
 
 def main() -> None:
+    # whole-bench files of issue 19 (scripts/bench_real.py): instruments first, several mechanisms at once
+    import bench_real
+
     ap = argparse.ArgumentParser()
     ap.add_argument("--batch", default="tune",
                     choices=("tune", "heldout", "heldout2", "heldout3", "heldout4", "heldout5", "heldout6", "heldout7",
                              "heldout8", "heldout9", "heldout10", "heldout11", "heldout12", "speed", "controls", "variants", "all",
-                             "bench", "bench-heldout", "bench-heldout2", "bench-heldout3",
-                             "bench-heldout4", "bench-heldout5"))
+                             *bench_real.BATCHES))
     args = ap.parse_args()
-    if args.batch.startswith("bench"):
-        # whole-bench files of issue 19 (scripts/bench_real.py): instruments first, several mechanisms at once
-        import bench_real
-
+    if args.batch in bench_real.BATCHES:
         bench_real.run_batch(args.batch)
         return
     if args.batch in ("speed", "all", "tune"):

@@ -401,10 +401,11 @@ class JointModel:
             base, smp = split_name(n)
             p = out[base]
             out = Parameters.of(list(out.items) + [replace(p, name=n, sample=smp, vary=True)])
-        for src in (fixed, initial):
-            out = out.with_values({k: v for k, v in src.items() if k in out and "@" in k})
         # a per-sample copy given in ``fixed`` is held there (an effect off in that sample), unless it is
-        # named in ``fit``
+        # named in ``fit``; a start value in ``initial`` does not move a held copy
+        held = {k for k in fixed if "@" in k and k not in fit}
+        out = out.with_values({k: v for k, v in fixed.items() if k in out and "@" in k})
+        out = out.with_values({k: v for k, v in initial.items() if k in out and "@" in k and k not in held})
         for k in fixed:
             if "@" in k and k not in out:
                 base = split_name(k)[0]

@@ -475,9 +475,7 @@ def refit_all_rows(model: JointModel, data: Dataset, names: Sequence[str], fixed
     ``max_nfev`` caps each start's solver (a candidate's check: a fit that has not converged by then is
     refused, so an accepted one is the command's fit).
     """
-    held = {k for k in fixed if "@" in k}
-    params = model.make_params(data, names, fixed, initial=_rounded({k: v for k, v in init.items() if k not in held}),
-                               per_sample=per_sample)
+    params = model.make_params(data, names, fixed, initial=_rounded(init), per_sample=per_sample)
     return fit(model, data, params=params, grid=grid, max_nfev=max_nfev)
 
 
@@ -861,6 +859,12 @@ class Search:
         ho, mse = _cv(m, self.search, names, f.params, fx, self.fold, self.block, per_sample=per_sample)
         return f, ho, mse
 
+    def _fit_held(self, m: JointModel, names: tuple, start: Mapping[str, float], per_sample: Sequence[str],
+                  eff: Effect, held: Mapping[str, float]) -> tuple[FitResult, float, np.ndarray]:
+        """:meth:`_fit_one` with ``eff``'s copies ``held`` off, from a grid over its copies that stay fitted."""
+        kept = [f"{n}@{smp}" for n in eff.full_names() for smp in self.search.samples if f"{n}@{smp}" not in held]
+        return self._fit_one(m, names, start, per_sample, held=held, grid=self.settings.grid, grid_names=kept)
+
     def _absent(self, eff: Effect, m: JointModel, f: FitResult) -> dict:
         """Per-sample copies of ``eff`` to hold off: in each sample where a copy of ``f`` (a per-sample fit) is
         not resolved (on a bound, a time or length outside what the record resolves), every copy of that
@@ -904,8 +908,7 @@ class Search:
             f3, ho3, mse3 = self._fit_one(m2, names2, f2.params, ps3)
             held = self._absent(eff, m2, f3)
             if held:
-                kept3 = [f"{n}@{smp}" for n in new for smp in self.search.samples if f"{n}@{smp}" not in held]
-                f3, ho3, mse3 = self._fit_one(m2, names2, f3.params, ps3, held=held, grid=grid, grid_names=kept3)
+                f3, ho3, mse3 = self._fit_held(m2, names2, f3.params, ps3, eff, held)
             if ho3 < ho2:
                 row = [eff, m2, new, f3, ho3, mse3, tuple(new), (old.name,)]
                 self.cand_held[(eff.name, (old.name,))] = held
@@ -935,9 +938,7 @@ class Search:
                 # bound, a stand-in for another effect): the effect fitted in the other samples only
                 held = self._absent(eff, m, f2)
                 if held:
-                    kept = [f"{n}@{smp}" for n in new for smp in self.search.samples if f"{n}@{smp}" not in held]
-                    f3, ho3, mse3 = self._fit_one(m, ch.names + new, f2.params, ps, held=held, grid=s.grid,
-                                                  grid_names=kept)
+                    f3, ho3, mse3 = self._fit_held(m, ch.names + new, f2.params, ps, eff, held)
                     dm, se = _gain(mse, mse3, self.strata)
                     if dm > s.z * se and f3.bic < f.bic - s.bic_threshold:
                         row[3:7] = [f3, ho3, mse3, tuple(new)]
@@ -1304,9 +1305,11 @@ class Search:
         if order is None:
             self.held = old_held
             return False
-        m = ch.model.with_effects(list(ch.model.effects) + order)
-        r2 = refit_all_rows(m, data, names, fixed, {k: v for k, v in r.params.items() if k in r.fitted}, s.grid,
-                            per_sample=ps)
+        r2 = r
+        if order != effects:  # effects of one stage compose in the model's order: refit in the chain's order
+            m = ch.model.with_effects(list(ch.model.effects) + order)
+            r2 = refit_all_rows(m, data, names, fixed, {k: v for k, v in r.params.items() if k in r.fitted}, s.grid,
+                                per_sample=ps)
         ch.current, ch.names, ch.per_sample, ch.all_rows, ch.chosen = m, names, ps, r2, order
         ch.steps = ch.steps[:1] + inter + [_step(r2, ps, {k: v for k, v in r.params.items() if k in r.fitted})]
         self.recommended = [e.name for e in order]
