@@ -123,6 +123,25 @@ def first_order_lag(data: Dataset, u: np.ndarray, tau_s: float) -> np.ndarray:
 _LAG_BLOCK = 30.0
 
 
+def _linear_scan(a: np.ndarray, b: np.ndarray, v0: float) -> np.ndarray:
+    """``v_k = a_k v_(k-1) + b_k`` (``v_(-1) = v0``) for ``0 <= a_k <= 1`` by a parallel prefix scan: ``log2 n``
+    passes of whole-array NumPy operations, each composing every step with the one ``d`` rows before it
+    (``(a2, b2) o (a1, b1) = (a2 a1, a2 b1 + b2)``, d = 1, 2, 4, ...); it stops early once every product of
+    ``a`` has underflowed (a short ``tau``: a few passes). No exponent grows, so nothing overflows.
+    Replaced a Python loop over every row (issue 19: 15 s of a 34 s diagnosis on a jittered 60,000-row file)."""
+    A = a.astype(float, copy=True)
+    B = b.astype(float, copy=True)
+    B[0] += A[0] * v0
+    A[0] = 0.0
+    d, n = 1, A.size
+    while d < n and A.any():
+        B[d:] += A[d:] * B[:-d]
+        A[d:] *= A[:-d]
+        A[:d] = 0.0
+        d *= 2
+    return B
+
+
 def _lag_nonuniform(u: np.ndarray, dt: np.ndarray, tau: float) -> np.ndarray:
     """``v_k = a_k v_(k-1) + (1 - a_k) u_k``, ``a_k = exp(-dt_k / tau)``, ``v_0 = u_0``, for uneven steps ``dt``
     ((n - 1,) s), in blocks of NumPy calls (speed: a logger's jittered stamps made this a Python loop over every
@@ -135,11 +154,8 @@ def _lag_nonuniform(u: np.ndarray, dt: np.ndarray, tau: float) -> np.ndarray:
     out = np.empty_like(u)
     out[0] = u[0]
     prev, s, m = float(u[0]), 0, decay.size
-    if m and cum[-1] > _LAG_BLOCK * m / 50.0:  # tau within a few steps: blocks of a row or two; the loop is faster
-        a = np.exp(-decay)
-        for k in range(m):
-            prev = a[k] * prev + b[k]
-            out[k + 1] = prev
+    if m and cum[-1] > _LAG_BLOCK * 16.0:  # many blocks (tau short against the record): the prefix scan
+        out[1:] = _linear_scan(np.exp(-decay), b, prev)
         return out
     while s < m:
         base = cum[s - 1] if s else 0.0
