@@ -169,3 +169,21 @@ def test_rest_angle_holds_the_joint_bent_once_loaded_and_not_before(tube1):
     both = model_for_pattern(tube1, ["angle_bias", "rest_angle"]).predict(
         data, vals | {"rest_angle.rest_deg": 2.0, "angle_bias.bias_deg": -0.5})
     np.testing.assert_allclose(both, got - 0.5)
+
+
+@pytest.mark.parametrize("tau_s", [1e-3, 0.03, 1.0, 50.0, 1e5])
+def test_first_order_lag_on_jittered_stamps_equals_the_recursion(tau_s):
+    """Every path of the non-uniform lag (prefix scan, blocks) equals the row-by-row recursion."""
+    from camtube.model.effects.history import _lag_nonuniform
+
+    rng = np.random.default_rng(7)
+    dt = 0.02 + rng.normal(0.0, 0.002, 4999)
+    dt[100] = 0.0  # a repeated stamp
+    u = np.sin(np.cumsum(np.r_[0.0, dt])) + rng.normal(0.0, 0.1, 5000)
+    ref = np.empty_like(u)
+    ref[0] = prev = u[0]
+    for k, step in enumerate(dt):
+        a = math.exp(-max(step, 0.0) / tau_s)
+        prev = a * prev + (1.0 - a) * u[k + 1]
+        ref[k + 1] = prev
+    np.testing.assert_allclose(_lag_nonuniform(u, dt, tau_s), ref, rtol=1e-11, atol=1e-12)
