@@ -44,7 +44,7 @@ FAMILIES = {
     "backbone": (set(), None),
     "zero drift": (set(), "time"),
     "lag": (set(), None),
-    "friction": ({"friction"}, None),
+    "friction": ({"friction", "capstan"}, None),  # one family: friction at the guide
 }
 
 

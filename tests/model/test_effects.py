@@ -187,3 +187,45 @@ def test_first_order_lag_on_jittered_stamps_equals_the_recursion(tau_s):
         prev = a * prev + (1.0 - a) * u[k + 1]
         ref[k + 1] = prev
     np.testing.assert_allclose(_lag_nonuniform(u, dt, tau_s), ref, rtol=1e-11, atol=1e-12)
+
+
+def test_capstan_gives_the_mean_tension_of_a_tendon_wrapping_a_guide(tube1):
+    """A guide between the load cell and the joint: the joint side carries the cell's tension times
+    exp(-mu_wrap) while the tendon is pulled, exp(+mu_wrap) while it is released, and keeps the last state
+    through a dwell. The tendon stretches by its mean tension (half of it on either side of the guide)."""
+    t = np.arange(0.0, 30.0, 0.05)
+    stroke = np.interp(t, [0, 10, 15, 25, 30], [0.0, 2.0, 2.0, 0.0, 0.0])   # pull, dwell, release, rest
+    tj = 1.5 * stroke                                                      # joint-side tension, N
+    pulling = t <= 15.0                                                    # the last motion's direction
+    mu = 0.3
+    cell = tj * np.exp(np.where(pulling, mu, -mu))
+    data = _data(stroke, time=t, force=cell)
+    vals = pattern_values(tube1)
+    model = model_for_pattern(tube1, ["capstan"])
+    got = model.predict(data, vals | {"capstan.mu_wrap": mu, "capstan.slip_mm_s": 1e-5})
+    c = model.compliance_mm_per_N(vals)
+    arm = model.geometry.moment_arm_mm
+    want = np.degrees((stroke - c * 0.5 * (tj + cell)) / arm)
+    np.testing.assert_allclose(got[1:], want[1:], atol=1e-9)
+    # off: the paper's model
+    np.testing.assert_allclose(model.predict(data, vals | {"capstan.mu_wrap": 0.0, "capstan.slip_mm_s": 1.0}),
+                               model_for_pattern(tube1).predict(data, vals), atol=1e-12)
+
+
+def test_a_thinned_record_keeps_the_speed_of_the_full_one():
+    """Steps between kept rows average over the dropped ones; the thinned copy carries the full record's speed."""
+    from camtube.model.diagnose.search import thin
+
+    t = np.arange(0.0, 40.0, 0.01)
+    stroke = np.clip(np.sin(t), 0.0, None)          # pulls, releases, rests at zero
+    data = _data(stroke, time=t, samples=["a"] * 2000 + ["b"] * 2000)
+    full = data.stroke_speed_mm_s
+    moving = np.r_[True, np.diff(stroke) != 0]
+    np.testing.assert_allclose(full[1:2000][moving[1:2000]], (np.diff(stroke[:2000]) / 0.01)[moving[1:2000]])
+    rest = np.flatnonzero(~moving[:2000])
+    last = np.maximum.accumulate(np.where(moving[:2000], np.arange(2000), 0))
+    assert rest.size > 100 and np.all(full[rest] == full[last[rest]])   # a rest keeps the last motion's speed
+    small = thin(data, 400)
+    assert len(small) < len(data)
+    idx = np.searchsorted(t[:2000], small.time_s[small.sample == "a"])
+    np.testing.assert_array_equal(small.stroke_speed_mm_s[small.sample == "a"], full[idx])

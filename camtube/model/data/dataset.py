@@ -10,6 +10,9 @@ from typing import Any, Callable
 
 import numpy as np
 
+#: Column of :attr:`Dataset.extra` that carries the stroke speed (mm/s) of the full record into a thinned copy.
+SPEED_COLUMN = "stroke_speed_mm_s"
+
 
 class Cache:
     """Derived data of one value, computed once and kept with it (the way trimesh's ``caching.Cache`` sits on a
@@ -148,6 +151,39 @@ class Dataset:
             sg = np.where(sg == 0, first, sg)
             d[sl] = np.concatenate(([sg[0]], sg))
         return d
+
+    @property
+    def stroke_speed_mm_s(self) -> np.ndarray:
+        """(n,) float: the stroke's speed (mm/s, + loading): each row's step over its time step, per sample,
+        carried over pauses (a dwell or a rest keeps the last motion's speed); the first row takes the first
+        real step's. A column ``stroke_speed_mm_s`` in :attr:`extra` wins: a thinned copy carries the speed of
+        the full record there (:meth:`with_stroke_speed`), since steps between kept rows average over the
+        dropped ones. Computed once per Dataset, read-only."""
+        if SPEED_COLUMN in self.extra:
+            return self.extra[SPEED_COLUMN]
+        hit = self.cache.get("dataset.stroke_speed")
+        if hit is not None:
+            return hit
+        out = np.zeros(len(self))
+        for _, sl in self.sample_slices():
+            ss, ts = self.stroke_mm[sl], self.time_s[sl]
+            if ss.size < 2:
+                continue
+            ds, dt = np.diff(ss), np.diff(ts)
+            moving = (ds != 0.0) & (dt > 0.0)
+            if not moving.any():
+                continue
+            v = np.where(moving, ds / np.where(dt > 0.0, dt, 1.0), 0.0)
+            last = np.maximum.accumulate(np.where(moving, np.arange(ds.size), -1))
+            held = v[np.where(last >= 0, last, int(np.argmax(moving)))]
+            out[sl] = np.concatenate((held[:1], held))
+        out.setflags(write=False)
+        return self.cache.set("dataset.stroke_speed", out)
+
+    def with_stroke_speed(self) -> "Dataset":
+        """This Dataset with its stroke speed as the column ``stroke_speed_mm_s`` (kept by :meth:`take`)."""
+        return Dataset(self.sample, self.cycle, self.time_s, self.stroke_mm, self.force_N, self.angle_deg,
+                       {**self.extra, SPEED_COLUMN: self.stroke_speed_mm_s})
 
     def take(self, mask: np.ndarray) -> "Dataset":
         """Rows where ``mask`` (bool or index array) selects."""

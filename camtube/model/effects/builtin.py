@@ -232,7 +232,35 @@ FRICTION = Effect(
     meaning="tendon-sheath friction between the load cell and the joint: the tendon's mean tension is "
             "lower than measured while pulling and higher while releasing (friction hysteresis)",
     signature="the residual flips sign with the direction of motion and grows with force",
+    family="friction",
     off={"mu": 0.0},
+)
+
+
+def _capstan(ctx: Context, force: np.ndarray, p: dict) -> np.ndarray:
+    slide = np.tanh(ctx.data.stroke_speed_mm_s / max(p["slip_mm_s"], 1e-6))
+    return force * 0.5 * (1.0 + np.exp(-p["mu_wrap"] * slide))
+
+
+CAPSTAN = Effect(
+    name="capstan", stage="force",
+    params=(Param("mu_wrap", "", -0.5, 3.0, 0.2,
+                  "friction coefficient times the wrap angle (rad) of the guide: the joint-side tension is "
+                  "exp(-mu_wrap) times the load cell's while pulling, exp(+mu_wrap) while releasing",
+                  starts=(0.1, 0.3, 0.8)),
+            Param("slip_mm_s", "mm/s", 1e-3, 10.0, 0.05,
+                  "tendon speed at which the friction is 76 % developed (tanh); held at rest", log=True,
+                  starts=(0.01, 0.1))),
+    apply=_capstan,
+    meaning="capstan friction where the tendon wraps a guide between the load cell and the joint: the "
+            "tension falls by exp(-mu_wrap) across the guide while pulling and rises while releasing, so the "
+            "tendon's mean tension (what stretches it) is (1 + exp(-mu_wrap s)) / 2 of the load cell's, "
+            "s = tanh(speed / slip_mm_s) the sliding state, kept while the drive rests",
+    signature="the residual flips sign with the direction of motion and grows with force; loading and "
+              "unloading differ by unequal amounts (exponential), and the state persists through dwells",
+    family="friction",
+    history=True,
+    off={"mu_wrap": 0.0},
 )
 
 
@@ -674,7 +702,7 @@ FORCE_ZERO = Effect(
 )
 
 #: The built-in effects, in their documented order.
-BUILTIN_EFFECTS = (SLACK, PLAY, CREEP, CREEP_LOAD, FRICTION, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
+BUILTIN_EFFECTS = (SLACK, PLAY, CREEP, CREEP_LOAD, FRICTION, CAPSTAN, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
                    HARDSTOP, REST_ANGLE, ANGLE_BIAS, FORCE_ZERO)
 #: Built-in effect names in that order.
 BUILTINS = tuple(e.name for e in BUILTIN_EFFECTS)
