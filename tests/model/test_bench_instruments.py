@@ -19,7 +19,7 @@ from camtube.model.data import format_csv, read_measurements
 from camtube.model.diagnose.instruments import check_instruments, with_aside
 from camtube.model.diagnose.search import explanation_label, explained_share
 from camtube.model.sim.bench import (
-    Clock, Drive, Protocol, SampleBench, Tendon, Tracker, motor_profile, simulate_bench,
+    Clock, Drive, Guide, Protocol, SampleBench, Tendon, Tracker, motor_profile, simulate_bench,
 )
 from tests.conftest import PATTERNS
 
@@ -91,6 +91,25 @@ def test_the_tracker_lag_is_estimated_within_its_uncertainty_and_corrected(tube2
         assert after < 1.1 * rec.floor_deg < before
     else:
         assert ins.lag.applied_ms == 0.0
+
+
+@pytest.mark.parametrize("lag_ms", [0.0, 40.0])
+def test_friction_at_the_guide_is_not_read_as_a_tracker_lag(tube2, lag_ms):
+    """The guide's hysteresis fades in and out with the tendon's speed at every start and stop, which a delay of
+    the angle mimics: the lag regression has the capstan's sliding state among its regressors (issue 19: 10-40 ms
+    false lags were corrected on friction files), and a real lag beside the friction is still found."""
+    tr = Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0, lag_ms=lag_ms)
+    rec = simulate_bench(tube2, SampleBench(guide=Guide(mu=0.2), tracker=tr),
+                         Protocol(n_cycles=12, ramp_s=2.0, dwell_s=1.0, rest_s=1.0, first_dwell_s=2.0),
+                         Clock(rate_hz=50.0, n_repeats=0), seed=6)
+    ins = check_instruments(rec.data)
+    assert abs(ins.lag.lag_ms - lag_ms) < max(3.0 * ins.lag.se_ms, 5.0)
+    assert (ins.lag.applied_ms == 0.0) if not lag_ms else abs(ins.lag.applied_ms - lag_ms) <= 10.0 + 1e-9
+    # and the capstan law then fits the guide at the floor
+    model, fixed = model_for_pattern(tube2, ["capstan"]), pattern_values(tube2)
+    r = fit(model, ins.data, ["E_t", "capstan.mu_wrap", "capstan.slip_mm_s", "capstan.hold"], fixed)
+    assert r.rmse < 1.1 * rec.floor_deg
+    assert abs(r.params["capstan.mu_wrap"] / (0.2 * math.pi / 2) - 1.0) < 0.05
 
 
 def test_missing_values_are_dropped_and_counted_or_refused_with_the_line(tube2, tmp_path, capsys):

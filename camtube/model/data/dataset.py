@@ -154,11 +154,11 @@ class Dataset:
 
     @property
     def stroke_speed_mm_s(self) -> np.ndarray:
-        """(n,) float: the stroke's speed (mm/s, + loading): each row's step over its time step, per sample,
-        carried over pauses (a dwell or a rest keeps the last motion's speed); the first row takes the first
-        real step's. A column ``stroke_speed_mm_s`` in :attr:`extra` wins: a thinned copy carries the speed of
-        the full record there (:meth:`with_stroke_speed`), since steps between kept rows average over the
-        dropped ones. Computed once per Dataset, read-only."""
+        """(n,) float: the stroke's speed (mm/s, + loading): each row's step over its time step, per sample; 0
+        where the stroke does not move (a dwell, a rest: :attr:`direction` keeps the last motion's sign there);
+        the first row takes the second's. A column ``stroke_speed_mm_s`` in :attr:`extra` wins: a thinned copy
+        carries the speed of the full record there (:meth:`with_stroke_speed`), since steps between kept rows
+        average over the dropped ones. Computed once per Dataset, read-only."""
         if SPEED_COLUMN in self.extra:
             return self.extra[SPEED_COLUMN]
         hit = self.cache.get("dataset.stroke_speed")
@@ -170,13 +170,8 @@ class Dataset:
             if ss.size < 2:
                 continue
             ds, dt = np.diff(ss), np.diff(ts)
-            moving = (ds != 0.0) & (dt > 0.0)
-            if not moving.any():
-                continue
-            v = np.where(moving, ds / np.where(dt > 0.0, dt, 1.0), 0.0)
-            last = np.maximum.accumulate(np.where(moving, np.arange(ds.size), -1))
-            held = v[np.where(last >= 0, last, int(np.argmax(moving)))]
-            out[sl] = np.concatenate((held[:1], held))
+            v = np.where(dt > 0.0, ds / np.where(dt > 0.0, dt, 1.0), 0.0)
+            out[sl] = np.concatenate((v[:1], v))
         out.setflags(write=False)
         return self.cache.set("dataset.stroke_speed", out)
 

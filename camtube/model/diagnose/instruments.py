@@ -18,7 +18,10 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
   ``tau`` (whole rows: interpolating between rows averages the noise and favours half-row shifts) the
   angle is read ``tau`` later and regressed, per sample, on the force (smoothed by a centred running mean):
   a cubic, a step and a hysteresis proportional to the force that flip with the direction of motion
-  (friction in the joint, at the guide), and the force minus its low-passed copies with time constants of
+  (friction in the joint, at the guide), the force times the guide's sliding state ``tanh(v / v_slip)`` to
+  second order for two slip speeds and what it keeps at rest (a capstan whose friction develops with the
+  tendon's speed changes the hysteresis smoothly at every start and stop, which a delay mimics: 40-85 ms false
+  lags on the bench's friction files without these), and the force minus its low-passed copies with time constants of
   2, 8 and 32 s (a slow relaxation of the joint's backbone makes the angle follow the force's history: not
   a delay). The step also absorbs what a delay does at constant speed, so the lag is resolved by the parts
   of the record where the speed changes (ramps that start and stop smoothly, reversals, dwells); on a
@@ -183,6 +186,8 @@ RELAX_TAUS_S = (2.0, 8.0, 32.0)
 #: Widths (fractions of the force's range) of the play operators that absorb friction in the joint (it holds
 #: the angle while the force reverses, which a delay would otherwise be fitted to).
 STICK_WIDTHS = (0.01, 0.03)
+#: Slip speeds of the guide-friction regressors, as fractions of the median stroke speed while moving.
+SLIP_FRACTIONS = (0.05, 0.2)
 #: Width (s) of the centred running mean of the force in the lag regression (short against the motion: a
 #: wide one flattens the force's turning points, which a shift of the angle then mimics).
 SMOOTH_S = 0.1
@@ -223,6 +228,17 @@ def _lag_design(data: Dataset) -> list:
         # with the direction of motion
         dirn = direction[sl].astype(float)
         cols = [np.ones_like(x), x, x * x, x ** 3, dirn * x, dirn]
+        # friction at a guide that develops with the tendon's speed (capstan, regularised): the force times the
+        # sliding state tanh(v / v_slip) for slip speeds a fraction of the typical speed (a delay mimics that
+        # smooth change of the hysteresis at every start and stop otherwise)
+        v = data.stroke_speed_mm_s[sl]
+        vmed = float(np.median(np.abs(v[v != 0.0]))) if np.any(v != 0.0) else 0.0
+        if vmed > 0.0:
+            for k in SLIP_FRACTIONS:
+                slide = np.tanh(v / (k * vmed))
+                cols += [slide, x * slide, slide * slide, x * slide * slide]   # F exp(-mu s) to second order
+            rest = (v == 0.0).astype(float)
+            cols += [rest, x * rest]                       # what the guide keeps while the drive rests
         for w in STICK_WIDTHS:  # friction that holds the joint while the force reverses: a play of the force
             cols.append(_play(x, w * float(np.ptp(x))) - x)
         for tau in RELAX_TAUS_S:

@@ -238,7 +238,8 @@ FRICTION = Effect(
 
 
 def _capstan(ctx: Context, force: np.ndarray, p: dict) -> np.ndarray:
-    slide = np.tanh(ctx.data.stroke_speed_mm_s / max(p["slip_mm_s"], 1e-6))
+    v = ctx.data.stroke_speed_mm_s
+    slide = np.where(v != 0.0, np.tanh(v / max(p["slip_mm_s"], 1e-6)), p["hold"] * ctx.data.direction)
     return force * 0.5 * (1.0 + np.exp(-p["mu_wrap"] * slide))
 
 
@@ -249,13 +250,18 @@ CAPSTAN = Effect(
                   "exp(-mu_wrap) times the load cell's while pulling, exp(+mu_wrap) while releasing",
                   starts=(0.1, 0.3, 0.8)),
             Param("slip_mm_s", "mm/s", 1e-3, 10.0, 0.05,
-                  "tendon speed at which the friction is 76 % developed (tanh); held at rest", log=True,
-                  starts=(0.01, 0.1))),
+                  "tendon speed at which the friction is 76 % developed (tanh)", log=True,
+                  starts=(0.01, 0.1)),
+            Param("hold", "", -0.5, 1.0, 0.5,
+                  "share of the sliding friction the guide keeps while the drive rests (1: static friction "
+                  "keeps the last motion's state; 0: the guide releases; the range goes below 0 so that a "
+                  "guide that releases is not a fit on its bound)", starts=(0.1, 0.9))),
     apply=_capstan,
     meaning="capstan friction where the tendon wraps a guide between the load cell and the joint: the "
             "tension falls by exp(-mu_wrap) across the guide while pulling and rises while releasing, so the "
             "tendon's mean tension (what stretches it) is (1 + exp(-mu_wrap s)) / 2 of the load cell's, "
-            "s = tanh(speed / slip_mm_s) the sliding state, kept while the drive rests",
+            "s = tanh(speed / slip_mm_s) the sliding state; while the drive rests, s = hold times the last "
+            "motion's direction",
     signature="the residual flips sign with the direction of motion and grows with force; loading and "
               "unloading differ by unequal amounts (exponential), and the state persists through dwells",
     family="friction",
