@@ -125,6 +125,9 @@ HELDOUT2_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", 
 #: never replaces the shared one; bench-heldout2 had been looked at), from a seed not used before; run once.
 HELDOUT3_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
                   ("toe", "slack"), ("creep", "slack"), "friction"]
+#: The sixth fresh held-out batch (issue 19, after the guide's capstan law): friction at the guide beside a toe.
+HELDOUT6_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
+                  ("friction", "toe"), ("creep", "slack"), "friction"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -132,7 +135,11 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            "bench-heldout4": (20261226, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was restricted to samples each explained alone (a test of
            # an effect the library lacks caught the looser rule): the same composition, a seed not used before
-           "bench-heldout5": (20261227, HELDOUT3_KINDS)}
+           "bench-heldout5": (20261227, HELDOUT3_KINDS),
+           # drawn once capstan, the guide's law at rest and the lag regression's friction terms were settled
+           # (the tuned batch and the earlier held-out batches had been looked at): a seed not used before, with
+           # guide friction beside a toe in one file; run once
+           "bench-heldout6": (20261228, HELDOUT6_KINDS)}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
