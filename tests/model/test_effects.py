@@ -234,3 +234,10 @@ def test_a_thinned_record_keeps_the_speed_of_the_full_one():
     assert len(small) < len(data)
     idx = np.searchsorted(t[:2000], small.time_s[small.sample == "a"])
     np.testing.assert_array_equal(small.stroke_speed_mm_s[small.sample == "a"], full[idx])
+
+
+def test_every_builtin_says_where_it_sits_on_the_bench():
+    """The answer names the side of the bench (drive, tendon, joint, instruments) of each recommended effect."""
+    from camtube.model.report.diagnosis import SIDES
+
+    assert set(BUILTINS) <= set(SIDES)

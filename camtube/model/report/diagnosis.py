@@ -234,6 +234,9 @@ SIDES = {
     "viscoelastic": "tendon (delayed compliance); the joint's own relaxation does not show here (the measured "
                     "force carries it)",
     "friction": "tendon (friction at the guide or in a sheath)",
+    "capstan": "tendon at the guide it wraps, between the load cell and the joint (the cell reads more than the "
+               "joint pulls while pulling, less while releasing); a second load cell at the joint side would "
+               "measure the ratio",
     "series": "tendon or sheath (a compliance in series: the same as a softer tendon)",
     "force_zero": "instruments (the load cell's zero)",
     "angle_bias": "instruments (the tracker's offset), or a joint that rests bent",
