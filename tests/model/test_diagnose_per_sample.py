@@ -82,3 +82,16 @@ def test_samples_that_each_need_a_different_first_effect_are_diagnosed_one_at_a_
     assert d.held.get("slack.deadband_mm@S2") == 0.0
     assert any(k.endswith("@S1") and k.split(".")[0] in CREEP_FAMILY for k in d.held)
     assert any(n.startswith("each sample diagnosed alone: S1 shows slack; S2 shows creep") for n in d.sample_notes)
+
+
+def test_a_copy_left_on_the_bound_where_its_effect_is_off_is_held_there():
+    """A per-sample copy that ends on the bound where its effect is off (a toe of 0 mm) is held at that value, so
+    the printed command holds it (--fix toe.toe_mm@S2=0) instead of refusing a parameter on its bound; a copy at
+    an off value inside its range (a creep of 0 mm in -5..5) is an estimate and stays fitted."""
+    from camtube.model.diagnose.search import _off_on_bound
+    from camtube.model.effects import BUILTIN_EFFECTS
+
+    catalog = {e.name: e for e in BUILTIN_EFFECTS}
+    got = _off_on_bound(catalog, {"toe.toe_mm@S1": 0.2, "toe.toe_mm@S2": 1e-13, "creep.creep_mm@S1": 0.0,
+                                  "toe.toe_mm": 0.0, "E_t": 28.0, "capstan.mu_wrap@S2": 0.0})
+    assert got == {"toe.toe_mm@S2": 0.0}

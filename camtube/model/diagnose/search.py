@@ -480,6 +480,24 @@ def refit_all_rows(model: JointModel, data: Dataset, names: Sequence[str], fixed
     return fit(model, data, params=params, grid=grid, max_nfev=max_nfev)
 
 
+def _off_on_bound(catalog: Mapping[str, Effect], params: Mapping[str, float]) -> dict:
+    """Per-sample copies (``name@S``) among ``params`` at their effect's ``off`` value where that value is a
+    bound of the parameter: ``name@S -> off value``."""
+    out = {}
+    for nm, v in params.items():
+        base, at, _ = nm.partition("@")
+        eff_name, _, pname = base.partition(".")
+        eff = catalog.get(eff_name)
+        if not at or eff is None or pname not in (eff.off or {}):
+            continue
+        spec = next((p for p in eff.params if p.name == pname), None)
+        off = float(eff.off[pname])
+        tol = 1e-9 * max(1.0, spec.hi - spec.lo) if spec is not None else 0.0
+        if spec is not None and min(abs(off - spec.lo), abs(off - spec.hi)) <= tol and abs(float(v) - off) <= tol:
+            out[nm] = off
+    return out
+
+
 def _search_fit(model: JointModel, data: Dataset, names: Sequence[str], values: Mapping[str, float],
                 fixed: Mapping[str, float], **fit_options) -> FitResult:
     """A looser, capped fit of the search: starts at ``values`` (every name, per-sample copies included).
@@ -1387,6 +1405,9 @@ class Search:
                 if c.effect not in catalog and c.effect in self.registry:
                     catalog[c.effect] = self.registry[c.effect]
         recommended, steps, floor, stop = list(self.recommended), list(ch.steps), self.floor, self.stop
+        # a sample's copy that ended on the bound where its effect is off: that sample does not show the effect.
+        # Held there (the same fit), the printed command holds it (--fix NAME@S=VALUE) instead of refusing it
+        self.held.update(_off_on_bound(catalog, steps[-1].params))
         # complete, partial (recommended), or partial effects that are not recommended (see explanation_label)
         partial: tuple = ()
         partial_steps: tuple = ()
