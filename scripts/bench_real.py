@@ -27,7 +27,7 @@ from camtube.design.loader import load_pattern
 from camtube.model.core.predict import model_for_pattern, pattern_values
 from camtube.model.data import format_csv, read_measurements
 from camtube.model.diagnose import diagnose
-from camtube.model.diagnose.instruments import check_instruments
+from camtube.model.diagnose.instruments import check_instruments, confirm_lag
 from camtube.model.sim.bench import (
     Backbone, Clock, Drive, Guide, LoadCell, Protocol, SampleBench, Tendon, Tracker, simulate_bench,
 )
@@ -152,8 +152,9 @@ def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
     t0 = time.perf_counter()
     meas = read_measurements(path)
     ins = check_instruments(meas.data, dropped=meas.summary(), n_dropped=meas.missing_lines.size)
-    t1 = time.perf_counter()
     model = model_for_pattern(pattern)
+    ins = confirm_lag(ins, model, pattern_values(pattern))   # as camtube model diagnose does
+    t1 = time.perf_counter()
     d = diagnose(model, ins.data, ["E_t"], pattern_values(pattern))
     t2 = time.perf_counter()
     rec_list = list(d.recommended)

@@ -91,7 +91,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import read_measurements, select_cycles
     from camtube.model.diagnose import diagnose
-    from camtube.model.diagnose.instruments import check_instruments
+    from camtube.model.diagnose.instruments import check_instruments, confirm_lag
     from camtube.model.report.diagnosis import diagnosis_json, diagnosis_text, write_report
 
     check_suffix(args.json, (".json",), "--json")
@@ -106,10 +106,11 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     rows = select_cycles(meas.data, args.cycles)
     ins = check_instruments(rows, lag_ms=args.lag_ms, dropped=meas.summary(),
                             n_dropped=int(meas.missing_lines.size + meas.backward_lines.size))
-    rows = ins.data
     fit_names, held = fitted_and_held(model, args.fit_params, args.fix, with_effects=False)
     fixed = pattern_values(pattern)
     fixed.update(held)
+    ins = confirm_lag(ins, model, fixed, fit_names)
+    rows = ins.data
     cands = [reg.get_effect(c) for c in split_names(args.candidates)] or None
     try:
         lo, hi = (float(v) for v in args.modulus_range.split(","))

@@ -48,6 +48,12 @@ SPIKE_Z = 8.0
 NEIGHBOURS = 2
 #: A lag is corrected only when it lowers the residual RMS of the lag regression by this fraction.
 MIN_FALL = 0.02
+#: A lag the regression resolves but barely improves with (below :data:`MIN_FALL`) is corrected when it lowers the
+#: current model's RMSE by this fraction (:func:`confirm_lag`) ...
+MODEL_LAG_FALL = 0.05
+#: ... and that model is within this many times the angle's white noise without it (a model that misfits more
+#: than that would take a shift of the angle for any missing effect with a history).
+MODEL_LAG_MAX_RATIO = 3.0
 #: A sampling interval this far off the sample's median is a rate change.
 RATE_CHANGE = 0.2
 
@@ -66,6 +72,9 @@ class Lag:
         The lag corrected (0 when none was).
     fall : float
         Relative fall of the residual RMS of the lag regression from no lag to the estimate.
+    model_rmse_deg : tuple
+        ``(without, with)``: the current model's RMSE without the lag and with the lag applied, when the model
+        confirmed a lag the regression resolved but did not lower enough (:func:`confirm_lag`); else empty.
     """
 
     lag_ms: float
@@ -73,6 +82,7 @@ class Lag:
     given: bool = False
     applied_ms: float = 0.0
     fall: float = 0.0
+    model_rmse_deg: tuple = ()
 
 
 @dataclass(frozen=True, eq=False)
@@ -130,6 +140,12 @@ class Instruments:
         if lg.given:
             out.append(f"angle lag: {lg.lag_ms:.4g} ms as given (--lag-ms); the angle is read {lg.applied_ms:.4g} ms "
                        "later (whole rows)")
+        elif lg.applied_ms and lg.model_rmse_deg:
+            out.append(f"angle lag: the tracker lags the load cell by {lg.lag_ms:.3g} +- {lg.se_ms:.2g} ms "
+                       f"(an instrument property, not the joint's); the lag regression alone barely improves with "
+                       f"it ({100 * lg.fall:.1f} % < {100 * MIN_FALL:g} %), the current model's RMSE falls from "
+                       f"{lg.model_rmse_deg[0]:.3f} to {lg.model_rmse_deg[1]:.3f} deg with it: corrected, the "
+                       f"angle is read {lg.applied_ms:.3g} ms later (whole rows; --lag-ms 0 to keep it)")
         elif lg.applied_ms:
             out.append(f"angle lag: the tracker lags the load cell by {lg.lag_ms:.3g} +- {lg.se_ms:.2g} ms "
                        f"(an instrument property, not the joint's); corrected: the angle is read {lg.applied_ms:.3g}"
@@ -449,3 +465,48 @@ def with_aside(ins: Instruments, predicted_deg: np.ndarray, floor_deg: float) ->
     rmse = math.sqrt((sse + extra) / max(n + counted, 1))
     allowed = math.sqrt((n * floor_deg ** 2 + extra) / max(n + counted, 1))
     return rmse, allowed, counted
+
+
+def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Instruments:
+    """The instruments' check with a lag the regression resolved but did not correct tested against the current
+    model.
+
+    At a low logging rate a lag of one or two rows lowers the lag regression's residual by less than
+    :data:`MIN_FALL` (its force terms absorb part of a delay at constant speed), so it is left uncorrected. When
+    the estimate is resolved (beyond three standard errors and a quarter of the sampling interval) and the current
+    model fits within :data:`MODEL_LAG_MAX_RATIO` x the angle's white noise, the model is fitted to the angle read
+    the estimate's whole rows later (and one row either side); the best of those is corrected when it lowers the
+    RMSE by :data:`MODEL_LAG_FALL`. Otherwise ``ins`` is returned as it is.
+    """
+    from camtube.model.core.fit import FitError, fit
+    from camtube.model.effects.builtin import _white_noise_sd
+
+    lg = ins.lag
+    if lg.given or lg.applied_ms or not math.isfinite(lg.se_ms) or not ins.rates_hz:
+        return ins
+    dt_ms = 1e3 / float(np.median(list(ins.rates_hz.values())))
+    if not (abs(lg.lag_ms) > 3.0 * lg.se_ms and abs(lg.lag_ms) > 0.25 * dt_ms):
+        return ins
+    try:
+        r0 = fit(model, ins.data, list(fit_names), fixed)
+        noise = min(_white_noise_sd(r0.residuals[sl]) for _, sl in ins.data.sample_slices())
+        if not (noise > 0.0 and r0.rmse <= MODEL_LAG_MAX_RATIO * noise):
+            return ins
+        k0 = int(round(lg.lag_ms / dt_ms))
+        sign = 1 if lg.lag_ms > 0 else -1
+        best = (r0.rmse, 0.0)
+        for k in sorted({k0 - sign, k0, k0 + sign}):
+            if k == 0 or (k > 0) != (lg.lag_ms > 0):
+                continue
+            shifted, _, applied = shift_angle(ins.data, k * dt_ms)
+            rk = fit(model, shifted, list(fit_names), fixed).rmse
+            if rk < best[0]:
+                best = (rk, k * dt_ms)
+    except FitError:
+        return ins
+    if not best[1] or best[0] > (1.0 - MODEL_LAG_FALL) * r0.rmse:
+        return ins
+    new = check_instruments(ins.raw, lag_ms=best[1], dropped=ins.dropped, n_dropped=ins.n_dropped)
+    return Instruments(new.data, new.raw, new.aside, new.kept, new.rates_hz, new.rate_changes,
+                       Lag(lg.lag_ms, lg.se_ms, False, new.lag.applied_ms, lg.fall, (r0.rmse, best[0])),
+                       new.dropped, new.n_dropped)
