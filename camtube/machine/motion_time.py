@@ -325,7 +325,8 @@ def estimate_program(text: str, profile) -> MotionEstimate:
     feed = 0.0
     rows_d, rows_f, rows_feed, rows_stop, rows_inv = [], [], [], [], []
     for raw in text.splitlines():
-        line = re.sub(r"\(.*?\)", "", raw.split(";", 1)[0]).upper()
+        # parenthesised comments first: a ';' inside one (a profile's description) starts no comment
+        line = re.sub(r"\(.*?\)", "", raw).split(";", 1)[0].upper()
         if not line.strip():
             continue
         words = _WORD.findall(line)
