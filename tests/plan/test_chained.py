@@ -150,7 +150,7 @@ def test_the_job_file_round_trips_a_chained_job(tmp_path, pair):
     assert gcode(back, d) == gcode(job, d)
 
 
-@pytest.mark.parametrize("machine", ["linuxcnc-path", "linuxcnc-rotary"])
+@pytest.mark.parametrize("machine", ["linuxcnc-path", "linuxcnc-path-airbearing", "linuxcnc-rotary"])
 def test_a_chain_opens_the_gate_once(machine, pair):
     """rs274 (LinuxCNC's interpreter) reads the program: one gate-on and one rapid per group of drill passes,
     every feed move with the gate on, the gate switched only at rest (after G61 on the blended profiles)."""
@@ -208,6 +208,7 @@ def test_the_path_profiles_plan_chained_and_the_rotary_profile_does_not(tmp_path
     from camtube.commands import main
 
     assert load_profile("linuxcnc-path").ordering == "chained"
+    assert load_profile("linuxcnc-path-airbearing").ordering == "chained"
     assert load_profile("linuxcnc-rotary").ordering == "interleaved"
     dxf = ROOT / "examples" / "curved" / "slotted.dxf"
     for machine, ordering in (("linuxcnc-path", "chained"), ("linuxcnc-rotary", "interleaved")):
