@@ -176,17 +176,37 @@ def _nearest_vertex(points, p: tuple[float, float], allowed=None) -> int:
     return d.index(min(d))
 
 
+#: A chained group starts on the most curved smooth stretch of its contour: where the curvature is at least
+#: this share of the contour's largest (smooth) curvature.
+LINK_CURVATURE_SHARE = 0.5
+
+
 def smooth_vertices(contour: Contour) -> np.ndarray | None:
-    """(n,) bool: the vertices of a closed curved contour where the drawing is smooth (turn at most
-    ``TOL.corner_deg``, and so are both neighbours); None for a rectangle, a polygon without a smooth
-    vertex or a slit (every start is then allowed)."""
+    """(n,) bool: the vertices of a closed curved contour where a chained group may start (and its links lie).
+
+    Where the drawing is smooth (a turn of at most ``TOL.corner_deg`` at the vertex and both neighbours),
+    so no link is at a drawn corner; and of those, where it is most curved (curvature at least
+    :data:`LINK_CURVATURE_SHARE` of the largest), where the machine runs slowly anyway, so the near-stop a
+    5 um link costs is short (on a straight or a flat flank it would brake from the scan speed). None for
+    a rectangle, a polygon without a smooth vertex or a slit (every start is then allowed).
+    """
     from camtube.plan.paths import turn_angles_deg
 
     if not contour.closed or len(contour.points) <= 4:
         return None
-    ok = turn_angles_deg(contour.points, True) <= TOL.corner_deg
+    p = np.asarray(contour.points, dtype=float)
+    turn = turn_angles_deg(p, True)
+    ok = turn <= TOL.corner_deg
     ok = ok & np.roll(ok, 1) & np.roll(ok, -1)
-    return ok if ok.any() else None
+    if not ok.any():
+        return None
+    seg = np.hypot(*(np.roll(p, -1, axis=0) - p).T)  # edge i -> i + 1
+    with np.errstate(divide="ignore", invalid="ignore"):
+        curv = np.radians(turn) / (0.5 * (seg + np.roll(seg, 1)))
+    k_max = float(np.nanmax(np.where(ok, curv, np.nan)))
+    if k_max > 0:
+        ok = ok & (curv >= LINK_CURVATURE_SHARE * k_max)
+    return ok
 
 
 def _chain_starts(design: Sequence[Contour], order: Sequence[int], start: tuple[float, float],

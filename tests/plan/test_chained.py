@@ -90,9 +90,11 @@ def test_links_are_short_beam_on_moves_inside_the_cut(pair):
 
 
 @pytest.mark.parametrize("name", ["filleted", "slotted", "elliptical"])
-def test_links_of_a_curved_drawing_lie_where_it_is_smooth(name):
+def test_links_of_a_curved_drawing_lie_where_it_is_smooth_and_slow(name):
     """No link at a drawn corner: a group starts (and its links lie) where the drawing turns by less than
-    TOL.corner_deg, read on the design contour (flattened to 25 nm)."""
+    TOL.corner_deg, read on the design contour (flattened to 25 nm); and where it is most curved (the
+    machine is slow there anyway): on a fillet or a slot's end, at an ellipse's tip (radius of curvature
+    b^2 / a = 0.027 mm there, 7.5 mm on its flanks)."""
     job = plan_job(drawing(name), ordering="chained")
     for starts in job.passes.starts:
         for i, k in enumerate(starts.tolist()):
@@ -100,6 +102,13 @@ def test_links_of_a_curved_drawing_lie_where_it_is_smooth(name):
             turn = turn_angles_deg(c.points, True)
             n = len(c.points)
             assert max(turn[(k - 1) % n], turn[k], turn[(k + 1) % n]) <= TOL.corner_deg
+            x0, y0, x1, y1 = c.bounds
+            x, y = c.points[k]
+            if name == "elliptical":  # within 0.1 mm of the top or bottom tip
+                assert min(abs(y - y0), abs(y1 - y)) < 0.1 and abs(x - 0.5 * (x0 + x1)) < 0.1
+            else:  # on a fillet or a slot's half circle: within the radius of the top or bottom
+                r = 0.1 if name == "filleted" else 0.2
+                assert min(abs(y - y0), abs(y1 - y)) <= r + 1e-9
 
 
 def test_a_polygon_with_corners_starts_its_links_on_a_smooth_part():
