@@ -229,3 +229,18 @@ def test_the_path_profiles_plan_chained_and_the_rotary_profile_does_not(tmp_path
     assert main(["toolpath", str(dxf), "--outer-radius", "0.8", "--machine", "linuxcnc-path", "-q",
                  "--ordering", "interleaved", "--set", "process.repeats=1", "-o", str(out)]) == 0
     assert read_job(out / "slotted.job.json").ordering == "interleaved"
+
+
+def test_a_chained_job_on_the_overtravel_profile_gets_its_leads_and_no_links(pair):
+    """Over-travel gives every edge its own beam-off leads: a chained job's links become rapids there (the gate
+    never stays open between passes), and the program is what the estimate timed."""
+    _, job = pair
+    dialect = dialect_from_profile(load_profile("linuxcnc-surface"))
+    text = gcode(job, dialect)  # safety-checked while written
+    est = job_estimate(job, dialect)
+    assert est.link_length_mm == 0.0
+    assert estimate_program(text, dialect.profile).total_s == pytest.approx(est.total_s, rel=1e-9)
+    lines = text.splitlines()
+    for k, ln in enumerate(lines):
+        if ln.startswith("(pass "):  # every pass is entered with the gate closed
+            assert lines[k + 1].startswith("G0 ")
