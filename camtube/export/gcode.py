@@ -182,7 +182,8 @@ class _Emitter:
                 i += 1
             chain = (bool(link_in[k]), bool(link_out[k]))
             if memo:
-                bkey = (geom, speed) + chain
+                # a linked pass's text starts with its link, whose feed depends on the path it comes from
+                bkey = (geom, speed, int(pk.pass_geom[p0 + k - 1]) if chain[0] else -1, chain[1])
                 blk = blocks.get(bkey)
                 if blk is None:
                     blk = self._rows(X, Y, Z, F, K, L, i, r1, *chain)
