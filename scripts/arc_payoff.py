@@ -15,6 +15,12 @@ For every distinct pass path of a curved drawing (one per cut and drill offset),
 - **bound**: the same with the whole acceleration normal and tangential (the time-optimal bound's model).
 
 Prints per drawing the sum over its passes (every pass of the job) and the ratio arcs / chords.
+
+``--run`` (LinuxCNC installed): the check on the controller itself. One slot of the slotted drawing
+(0.4 x 3 mm, 0.2 mm half-circles) cut 10 times round without a stop, written twice by hand: as ``G1``
+lines and ``G3`` arcs (G93, ``F`` the inverse of each move's minutes at 25 mm/s), and as the chords a pass
+path gets (``simplify_closed``, 1 um); both run with ``camtube.motion.linuxcnc.run_program`` on the
+machine, beside the chords' estimate and the arc model for the same 10 loops.
 """
 from __future__ import annotations
 
@@ -75,6 +81,52 @@ def arc_time_s(ring: np.ndarray, v: float, a: float, normal: float, tangential: 
     return chain_time_s(L, vmax, acc)
 
 
+def run_slot(profile, loops: int = 10, v: float = 25.0) -> None:
+    """The ``--run`` check (module docstring): print LinuxCNC's run time of the slot as arcs and as chords."""
+    import tempfile
+
+    from camtube.machine.motion_time import estimate_program
+    from camtube.motion.linuxcnc import run_program
+    from camtube.plan.paths import simplify_closed
+
+    x0, x1, y0, y1, r = 1.6, 2.0, 1.0, 3.6, 0.2  # the straight sides x = x0, x1 from y0 to y1; half-circles r
+    xc = 0.5 * (x0 + x1)
+    pre = ["G21 G90 G17 G40 G49 G80", "G61", "M65 P0", "G93", "G0 Z0"]
+    post = ["M63 P0", "M65 P0", "G94", "M2"]
+    f = lambda L: f"F{60.0 * v / L:.3f}"  # noqa: E731  (G93: 1 / minutes of the move)
+    arcs = pre + [f"G0 X{x1:.6f} Y{y0:.6f}", "M62 P0", "G64 P0.001"]
+    for k in range(loops):
+        arcs += [f"G1 X{x1:.6f} Y{y1:.6f} {f(y1 - y0)}", f"G3 X{x0:.6f} Y{y1:.6f} I{-r:.6f} J0 {f(math.pi * r)}",
+                 f"G1 X{x0:.6f} Y{y0:.6f} {f(y1 - y0)}"] + (["G61"] if k == loops - 1 else []) + [
+                 f"G3 X{x1:.6f} Y{y0:.6f} I{r:.6f} J0 {f(math.pi * r)}"]
+    t = np.linspace(0.0, math.pi, 4000)  # the slot flattened finely (25 nm), then as a pass path's chords
+    ring = np.vstack([[x1, y0], np.column_stack([xc + r * np.cos(t), y1 + r * np.sin(t)]),
+                      np.column_stack([xc - r * np.cos(t), y0 - r * np.sin(t)])[:-1]])
+    pts = simplify_closed(ring, 0.001, 0.0)
+    loop = np.vstack([pts[1:], pts[:1]])
+    chords = pre + [f"G0 X{pts[0, 0]:.6f} Y{pts[0, 1]:.6f}", "M62 P0", "G64 P0.001"]
+    prev = pts[0]
+    for k in range(loops):
+        for j, q in enumerate(loop):
+            if k == loops - 1 and j == len(loop) - 1:
+                chords.append("G61")
+            chords.append(f"G1 X{q[0]:.6f} Y{q[1]:.6f} {f(math.dist(prev, q))}")
+            prev = q
+    a = min(profile.axis(c).max_acceleration for c in profile.axes[:2])
+    L = np.array([y1 - y0, math.pi * r] * 2 * loops)
+    model = chain_time_s(L, np.array([v, min(v, math.sqrt(NORMAL_SHARE * a * r))] * 2 * loops),
+                         np.array([a, TANGENTIAL_SHARE * a] * 2 * loops))
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, lines in (("arcs", arcs), ("chords", chords)):
+            path = Path(tmp) / f"slot-{name}.ngc"
+            text = "\n".join(lines + post) + "\n"
+            path.write_text(text)
+            run = run_program(path, profile).run_time_s
+            extra = (f", estimate {estimate_program(text, profile).total_s:.3f} s" if name == "chords"
+                     else f", arc model {model:.3f} s")
+            print(f"{profile.name}: the slot {loops} times round as {name}: LinuxCNC {run:.3f} s{extra}", flush=True)
+
+
 def main() -> int:
     from run_motion import DRAWINGS, load_job
 
@@ -88,6 +140,8 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--machine", default="linuxcnc-path")
     ap.add_argument("--preset", action="append", help=f"drawing(s) (default {', '.join(DRAWINGS)})")
+    ap.add_argument("--run", action="store_true",
+                    help="also run one slot as G2/G3 arcs and as chords on LinuxCNC (real time, about 10 s)")
     args = ap.parse_args()
     profile = load_profile(args.machine)
     dialect = dialect_from_profile(profile)
@@ -117,6 +171,14 @@ def main() -> int:
             arcs += n * arc_time_s(ring, v, a, NORMAL_SHARE, TANGENTIAL_SHARE)
             bound += n * arc_time_s(ring, v, a, 1.0, 1.0)
         print(f"| {name} | {len(job.passes)} | {chords:.2f} | {arcs:.2f} | {arcs / chords:.3f} | {bound:.2f} |")
+    if args.run:
+        from camtube.motion.linuxcnc import unavailable_reason
+
+        why = unavailable_reason()
+        if why:
+            print(why, file=sys.stderr)
+            return 2
+        run_slot(profile)
     return 0
 
 
