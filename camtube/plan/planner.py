@@ -19,7 +19,8 @@ Three orderings of those passes (see ``docs/plan.md``):
   offsets, inside the cut region, so the machine neither stops, rapids nor switches
   the gate between them. Each notch cools for a round between two of its groups.
   A closed cut's passes start at a vertex where the drawing is smooth (no drawn
-  corner) when it has one, so the links lie on a smooth part of the path.
+  corner) and most curved when it has one (:func:`smooth_vertices`), so the links
+  lie on a smooth part of the path where the machine runs slowly anyway.
 
 Travel order inside a round is a serpentine ("boustrophedon") tour: cuts whose
 circumferential ranges overlap form one band; bands are visited in ``y`` order,
@@ -363,7 +364,7 @@ def _plan(source, process, ordering, outer_radius_mm, length_mm, name, progress)
         fwd = tour(design)
         # sequential, chained: a slit's passes alternate direction; an even number of them ends where it began
         returns = ordering in ("sequential", "chained") and proc.drill_passes % 2 == 0
-        # chained: the links between a cut's drill passes lie where the drawing is smooth
+        # chained: the links between a cut's drill passes lie where the drawing is smooth and most curved
         smooth = [smooth_vertices(c) for c in design] if ordering == "chained" else None
         s0, end = _chain_starts(design, fwd, (0.0, 0.0), returns, smooth)
         starts = [s0]
