@@ -48,7 +48,8 @@ class Request:
     dialects : sequence of Dialect, optional
         G-code dialects (default: all).
     ordering : str, optional
-        Pass ordering (default: the planner's).
+        Pass ordering (default: the first dialect's machine profile's ``ordering`` when dialects are
+        given, else the planner's).
     cad : CadOptions
     """
 
@@ -116,7 +117,10 @@ def outputs(loaded: Loaded, request: Request, progress: Progress = NO_PROGRESS):
         published then).
     """
     pattern = loaded.pattern
-    job = plan(loaded, request.ordering, progress)
+    ordering = request.ordering
+    if ordering is None and request.dialects:  # the machine's own ordering (linuxcnc-path: chained)
+        ordering = getattr(getattr(request.dialects[0], "profile", None), "ordering", None)
+    job = plan(loaded, ordering, progress)
     files: dict = {}
     est = cad = None
     if request.what in (TOOLPATH, BUILD):

@@ -27,10 +27,13 @@ PRESETS = ("tube1", "tube2", "tube3", "tube1-bidirectional")
 DRAWINGS = ("filleted", "slotted", "elliptical")
 CURVED_RO_MM = 0.8
 MACHINES = ("linuxcnc-surface", "linuxcnc-rotary")
+#: The sort order of the table's machines.
+MACHINE_ORDER = ("linuxcnc-rotary", "linuxcnc-surface", "linuxcnc-path", "linuxcnc-path-airbearing")
 
 
-def load_job(preset: str, overrides=()):
-    """The planned job of a preset (``tube1``) or of a curved drawing (``filleted``), with ``--set`` overrides."""
+def load_job(preset: str, overrides=(), ordering: str = "interleaved"):
+    """The planned job of a preset (``tube1``) or of a curved drawing (``filleted``), with ``--set`` overrides,
+    in ``ordering`` (a run uses its machine profile's, ``profile.ordering``)."""
     from camtube.design.source import DrawingOptions, load_source
     from camtube.plan import plan_job
 
@@ -39,7 +42,7 @@ def load_job(preset: str, overrides=()):
                              DrawingOptions(outer_radius_mm=CURVED_RO_MM))
     else:
         loaded = load_source(ROOT / "patterns" / f"{preset}.yaml", overrides)
-    return plan_job(loaded.pattern)
+    return plan_job(loaded.pattern, ordering=ordering)
 
 
 def run_one(machine: str, preset: str, workdir=None, overrides=()) -> dict:
@@ -54,7 +57,7 @@ def run_one(machine: str, preset: str, workdir=None, overrides=()) -> dict:
 
     profile = load_profile(machine)
     dialect = dialect_from_profile(profile)
-    job = load_job(preset, overrides)
+    job = load_job(preset, overrides, profile.ordering)
     bound = time_optimal_s(job, profile)
     with tempfile.TemporaryDirectory(prefix="camtube-run-motion-") as tmp:
         streams = toolpath_streams(job, (dialect,))
@@ -68,6 +71,7 @@ def run_one(machine: str, preset: str, workdir=None, overrides=()) -> dict:
     d = rep.as_dict()
     d["preset"] = preset + "".join(f" {o}" for o in overrides)
     d["optimal_s"] = bound
+    d["ordering"] = job.ordering
     return d
 
 
@@ -81,7 +85,7 @@ def rescore(r: dict) -> dict:
 
     name, *overrides = r["preset"].split()
     profile = load_profile(r["machine"])
-    job = load_job(name, tuple(overrides))
+    job = load_job(name, tuple(overrides), r.get("ordering", "interleaved"))  # rows before issue 21's chaining
     est = estimate_program(gcode(job, dialect_from_profile(profile)), profile).total_s
     return dict(r, estimate_s=est, estimate_error=est / r["run_time_s"] - 1.0, optimal_s=time_optimal_s(job, profile))
 
@@ -103,10 +107,16 @@ def table(rows: list[dict]) -> str:
         # the own-pass figures come as a pair; a run made before them has neither
         own = (f"{_um(r['max_path_dev_mm'])} / {_um(r['max_vertex_miss_mm'])}" if "max_vertex_miss_mm" in r
                else "– / –")
-        out.append(f"| {r['machine']} | {r['preset']} | {r['run_time_s']:.2f} | {r['estimate_s']:.2f} "
+        # chained passes: the links are beam-on path beyond the cut length, stated beside it
+        link = r.get("link_length_mm", 0.0)
+        beam = f"{100 * r['length_error']:+.3f} %" + (
+            f" (links {link:.2f} mm; {100 * r['path_length_error']:+.3f} % of cut + links)" if link > 0 else "")
+        order = r.get("ordering", "interleaved")
+        job = r["preset"] + ("" if order == "interleaved" else f" ({order})")
+        out.append(f"| {r['machine']} | {job} | {r['run_time_s']:.2f} | {r['estimate_s']:.2f} "
                    f"({100 * r['estimate_error']:+.2f} %) | {r['lower_bound_s']:.2f} | "
                    f"{r['run_time_s'] / r['lower_bound_s']:.3f} | {opt:.2f} | {r['run_time_s'] / opt:.3f} | "
-                   f"{100 * r['length_error']:+.3f} % | {100 * dose:.2f} % | "
+                   f"{beam} | {100 * dose:.2f} % | "
                    f"{100 * r['speed_share']:.2f} % | {1000 * r['max_outside_mm']:.3f} | "
                    f"{1000 * r['max_corner_miss_mm']:.3f} | {own} |")
     return "\n".join(out)
@@ -128,9 +138,12 @@ def main() -> int:
     args = ap.parse_args()
     if args.table:
         rows = [json.loads(x) for x in Path(args.table).read_text().splitlines() if x.strip()]
-        last = {(r["machine"], r["preset"]): r for r in rows if "error" not in r}  # a rerun replaces a run
+        # a rerun replaces a run (per machine, job and ordering)
+        last = {(r["machine"], r["preset"], r.get("ordering", "interleaved")): r for r in rows if "error" not in r}
         kinds = {name: k for k, name in enumerate(PRESETS + DRAWINGS)}
-        rows = sorted(last.values(), key=lambda r: (r["preset"].split()[0] in DRAWINGS, r["machine"] != "linuxcnc-rotary",
+        mk = {m: k for k, m in enumerate(MACHINE_ORDER)}
+        rows = sorted(last.values(), key=lambda r: (r["preset"].split()[0] in DRAWINGS, mk.get(r["machine"], 99),
+                                                    r.get("ordering", "interleaved") != "interleaved",
                                                     kinds.get(r["preset"].split()[0], 99)))
         if args.rescore:
             rows = [rescore(r) for r in rows]

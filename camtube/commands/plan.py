@@ -14,9 +14,12 @@ def register(sub) -> None:
         p.add_argument("-o", "--output", required=True, metavar="DIR",
                        help="output directory (created; files of this command are replaced all at once, "
                             "other files in it are kept)")
-        p.add_argument("--ordering", choices=ORDERINGS, default=DEFAULT_ORDERING,
-                       help=f"pass ordering (default {DEFAULT_ORDERING}: one round per repeat/focus/drill "
-                            "visits every cut; sequential: all passes of a cut, then the next)")
+        p.add_argument("--ordering", choices=ORDERINGS, default=None,
+                       help=f"pass ordering (default: the machine profile's, {DEFAULT_ORDERING} unless it says "
+                            f"otherwise; {DEFAULT_ORDERING}: one round per repeat/focus/drill visits every cut; "
+                            "sequential: all passes of a cut, then the next; chained: one round per "
+                            "repeat/focus visits every cut and cuts its drill passes as one beam-on path, "
+                            "each joined to the next by a beam-on link inside the cut)")
         p.add_argument("--dialect", choices=("all",) + tuple(DIALECTS), default="all",
                        help="G-code dialect(s) to write (default all: linuxcnc .ngc rotary X/A/Z, "
                             "grbl .nc flat X/Y/Z)")

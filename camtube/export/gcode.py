@@ -14,11 +14,14 @@ safety check on them, and only then formats them; memory stays bounded however
 long the job. :func:`gcode` joins the chunks (small jobs, tests). Same job and
 dialect: byte-identical text.
 
-Rows by kind: RAPID ``G0 <x> <y>``; FOCUS ``G0 <z>``; CUT and LEAD ``G1 <x> <y> F..``.
+Rows by kind: RAPID ``G0 <x> <y>``; FOCUS ``G0 <z>``; CUT, LINK and LEAD ``G1 <x> <y> F..``.
 The beam gate follows the rows' ``laser`` flags: ``laser_on`` before the first
 laser-on row after laser-off rows (preceded by the settings lines where power or
 frequency change), ``laser_off`` before a laser-off row after laser-on rows and at
-the end of every pass, so a LEAD move (over-travel, lead-in) runs with the gate closed.
+the end of every pass, so a LEAD move (over-travel, lead-in) runs with the gate closed;
+a chain of linked passes (the ``chained`` ordering) is one beam-on run: the gate stays
+open from its first pass to its last, and a pass entered by its LINK starts with that
+G1 move (no rapid).
 """
 from __future__ import annotations
 
@@ -29,7 +32,7 @@ from camtube.export.dialects import LINUXCNC, Dialect
 from camtube.fmt import format_duration_s
 from camtube.machine.kinematics import MachineMoves, machine_moves
 from camtube.machine.motion_time import job_estimate, slow_job_warning
-from camtube.plan.moves import FOCUS, RAPID, Moves, iter_moves, time_warning
+from camtube.plan.moves import FOCUS, LINK, RAPID, Moves, iter_moves, time_warning
 from camtube.plan.packed import no_gc
 from camtube.plan.safety import check_moves
 from camtube.progress import NO_PROGRESS, Progress
@@ -101,19 +104,26 @@ class _Emitter:
         self.prev_key = key
         return out
 
-    def _rows(self, X, Y, Z, F, K, L, lo: int, hi: int) -> tuple[str, str, bool, bool]:
+    def _rows(self, X, Y, Z, F, K, L, lo: int, hi: int, open_in: bool = False, open_out: bool = False
+              ) -> tuple[str, str, bool, bool]:
         """Text of rows [lo, hi) of one pass: (before the first gate-on, after it, gate opened at all,
         gate opened again later).
 
-        Starts with the gate closed and ends with it closed. A later gate-on (after a lead
-        move inside the pass) is the marker ``_REOPEN``, replaced by the pass's formatted
-        ``laser_on`` in :meth:`chunk` (the text is shared by passes of any power).
+        Starts with the gate closed and ends with it closed, except in a chain of linked passes:
+        ``open_in`` (the pass is entered by a link: the gate is open and the path blended already)
+        and ``open_out`` (the next pass is linked to this one: the beam-on run goes on). A later
+        gate-on (after a lead move inside the pass) is the marker ``_REOPEN``, replaced by the
+        pass's formatted ``laser_on`` in :meth:`chunk` (the text is shared by passes of any power).
         """
         d = self.d
         parts: list[str] = []
         before = None
-        state = False
+        state = open_in
         blend_on, blend_off = d.blend_on, d.blend_off
+
+        def run_ends(i: int) -> bool:  # row i is the last beam-on row of its beam-on run
+            return (not open_out and i + 1 == hi) or (i + 1 < hi and not L[i + 1])
+
         for i in range(lo, hi):
             on = L[i]
             if on != state:
@@ -122,10 +132,9 @@ class _Emitter:
                 else:
                     parts.append((_REOPEN if on else d.laser_off) + "\n")
                 state = on
-                last = on and (i + 1 == hi or not L[i + 1])
-                if on and blend_on is not None and not last:
+                if on and blend_on is not None and not run_ends(i):
                     parts.append(blend_on + "\n")  # the beam-on run is one blended path ...
-            if on and blend_off is not None and (i + 1 == hi or not L[i + 1]):
+            if on and blend_off is not None and run_ends(i):
                 parts.append(blend_off + "\n")  # ... that ends at rest, where the gate closes
             k = K[i]
             if k == RAPID:
@@ -134,8 +143,9 @@ class _Emitter:
                 parts.append(self.focus(Z[i]) + "\n")
             else:
                 parts.append(self.feed(X[i], Y[i], F[i]) + "\n")
-        if state:
+        if state and not open_out:
             parts.append(d.laser_off)
+            state = False
         text = "".join(parts)
         if before is None:
             return text.rstrip("\n"), "", False, False
@@ -155,6 +165,10 @@ class _Emitter:
         s = slice(p0, p1)
         cols = [pk.pass_cut[s], pk.pass_repeat[s], pk.pass_focus[s], pk.pass_z[s], pk.pass_drill[s],
                 pk.pass_offset[s], pk.pass_geom[s], pk.pass_speed[s], pk.pass_power[s], pk.pass_freq[s]]
+        # chains of linked passes (a pass whose first row is its LINK): entered with the gate open, left
+        # with it open for the next pass; a chunk never ends inside a chain (plan.moves.iter_moves)
+        link_in = [r0 < len(K) and K[r0] == LINK for r0 in rows[:-1]]
+        link_out = link_in[1:] + [False]
         design = self.job.design
         comment, rapid, focus = self.comment, self.rapid, self.focus
         blocks, memo = self.blocks, self.memo
@@ -166,15 +180,17 @@ class _Emitter:
             while i < r1 and K[i] in (RAPID, FOCUS) and not L[i]:  # the pass's leading rapid and focus rows
                 text.append(rapid(X[i], Y[i]) if K[i] == RAPID else focus(Z[i]))
                 i += 1
+            chain = (bool(link_in[k]), bool(link_out[k]))
             if memo:
-                bkey = (geom, speed)
+                # a linked pass's text starts with its link, whose feed depends on the path it comes from
+                bkey = (geom, speed, int(pk.pass_geom[p0 + k - 1]) if chain[0] else -1, chain[1])
                 blk = blocks.get(bkey)
                 if blk is None:
-                    blk = self._rows(X, Y, Z, F, K, L, i, r1)
+                    blk = self._rows(X, Y, Z, F, K, L, i, r1, *chain)
                     if len(blocks) < MEMO_MAX:
                         blocks[bkey] = blk
             else:
-                blk = self._rows(X, Y, Z, F, K, L, i, r1)
+                blk = self._rows(X, Y, Z, F, K, L, i, r1, *chain)
             before, after, opened, reopened = blk
             if opened:
                 settings, gate_on = self._gate_on((pw, fq, speed))

@@ -99,6 +99,8 @@ def _head(job, dialect=None) -> dict:
         "total_time_s": est.total_s, "lower_bound_s": est.lower_bound_s, "ratio": est.ratio,
         "constant_speed_time_s": est.constant_speed_s,
     }
+    if est.link_length_mm > 0:  # chained passes: the beam is on along the cut length plus the links
+        summary["link_length_mm"] = est.link_length_mm
     machine = dialect.profile.record() if getattr(dialect, "profile", None) is not None else None
     return {
         "schema": SCHEMA, "generator": f"camtube {__version__}", "name": job.name,
@@ -214,7 +216,7 @@ def read_job(source) -> "camtube.plan.Job":  # noqa: F821
         raise _bad(where, f"ordering {ordering!r} is not one of {', '.join(ORDERINGS)}")
     if sorted(tour.tolist()) != list(range(len(design))):
         raise _bad(where, "tour is not a permutation of the cut indices")
-    n_dir = 2 if ordering == "interleaved" else 1
+    n_dir = 2 if ordering in ("interleaved", "chained") else 1
     if starts.shape != (n_dir, len(design)) or (starts < 0).any() or any(
             int(k) >= len(c.points) for row in starts for k, c in zip(row, design)):
         raise _bad(where, f"each cut needs {n_dir} start vertex index(es) within its points")

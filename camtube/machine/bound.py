@@ -3,7 +3,9 @@
 Beside the lower bound (cut length / scan speed), which no machine reaches, this is
 the time of the fastest motion a machine with the profile's limits could make along
 the job's paths when it must come to rest at every true corner (a turn above
-``TOL.corner_deg``) and at both ends of every pass, and may run anywhere else as
+``TOL.corner_deg``) and at both ends of every beam-on run (a pass, or a chain of
+passes joined by beam-on links, whose turns are taken at the speed their
+curvature allows like any other vertex), and may run anywhere else as
 fast as the scan speed, its axes' velocity limits and the path's curvature allow:
 
 - along a chord of direction ``t`` the speed changes at most at
@@ -26,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from camtube.plan.moves import CUT, FOCUS, LEAD, RAPID, iter_moves
+from camtube.plan.moves import CUT, FOCUS, LEAD, LINK, RAPID, iter_moves
 from camtube.tol import TOL
 
 
@@ -91,7 +93,8 @@ class OptimalTime:
     free_s : float
         Rapid and focus moves, each from rest to rest.
     stops : int
-        Stops along the paths (true corners and pass ends).
+        Stops along the paths (true corners and the ends of beam-on runs: a pass, or a chain of linked
+        passes).
     """
 
     path_s: float
@@ -141,14 +144,16 @@ def time_optimal(job, profile, corner_deg: float = TOL.corner_deg) -> OptimalTim
         vmax = _along(vlim, u)
         a = _along(alim, u)
         free_s += float(_trapezoids(L[free & ok], 0.0, 0.0, vmax[free & ok], a[free & ok]).sum())
-        path = ((mv.kind == CUT) | (mv.kind == LEAD)) & ok
+        path = ((mv.kind == CUT) | (mv.kind == LEAD) | (mv.kind == LINK)) & ok
         idx = np.flatnonzero(path)
         if len(idx) == 0:
             continue
         vcap = np.minimum(vmax[idx], mv.speed[idx])
-        # junction after path row k (to row k + 1): consecutive rows of the same pass, turn below the corner angle
+        # junction after path row k (to row k + 1): consecutive rows of the same pass (or of a chain of linked
+        # passes: the next row is a link), turn below the corner angle
         nxt = np.concatenate((idx[1:], [-1]))
-        same = (nxt == idx + 1) & (mv.pass_index[np.maximum(nxt, 0)] == mv.pass_index[idx]) & (nxt >= 0)
+        nn = np.maximum(nxt, 0)
+        same = (nxt == idx + 1) & ((mv.pass_index[nn] == mv.pass_index[idx]) | (mv.kind[nn] == LINK)) & (nxt >= 0)
         ua, ub = u[idx], u[np.maximum(nxt, 0)]
         cosphi = np.clip(np.einsum("ij,ij->i", ua, ub), -1.0, 1.0)
         reach = math.sqrt(2.0) * offsets[mv.pass_index[idx]] + TOL.path + TOL.safety

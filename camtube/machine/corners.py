@@ -28,7 +28,7 @@ from typing import Iterator
 
 import numpy as np
 
-from camtube.plan.moves import CUT, FOCUS, LEAD, RAPID, Moves, iter_moves
+from camtube.plan.moves import CUT, FOCUS, LEAD, LINK, RAPID, Moves, iter_moves
 
 LEAD_MARGIN = 1.25
 LEAD_CYCLES = 4
@@ -61,6 +61,10 @@ def overtravel(job, mv: Moves, profile, final: bool = False) -> Moves:
     """
     if len(mv) == 0:
         return mv
+    if (mv.kind == LINK).any():  # every edge gets its own leads: a chained pass is entered by a rapid again
+        link = mv.kind == LINK
+        mv = Moves(mv.x, mv.y, mv.z, np.where(link, RAPID, mv.kind).astype(np.int8), mv.laser & ~link,
+                   mv.pass_index, mv.vertex, np.where(link, 0.0, mv.speed), mv.start)
     x0, y0, z0 = mv.starts()
     length = job.length_mm
     cut = np.flatnonzero(mv.kind == CUT)

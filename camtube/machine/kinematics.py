@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from camtube.machine.profile import MachineProfile
-from camtube.plan.moves import CUT, LEAD, Moves, job_moves
+from camtube.plan.moves import CUT, LEAD, LINK, Moves, job_moves
 
 
 @dataclass(frozen=True, eq=False)
@@ -28,7 +28,7 @@ class MachineMoves:
     ax, ay, az : (m,) float
         Axis values (mm, or deg for a rotary second axis), rounded to ``profile.decimals``.
     feed : (m,) float
-        F of every feed move (CUT, LEAD; 1/min in G93, else mm/min or deg/min), rounded; 0 elsewhere.
+        F of every feed move (CUT, LINK, LEAD; 1/min in G93, else mm/min or deg/min), rounded; 0 elsewhere.
     profile : MachineProfile
         The machine (axes, rotary or flat, decimals, feed mode).
     outer_radius_mm : float
@@ -85,7 +85,7 @@ def machine_moves(job, machine, moves: Moves | None = None) -> MachineMoves:
     dy = np.diff(np.concatenate(([s_ys], ys)))
     dz = np.diff(np.concatenate(([s_az], az)))
     surf = np.hypot(dx, dy)
-    feedrow = (mv.kind == CUT) | (mv.kind == LEAD)
+    feedrow = (mv.kind == CUT) | (mv.kind == LEAD) | (mv.kind == LINK)
     feed = np.zeros(len(mv))
     with np.errstate(divide="ignore", invalid="ignore"):
         minutes = surf / (mv.speed * 60.0)

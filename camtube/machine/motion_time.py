@@ -34,7 +34,7 @@ import numpy as np
 from camtube.machine.bound import time_optimal
 from camtube.machine.corners import strategy_moves
 from camtube.machine.kinematics import machine_moves
-from camtube.plan.moves import FOCUS, RAPID, Moves, estimate, iter_moves
+from camtube.plan.moves import FOCUS, LINK, RAPID, Moves, estimate, iter_moves
 
 _LINEAR = "XYZUVW"
 
@@ -280,12 +280,15 @@ def estimate_machine_moves(mm, profile) -> MotionEstimate:
     rapid = (n.kind == RAPID) | (n.kind == FOCUS)
     req = _requested_velocity(d, letters, mm.feed, ~rapid, mm.profile.feed_mode)
     joined = _joined(d, letters, profile)
-    # every pass starts from rest (a pass boundary is a chunk boundary: the estimate does not depend on chunking)
-    joined[:-1] &= n.pass_index[1:] == n.pass_index[:-1]
+    # every pass starts from rest, unless it is entered by a beam-on link from the pass before (a chain
+    # of linked passes is one beam-on run; chunks start and end at rest: the estimate does not depend
+    # on chunking)
+    same_run = (n.pass_index[1:] == n.pass_index[:-1]) | (n.kind[1:] == LINK)
+    joined[:-1] &= same_run
     blend = None
     if profile.corner_strategy == "blend":  # the emitter blends beam-on runs and stops where the gate switches
         blend = np.zeros(len(d), bool)
-        blend[:-1] = n.laser[:-1] & n.laser[1:] & (n.pass_index[1:] == n.pass_index[:-1])
+        blend[:-1] = n.laser[:-1] & n.laser[1:] & same_run
         joined &= blend
     return trajectory_time(d, letters, profile, req, joined, blend)
 
@@ -325,7 +328,8 @@ def estimate_program(text: str, profile) -> MotionEstimate:
     feed = 0.0
     rows_d, rows_f, rows_feed, rows_stop, rows_inv = [], [], [], [], []
     for raw in text.splitlines():
-        line = re.sub(r"\(.*?\)", "", raw.split(";", 1)[0]).upper()
+        # parenthesised comments first: a ';' inside one (a profile's description) starts no comment
+        line = re.sub(r"\(.*?\)", "", raw).split(";", 1)[0].upper()
         if not line.strip():
             continue
         words = _WORD.findall(line)

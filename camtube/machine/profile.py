@@ -16,7 +16,9 @@ Keys (units in the comments of the shipped files; ``docs/motion.md`` has the tab
 ``power_output``, ``frequency_output``, ``gating`` (``time`` | ``distance``),
 ``dose_output``, ``radius_output`` for LinuxCNC; ``spindle`` M3/M4 and
 ``s_per_watt`` for GRBL), ``rotary_range_deg``, ``wrap``, ``comment``
-(``paren`` | ``semicolon``), ``decimals``, ``feed_decimals``, ``warn_time_factor``.
+(``paren`` | ``semicolon``), ``decimals``, ``feed_decimals``, ``warn_time_factor``,
+``ordering`` (the pass ordering a job for this machine is planned with when none is
+asked for: ``interleaved``, ``sequential`` or ``chained``; default ``interleaved``).
 
 ``laser.gating`` says how the laser's pulses follow the motion. ``time``: the laser
 fires at its set frequency whenever the gate is open, so the dose per millimetre
@@ -117,6 +119,10 @@ class MachineProfile:
     warn_time_factor : float
         Warn before writing when the estimate exceeds the lower bound (cut length / scan
         speed) by more than this factor.
+    ordering : {"interleaved", "sequential", "chained"}
+        The pass ordering a job for this machine is planned with unless another is asked for
+        (:mod:`camtube.plan.planner`; ``chained`` joins the drill passes of a cut into one beam-on
+        path).
     source : str | None
         File the profile was read from.
     """
@@ -145,6 +151,7 @@ class MachineProfile:
     dose_output: int | None = None
     radius_output: int | None = None
     warn_time_factor: float = 3.0
+    ordering: str = "interleaved"
     source: str | None = None
 
     def axis(self, letter: str) -> AxisLimits:
@@ -198,7 +205,7 @@ _LASER_KEYS = ("gate_output", "power_output", "frequency_output", "spindle", "s_
                "radius_output")
 _KEYS = ("description", "dialect", "suffix", "rotary", "axes", "limits", "blending", "corner_strategy",
          "servo_period_s", "laser", "rotary_range_deg", "wrap", "comment", "decimals", "feed_decimals",
-         "warn_time_factor")
+         "warn_time_factor", "ordering")
 _REQUIRED = ("dialect", "axes", "limits")
 
 
@@ -354,6 +361,9 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
         ck.add("laser.dose_output", "only distance gating uses dose_output and radius_output", None,
                "laser.gating: distance", "add laser.gating: distance, or remove them")
     warn_factor = ck.number(m.get("warn_time_factor", 3.0), "warn_time_factor", 1.0, strict=False)
+    from camtube.plan.planner import DEFAULT_ORDERING, ORDERINGS
+
+    ordering = ck.choice(m.get("ordering", DEFAULT_ORDERING), "ordering", ORDERINGS)
     rng = m.get("rotary_range_deg")
     if rng is not None:
         if not (isinstance(rng, list) and len(rng) == 2 and all(isinstance(v, (int, float)) for v in rng)
@@ -382,7 +392,7 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
         frequency_output=outs.get("frequency_output"), spindle=spindle if dialect == "grbl" else None,
         s_per_watt=spw, rotary_range_deg=rng, wrap=wrap, comment=comment, decimals=dec, feed_decimals=fdec,
         gating=gating, dose_output=outs.get("dose_output"), radius_output=outs.get("radius_output"),
-        warn_time_factor=warn_factor if warn_factor is not None else 3.0, source=file)
+        warn_time_factor=warn_factor if warn_factor is not None else 3.0, ordering=ordering, source=file)
 
 
 def read_profile(path: str | os.PathLike) -> MachineProfile:

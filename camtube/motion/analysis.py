@@ -27,9 +27,14 @@ Figures (:class:`MotionReport`):
   drawing, :func:`camtube.machine.bound.design_corners`: every vertex of a rectangle, none of a
   slot or an ellipse; matched by focus level) to the beam-on path at that focus;
 - each stretch of the beam-on path against its own pass (the k-th stretch with the gate open is the
-  k-th pass): the farthest sample from the pass's commanded path, and the farthest vertex of that
-  path (on a curve: a point of the drawn curve) from the stretch (curves followed within the path
-  tolerance).
+  k-th beam-on run: a pass, or a chain of passes joined by beam-on links, ``chained`` ordering): the
+  farthest sample from the run's commanded path (its passes' paths and the links between them), and
+  the farthest vertex of that path (on a curve: a point of the drawn curve) from the stretch (curves
+  followed within the path tolerance).
+
+The beam-on path is compared with the job's cut length (the passes' paths) and, where passes are
+chained, with the cut length plus the links (``link_length_mm``): the links are beam-on path the
+passes do not have, stated apart.
 """
 from __future__ import annotations
 
@@ -61,6 +66,12 @@ class JobGeometry:
         offset into the material (mm).
     paths : tuple of ((k, 2) float, bool, float)
         Every distinct pass path (vertices, closed, focus offset mm).
+    pass_paths : tuple of int
+        Per pass, its index in ``paths``.
+    pass_link : tuple of bool
+        Per pass, entered from the pass before by a beam-on link (a chain is one beam-on run).
+    link_length_mm : float
+        Total length of the links (beam-on path that is not part of ``cut_length_mm``).
     estimate_s, lower_bound_s : float
         The job's time estimate and lower bound (s), NaN if unknown.
     """
@@ -76,6 +87,8 @@ class JobGeometry:
     frequency_khz: float = math.nan
     paths: tuple = ()
     pass_paths: tuple = ()
+    pass_link: tuple = ()
+    link_length_mm: float = 0.0
 
     @classmethod
     def from_job(cls, job, estimate_s: float = math.nan) -> "JobGeometry":
@@ -97,7 +110,8 @@ class JobGeometry:
         return cls(job.name, float(job.outer_radius_mm), float(job.process.scan_speed_mm_s),
                    float(job.cut_length_mm), tuple(np.asarray(c.points, float) for c in job.design), corners,
                    float(estimate_s), float(job.cut_length_mm / job.process.scan_speed_mm_s),
-                   float(job.process.frequency_khz), paths, order)
+                   float(job.process.frequency_khz), paths, order, tuple(bool(v) for v in pk.pass_link.tolist()),
+                   float(job.link_length_mm))
 
     @classmethod
     def from_job_file(cls, path: str | os.PathLike) -> "JobGeometry":
@@ -145,6 +159,7 @@ class MotionReport:
     distance_gated: bool = False
     max_path_dev_mm: float = math.nan
     max_vertex_miss_mm: float = math.nan
+    link_length_mm: float = 0.0
 
     @property
     def estimate_error(self) -> float:
@@ -153,8 +168,13 @@ class MotionReport:
 
     @property
     def length_error(self) -> float:
-        """beam-on length / cut length - 1."""
+        """beam-on length / cut length - 1 (the links of chained passes count against it)."""
         return self.beam_on_length_mm / self.cut_length_mm - 1.0
+
+    @property
+    def path_length_error(self) -> float:
+        """beam-on length / (cut length + links) - 1: the beam-on path against every beam-on move commanded."""
+        return self.beam_on_length_mm / (self.cut_length_mm + self.link_length_mm) - 1.0
 
     def table(self) -> str:
         """Plain-text table of the figures."""
@@ -166,7 +186,11 @@ class MotionReport:
                                                         f"{self.run_time_s / self.lower_bound_s:.3f})"),
             ("beam-on time", f"{self.beam_on_time_s:.3f}", "s"),
             ("beam-on path", f"{self.beam_on_length_mm:.4f}", f"mm ({100 * self.length_error:+.3f} % of the "
-                                                              f"cut length {self.cut_length_mm:.4f} mm)"),
+                                                              f"cut length {self.cut_length_mm:.4f} mm"
+                                                              + (f"; links {self.link_length_mm:.4f} mm, "
+                                                                 f"{100 * self.path_length_error:+.3f} % of cut "
+                                                                 "length + links)" if self.link_length_mm > 0
+                                                                 else ")")),
             ("within +-5 % of scan speed", f"{100 * self.speed_share:.2f}", f"% of the beam-on path (scan "
                                                                             f"{self.scan_speed_mm_s:g} mm/s, median "
                                                                             f"{self.median_speed_mm_s:.2f})"),
@@ -186,7 +210,8 @@ class MotionReport:
 
     def as_dict(self) -> dict:
         d = dict(self.__dict__)
-        d.update(estimate_error=self.estimate_error, length_error=self.length_error)
+        d.update(estimate_error=self.estimate_error, length_error=self.length_error,
+                 path_length_error=self.path_length_error)
         return d
 
 
@@ -255,24 +280,41 @@ def _corner_miss_mm(corners: np.ndarray, a: np.ndarray, b: np.ndarray, fz: np.nd
     return worst
 
 
+def _beam_runs(geom) -> list[tuple[int, ...]]:
+    """The beam-on runs of a job: per run, the indices (into ``geom.paths``) of its passes' paths in order."""
+    runs: list[list[int]] = []
+    link = geom.pass_link or (False,) * len(geom.pass_paths)
+    for k, linked in zip(geom.pass_paths, link):
+        if linked and runs:
+            runs[-1].append(k)
+        else:
+            runs.append([k])
+    return [tuple(r) for r in runs]
+
+
 def _own_pass_mm(rec_x, rec_y, gate, geom) -> tuple[float, float]:
     """(farthest beam-on sample from its own pass's path, farthest vertex of a pass's path from its own beam-on
-    path), mm: the k-th stretch of samples with the gate open is the k-th pass (NaN if the counts differ)."""
+    path), mm: the k-th stretch of samples with the gate open is the k-th beam-on run, a pass or a chain of
+    linked passes, whose path is its passes' paths joined by the links (NaN if the counts differ)."""
     import shapely
 
     g = gate[1:].astype(np.int8)  # the gate of sample k + 1 is that of the step k -> k + 1
     edges = np.flatnonzero(np.diff(np.concatenate(([0], g, [0]))))
     starts, ends = edges[::2], edges[1::2]  # the beam is on from sample s to sample e (gate set at s + 1 .. e)
-    if len(starts) != len(geom.pass_paths) or not geom.pass_paths:
+    runs = _beam_runs(geom)
+    if len(starts) != len(runs) or not runs:
         return math.nan, math.nan
     dev = miss = 0.0
     lines = {}
-    for s, e, k in zip(starts.tolist(), ends.tolist(), geom.pass_paths):
+    for s, e, k in zip(starts.tolist(), ends.tolist(), runs):
         pts = np.column_stack([rec_x[s:e + 1], rec_y[s:e + 1]])
         line = lines.get(k)
         if line is None:
-            pp, closed, _ = geom.paths[k]
-            line = lines[k] = shapely.LineString(np.vstack([pp, pp[:1]]) if closed else pp)
+            rings = []
+            for j in k:
+                pp, closed, _ = geom.paths[j]
+                rings.append(np.vstack([pp, pp[:1]]) if closed else pp)
+            line = lines[k] = shapely.LineString(np.concatenate(rings))  # a link joins each ring to the next
         dev = max(dev, float(shapely.distance(line, shapely.points(pts)).max()))
         beam = shapely.LineString(pts) if len(pts) > 1 else shapely.Point(pts[0])
         miss = max(miss, float(shapely.distance(beam, shapely.points(np.asarray(line.coords))).max()))
@@ -335,4 +377,5 @@ def analyse(rec, geom: JobGeometry, profile, estimate_s: float | None = None) ->
     dose_share = float(lo[good].sum() / length) if length > 0 else 0.0
     return MotionReport(geom.name, profile.name, rec.run_time_s, est, geom.lower_bound_s, float(dt[on].sum()),
                         length, geom.cut_length_mm, v, share, median, outside, miss, len(geom.corners), len(rec),
-                        rec.wall_s, dose_share, nominal, rate is not None, path_dev, vertex_miss)
+                        rec.wall_s, dose_share, nominal, rate is not None, path_dev, vertex_miss,
+                        geom.link_length_mm)

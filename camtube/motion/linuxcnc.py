@@ -303,10 +303,13 @@ def split_program(text: str, max_moves: int = PIECE_MOVES) -> list[str]:
     Every piece repeats the modal preamble (units, blending, feed mode, gate off; not the
     preamble's moves) and ends with ``M2``; the last keeps the original postamble. The machine
     is at rest with the gate closed between passes, so running the pieces one after the other
-    moves it exactly as the whole program does.
+    moves it exactly as the whole program does. A pass entered by a beam-on link (its first
+    line a ``G1``: chained passes) continues the run of the one before and is never the first
+    of a piece.
     """
     lines = text.splitlines()
-    starts = [i for i, ln in enumerate(lines) if ln.startswith(("(pass ", "; pass "))]
+    starts = [i for i, ln in enumerate(lines) if ln.startswith(("(pass ", "; pass "))
+              and not (i + 1 < len(lines) and lines[i + 1].startswith("G1 "))]
     if not starts:
         return [text]
     head = lines[:starts[0]]

@@ -104,6 +104,15 @@ class Job:
         return float(pk.geom_length_mm[pk.pass_geom].sum())
 
     @property
+    def link_length_mm(self) -> float:
+        """Total length (mm) of the beam-on links between chained passes (the ``chained`` ordering; 0 otherwise).
+
+        Not part of :attr:`cut_length_mm` (the passes' paths), so the lower bound stays the passes' length
+        over the scan speed; the beam is on along the cut length plus this.
+        """
+        return self.packed.link_length_mm()
+
+    @property
     def packed(self):
         """:class:`camtube.plan.packed.Packed` arrays of the passes (the planner's, or packed once, kept in the cache)."""
         if isinstance(self.passes, PassView):

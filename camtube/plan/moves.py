@@ -10,9 +10,13 @@ returns to its start; an open one, a slit, ends at its last point).
 The machine starts at x = y = z = 0.
 
 Move kinds: ``RAPID`` (G0, laser off), ``FOCUS`` (G0 Z, laser off), ``CUT``
-(G1, laser on, inside the cut region of its pass) and ``LEAD`` (G1 at the
+(G1, laser on, inside the cut region of its pass), ``LEAD`` (G1 at the
 row's speed with the laser off: a lead-in or over-travel that may leave the cut
-region but never the tube; a post-processor or a corner strategy adds them).
+region but never the tube; a post-processor or a corner strategy adds them) and
+``LINK`` (G1 at the scan speed with the laser on, in place of the rapid of a pass
+that is chained to the one before it, ``Packed.pass_link``: from the end of that
+pass to the start of this one, across the strip between the two drill offsets of
+one cut, inside its cut region; the ``chained`` ordering).
 
 Large jobs are never held as one move list: :func:`iter_moves` yields the moves
 of :data:`CHUNK_PASSES` passes at a time (each chunk starts where the previous
@@ -26,8 +30,10 @@ from typing import Iterable, Iterator
 
 import numpy as np
 
-RAPID, FOCUS, CUT, LEAD = 0, 1, 2, 3
-KIND_NAMES = {RAPID: "rapid", FOCUS: "focus", CUT: "cut", LEAD: "lead"}
+RAPID, FOCUS, CUT, LEAD, LINK = 0, 1, 2, 3, 4
+KIND_NAMES = {RAPID: "rapid", FOCUS: "focus", CUT: "cut", LEAD: "lead", LINK: "link"}
+#: Kinds of the beam-on moves.
+BEAM_KINDS = (CUT, LINK)
 
 #: Passes per chunk of the streaming writers (a few MB of arrays and text).
 CHUNK_PASSES = 4096
@@ -42,7 +48,7 @@ class Moves:
     x, y, z : (m,) float
         Target of each move (mm; z = focus offset into the material, >= 0).
     kind : (m,) int8
-        RAPID, FOCUS, CUT or LEAD.
+        RAPID, FOCUS, CUT, LEAD or LINK.
     laser : (m,) bool
         Beam gate during the move (the post-processor switches it where it changes).
     pass_index : (m,) int
@@ -50,7 +56,7 @@ class Moves:
     vertex : (m,) int
         Row of ``job.packed.vertices`` a move ends at (-1 if none, e.g. a lead move).
     speed : (m,) float
-        Speed on the outer surface (mm/s) of CUT and LEAD moves; 0 for rapid and focus moves.
+        Speed on the outer surface (mm/s) of CUT, LINK and LEAD moves; 0 for rapid and focus moves.
     start : tuple[float, float, float]
         (x, y, z) where the first move starts: the origin, or the end of the previous chunk.
     """
@@ -150,12 +156,13 @@ def job_moves(job, lo: int = 0, hi: int | None = None) -> Moves:
     n_pass = hi - lo
     pidx = np.repeat(np.arange(n_pass), cnt)
     kind = np.full(m, CUT, dtype=np.int8)
-    kind[row0] = RAPID
+    # a chained pass is entered by a beam-on link from the end of the one before (same focus: no focus row)
+    kind[row0] = np.where(pk.pass_link[lo:hi], LINK, RAPID)
     kind[(row0 + 1)[foc == 1]] = FOCUS
     j = np.arange(m) - np.repeat(row0 + 1 + foc, cnt)  # 0.. on cut rows, negative before
     fp, sp_ = first[pidx], size[pidx]
     vtx = np.where(j >= 0, fp + (j + 1) % sp_, fp)
-    laser = kind == CUT
+    laser = (kind == CUT) | (kind == LINK)
     zz = z[pidx]
     zz[row0] = z_prev
     v = pk.vertices[vtx]
@@ -164,10 +171,13 @@ def job_moves(job, lo: int = 0, hi: int | None = None) -> Moves:
 
 
 def iter_moves(job, chunk_passes: int = CHUNK_PASSES) -> Iterator[Moves]:
-    """The job's moves, :data:`CHUNK_PASSES` passes at a time (consecutive chunks, no gaps)."""
-    n = job.packed.n_pass
-    for lo in range(0, n, chunk_passes):
-        yield job_moves(job, lo, lo + chunk_passes)
+    """The job's moves, about :data:`CHUNK_PASSES` passes at a time (consecutive chunks, no gaps).
+
+    A chunk never splits a chain of linked passes: each starts with a pass entered by a rapid,
+    so every chunk starts and ends at rest with the gate closed.
+    """
+    for lo, hi in job.packed.chunk_bounds(chunk_passes):
+        yield job_moves(job, lo, hi)
 
 
 @dataclass(frozen=True)
@@ -189,6 +199,9 @@ class Estimate:
     passes, cuts : int
     lead_s : float
         Laser-off feed moves (LEAD) at their own speed.
+    link_length_mm, link_s : float
+        Beam-on links between chained passes (LINK): their length (not part of ``cut_length_mm``,
+        so not of the lower bound) and their time at the scan speed.
     motion_s : float or None
         The motion-aware time for a machine profile (trapezoidal moves with its axis limits
         and blending, :mod:`camtube.machine.motion_time`); when set it is :attr:`total_s`.
@@ -206,11 +219,13 @@ class Estimate:
     lead_s: float = 0.0
     motion_s: float | None = None
     machine: str | None = None
+    link_length_mm: float = 0.0
+    link_s: float = 0.0
 
     @property
     def constant_speed_s(self) -> float:
-        """Every move at its nominal speed (no acceleration): cut + rapid + focus + lead."""
-        return self.cut_s + self.rapid_s + self.focus_s + self.lead_s
+        """Every move at its nominal speed (no acceleration): cut + link + rapid + focus + lead."""
+        return self.cut_s + self.link_s + self.rapid_s + self.focus_s + self.lead_s
 
     @property
     def total_s(self) -> float:
@@ -223,13 +238,17 @@ class Estimate:
 
 
 def _estimate_of(job, chunks: Iterable[Moves]) -> Estimate:
-    length = cut_s = rapid_d = focus_d = lead_s = 0.0
+    length = cut_s = rapid_d = focus_d = lead_s = link_mm = link_s = 0.0
     for mv in chunks:
         x0, y0, z0 = mv.starts()
         d = np.hypot(mv.x - x0, mv.y - y0)
         cut = mv.kind == CUT
         length += float(d[cut].sum())
         cut_s += float((d[cut] / mv.speed[cut]).sum()) if cut.any() else 0.0
+        link = mv.kind == LINK
+        if link.any():
+            link_mm += float(d[link].sum())
+            link_s += float((d[link] / mv.speed[link]).sum())
         lead = mv.kind == LEAD
         if lead.any():
             lead_s += float((d[lead] / mv.speed[lead]).sum())
@@ -238,7 +257,7 @@ def _estimate_of(job, chunks: Iterable[Moves]) -> Estimate:
     pr = job.process
     lower = length / pr.scan_speed_mm_s
     return Estimate(cut_s, rapid_d / pr.rapid_speed_mm_s, focus_d / pr.focus_speed_mm_s, lower, length,
-                    len(job.passes), len(job.design), lead_s)
+                    len(job.passes), len(job.design), lead_s, link_length_mm=link_mm, link_s=link_s)
 
 
 def estimate(job, moves: Moves | Iterable[Moves] | None = None) -> Estimate:

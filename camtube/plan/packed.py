@@ -83,6 +83,10 @@ class Packed:
         Repeat, focus level (0 surface, 1 defocused) and drill index of each pass.
     pass_offset : (P,) float
         Inward offset of the pass's path from its design line (mm).
+    pass_link : (P,) bool
+        Pass ``p`` is entered from the end of pass ``p - 1`` with the beam on, by a link across
+        the strip between their paths (the ``chained`` ordering: drill passes of one closed cut
+        at one focus); False: entered by a rapid with the gate closed.
     """
 
     vertices: np.ndarray
@@ -98,6 +102,7 @@ class Packed:
     pass_focus: np.ndarray
     pass_drill: np.ndarray
     pass_offset: np.ndarray
+    pass_link: np.ndarray
 
     @classmethod
     def build(cls, geoms: Sequence[Contour], pass_geom, pass_cut, pass_z, pass_speed, pass_power, pass_freq,
@@ -113,12 +118,15 @@ class Packed:
 
     @classmethod
     def of_arrays(cls, vertices, geom_offset, geom_closed, pass_geom, pass_cut, pass_z, pass_speed, pass_power,
-                  pass_freq, pass_repeat, pass_focus, pass_drill, pass_offset) -> "Packed":
+                  pass_freq, pass_repeat, pass_focus, pass_drill, pass_offset, pass_link=None) -> "Packed":
         arr = lambda a, t: a if isinstance(a, np.ndarray) and a.dtype == t else np.ascontiguousarray(a, dtype=t)  # noqa: E731
+        if pass_link is None:
+            pass_link = np.zeros(len(pass_geom), dtype=bool)
         return cls(arr(vertices, float).reshape(-1, 2), arr(geom_offset, np.int64), arr(geom_closed, bool),
                    arr(pass_geom, np.int32), arr(pass_cut, np.int32), arr(pass_z, float), arr(pass_speed, float),
                    arr(pass_power, float), arr(pass_freq, float), arr(pass_repeat, np.int32),
-                   arr(pass_focus, np.int8), arr(pass_drill, np.int32), arr(pass_offset, float))
+                   arr(pass_focus, np.int8), arr(pass_drill, np.int32), arr(pass_offset, float),
+                   arr(pass_link, bool))
 
     @property
     def n_pass(self) -> int:
@@ -142,6 +150,30 @@ class Packed:
         seg[last[~self.geom_closed]] = 0.0  # open paths do not
         c = np.concatenate(([0.0], np.cumsum(seg)))
         return c[self.geom_offset[1:]] - c[self.geom_offset[:-1]]
+
+    def link_length_mm(self) -> float:
+        """Total length (mm) of the beam-on links between chained passes (:attr:`pass_link`)."""
+        p = np.flatnonzero(self.pass_link)
+        if len(p) == 0:
+            return 0.0
+        g_prev, g = self.pass_geom[p - 1], self.pass_geom[p]
+        end = np.where(self.geom_closed[g_prev], self.geom_offset[g_prev], self.geom_offset[g_prev + 1] - 1)
+        return float(np.hypot(*(self.vertices[self.geom_offset[g]] - self.vertices[end]).T).sum())
+
+    def chunk_bounds(self, chunk_passes: int) -> list[tuple[int, int]]:
+        """[(lo, hi), ...]: consecutive ranges of about ``chunk_passes`` passes that never split a chain
+        of linked passes (each range starts with a pass entered by a rapid)."""
+        n = self.n_pass
+        out = []
+        lo = 0
+        link = self.pass_link
+        while lo < n:
+            hi = min(n, lo + chunk_passes)
+            while hi < n and link[hi]:
+                hi += 1
+            out.append((lo, hi))
+            lo = hi
+        return out
 
     def pass_end(self, p: int) -> tuple[float, float]:
         """Where pass ``p`` leaves the beam: its first vertex (closed path) or its last (open)."""

@@ -7,11 +7,20 @@ The paper's process, for every cut contour (notch or tendon hole)::
             for drill in range(4):           # each cut offset 0.005 mm further into the removed region
                 cut the contour once at 25 mm/s, 2.0 W, 60 kHz
 
-Two orderings of those passes (see ``docs/plan.md``):
+Three orderings of those passes (see ``docs/plan.md``):
 
 - ``sequential``: all passes of one cut, then the next cut (the paper's wording).
 - ``interleaved`` (default): one round per (repeat, focus, drill); a round visits
   every cut, so each notch cools for a whole round between two of its passes.
+- ``chained``: one round per (repeat, focus); a round visits every cut and cuts its
+  drill passes one after the other (the paper's inner loop) as one beam-on path:
+  each drill pass of a closed cut is entered from the end of the one before by a
+  beam-on *link* (:data:`camtube.plan.moves.LINK`) across the strip between the two
+  offsets, inside the cut region, so the machine neither stops, rapids nor switches
+  the gate between them. Each notch cools for a round between two of its groups.
+  A closed cut's passes start at a vertex where the drawing is smooth (no drawn
+  corner) and most curved when it has one (:func:`smooth_vertices`), so the links
+  lie on a smooth part of the path where the machine runs slowly anyway.
 
 Travel order inside a round is a serpentine ("boustrophedon") tour: cuts whose
 circumferential ranges overlap form one band; bands are visited in ``y`` order,
@@ -44,7 +53,7 @@ from camtube.plan.paths import simplify_closed
 from camtube.progress import NO_PROGRESS, Progress
 from camtube.tol import TOL
 
-ORDERINGS = ("interleaved", "sequential")
+ORDERINGS = ("interleaved", "sequential", "chained")
 DEFAULT_ORDERING = "interleaved"
 
 
@@ -156,21 +165,61 @@ def tour(contours: Sequence[Contour]) -> list[int]:
     return order.tolist()
 
 
-def _nearest_vertex(points, p: tuple[float, float]) -> int:
-    """Index of the vertex of ``points`` ((n, 2) sequence) nearest to ``p`` (first on ties)."""
+def _nearest_vertex(points, p: tuple[float, float], allowed=None) -> int:
+    """Index of the vertex of ``points`` ((n, 2) sequence) nearest to ``p`` (first on ties).
+
+    ``allowed``: (n,) bool, the vertices that may be chosen (None or none allowed: all).
+    """
     px, py = p
     d = [(q[0] - px) ** 2 + (q[1] - py) ** 2 for q in points]
+    if allowed is not None and any(allowed):
+        d = [v if ok else math.inf for v, ok in zip(d, allowed)]
     return d.index(min(d))
 
 
+#: A chained group starts on the most curved smooth stretch of its contour: where the curvature is at least
+#: this share of the contour's largest (smooth) curvature.
+LINK_CURVATURE_SHARE = 0.5
+
+
+def smooth_vertices(contour: Contour) -> np.ndarray | None:
+    """(n,) bool: the vertices of a closed curved contour where a chained group may start (and its links lie).
+
+    Where the drawing is smooth (a turn of at most ``TOL.corner_deg`` at the vertex and both neighbours),
+    so no link is at a drawn corner; and of those, where it is most curved (curvature at least
+    :data:`LINK_CURVATURE_SHARE` of the largest), where the machine runs slowly anyway, so the near-stop a
+    5 um link costs is short (on a straight or a flat flank it would brake from the scan speed). None for
+    a rectangle, a polygon without a smooth vertex or a slit (every start is then allowed).
+    """
+    from camtube.plan.paths import turn_angles_deg
+
+    if not contour.closed or len(contour.points) <= 4:
+        return None
+    p = np.asarray(contour.points, dtype=float)
+    turn = turn_angles_deg(p, True)
+    ok = turn <= TOL.corner_deg
+    ok = ok & np.roll(ok, 1) & np.roll(ok, -1)
+    if not ok.any():
+        return None
+    seg = np.hypot(*(np.roll(p, -1, axis=0) - p).T)  # edge i -> i + 1
+    with np.errstate(divide="ignore", invalid="ignore"):
+        curv = np.radians(turn) / (0.5 * (seg + np.roll(seg, 1)))
+    k_max = float(np.nanmax(np.where(ok, curv, np.nan)))
+    if k_max > 0:
+        ok = ok & (curv >= LINK_CURVATURE_SHARE * k_max)
+    return ok
+
+
 def _chain_starts(design: Sequence[Contour], order: Sequence[int], start: tuple[float, float],
-                  slit_returns: bool = False) -> tuple[dict[int, int], tuple[float, float]]:
+                  slit_returns: bool = False, smooth: Sequence | None = None
+                  ) -> tuple[dict[int, int], tuple[float, float]]:
     """Start vertex of each contour in ``order`` (nearest to where the previous one left the beam).
 
     A closed contour starts at its vertex nearest the previous end and ends there; an
     open one (a slit) starts at its nearer end (index 0 or n - 1) and ends at the other
     (or at the same end if ``slit_returns``: an even number of alternating passes).
-    Returns the starts and the point where the last contour leaves the beam.
+    ``smooth``: per contour, the vertices a closed contour may start at (:func:`smooth_vertices`;
+    None: any). Returns the starts and the point where the last contour leaves the beam.
     """
     out: dict[int, int] = {}
     p = start
@@ -178,7 +227,7 @@ def _chain_starts(design: Sequence[Contour], order: Sequence[int], start: tuple[
         c = design[i]
         pts = c.points
         if c.closed:
-            k = _nearest_vertex(pts, p)
+            k = _nearest_vertex(pts, p, None if smooth is None else smooth[i])
             p = pts[k]
         else:
             last = len(pts) - 1
@@ -274,7 +323,7 @@ def plan_job(
         seam; a drawing is read into one by :mod:`camtube.design.drawing`), or contours.
     process : Process, optional
         Defaults to the pattern's process (or the paper's for a DXF).
-    ordering : {"interleaved", "sequential"}
+    ordering : {"interleaved", "sequential", "chained"}
         Pass ordering (see the module docstring).
     outer_radius_mm, length_mm : float, optional
         Tube outer radius and length; required for a DXF (the length may come
@@ -313,14 +362,16 @@ def _plan(source, process, ordering, outer_radius_mm, length_mm, name, progress)
     n_total = len(design) * repeats * 2 * proc.drill_passes
     with progress.task("planning", total=n_total) as task:
         fwd = tour(design)
-        # sequential: a slit's passes alternate direction; an even number of them ends where it began
-        returns = ordering == "sequential" and proc.drill_passes % 2 == 0
-        s0, end = _chain_starts(design, fwd, (0.0, 0.0), returns)
+        # sequential, chained: a slit's passes alternate direction; an even number of them ends where it began
+        returns = ordering in ("sequential", "chained") and proc.drill_passes % 2 == 0
+        # chained: the links between a cut's drill passes lie where the drawing is smooth and most curved
+        smooth = [smooth_vertices(c) for c in design] if ordering == "chained" else None
+        s0, end = _chain_starts(design, fwd, (0.0, 0.0), returns, smooth)
         starts = [s0]
-        if ordering == "interleaved":
+        if ordering in ("interleaved", "chained"):
             # backward rounds start where forward rounds end and vice versa
-            s1, end = _chain_starts(design, fwd[::-1], end)
-            starts = [_chain_starts(design, fwd, end)[0], s1]
+            s1, end = _chain_starts(design, fwd[::-1], end, returns, smooth)
+            starts = [_chain_starts(design, fwd, end, returns, smooth)[0], s1]
         task.advance(n_total // 4)
         start_arr = np.array([[st[i] for i in range(len(design))] for st in starts], dtype=np.int64)
         packed = assemble(design, fwd, start_arr, repeats, ordering, proc)
@@ -335,6 +386,8 @@ def pass_sequence(order: Sequence[int], n_cut: int, repeats: int, n_drill: int, 
     ``sequential``: every pass of a cut (repeat, focus, drill), then the next cut in ``order``.
     ``interleaved``: round ``k`` = (repeat, focus, drill) visits every cut, along ``order``
     on even rounds and backwards on odd ones.
+    ``chained``: round ``k`` = (repeat, focus) visits every cut, along ``order`` on even rounds
+    and backwards on odd ones, and cuts its drill passes one after the other.
     """
     order = np.asarray(order, dtype=np.int32)
     per_cut = repeats * 2 * n_drill
@@ -344,6 +397,15 @@ def pass_sequence(order: Sequence[int], n_cut: int, repeats: int, n_drill: int, 
         cut_a = np.repeat(order, per_cut)
         rep_a, foc_a, dri_a = (np.tile(a, n_cut) for a in (r_k, f_k, d_k))
         dir_a = np.zeros(len(cut_a), dtype=np.int32)
+    elif ordering == "chained":
+        rounds = np.arange(2 * repeats, dtype=np.int32)
+        dir_r = rounds % 2
+        cut_r = np.where(dir_r[:, None] == 0, order[None, :], order[::-1][None, :])  # (rounds, n_cut)
+        cut_a = np.repeat(cut_r.ravel(), n_drill)
+        rep_a = np.repeat(rounds // 2, n_cut * n_drill)
+        foc_a = np.repeat(rounds % 2, n_cut * n_drill)
+        dri_a = np.tile(np.arange(n_drill, dtype=np.int32), 2 * repeats * n_cut)
+        dir_a = np.repeat(dir_r, n_cut * n_drill)
     else:
         dir_k = k % 2
         cut_a = np.where(dir_k[:, None] == 0, order[None, :], order[::-1][None, :]).ravel()
@@ -355,6 +417,8 @@ def _round_pairs(repeats: int, n_drill: int, ordering: str) -> set[tuple[int, in
     """The (tour direction, drill) pairs the rounds of :func:`pass_sequence` use."""
     if ordering == "sequential":
         return {(0, d) for d in range(n_drill)}
+    if ordering == "chained":
+        return {(k % 2, d) for k in range(2 * repeats) for d in range(n_drill)}
     return {(k % 2, k % n_drill) for k in range(repeats * 2 * n_drill)}
 
 
@@ -404,7 +468,7 @@ def assemble(design: Sequence[Contour], order: Sequence[int], starts: np.ndarray
     other: dict[int, np.ndarray] = {}
     for r in np.flatnonzero(~is_rect[i_u]).tolist():
         t, i, d = int(t_u[r]), int(i_u[r]), int(d_u[r])
-        path = pass_path(design[i], float(offsets[d]), int(starts[t, i]), d, i, ordering == "sequential")
+        path = pass_path(design[i], float(offsets[d]), int(starts[t, i]), d, i, ordering in ("sequential", "chained"))
         other[r] = np.asarray(path.points, dtype=float).reshape(-1, 2)
         sizes[r] = len(path.points)
     geom_offset = np.zeros(len(t_u) + 1, dtype=np.int64)
@@ -434,8 +498,13 @@ def assemble(design: Sequence[Contour], order: Sequence[int], starts: np.ndarray
     n = len(cut_a)
     pass_offset = offsets[dri_a] if closed.all() else np.where(closed[cut_a], offsets[dri_a], 0.0)
     pass_z = focus[foc_a]
+    link = np.zeros(n, dtype=bool)
+    if ordering == "chained" and n > 1:
+        # a drill pass of a closed cut follows the one before it (same cut, repeat and focus) with the beam on
+        link[1:] = ((cut_a[1:] == cut_a[:-1]) & (rep_a[1:] == rep_a[:-1]) & (foc_a[1:] == foc_a[:-1])
+                    & closed[cut_a[1:]])
     foc_a = foc_a.astype(np.int8)
     const = lambda v: np.broadcast_to(np.float64(v), (n,))  # noqa: E731  (read-only, no memory per pass)
     return Packed.of_arrays(vertices, geom_offset, closed[i_u], pass_geom, cut_a, pass_z,
                             const(process.scan_speed_mm_s), const(process.power_w), const(process.frequency_khz),
-                            rep_a, foc_a, dri_a, pass_offset)
+                            rep_a, foc_a, dri_a, pass_offset, link)

@@ -9,7 +9,9 @@ which do not print moves, first check the whole neutral move list
 ~0.1 s per 10^6 moves):
 
 1. the beam is off on every rapid, focus (Z) and lead move; the beam is on only
-   during cutting moves;
+   during cutting moves and the links between chained passes (``LINK``), which are
+   checked like cutting moves (rule 3: inside the cut region of the pass they enter,
+   the cut of the pass they leave);
 2. a focus move changes only z; rapid, lead and laser-on moves keep z;
 3. every laser-on move lies inside the design cut region of its pass, grown
    by :data:`camtube.tol.TOL.safety` (both ends inside an axis-aligned
@@ -27,7 +29,7 @@ import math
 import numpy as np
 
 from camtube.errors import SafetyError
-from camtube.plan.moves import CUT, FOCUS, KIND_NAMES, LEAD, RAPID, Moves, iter_moves
+from camtube.plan.moves import BEAM_KINDS, CUT, FOCUS, KIND_NAMES, LEAD, LINK, RAPID, Moves, iter_moves
 from camtube.plan.packed import is_axis_rectangle
 from camtube.tol import TOL
 
@@ -89,11 +91,12 @@ def check_moves(job, moves: Moves, tol: float = TOL.safety) -> None:
     kind, laser = moves.kind, moves.laser
     reasons: list[tuple[np.ndarray, str]] = []
 
-    reasons.append((laser & (kind != CUT), "the laser is on during a {kind} move"))
+    reasons.append((laser & ~np.isin(kind, BEAM_KINDS), "the laser is on during a {kind} move"))
+    reasons.append(((kind == LINK) & ~laser, "a link between chained passes runs with the laser off"))
     reasons.append(((kind == FOCUS) & ((np.abs(x - x0) > tol) | (np.abs(y - y0) > tol)),
                     "a focus move also moves x or y"))
     reasons.append((((kind == RAPID) | (kind == LEAD)) & (np.abs(z - z0) > tol), "a {kind} move changes the focus"))
-    reasons.append((~np.isin(kind, (RAPID, FOCUS, CUT, LEAD)), "unknown move kind"))
+    reasons.append((~np.isin(kind, (RAPID, FOCUS, CUT, LEAD, LINK)), "unknown move kind"))
     reasons.append((laser & (np.abs(z - z0) > tol), "the focus changes while the laser is on"))
     length = job.length_mm
     reasons.append(((x < -tol) | (x > length + tol), f"x leaves the tube 0 <= x <= {length:g} mm"))
@@ -124,6 +127,15 @@ def check_moves(job, moves: Moves, tol: float = TOL.safety) -> None:
         mask = np.zeros(len(moves), dtype=bool)
         mask[on[bad_on]] = True
         reasons.append((mask, "a laser-on move leaves the cut region of its pass"))
+        # a link joins two passes of one cut: the pass it leaves must be of the cut it enters
+        lk = np.flatnonzero(kind == LINK)
+        if len(lk):
+            prev = moves.pass_index[lk] - 1
+            pk = job.packed
+            bad = (prev < 0) | (pk.pass_cut[np.maximum(prev, 0)] != pk.pass_cut[moves.pass_index[lk]])
+            mask = np.zeros(len(moves), dtype=bool)
+            mask[lk[bad]] = True
+            reasons.append((mask, "a link joins passes of different cuts"))
 
     bad_any = np.zeros(len(moves), dtype=bool)
     for m, _ in reasons:

@@ -55,7 +55,7 @@ def test_schema_and_content(job):
     assert [k["offset_mm"] for k in d["classes"][:4]] == pytest.approx([0.0, 0.005, 0.01, 0.015])
 
 
-@pytest.mark.parametrize("ordering", ["interleaved", "sequential"])
+@pytest.mark.parametrize("ordering", ["interleaved", "sequential", "chained"])
 @pytest.mark.parametrize("name", ["tube1-bidirectional", "tube3"])
 def test_reader_expands_to_the_planners_passes(tmp_path, name, ordering):
     job = plan_job(load_pattern(PATTERNS / f"{name}.yaml"), ordering=ordering)
@@ -73,7 +73,7 @@ def test_reader_expands_slits_and_general_polygons(tmp_path):
     hexagon = Contour(tuple((2 + 0.4 * np.cos(a), 3 + 0.8 * np.sin(a))
                             for a in np.linspace(0, 2 * np.pi, 6, endpoint=False)), "cut")
     slit = Contour(((4.0, 1.0), (4.5, 1.2), (5.0, 1.2)), "cut", closed=False)
-    for ordering in ("interleaved", "sequential"):
+    for ordering in ("interleaved", "sequential", "chained"):
         job = plan_job([hexagon, slit, rectangle(6, 1, 6.5, 2.5)], Process(kerf_mm=0.01), ordering=ordering,
                        outer_radius_mm=1.0, length_mm=8.0)
         back = read_job(json.loads(job_json(job)))

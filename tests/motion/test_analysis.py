@@ -88,3 +88,53 @@ def test_the_dose_counts_each_cycles_pulses_over_the_step_to_its_position(job):
     late = Recording(cut.cycle, cut.axial, cut.circ, cut.focus, cut.gate, 1e-4, 0.0,
                      np.concatenate(([0.0], rate[:-1])))
     assert analyse(late, geom, prof).dose_share < 0.5
+
+
+def chained_trace(job, speed_mm_s, period_s, link_shift_mm=0.0):
+    """Sampled beam path of a chained job: each group one beam-on stretch (its passes and the links between
+    them, the gate open throughout), the gate closed at rest between groups. ``link_shift_mm`` moves the
+    samples inside every link sideways (at right angles to it, along the passes) by that much: a beam that
+    strays from the commanded link."""
+    from camtube.plan.moves import LINK, job_moves
+
+    mv = job_moves(job)
+    x0, y0, _ = mv.starts()
+    xs, ys, zs, gs = [[0.0]], [[0.0]], [[0.0]], [[False]]
+    for i in range(len(mv)):
+        a, b = np.array([x0[i], y0[i]]), np.array([mv.x[i], mv.y[i]])
+        n = max(1, int(round(math.dist(a, b) / (speed_mm_s * period_s))))
+        seg = a + (b - a) * (np.arange(1, n + 1) / n)[:, None]
+        if mv.kind[i] == LINK:
+            u = (b - a) / math.dist(a, b)
+            seg[:-1] += link_shift_mm * np.array([-u[1], u[0]])
+        xs.append(seg[:, 0]), ys.append(seg[:, 1]), zs.append(np.full(n, -mv.z[i]))
+        gs.append(np.full(n, bool(mv.laser[i])))
+    x, y, z, g = (np.concatenate(v) for v in (xs, ys, zs, gs))
+    return Recording(np.arange(len(x)), x, y, z, g, period_s, 0.0)
+
+
+def test_a_chained_job_is_scored_per_group_with_its_links_stated():
+    """A chained job's gate opens once per group: each stretch is scored against its group's path (its passes
+    joined by the links); the links' length is stated beside the cut length (issue 21)."""
+    from camtube.design.source import DrawingOptions, load_source
+    from tests.conftest import ROOT
+
+    loaded = load_source(ROOT / "examples" / "curved" / "slotted.dxf", ["process.repeats=1"],
+                         DrawingOptions(outer_radius_mm=0.8))
+    job = plan_job(loaded.pattern, ordering="chained")
+    geom = JobGeometry.from_job(job, estimate_s=1.0)
+    assert geom.link_length_mm == pytest.approx(job.link_length_mm) and geom.link_length_mm > 0
+    prof = load_profile("linuxcnc-path")
+    r = analyse(chained_trace(job, 25.0, 5e-5), geom, prof)  # 1.25 um steps: 4 per link
+    groups = int(np.count_nonzero(~job.packed.pass_link))
+    assert groups < len(job.passes)
+    # own group: every sample on its group's path, every vertex reached (a pass-by-pass pairing has no answer)
+    assert r.max_path_dev_mm < 1e-9 and r.max_vertex_miss_mm < 1e-9
+    # the beam-on path is the cut length plus the links, exactly
+    assert r.link_length_mm == pytest.approx(job.link_length_mm)
+    assert r.path_length_error == pytest.approx(0.0, abs=1e-9)
+    assert r.length_error == pytest.approx(job.link_length_mm / job.cut_length_mm, rel=1e-6)
+    assert r.max_outside_mm < 1e-9 and r.dose_share == pytest.approx(1.0)
+    # a beam that strays 2 um off its links is seen
+    off = analyse(chained_trace(job, 25.0, 5e-5, link_shift_mm=0.002), geom, prof)
+    assert off.max_path_dev_mm == pytest.approx(0.002, rel=0.05)

@@ -89,3 +89,15 @@ def test_the_old_module_path_warns_and_nothing_of_camtube_imports_it():
             if isinstance(node, ast.ImportFrom) and node.module == "camtube.export.motion_time":
                 users.append(str(path))
     assert not users
+
+
+def test_a_semicolon_inside_a_paren_comment_is_no_comment_start():
+    """LinuxCNC reads ``(a; b X1)`` as one comment: the estimate must not take ``X1`` for a move (a profile's
+    description with a ';' in it once made the estimate count a move of 250 mm)."""
+    from camtube.machine import load_profile
+    from camtube.machine.motion_time import estimate_program
+
+    p = load_profile("linuxcnc-path")
+    plain = estimate_program("G21 G90 G61\nG0 X1\nM2\n", p)
+    assert estimate_program("(header; limits X250 Y250)\nG21 G90 G61\nG0 X1\nM2\n", p) == plain
+    assert estimate_program("G21 G90 G61\nG0 X1 ; X250\nM2\n", p) == plain

@@ -100,7 +100,7 @@ def test_general_polygon_offset_uses_a_mitred_inward_buffer():
         offset_contour(tri, 0.5)
 
 
-@pytest.mark.parametrize("ordering", ["interleaved", "sequential"])
+@pytest.mark.parametrize("ordering", ["interleaved", "sequential", "chained"])
 def test_orderings(presets, ordering):
     job = plan_job(presets["tube1"], ordering=ordering)
     cuts = [p.cut_index for p in job.passes]
@@ -108,6 +108,17 @@ def test_orderings(presets, ordering):
     if ordering == "sequential":
         # all 32 passes of a cut are consecutive
         assert sum(1 for a, b in zip(cuts, cuts[1:]) if a != b) == n_cut - 1
+    elif ordering == "chained":
+        # a round of n_cut x drill passes visits every cut once with one (repeat, focus), its drill passes in a row
+        n_drill = job.process.drill_passes
+        per = n_cut * n_drill
+        for k in range(0, len(cuts), per):
+            rnd = job.passes[k:k + per]
+            assert sorted(p.cut_index for p in rnd[::n_drill]) == list(range(n_cut))
+            assert len({(p.repeat, p.focus_level) for p in rnd}) == 1
+            for g in range(0, per, n_drill):
+                assert [(p.cut_index, p.drill_index) for p in rnd[g:g + n_drill]] == \
+                    [(rnd[g].cut_index, d) for d in range(n_drill)]
     else:
         # a round of n_cut passes visits every cut once with one (repeat, focus, drill)
         for k in range(0, len(cuts), n_cut):
@@ -215,5 +226,5 @@ def test_every_planned_job_is_safe(n, w, s, angle):
 
     p = load_pattern(PATTERNS / "tube1.yaml", [f"notch.count={n}", f"notch.width={w:.3f}", f"notch.arc={s:.3f}",
                                                f"notch.angle_deg={angle:.3f}", f"tube.length={3 + 2 * n}"])
-    for ordering in ("interleaved", "sequential"):
+    for ordering in ("interleaved", "sequential", "chained"):
         check_job(plan_job(p, ordering=ordering))
