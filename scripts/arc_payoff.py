@@ -42,27 +42,10 @@ NORMAL_SHARE, TANGENTIAL_SHARE = math.sqrt(0.75), 0.5
 
 
 def chain_time_s(L: np.ndarray, vmax: np.ndarray, a: np.ndarray) -> float:
-    """Time (s) of segments joined at the lower of their speed limits, from rest to rest."""
-    m = len(L)
-    vj = np.minimum(vmax, np.concatenate((vmax[1:], [0.0])))
-    vj[-1] = 0.0
-    vl, Ll, al = vj.tolist(), L.tolist(), a.tolist()
-    nxt = 0.0
-    for i in range(m - 1, -1, -1):
-        if vl[i] > 0:
-            vl[i] = min(vl[i], math.sqrt(nxt * nxt + 2 * al[i + 1] * Ll[i + 1]))
-        nxt = vl[i]
-    prev = 0.0
-    for i in range(m):
-        if vl[i] > 0:
-            vl[i] = min(vl[i], math.sqrt(prev * prev + 2 * al[i] * Ll[i]))
-        prev = vl[i]
-    v1 = np.array(vl)
-    v0 = np.concatenate(([0.0], v1[:-1]))
-    vp = np.sqrt(a * L + 0.5 * (v0 ** 2 + v1 ** 2))
-    vc = np.minimum(vp, vmax)
-    cruise = np.maximum(L - (vc ** 2 - v0 ** 2) / (2 * a) - (vc ** 2 - v1 ** 2) / (2 * a), 0.0)
-    return float(((vc - v0) / a + (vc - v1) / a + np.where(vc > 0, cruise / vc, 0.0)).sum())
+    """Time (s) of segments joined at the lower of their speed limits, from rest to rest (the estimate's passes)."""
+    from camtube.machine.motion_time import chain_times
+
+    return float(chain_times(L, vmax, a, np.ones(len(L), bool))[0].sum())
 
 
 def arc_time_s(ring: np.ndarray, v: float, a: float, normal: float, tangential: float) -> float:

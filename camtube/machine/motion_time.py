@@ -199,6 +199,32 @@ def _blend_arcs(L, vmax, a, req, u, blend, tol_mm, a_plane, sample_s=0.0, gap_s=
     return Lo[keep], np.array(out_v)[keep], np.array(out_a)[keep], np.array(out_j, dtype=bool)[keep]
 
 
+def chain_times(L: np.ndarray, vmax: np.ndarray, a: np.ndarray, joined: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Times (s) of a chain of moves (lengths ``L``, speed limits ``vmax``, accelerations ``a``, all (m,)) from rest
+    to rest, ``joined[i]``: move ``i`` runs into move ``i + 1`` at the lower of their limits (the last is ignored);
+    and each move's exit speed. A backward pass (each move must be able to slow down for the next) and a forward
+    pass (it can only speed up so fast) bound the junction speeds."""
+    m = len(L)
+    joined = np.asarray(joined, bool).copy()
+    joined[-1] = False
+    vj = np.where(joined, np.minimum(vmax, np.concatenate((vmax[1:], [0.0]))), 0.0)
+    vjl = vj.tolist()
+    Ll, al = L.tolist(), a.tolist()
+    nxt = 0.0
+    for i in range(m - 1, -1, -1):
+        if vjl[i] > 0:
+            vjl[i] = min(vjl[i], math.sqrt(nxt * nxt + 2 * al[i + 1] * Ll[i + 1]))
+        nxt = vjl[i]
+    prev = 0.0
+    for i in range(m):
+        if vjl[i] > 0:
+            vjl[i] = min(vjl[i], math.sqrt(prev * prev + 2 * al[i] * Ll[i]))
+        prev = vjl[i]
+    v1 = np.array(vjl)
+    v0 = np.concatenate(([0.0], v1[:-1]))
+    return _segment_times(L, v0, v1, vmax, a), v1
+
+
 def trajectory_time(d: np.ndarray, letters, profile, requested_v: np.ndarray, joined: np.ndarray,
                     blend: np.ndarray | None = None) -> MotionEstimate:
     """Time of a sequence of straight moves.
@@ -235,25 +261,7 @@ def trajectory_time(d: np.ndarray, letters, profile, requested_v: np.ndarray, jo
     m = len(L)
     if m == 0:
         return MotionEstimate(0.0, 0, 0)
-    joined[-1] = False
-    # junction speed limits: v_j[i] = speed at the end of move i
-    vj = np.where(joined, np.minimum(vmax, np.concatenate((vmax[1:], [0.0]))), 0.0)
-    # backward pass (must be able to stop / slow down), then forward pass (can only speed up so fast)
-    vjl = vj.tolist()
-    Ll, al = L.tolist(), a.tolist()
-    nxt = 0.0
-    for i in range(m - 1, -1, -1):
-        if vjl[i] > 0:
-            vjl[i] = min(vjl[i], math.sqrt(nxt * nxt + 2 * al[i + 1] * Ll[i + 1]))
-        nxt = vjl[i]
-    prev = 0.0
-    for i in range(m):
-        if vjl[i] > 0:
-            vjl[i] = min(vjl[i], math.sqrt(prev * prev + 2 * al[i] * Ll[i]))
-        prev = vjl[i]
-    v1 = np.array(vjl)
-    v0 = np.concatenate(([0.0], v1[:-1]))
-    t = _segment_times(L, v0, v1, vmax, a)
+    t, v1 = chain_times(L, vmax, a, joined)
     return MotionEstimate(float(t.sum()), m, int(np.count_nonzero(v1 == 0)))
 
 

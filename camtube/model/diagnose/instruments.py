@@ -498,7 +498,7 @@ def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Ins
         for k in sorted({k0 - sign, k0, k0 + sign}):
             if k == 0 or (k > 0) != (lg.lag_ms > 0):
                 continue
-            shifted, _, applied = shift_angle(ins.data, k * dt_ms)
+            shifted = shift_angle(ins.data, k * dt_ms)[0]
             rk = fit(model, shifted, list(fit_names), fixed).rmse
             if rk < best[0]:
                 best = (rk, k * dt_ms)

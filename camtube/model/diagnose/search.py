@@ -490,10 +490,10 @@ def _off_on_bound(catalog: Mapping[str, Effect], params: Mapping[str, float]) ->
         eff = catalog.get(eff_name)
         if not at or eff is None or pname not in (eff.off or {}):
             continue
-        spec = next((p for p in eff.params if p.name == pname), None)
+        spec = next(p for p in eff.params if p.name == pname)   # Effect checks that off names its parameters
         off = float(eff.off[pname])
-        tol = 1e-9 * max(1.0, spec.hi - spec.lo) if spec is not None else 0.0
-        if spec is not None and min(abs(off - spec.lo), abs(off - spec.hi)) <= tol and abs(float(v) - off) <= tol:
+        tol = 1e-9 * max(1.0, spec.hi - spec.lo)
+        if min(abs(off - spec.lo), abs(off - spec.hi)) <= tol and abs(float(v) - off) <= tol:
             out[nm] = off
     return out
 
