@@ -41,7 +41,7 @@ FAMILIES = {
     "slack": ({"slack"}, None),
     "lost motion": ({"slack", "play"}, None),
     "creep": ({"creep", "creep_load", "viscoelastic"}, None),  # a slow viscoelastic element and creep: known equivalents
-    "backbone": (set(), None),
+    "backbone": ({"relaxation"}, None),  # the joint's backbone relaxing: `relaxation` (its set: the baseline's rest_angle)
     "zero drift": (set(), "time"),
     "lag": (set(), None),
     "friction": ({"friction", "capstan"}, None),  # one family: friction at the guide

@@ -218,3 +218,27 @@ def test_a_change_of_the_logging_rate_is_reported():
     ins = check_instruments(d)
     assert ins.rates_hz["A"] == pytest.approx(50.0)
     assert any("sampling rate of sample A changes: 25 Hz from t = 40" in line for line in ins.lines())
+
+
+def test_a_relaxing_backbone_is_recommended_in_the_place_of_the_rest_angle(tube2):
+    """A backbone with a Maxwell arm (the bench simulator's joint, no set): the unloaded joint stands at
+    k1 / (k + k1) of the arm's relaxed angle and creeps back. The baseline's constant rest angle takes some of it;
+    `relaxation` explains it in its place (the rest angle held at 0, said so, and held in the printed command),
+    with the physical share and relaxation time, to the floor."""
+    from camtube.model.diagnose import diagnose
+    from camtube.model.report.diagnosis import add_command, diagnosis_text
+    from camtube.model.sim.bench import Backbone
+
+    share, tau_s = 0.3, 2.0
+    pace = Protocol(n_cycles=12, ramp_s=3.0, dwell_s=2.0, rest_s=3.0, first_dwell_s=2.0)
+    bench = SampleBench(backbone=Backbone(relax=((share, tau_s),)), tracker=QUIET)
+    rec = simulate_bench(tube2, bench, pace, Clock(rate_hz=25.0, n_repeats=0), seed=5)
+    d = diagnose(model_for_pattern(tube2), rec.data, ("E_t",), pattern_values(tube2))
+    assert d.baseline == ("rest_angle",) and d.recommended == ("relaxation",)
+    assert d.held == {"rest_angle.rest_deg": 0.0}
+    final = d.waterfall[-1]
+    assert final.rmse_deg <= 1.15 * rec.floor_deg < d.waterfall[0].rmse_deg / 2.0
+    assert abs(final.params["relaxation.fraction"] / (share / (1.0 + share)) - 1.0) < 0.05
+    assert abs(final.params["relaxation.tau_s"] / tau_s - 1.0) < 0.1
+    assert "rest_angle (the baseline) held at rest_angle.rest_deg = 0" in diagnosis_text(d)
+    assert "--fix rest_angle.rest_deg=0" in add_command(d, "camtube model fit x.csv")

@@ -29,9 +29,11 @@ def test_an_early_stand_in_is_replaced_by_the_effect_that_explains_it():
     sim, d = _run("tube2", Hidden(toe_mm=0.3, toe_form="fung", play_mm=0.116), 9003, baseline=())
     chain = d.recommended or d.partial
     assert d.candidates[0].effect == "slack"
-    # (without the baseline an offset then stands in for the joint's rest angle: see the first-rest test below)
+    # (without the baseline an offset, or the backbone's relaxation, then stands in for the joint's rest angle:
+    # see the first-rest test below; the relaxation also holds the unloaded joint bent)
     assert "slack" not in chain and {"play", "toe_shape"} <= set(chain) and set(chain) <= {"play", "toe_shape",
-                                                                                         "angle_bias", "force_zero"}
+                                                                                         "angle_bias", "force_zero",
+                                                                                         "relaxation"}
     assert d.replaced == ((("slack",), "toe_shape"),)
     steps = d.waterfall if d.recommended else d.partial_steps
     assert all(b.rmse_deg < a.rmse_deg for a, b in zip(steps, steps[1:]))

@@ -218,6 +218,39 @@ def test_capstan_gives_the_mean_tension_of_a_tendon_wrapping_a_guide(tube1):
                                model_for_pattern(tube1).predict(data, vals), atol=1e-12)
 
 
+def test_relaxation_follows_a_joint_with_a_relaxing_backbone(tube1):
+    """A backbone of a spring k and a Maxwell arm (k1, tau), stepped in time by hand: while the tendon is taut the
+    joint follows it; once the tendon goes slack the joint stands at k1 / (k + k1) of the arm's relaxed angle and
+    creeps back. The effect's two-pass lag stays within 2 % of that free angle's scale."""
+    dt = 0.01
+    t = np.arange(0.0, 60.0, dt)
+    stroke = np.interp(t % 20.0, [0, 5, 10, 15, 20], [0.0, 2.0, 2.0, 0.0, 0.0])  # pull, dwell, release, rest
+    data = _data(stroke, time=t)
+    vals = pattern_values(tube1)
+    kin = model_for_pattern(tube1).predict(data, vals)
+    model = model_for_pattern(tube1, ["relaxation"])
+    for c, tau_s, tol in ((0.1, 3.0, 0.005), (0.3, 2.0, 0.02)):
+        got = model.predict(data, vals | {"relaxation.fraction": c, "relaxation.tau_s": tau_s})
+        relaxed, ref = 0.0, np.empty(t.size)
+        for k in range(t.size):
+            ref[k] = max(kin[k], c * relaxed)
+            a = math.exp(-dt / tau_s)
+            relaxed = a * relaxed + (1.0 - a) * ref[k]
+        assert np.abs(got - ref).max() < tol * c * kin.max()
+        rest = (t % 20.0) > 15.5
+        assert np.all(got[rest] > 0.5 * c * kin.max() * np.exp(-5.0 / tau_s))   # it rests bent, not straight
+    # on top of a rest angle earlier in the chain: the slack joint stands above it
+    both = model_for_pattern(tube1, ["rest_angle", "relaxation"])
+    v = vals | {"rest_angle.rest_deg": 2.0, "relaxation.fraction": 0.1, "relaxation.tau_s": 3.0}
+    got = both.predict(data, v)
+    only = model_for_pattern(tube1, ["rest_angle"]).predict(data, v)
+    late = t > 20.0
+    assert np.all(got[late] >= only[late] - 1e-12) and np.all(got[late & ((t % 20.0) > 15.5)] > 2.0 + 1e-3)
+    # off: the paper's model
+    np.testing.assert_allclose(model.predict(data, vals | {"relaxation.fraction": 0.0, "relaxation.tau_s": 1.0}),
+                               kin, atol=1e-12)
+
+
 def test_a_thinned_record_keeps_the_speed_of_the_full_one():
     """Steps between kept rows average over the dropped ones; the thinned copy carries the full record's speed."""
     from camtube.model.diagnose.search import thin

@@ -113,6 +113,10 @@ GRID = 3
 #: Effects every real joint may show, which the diagnosis takes into its baseline (tried before every round)
 #: instead of recommending them as missing physics: friction in the joint holds the unloaded joint bent.
 BASELINE = ("rest_angle",)
+#: Candidates that may take a baseline effect's place: each is also fitted with that effect held at its ``off``
+#: values (a relaxing backbone holds the unloaded joint bent for a while, as friction holds it for good; where
+#: the relaxation explains the bent rest the constant rest angle goes to zero, on its bound).
+BASELINE_STAND_INS = {"rest_angle": ("relaxation",)}
 #: A chain of effects is recommended only when its all-rows RMSE is within this multiple of the noise floor.
 REACH_RATIO = 1.15
 #: A chain above :data:`REACH_RATIO` x the floor is still recommended (labelled a partial explanation) when it
@@ -508,7 +512,8 @@ def _search_fit(model: JointModel, data: Dataset, names: Sequence[str], values: 
     per_sample = fit_options.pop("per_sample", ())
     starts = fit_options.pop("starts", ())
     params = model.make_params(data, names, fixed, per_sample=per_sample)
-    params = params.with_values({k: v for k, v in values.items() if k in params and not ("@" in k and k in fixed)})
+    # held values stay held (per-sample copies held off, a baseline effect a stand-in holds off)
+    params = params.with_values({k: v for k, v in values.items() if k in params and not (k in fixed and k not in names)})
     starts = [{k: v for k, v in st.items() if k in params} for st in starts]
     options = {"max_nfev": 100, "keep": 1, "tol": 1e-8, **fit_options}
     return fit(model, data, params=params, starts=[st for st in starts if st], **options)
@@ -843,7 +848,7 @@ class Search:
         out = []
         for i in counts:
             mi = start.with_effects(list(start.effects) + list(effects[:i]))
-            ni = _names_for(mi, self.settings.fit_params)
+            ni = _drop_names(_names_for(mi, self.settings.fit_params), self.held)
             psi = [n for n in per_sample if n.split("@")[0] in ni]
             ri = refit_all_rows(mi, self.data, ni, self._fx(mi),
                                 {k: v for k, v in values.items() if k.split("@")[0] in ni}, self.settings.grid,
@@ -883,6 +888,15 @@ class Search:
         """:meth:`_fit_one` with ``eff``'s copies ``held`` off, from a grid over its copies that stay fitted."""
         kept = [f"{n}@{smp}" for n in eff.full_names() for smp in self.search.samples if f"{n}@{smp}" not in held]
         return self._fit_one(m, names, start, per_sample, held=held, grid=self.settings.grid, grid_names=kept)
+
+    def _baseline_off(self, eff: Effect) -> dict:
+        """``{parameter: off value}`` of the baseline effects in the chain that ``eff`` may take the place of
+        (:data:`BASELINE_STAND_INS`); empty when there is none."""
+        out = {}
+        for b in self.chain.current.effects:
+            if b.name in self.baseline_added and eff.name in BASELINE_STAND_INS.get(b.name, ()) and b.off:
+                out.update({f"{b.name}.{k}": float(v) for k, v in b.off.items()})
+        return {k: v for k, v in out.items() if k in self.chain.names}
 
     def _absent(self, eff: Effect, m: JointModel, f: FitResult) -> dict:
         """Per-sample copies of ``eff`` to hold off: in each sample where a copy of ``f`` (a per-sample fit) is
@@ -947,26 +961,45 @@ class Search:
             start = m.initial_values(self.search, base=ch.fit.params)
             f, ho, mse = self._fit_one(m, ch.names + new, start, ch.per_sample, grid=s.grid, grid_names=new,
                                        starts=[init] if init else ())
+            off = self._baseline_off(eff)
+            if off:
+                # in the place of the baseline effect it may stand in for (that effect held at its off values)
+                f2, ho2, mse2 = self._fit_one(m, _drop_names(ch.names, off) + new, start,
+                                              list(_drop_names(ch.per_sample, off)), held=off, grid=s.grid,
+                                              grid_names=new, starts=[init] if init else ())
+                if ho2 < ho or _off_at_bound(f, off):
+                    f, ho, mse = f2, ho2, mse2
+                    self.cand_held[(eff.name, ())] = off
             fits.append([eff, m, new, f, ho, mse, ()])
         if try_per_sample:
             for row in sorted([r for r in fits if r[2]], key=lambda r: r[4])[:PER_SAMPLE_TRIES]:
                 eff, m, new, f, ho, mse, _ = row
-                ps = list(ch.per_sample) + list(new)
-                f2, ho2, mse2 = self._fit_one(m, ch.names + new, f.params, ps)
+                off = self.cand_held.get((eff.name, ()), {})   # a baseline effect it stands in for
+                names = _drop_names(ch.names, off) + new
+                ps = list(_drop_names(ch.per_sample, off)) + list(new)
+                f2, ho2, mse2 = self._fit_one(m, names, f.params, ps, held=off)
+                off_all = self._baseline_off(eff)
+                if not off and _off_at_bound(f2, off_all):   # per sample, it takes the baseline effect's place
+                    off = off_all
+                    names = _drop_names(ch.names, off) + new
+                    ps = list(_drop_names(ch.per_sample, off)) + list(new)
+                    f2, ho2, mse2 = self._fit_one(m, names, f2.params, ps, held=off)
                 # in a sample that does not show the effect its copies are not resolved (a time constant on a
                 # bound, a stand-in for another effect): the effect fitted in the other samples only
                 held = self._absent(eff, m, f2)
                 if held:
-                    f3, ho3, mse3 = self._fit_held(m, ch.names + new, f2.params, ps, eff, held)
+                    f3, ho3, mse3 = self._fit_held(m, names, f2.params, ps, eff, {**off, **held})
                     dm, se = _gain(mse, mse3, self.strata)
                     if dm > s.z * se and f3.bic < f.bic - s.bic_threshold:
                         row[3:7] = [f3, ho3, mse3, tuple(new)]
-                        self.cand_held[(eff.name, ())] = held
+                        self.cand_held[(eff.name, ())] = {**off, **held}
                     # a per-sample version with unresolved copies does not replace the shared one
                     continue
                 dm, se = _gain(mse, mse2, self.strata)
                 if dm > s.z * se and f2.bic < f.bic - s.bic_threshold:
                     row[3:7] = [f2, ho2, mse2, tuple(new)]
+                    if off:
+                        self.cand_held[(eff.name, ())] = off
         for row in ([] if swap_all else list(fits)):
             eff, m, new, f = row[:4]
             for old in swappable:
@@ -1006,7 +1039,10 @@ class Search:
         if new and not why:
             why += _resolution_problems(m, list(f.fitted), f.params, f.stderr, f.at_bound, self.data,
                                         s.modulus_range_gpa)
-        held = dict(self.cand_held.get((eff.name, tuple(swap[0]) if swap else ()), {})) if eff_ps else {}
+        # per-sample copies held off (absent in a sample), and a baseline effect a stand-in holds off
+        held = dict(self.cand_held.get((eff.name, tuple(swap[0]) if swap else ()), {}))
+        if not eff_ps:
+            held = {k: v for k, v in held.items() if "@" not in k}
         return Candidate(eff.name, tuple(e.name for e in m.effects), f.rmse, ho, dbic, params,
                          confounded=tuple(conf), significant=not why, why="; ".join(why),
                          predicted=f.predicted, values=dict(f.params), gain_z=gz, block_mse=mse,
@@ -1021,8 +1057,8 @@ class Search:
         keep = [e for e in ch.chosen if e.name not in c.replaces]
         m, names, ps = _without(ch.current, ch.names, ch.per_sample, [e for e in ch.chosen if e.name in c.replaces])
         m = m.with_effects(list(m.effects) + [eff])
-        names += eff.full_names()
-        ps += list(c.per_sample)
+        names = _drop_names(names + eff.full_names(), c.held)
+        ps = list(_drop_names(ps, c.held)) + list(c.per_sample)
         init = {k: v for k, v in c.values.items() if k.split("@")[0] in names}
         self.round_init = init
         r = refit_all_rows(m, data, names, self._fx(m, c.held), init, s.grid, per_sample=ps, max_nfev=CHECK_MAX_NFEV)
@@ -1430,7 +1466,8 @@ class Search:
                          tuple(notes), s.grid, partial, partial_steps, self.floor_parts, tuple(self.replaced),
                          {k: self.chosen_round[k] for k in recommended or partial if k in self.chosen_round},
                          self.given, tuple(self.baseline_added), self.baseline_gain, tuple(self.dropped), label,
-                         held={k: v for k, v in self.held.items() if k.split(".")[0] in set(recommended)})
+                         held={k: v for k, v in self.held.items() if k.split(".")[0] in set(recommended)
+                               or set(BASELINE_STAND_INS.get(k.split(".")[0], ())) & set(recommended)})
 
 
 def _sample_notes(model: JointModel, r: FitResult, samples: Sequence[str], ps: Sequence[str]) -> list[str]:
@@ -1529,6 +1566,17 @@ def _without(model: JointModel, names: Sequence[str], per_sample: Sequence[str],
     gone = {n for e in effects for n in e.full_names()}
     return (model.with_effects([e for e in model.effects if e.name not in drop]),
             tuple(n for n in names if n not in gone), [n for n in per_sample if n.split("@")[0] not in gone])
+
+
+def _off_at_bound(f: FitResult, off: Mapping[str, float]) -> bool:
+    """Whether ``f`` ended with a parameter of ``off`` on its bound at its off value (that effect is not needed)."""
+    return any(n in f.at_bound and abs(float(f.params[n]) - v) <= 1e-6 * max(1.0, abs(v)) for n, v in off.items())
+
+
+def _drop_names(names: Sequence[str], held: Mapping[str, float]) -> tuple:
+    """``names`` without those ``held`` (whole parameters held at a value; per-sample keys ``name@S`` do not
+    remove their shared name)."""
+    return tuple(n for n in names if n not in held)
 
 
 def _each_lower(rmse_deg: Sequence[float]) -> bool:

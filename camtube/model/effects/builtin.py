@@ -24,6 +24,8 @@ flat_walls     kinematics  flat (planar) instead of radial notch walls: other ar
 chords         kinematics  tendon as straight chords across the notches (none)
 hardstop       kinematics  notches close: the joint stops bending (stop_deg)
 rest_angle     kinematics  joint friction: once loaded, the unloaded joint rests bent (rest_deg)
+relaxation     kinematics  viscoelastic backbone: the slack joint stands at a share of the angle it held and
+                           returns with a relaxation time (fraction, tau_s)
 angle_bias     angle       tracker offset (bias_deg)
 force_zero     force       load-cell zero offset (zero_N)
 =============  ==========  =====================================================
@@ -652,6 +654,8 @@ HARDSTOP = Effect(
 
 def _rest_angle(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
     rest = math.radians(max(p["rest_deg"], 0.0))
+    if rest <= 0.0:  # off: the paper's model
+        return theta
     out = np.asarray(theta, float).copy()
     for _, sl in ctx.data.sample_slices():
         a = out[sl]
@@ -670,11 +674,64 @@ REST_ANGLE = Effect(
                   starts=(0.2, 1.0)),),
     apply=_rest_angle,
     family="rest",
+    off={"rest_deg": 0.0},
     meaning="friction in the joint (or a permanent set): once loaded, the joint's spring returns it only until "
             "its moment equals the friction, so the unloaded joint rests bent at rest_deg while the tendon "
             "goes slack",
     signature="after the first load, a positive residual where the tendon is slack or barely pulled (at rest "
               "and at the start of each pull); none before the first load",
+)
+
+
+def _relaxation(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
+    c = min(max(p["fraction"], 0.0), 0.99)
+    if c <= 0.0:
+        return theta
+    th = np.asarray(theta, float)
+    floor = _rest_floor(ctx.data, th)
+    # the arm's relaxed angle follows the angle the joint holds above its rest (by a first-order lag); unloaded,
+    # the joint stands at its rest plus c times it. Two passes: the second lets the arm follow the slack joint's
+    # own recovery (the slack phases' decay is then (1 - c) / tau, as it is for the standard linear solid)
+    held = np.maximum(th, floor)
+    for _ in range(2):
+        held = np.maximum(th, floor + c * first_order_lag(ctx.data, held - floor, p["tau_s"]))
+    return held
+
+
+def _rest_floor(data: Dataset, theta: np.ndarray) -> np.ndarray:
+    """(n,) the angle (rad) the unloaded joint rests at, per sample: 0 until it is first bent, then the lowest
+    angle after its largest (a rest angle earlier in the chain, such as ``rest_angle``'s, holds it there)."""
+    out = np.zeros_like(theta)
+    for _, sl in data.sample_slices():
+        a = theta[sl]
+        if a.size == 0:
+            continue
+        top = int(np.argmax(a))
+        rest = max(float(a[top:].min()), 0.0)
+        loaded = np.flatnonzero(a >= rest)
+        if rest > 0.0 and loaded.size:
+            out[sl.start + loaded[0]:sl.stop] = rest
+    return out
+
+
+RELAXATION = Effect(
+    name="relaxation", stage="kinematics",
+    params=(Param("fraction", "", 0.0, 0.9, 0.05,
+                  "share of the joint's angle its backbone's relaxing part holds when the tendon lets go "
+                  "(k1 / (k + k1): the relaxing stiffness over the whole)", starts=(0.02, 0.1, 0.3)),
+            Param("tau_s", "s", 1e-2, 1e5, lambda d, c: _period(d) / 8.0,
+                  "relaxation time of the backbone (the joint's return to straight while the tendon is slack)",
+                  log=True, kind="time")),
+    apply=_relaxation,
+    family="backbone",
+    meaning="viscoelastic backbone (a spring with a relaxing arm, standard linear solid): while the tendon pulls, "
+            "the joint follows the tendon and the force carries the backbone's relaxation; when the tendon goes "
+            "slack the joint does not spring straight but stands at a share of the angle it held, and creeps "
+            "back with the relaxation time",
+    signature="a positive residual where the tendon is slack or barely pulled, largest just after the unloading "
+              "and fading during the rest; larger after a long or high dwell",
+    history=True,
+    off={"fraction": 0.0},
 )
 
 
@@ -709,6 +766,6 @@ FORCE_ZERO = Effect(
 
 #: The built-in effects, in their documented order.
 BUILTIN_EFFECTS = (SLACK, PLAY, CREEP, CREEP_LOAD, FRICTION, CAPSTAN, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
-                   HARDSTOP, REST_ANGLE, ANGLE_BIAS, FORCE_ZERO)
+                   HARDSTOP, REST_ANGLE, RELAXATION, ANGLE_BIAS, FORCE_ZERO)
 #: Built-in effect names in that order.
 BUILTINS = tuple(e.name for e in BUILTIN_EFFECTS)

@@ -241,6 +241,8 @@ SIDES = {
     "force_zero": "instruments (the load cell's zero)",
     "angle_bias": "instruments (the tracker's offset), or a joint that rests bent",
     "rest_angle": "joint (friction or a permanent set)",
+    "relaxation": "joint (its polymer backbone relaxes; the tendon's own creep lengthens it under load instead, "
+                  "and shows while it pulls: a dwell with the tendon slack, the joint filmed, tells)",
     "hardstop": "joint (the notches close)",
     "kerf": "joint geometry", "flat_walls": "joint geometry", "chords": "joint geometry",
 }
@@ -271,11 +273,15 @@ def answer_lines(d: Diagnosis) -> list[str]:
                          for k, name in enumerate(d.recommended, 1)]
                 out.append(f"  sample {smp}: " + "; ".join(gains) + " deg")
             for name in d.recommended:
-                off = sorted({k.split("@")[1] for k in d.held if k.split(".")[0] == name})
+                off = sorted({k.split("@")[1] for k in d.held if "@" in k and k.split(".")[0] == name})
                 if off:
                     on = [smp for smp in samples if smp not in off]
                     out.append(f"  {name}: in sample(s) {', '.join(on)} only; held off in {', '.join(off)} "
                                "(that sample does not show it)")
+        for k, v in d.held.items():   # a baseline effect a recommended one stands in for
+            if "@" not in k and k.split(".")[0] in d.baseline:
+                out.append(f"  {k.split('.')[0]} (the baseline) held at {k} = {v:g}: the recommended effects "
+                           "explain the bent rest in its place")
     elif d.partial:
         out.append("answer: nothing the library has explains the misfit; the built-ins that lower it ("
                    + ", ".join(d.partial) + f") leave {_times(d.partial_steps[-1].rmse_deg, floor)} the noise floor "
