@@ -128,6 +128,9 @@ HELDOUT3_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", 
 #: The sixth fresh held-out batch (issue 19, after the guide's capstan law): friction at the guide beside a toe.
 HELDOUT6_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
                   ("friction", "toe"), ("creep", "slack"), "friction"]
+#: The seventh fresh held-out batch (issue 19, after `relaxation` and baseline stand-ins): a backbone beside a toe.
+HELDOUT7_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
+                  ("backbone", "toe"), ("creep", "slack"), "friction"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -139,7 +142,10 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            # drawn once capstan, the guide's law at rest and the lag regression's friction terms were settled
            # (the tuned batch and the earlier held-out batches had been looked at): a seed not used before, with
            # guide friction beside a toe in one file; run once
-           "bench-heldout6": (20261228, HELDOUT6_KINDS)}
+           "bench-heldout6": (20261228, HELDOUT6_KINDS),
+           # drawn once relaxation (the joint's backbone) and the baseline's stand-ins were settled (every batch
+           # above had been looked at): a seed not used before, with a backbone beside a toe; run once
+           "bench-heldout7": (20261229, HELDOUT7_KINDS)}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
