@@ -19,7 +19,8 @@ report directory with an index is complete).
      "replaced": [{"effects", "by"}], "dropped": [effect, ...],   # stepwise: swapped or dropped before the end
      "partial": [{"effect", "rmse_before_deg", "rmse_deg", "floor_ratio", "params"}],  # lower it, not a fix
      "waterfall": [{"effects", "rmse_deg", "per_sample"}],
-     "per_sample": [name, ...], "held": {"name@S": value},   # per-sample copies held off (absent in S)
+     "per_sample": [name, ...], "held": {"name@S": value,   # per-sample copies held off (absent in S)
+                                          "name": value},    # a baseline effect a stand-in holds off
      "final": {"effects", "rmse_deg", "params"}, "stop_reason", "command",
      "unexplained": null | {"share", "follows", "periodic": [{"variable", "period", "unit", "amplitude_deg"}],
                             "shape", "samples", ...}}   # camtube.model.unexplained
