@@ -145,3 +145,4 @@ def test_fit_is_unchanged_by_the_grouping(problem, monkeypatch):
     assert new.params == old.params and new.nfev == old.nfev
     assert np.array_equal(new.residuals, old.residuals) and np.array_equal(new.covariance, old.covariance,
                                                                              equal_nan=True)
+

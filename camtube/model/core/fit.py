@@ -137,11 +137,31 @@ def _blas_single_thread():
     nothing, and on a busy machine OpenBLAS threads waiting for a core make each
     matrix-vector product a hundred times slower.
     """
+    controller = _thread_controller()
+    return contextlib.nullcontext() if controller is None else controller.limit(limits=1, user_api="blas")
+
+
+_CONTROLLER: list = []
+
+
+def _thread_controller():
+    """A threadpoolctl controller of the loaded libraries, or ``None`` without threadpoolctl.
+
+    speed: building one scans every loaded library (about a millisecond, and a diagnosis fits hundreds of
+    times), so it is kept, and built again only when modules were imported since (a new BLAS comes in with an
+    import: the limit must reach it as ``threadpool_limits`` would).
+    """
+    import sys
+
+    if _CONTROLLER and _CONTROLLER[0] == len(sys.modules):
+        return _CONTROLLER[1]
     try:
-        from threadpoolctl import threadpool_limits
+        from threadpoolctl import ThreadpoolController
     except ModuleNotFoundError:
-        return contextlib.nullcontext()
-    return threadpool_limits(1, user_api="blas")
+        return None
+    controller = ThreadpoolController()
+    _CONTROLLER[:] = [len(sys.modules), controller]
+    return controller
 
 
 def rmse_by_sample(data: Dataset, residuals: np.ndarray) -> dict[str, float]:
