@@ -471,7 +471,8 @@ def _toe_forces(ctx: Context) -> tuple[np.ndarray, np.ndarray, tuple]:
     return f, low, (index, weight)
 
 
-def toe_elongation(ctx: Context, elong: np.ndarray, extra: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+def toe_elongation(ctx: Context, elong: np.ndarray, extra: Callable[[np.ndarray], np.ndarray],
+                   key: tuple | None = None) -> np.ndarray:
     """Add a toe law's elongation ``extra(force_N) -> mm`` (beyond the linear law) to ``elong`` (n,).
 
     The law is evaluated at :func:`local_force_N`; near zero force, where it is steep, it is averaged
@@ -480,16 +481,53 @@ def toe_elongation(ctx: Context, elong: np.ndarray, extra: Callable[[np.ndarray]
     nodes, on a grid of averaged forces per sample (:data:`TOE_POSTERIOR_GRID` points, interpolated:
     the law is evaluated at a few thousand nodes instead of sixteen per low row). Where the elongation
     would exceed the stroke the tendon is slack and the joint straight.
+
+    ``key`` (hashable, optional): every value ``extra`` depends on. With it the rows' toe elongations are
+    kept (:func:`_kept_toe_rows`) and reused while the force is the same.
     """
     f, low, (index, weight) = _toe_forces(ctx)
-    toe = extra(f)
     n = elong.size
-    if low.size:
-        rows = toe[:n].copy()
-        mean = toe[n:].reshape(-1, TOE_NODES).mean(axis=1)
-        rows[low] = mean[index] * (1.0 - weight) + mean[index + 1] * weight
-        toe = rows
+
+    def rows() -> np.ndarray:
+        toe = extra(f)
+        if low.size:
+            out = toe[:n].copy()
+            mean = toe[n:].reshape(-1, TOE_NODES).mean(axis=1)
+            out[low] = mean[index] * (1.0 - weight) + mean[index + 1] * weight
+            toe = out
+        return toe
+
+    toe = rows() if key is None else _kept_toe_rows(ctx, f, key, rows)
     return np.minimum(elong + toe, np.maximum(ctx.stroke_mm, elong))
+
+
+#: Toe laws' row elongations kept per Dataset (the most recently used).
+TOE_ROWS_KEPT = 16
+
+
+def _kept_toe_rows(ctx: Context, f: np.ndarray, key: tuple, compute: Callable[[], np.ndarray]) -> np.ndarray:
+    """``compute()`` for the law ``key`` at the force ``f``, kept per Dataset (least recently used dropped).
+
+    speed: a fit's finite-difference steps in the parameters of other effects (and the cross-validation
+    fits, from the same values) evaluate the law again with the same parameters and force; the same
+    computation gives the same numbers, so they are reused. A new force array starts afresh.
+    """
+    from collections import OrderedDict
+
+    hit = ctx.data.cache.get("builtin.toe_rows")
+    if hit is None or hit[0] is not f:
+        hit = ctx.data.cache.set("builtin.toe_rows", (f, OrderedDict()))
+    kept = hit[1]
+    toe = kept.get(key)
+    if toe is not None:
+        kept.move_to_end(key)
+        return toe
+    toe = compute()
+    toe.setflags(write=False)
+    kept[key] = toe
+    if len(kept) > TOE_ROWS_KEPT:
+        kept.popitem(last=False)
+    return toe
 
 
 def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
@@ -519,7 +557,7 @@ def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
         lo = xj.take(i)
         return lam * (lo + (pos - i) * (xj.take(i + 1) - lo) - tau)  # 0 .. offset_mm
 
-    return toe_elongation(ctx, elong, extra)
+    return toe_elongation(ctx, elong, extra, key=("toe_shape", c, mean, k))
 
 
 TOE_SHAPE = Effect(
