@@ -38,7 +38,6 @@ and ``predict(data) -> (m,)`` deg for any rows.
 """
 from __future__ import annotations
 
-import contextlib
 import math
 from dataclasses import dataclass, field
 from typing import Mapping, Sequence
@@ -48,6 +47,7 @@ import numpy as np
 from camtube.model.core.fdjac import GroupedJacobian, sample_groups
 from camtube.model.core.model import FitError, JointModel, unknown_parameter
 from camtube.model.core.params import Parameters
+from camtube.model.core.threads import one_blas_thread
 from camtube.model.data.dataset import Dataset
 
 __all__ = ["FitError", "FitResult", "fit", "grid_starts", "rmse_by_sample"]
@@ -135,33 +135,9 @@ def _blas_single_thread():
 
     The fit's linear algebra is tall and thin (n x p, p small): threads bring
     nothing, and on a busy machine OpenBLAS threads waiting for a core make each
-    matrix-vector product a hundred times slower.
+    matrix-vector product a hundred times slower (see :mod:`camtube.model.core.threads`).
     """
-    controller = _thread_controller()
-    return contextlib.nullcontext() if controller is None else controller.limit(limits=1, user_api="blas")
-
-
-_CONTROLLER: list = []
-
-
-def _thread_controller():
-    """A threadpoolctl controller of the loaded libraries, or ``None`` without threadpoolctl.
-
-    speed: building one scans every loaded library (about a millisecond, and a diagnosis fits hundreds of
-    times), so it is kept, and built again only when modules were imported since (a new BLAS comes in with an
-    import: the limit must reach it as ``threadpool_limits`` would).
-    """
-    import sys
-
-    if _CONTROLLER and _CONTROLLER[0] == len(sys.modules):
-        return _CONTROLLER[1]
-    try:
-        from threadpoolctl import ThreadpoolController
-    except ModuleNotFoundError:
-        return None
-    controller = ThreadpoolController()
-    _CONTROLLER[:] = [len(sys.modules), controller]
-    return controller
+    return one_blas_thread()
 
 
 def rmse_by_sample(data: Dataset, residuals: np.ndarray) -> dict[str, float]:
