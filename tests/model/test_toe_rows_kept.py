@@ -72,3 +72,14 @@ def test_the_least_recently_used_law_is_dropped(bench, monkeypatch):
     kept = data.cache.get("builtin.toe_rows")[1]
     assert [key[3] for key in kept] == [2.5, 1.5, 3.0]
     assert all(not toe.flags.writeable for toe in kept.values())
+
+
+def test_the_toe_table_kept_longest_is_the_least_recently_used(monkeypatch):
+    monkeypatch.setattr(builtin, "_TOE_TABLES", {})
+    monkeypatch.setattr(builtin, "TOE_TABLES_KEPT", 2)
+    first = builtin._toe_table(1.5, 3.0)
+    builtin._toe_table(2.0, 3.0)
+    assert builtin._toe_table(1.5, 3.0) is first          # kept, and now the most recent
+    builtin._toe_table(2.5, 3.0)                            # drops 2.0, not 1.5
+    assert [k[0] for k in builtin._TOE_TABLES] == [1.5, 2.5]
+    assert np.array_equal(first[1], builtin.weibull_toe_force(first[0], 1.5))

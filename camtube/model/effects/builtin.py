@@ -403,22 +403,27 @@ def local_force_sd_N(data: Dataset) -> np.ndarray:
 
 
 _TOE_TABLES: dict = {}
+#: Toe tables kept (the most recently used).
+TOE_TABLES_KEPT = 64
 
 
 def _toe_table(shape: float, x_min: float) -> tuple[np.ndarray, np.ndarray]:
     """``(x, tau(x))`` of :func:`weibull_toe_force` on ``TOE_GRID + 1`` points from 0 to at least ``x_min``.
 
     Cached by shape and range (the range rounded up to a power of two): a fit's finite-difference steps in
-    the other parameters reuse the table.
+    the other parameters reuse the table. The least recently used table is dropped (per-sample shapes and a
+    fit's trial steps come back to tables used a few evaluations before).
     """
     x_max = 2.0 ** math.ceil(math.log2(max(x_min, 1e-6)))
     key = (float(shape), x_max)
     hit = _TOE_TABLES.get(key)
     if hit is None:
-        if len(_TOE_TABLES) > 64:
-            _TOE_TABLES.clear()
         xg = x_max * (np.arange(TOE_GRID + 1) / TOE_GRID) ** 2
         hit = _TOE_TABLES[key] = (xg, weibull_toe_force(xg, shape))
+        if len(_TOE_TABLES) > TOE_TABLES_KEPT:
+            del _TOE_TABLES[next(iter(_TOE_TABLES))]      # a dict keeps insertion order: the oldest first
+    else:
+        _TOE_TABLES[key] = _TOE_TABLES.pop(key)            # most recently used last
     return hit
 
 
@@ -512,21 +517,17 @@ def _kept_toe_rows(ctx: Context, f: np.ndarray, key: tuple, compute: Callable[[]
     fits, from the same values) evaluate the law again with the same parameters and force; the same
     computation gives the same numbers, so they are reused. A new force array starts afresh.
     """
-    from collections import OrderedDict
-
     hit = ctx.data.cache.get("builtin.toe_rows")
     if hit is None or hit[0] is not f:
-        hit = ctx.data.cache.set("builtin.toe_rows", (f, OrderedDict()))
+        hit = ctx.data.cache.set("builtin.toe_rows", (f, {}))
     kept = hit[1]
-    toe = kept.get(key)
-    if toe is not None:
-        kept.move_to_end(key)
-        return toe
-    toe = compute()
-    toe.setflags(write=False)
-    kept[key] = toe
+    toe = kept.pop(key, None)
+    if toe is None:
+        toe = compute()
+        toe.setflags(write=False)
+    kept[key] = toe                                        # most recently used last (a dict keeps the order)
     if len(kept) > TOE_ROWS_KEPT:
-        kept.popitem(last=False)
+        del kept[next(iter(kept))]
     return toe
 
 
