@@ -186,6 +186,14 @@ def grid_starts(params: Parameters, names: Sequence[str], n: int = 3, cap: int =
     return out
 
 
+def finite_residual(r: np.ndarray) -> np.ndarray:
+    """``r`` with NaN and +inf as 1e3 and -inf as -1e3 deg: a trial step may leave an effect's valid region, and
+    a large finite residual steers it back. ``r`` itself when all is finite (speed: the usual case)."""
+    if np.isfinite(r).all():
+        return r
+    return np.nan_to_num(r, nan=1e3, posinf=1e3, neginf=-1e3)
+
+
 def _residual_and_jacobian(model: JointModel, data: Dataset, names: Sequence[str], values: Mapping[str, float],
                            sel: np.ndarray, residual, lo: np.ndarray, hi: np.ndarray):
     """``(fun, jac)`` for :func:`scipy.optimize.least_squares`: ``(residual, "2-point")``, or, when per-sample
@@ -310,10 +318,13 @@ def fit(
     measured = np.asarray(data.angle_deg, float)
     work = dict(start)
 
+    every_row = rows is None
+
     def residual(x: np.ndarray) -> np.ndarray:
         for nm, v in zip(names, x):
             work[nm] = float(v)
-        return (measured - model.predict(data, work))[sel]
+        r = measured - model.predict(data, work)
+        return r if every_row else r[sel]   # speed: no copy when every row is fitted
 
     r0 = residual(x0)
     if not np.all(np.isfinite(r0)):
@@ -322,8 +333,7 @@ def fit(
                        f"{ {nm: start[nm] for nm in names} }")
 
     def guarded(x: np.ndarray) -> np.ndarray:
-        # a trial step may leave an effect's valid region: a large finite residual steers it back
-        return np.nan_to_num(residual(x), nan=1e3, posinf=1e3, neginf=-1e3)
+        return finite_residual(residual(x))
 
     # start points: the given values, explicit starts, the best grid points (ranked by their SSE)
     xs = [x0]
