@@ -84,6 +84,14 @@ def fit_command_prefix(args: argparse.Namespace, instruments=None) -> str:
 
 
 def cmd_diagnose(args: argparse.Namespace) -> int:
+    from camtube.model.core.threads import one_blas_thread
+
+    # speed: the instrument checks' regressions and the report's analyses are tall and thin too
+    with one_blas_thread():
+        return _diagnose(args)
+
+
+def _diagnose(args: argparse.Namespace) -> int:
     from camtube.commands.common import load_from_args
     from camtube.errors import DataError
     from camtube.io import write_atomic

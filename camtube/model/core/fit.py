@@ -38,15 +38,16 @@ and ``predict(data) -> (m,)`` deg for any rows.
 """
 from __future__ import annotations
 
-import contextlib
 import math
 from dataclasses import dataclass, field
 from typing import Mapping, Sequence
 
 import numpy as np
 
+from camtube.model.core.fdjac import GroupedJacobian, sample_groups
 from camtube.model.core.model import FitError, JointModel, unknown_parameter
 from camtube.model.core.params import Parameters
+from camtube.model.core.threads import one_blas_thread
 from camtube.model.data.dataset import Dataset
 
 __all__ = ["FitError", "FitResult", "fit", "grid_starts", "rmse_by_sample"]
@@ -134,13 +135,9 @@ def _blas_single_thread():
 
     The fit's linear algebra is tall and thin (n x p, p small): threads bring
     nothing, and on a busy machine OpenBLAS threads waiting for a core make each
-    matrix-vector product a hundred times slower.
+    matrix-vector product a hundred times slower (see :mod:`camtube.model.core.threads`).
     """
-    try:
-        from threadpoolctl import threadpool_limits
-    except ModuleNotFoundError:
-        return contextlib.nullcontext()
-    return threadpool_limits(1, user_api="blas")
+    return one_blas_thread()
 
 
 def rmse_by_sample(data: Dataset, residuals: np.ndarray) -> dict[str, float]:
@@ -187,6 +184,39 @@ def grid_starts(params: Parameters, names: Sequence[str], n: int = 3, cap: int =
             if not params[nm].starts:
                 out += [{nm: v} for v in params[nm].grid(scan)]
     return out
+
+
+def finite_residual(r: np.ndarray) -> np.ndarray:
+    """``r`` with NaN and +inf as 1e3 and -inf as -1e3 deg: a trial step may leave an effect's valid region, and
+    a large finite residual steers it back. ``r`` itself when all is finite (speed: the usual case)."""
+    if np.isfinite(r).all():
+        return r
+    return np.nan_to_num(r, nan=1e3, posinf=1e3, neginf=-1e3)
+
+
+def _residual_and_jacobian(model: JointModel, data: Dataset, names: Sequence[str], values: Mapping[str, float],
+                           sel: np.ndarray, residual, lo: np.ndarray, hi: np.ndarray):
+    """``(fun, jac)`` for :func:`scipy.optimize.least_squares`: ``(residual, "2-point")``, or, when per-sample
+    copies of one parameter are fitted, a :class:`~camtube.model.core.fdjac.GroupedJacobian` that steps them
+    in one model evaluation (the same columns, fewer evaluations).
+
+    The grouping rests on :meth:`JointModel.predict` running each sample alone when any value is per-sample
+    (``values``: every name the model gets); a model class with its own ``predict`` keeps scipy's Jacobian.
+    """
+    groups = sample_groups(names)
+    per_sample = any("@" in k for k in values) and type(model).predict is JointModel.predict
+    if not per_sample or all(len(g) == 1 for g in groups):
+        return residual, "2-point"
+    slices = data.sample_slices()
+    rows = {}
+    for g in groups:
+        for i in (g if len(g) > 1 else ()):
+            mask = np.zeros(len(data), bool)
+            for smp, sl in slices:
+                mask[sl] |= smp == names[i].partition("@")[2]
+            rows[i] = mask[sel]
+    jac = GroupedJacobian(residual, lo, hi, groups, rows)
+    return jac.residual, jac
 
 
 def fit(
@@ -288,10 +318,13 @@ def fit(
     measured = np.asarray(data.angle_deg, float)
     work = dict(start)
 
+    every_row = rows is None
+
     def residual(x: np.ndarray) -> np.ndarray:
         for nm, v in zip(names, x):
             work[nm] = float(v)
-        return (measured - model.predict(data, work))[sel]
+        r = measured - model.predict(data, work)
+        return r if every_row else r[sel]   # speed: no copy when every row is fitted
 
     r0 = residual(x0)
     if not np.all(np.isfinite(r0)):
@@ -300,8 +333,7 @@ def fit(
                        f"{ {nm: start[nm] for nm in names} }")
 
     def guarded(x: np.ndarray) -> np.ndarray:
-        # a trial step may leave an effect's valid region: a large finite residual steers it back
-        return np.nan_to_num(residual(x), nan=1e3, posinf=1e3, neginf=-1e3)
+        return finite_residual(residual(x))
 
     # start points: the given values, explicit starts, the best grid points (ranked by their SSE)
     xs = [x0]
@@ -330,7 +362,8 @@ def fit(
             if p:
                 scale = np.maximum(np.abs(xstart), 1e-3 * np.where(np.isfinite(span), span, 1.0))
                 scale = np.where(scale > 0, scale, 1.0)
-                sol = least_squares(guarded, xstart, bounds=(lo, hi), x_scale=scale, method="trf",
+                fun, jac = _residual_and_jacobian(model, data, names, work, sel, guarded, lo, hi)
+                sol = least_squares(fun, xstart, jac=jac, bounds=(lo, hi), x_scale=scale, method="trf",
                                     max_nfev=max_nfev, xtol=tol, ftol=tol, gtol=tol)
                 cost = 2.0 * float(sol.cost)
                 cand = (cost, sol.x, np.atleast_2d(sol.jac), bool(sol.success), str(sol.message), int(sol.nfev),

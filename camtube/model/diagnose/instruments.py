@@ -40,6 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from camtube.model.core.threads import one_blas_thread
 from camtube.model.data.dataset import Dataset
 
 #: A row this many robust scales from its running median is a spike.
@@ -407,7 +408,8 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     if lag_ms is not None:
         lag = Lag(float(lag_ms), 0.0, given=True, applied_ms=float(lag_ms))  # whole rows below
     else:
-        lag = estimate_lag(clean)
+        with one_blas_thread():   # speed: the lag scan's regressions are tall and thin (camtube.model.core.threads)
+            lag = estimate_lag(clean)
         dt_ms = 1e3 / max(np.median(list(rates.values())) if rates else 1.0, 1e-9)
         if abs(lag.lag_ms) > 3.0 * lag.se_ms and abs(lag.lag_ms) > 0.25 * dt_ms and lag.fall >= MIN_FALL:
             lag = Lag(lag.lag_ms, lag.se_ms, applied_ms=lag.lag_ms, fall=lag.fall)

@@ -101,6 +101,7 @@ import numpy as np
 from camtube.model.core.fit import FitResult, fit
 from camtube.model.core.model import Effect, FitError, JointModel
 from camtube.model.core.registry import Registry, builtin_registry
+from camtube.model.core.threads import one_blas_thread
 from camtube.model.data.csvfile import check_fittable
 from camtube.model.data.dataset import Cache, Dataset
 
@@ -707,7 +708,8 @@ def diagnose(
     """
     settings = SearchSettings(tuple(fit_params), dict(fixed or {}), max_rows, max_effects, bic_threshold, min_gain,
                               min_excess, stop_ratio, z, grid, tuple(modulus_range_gpa), per_sample, dict(init or {}))
-    return Search(model, data, settings, candidates=candidates, registry=registry, baseline=baseline).run()
+    with one_blas_thread():  # speed: tall, thin linear algebra (see camtube.model.core.threads)
+        return Search(model, data, settings, candidates=candidates, registry=registry, baseline=baseline).run()
 
 
 class Search:

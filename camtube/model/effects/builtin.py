@@ -405,22 +405,27 @@ def local_force_sd_N(data: Dataset) -> np.ndarray:
 
 
 _TOE_TABLES: dict = {}
+#: Toe tables kept (the most recently used).
+TOE_TABLES_KEPT = 64
 
 
 def _toe_table(shape: float, x_min: float) -> tuple[np.ndarray, np.ndarray]:
     """``(x, tau(x))`` of :func:`weibull_toe_force` on ``TOE_GRID + 1`` points from 0 to at least ``x_min``.
 
     Cached by shape and range (the range rounded up to a power of two): a fit's finite-difference steps in
-    the other parameters reuse the table.
+    the other parameters reuse the table. The least recently used table is dropped (per-sample shapes and a
+    fit's trial steps come back to tables used a few evaluations before).
     """
     x_max = 2.0 ** math.ceil(math.log2(max(x_min, 1e-6)))
     key = (float(shape), x_max)
     hit = _TOE_TABLES.get(key)
     if hit is None:
-        if len(_TOE_TABLES) > 64:
-            _TOE_TABLES.clear()
         xg = x_max * (np.arange(TOE_GRID + 1) / TOE_GRID) ** 2
         hit = _TOE_TABLES[key] = (xg, weibull_toe_force(xg, shape))
+        if len(_TOE_TABLES) > TOE_TABLES_KEPT:
+            del _TOE_TABLES[next(iter(_TOE_TABLES))]      # a dict keeps insertion order: the oldest first
+    else:
+        _TOE_TABLES[key] = _TOE_TABLES.pop(key)            # most recently used last
     return hit
 
 
@@ -473,7 +478,8 @@ def _toe_forces(ctx: Context) -> tuple[np.ndarray, np.ndarray, tuple]:
     return f, low, (index, weight)
 
 
-def toe_elongation(ctx: Context, elong: np.ndarray, extra: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+def toe_elongation(ctx: Context, elong: np.ndarray, extra: Callable[[np.ndarray], np.ndarray],
+                   key: tuple | None = None) -> np.ndarray:
     """Add a toe law's elongation ``extra(force_N) -> mm`` (beyond the linear law) to ``elong`` (n,).
 
     The law is evaluated at :func:`local_force_N`; near zero force, where it is steep, it is averaged
@@ -482,16 +488,49 @@ def toe_elongation(ctx: Context, elong: np.ndarray, extra: Callable[[np.ndarray]
     nodes, on a grid of averaged forces per sample (:data:`TOE_POSTERIOR_GRID` points, interpolated:
     the law is evaluated at a few thousand nodes instead of sixteen per low row). Where the elongation
     would exceed the stroke the tendon is slack and the joint straight.
+
+    ``key`` (hashable, optional): every value ``extra`` depends on. With it the rows' toe elongations are
+    kept (:func:`_kept_toe_rows`) and reused while the force is the same.
     """
     f, low, (index, weight) = _toe_forces(ctx)
-    toe = extra(f)
     n = elong.size
-    if low.size:
-        rows = toe[:n].copy()
-        mean = toe[n:].reshape(-1, TOE_NODES).mean(axis=1)
-        rows[low] = mean[index] * (1.0 - weight) + mean[index + 1] * weight
-        toe = rows
+
+    def rows() -> np.ndarray:
+        toe = extra(f)
+        if low.size:
+            out = toe[:n].copy()
+            mean = toe[n:].reshape(-1, TOE_NODES).mean(axis=1)
+            out[low] = mean[index] * (1.0 - weight) + mean[index + 1] * weight
+            toe = out
+        return toe
+
+    toe = rows() if key is None else _kept_toe_rows(ctx, f, key, rows)
     return np.minimum(elong + toe, np.maximum(ctx.stroke_mm, elong))
+
+
+#: Toe laws' row elongations kept per Dataset (the most recently used).
+TOE_ROWS_KEPT = 16
+
+
+def _kept_toe_rows(ctx: Context, f: np.ndarray, key: tuple, compute: Callable[[], np.ndarray]) -> np.ndarray:
+    """``compute()`` for the law ``key`` at the force ``f``, kept per Dataset (least recently used dropped).
+
+    speed: a fit's finite-difference steps in the parameters of other effects (and the cross-validation
+    fits, from the same values) evaluate the law again with the same parameters and force; the same
+    computation gives the same numbers, so they are reused. A new force array starts afresh.
+    """
+    hit = ctx.data.cache.get("builtin.toe_rows")
+    if hit is None or hit[0] is not f:
+        hit = ctx.data.cache.set("builtin.toe_rows", (f, {}))
+    kept = hit[1]
+    toe = kept.pop(key, None)
+    if toe is None:
+        toe = compute()
+        toe.setflags(write=False)
+    kept[key] = toe                                        # most recently used last (a dict keeps the order)
+    if len(kept) > TOE_ROWS_KEPT:
+        del kept[next(iter(kept))]
+    return toe
 
 
 def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
@@ -521,7 +560,7 @@ def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
         lo = xj.take(i)
         return lam * (lo + (pos - i) * (xj.take(i + 1) - lo) - tau)  # 0 .. offset_mm
 
-    return toe_elongation(ctx, elong, extra)
+    return toe_elongation(ctx, elong, extra, key=("toe_shape", c, mean, k))
 
 
 TOE_SHAPE = Effect(
