@@ -178,11 +178,18 @@ CREEP = Effect(
 LOAD_TIME_REF_NS = 1000.0
 
 
+def _same_force(kept: np.ndarray, force: np.ndarray) -> bool:
+    """Whether ``force`` is the force array ``kept`` was computed from: the same object, or equal values (speed:
+    a force-stage effect such as ``force_zero`` makes a new array every evaluation, though a finite-difference
+    step in another effect's parameter leaves its values as they were)."""
+    return kept is force or (kept.shape == np.shape(force) and np.array_equal(kept, force))
+
+
 def load_time_Ns(ctx: Context) -> np.ndarray:
     """(n,) the tension carried so far, integrated over time per sample (trapezoids of the measured force,
     clipped at zero: a slack tendon carries none), in N s. Cached per Dataset and force array."""
     hit = ctx.data.cache.get("builtin.load_time")
-    if hit is not None and hit[0] is ctx.force_N:
+    if hit is not None and _same_force(hit[0], ctx.force_N):
         return hit[1]
     t = np.asarray(ctx.data.time_s, float)
     f = np.maximum(np.asarray(ctx.force_N, float), 0.0)
@@ -354,7 +361,7 @@ def local_force_N(ctx: Context) -> np.ndarray:
     f = np.asarray(ctx.force_N, float)
     # speed: a fit evaluates the model many times with the same force array (no force-stage effect)
     hit = ctx.data.cache.get("builtin.local_force")
-    if hit is not None and hit[0] is ctx.force_N:
+    if hit is not None and _same_force(hit[0], ctx.force_N):
         return hit[1]
     out = f.copy()
     for sl, rows, _ in _force_windows(ctx.data):
@@ -443,7 +450,7 @@ def _toe_forces(ctx: Context) -> tuple[np.ndarray, np.ndarray, tuple]:
     row's place in that grid (linear interpolation). Cached per Dataset and force array: they depend on the
     data only, and a fit evaluates the law many times."""
     hit = ctx.data.cache.get("builtin.toe_forces")
-    if hit is not None and hit[0] is ctx.force_N:
+    if hit is not None and _same_force(hit[0], ctx.force_N):
         return hit[1], hit[2], hit[3]
     fa = local_force_N(ctx)
     f = np.maximum(fa, 0.0)
