@@ -210,7 +210,8 @@ def baseline_lines(d: Diagnosis) -> list[str]:
                    f"{e.meaning if e else name}; {vals}")
         chain, before, after = d.baseline_gain.get(name, ((), d.given.rmse_deg, base.rmse_deg))
         on = f"the model with {', '.join(chain)}" if chain else "the current model"
-        out.append(f"  it lowers the RMSE of {on} from {before:.3f} to {after:.3f} deg")
+        out.append(f"  it lowers the RMSE of {on} from {before:.3f} to {after:.3f} deg"
+                   + (f"; it sits in the {SIDES[name]}" if name in SIDES else ""))
     out.append("  the recommended steps below start from the model with it, and the command includes it "
                "(--no-baseline: try it as an ordinary candidate instead)")
     return out
@@ -241,7 +242,9 @@ SIDES = {
     "series": "tendon or sheath (a compliance in series: the same as a softer tendon)",
     "force_zero": "instruments (the load cell's zero)",
     "angle_bias": "instruments (the tracker's offset), or a joint that rests bent",
-    "rest_angle": "joint (friction or a permanent set)",
+    "rest_angle": "joint (friction or a permanent set), or the drive: a carriage that its rail's friction holds "
+                  "within the nut's gap keeps the tendon taut while the motor rests at zero (lost motion); a "
+                  "displacement gauge on the carriage would tell",
     "relaxation": "joint (its polymer backbone relaxes; the tendon's own creep lengthens it under load instead, "
                   "and shows while it pulls: a dwell with the tendon slack, the joint filmed, tells)",
     "hardstop": "joint (the notches close)",
