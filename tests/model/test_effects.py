@@ -187,6 +187,14 @@ def test_first_order_lag_on_jittered_stamps_equals_the_recursion(tau_s):
         prev = a * prev + (1.0 - a) * u[k + 1]
         ref[k + 1] = prev
     np.testing.assert_allclose(_lag_nonuniform(u, dt, tau_s), ref, rtol=1e-11, atol=1e-12)
+    # the kept plan (what depends on the steps and tau alone) gives the same numbers, to the bit, and is reused
+    t = np.cumsum(np.r_[0.0, dt])
+    data = _data(np.zeros(t.size), time=t)
+    steps = np.diff(t)
+    first = first_order_lag(data, u, tau_s)
+    np.testing.assert_array_equal(first, _lag_nonuniform(u, steps, tau_s))
+    np.testing.assert_array_equal(first_order_lag(data, 2.0 * u, tau_s), _lag_nonuniform(2.0 * u, steps, tau_s))
+    assert len(data.cache.get("history.lag_plans")) == 1
 
 
 def test_capstan_gives_the_mean_tension_of_a_tendon_wrapping_a_guide(tube1):

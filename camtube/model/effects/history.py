@@ -114,8 +114,32 @@ def first_order_lag(data: Dataset, u: np.ndarray, tau_s: float) -> np.ndarray:
             a = math.exp(-h / tau)
             v[sl], _ = lfilter([1.0 - a], [1.0, -a], us, zi=[a * us[0]])
         else:
-            v[sl] = _lag_nonuniform(us, dt, tau)
+            v[sl] = _lag_nonuniform(us, dt, tau, plan=_lag_plan(data, sl, dt, tau))
     return v
+
+
+#: Lag plans kept per Dataset (the most recently used): a fit evaluates the lag many times with one ``tau``.
+LAG_PLANS_KEPT = 8
+
+
+def _lag_plan(data: Dataset, sl: slice, dt: np.ndarray, tau: float) -> tuple:
+    """What :func:`_lag_nonuniform` computes from the steps and ``tau`` alone, kept per Dataset, sample and
+    ``tau`` (speed: a fit's finite-difference steps in other parameters, and the two passes of ``relaxation``,
+    use one ``tau`` many times; the same computation gives the same numbers)."""
+    kept = data.cache.get("history.lag_plans")
+    if kept is None:
+        kept = data.cache.set("history.lag_plans", {})
+    key = (sl.start, sl.stop, tau)
+    plan = kept.pop(key, None)
+    if plan is None:
+        decay = np.maximum(dt, 0.0) / tau                    # -log a_k, k = 1 .. n-1
+        cum = np.cumsum(decay)
+        levels = _scan_levels(np.exp(-decay)) if decay.size and cum[-1] > _LAG_BLOCK * 16.0 else None
+        plan = (decay, -np.expm1(-decay), cum, levels)
+    kept[key] = plan                                        # most recently used last (a dict keeps the order)
+    if len(kept) > LAG_PLANS_KEPT:
+        del kept[next(iter(kept))]
+    return plan
 
 
 #: Decay (in units of tau) spanned by one block of :func:`_lag_nonuniform`: exp(30) keeps the scaled sums far
@@ -142,20 +166,52 @@ def _linear_scan(a: np.ndarray, b: np.ndarray, v0: float) -> np.ndarray:
     return B
 
 
-def _lag_nonuniform(u: np.ndarray, dt: np.ndarray, tau: float) -> np.ndarray:
+def _scan_levels(a: np.ndarray) -> tuple:
+    """``(a_0, [multiplier of each pass])`` of :func:`_linear_scan` for ``a``: they depend on ``a`` only, so a
+    lag with one ``tau`` computes them once (:func:`_apply_scan`)."""
+    A = a.astype(float, copy=True)
+    a0 = float(A[0]) if A.size else 0.0
+    A[0:1] = 0.0
+    levels = []
+    d, n = 1, A.size
+    while d < n and A.any():
+        levels.append(A[d:].copy())
+        A[d:] *= A[:-d]
+        A[:d] = 0.0
+        d *= 2
+    return a0, levels
+
+
+def _apply_scan(levels: tuple, b: np.ndarray, v0: float) -> np.ndarray:
+    """:func:`_linear_scan` from its :func:`_scan_levels`: the same operations on ``b`` (the same numbers)."""
+    a0, mult = levels
+    B = b.astype(float, copy=True)
+    if B.size:
+        B[0] += a0 * v0
+    d = 1
+    for m in mult:
+        B[d:] += m * B[:-d]
+        d *= 2
+    return B
+
+
+def _lag_nonuniform(u: np.ndarray, dt: np.ndarray, tau: float, plan: tuple | None = None) -> np.ndarray:
     """``v_k = a_k v_(k-1) + (1 - a_k) u_k``, ``a_k = exp(-dt_k / tau)``, ``v_0 = u_0``, for uneven steps ``dt``
     ((n - 1,) s), in blocks of NumPy calls (speed: a logger's jittered stamps made this a Python loop over every
     row). Within a block ``v_k = A_k (v_start + sum_j b_j / A_j)``, ``A_k`` the product of the ``a`` so far,
     computed through the cumulative sum of ``dt / tau``; a block ends once that sum has grown by
     :data:`_LAG_BLOCK`. Agrees with the row-by-row recursion to ~1e-14 relative."""
-    decay = np.maximum(dt, 0.0) / tau                    # -log a_k, k = 1 .. n-1
-    b = -np.expm1(-decay) * u[1:]                        # (1 - a_k) u_k
-    cum = np.cumsum(decay)
+    if plan is None:
+        decay = np.maximum(dt, 0.0) / tau                # -log a_k, k = 1 .. n-1
+        gain, cum, levels = -np.expm1(-decay), np.cumsum(decay), None
+    else:
+        decay, gain, cum, levels = plan
+    b = gain * u[1:]                                     # (1 - a_k) u_k
     out = np.empty_like(u)
     out[0] = u[0]
     prev, s, m = float(u[0]), 0, decay.size
     if m and cum[-1] > _LAG_BLOCK * 16.0:  # many blocks (tau short against the record): the prefix scan
-        out[1:] = _linear_scan(np.exp(-decay), b, prev)
+        out[1:] = _linear_scan(np.exp(-decay), b, prev) if levels is None else _apply_scan(levels, b, prev)
         return out
     while s < m:
         base = cum[s - 1] if s else 0.0
