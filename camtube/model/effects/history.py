@@ -134,7 +134,8 @@ def _lag_plan(data: Dataset, sl: slice, dt: np.ndarray, tau: float) -> tuple:
     if plan is None:
         decay = np.maximum(dt, 0.0) / tau                    # -log a_k, k = 1 .. n-1
         cum = np.cumsum(decay)
-        levels = _scan_levels(np.exp(-decay)) if decay.size and cum[-1] > _LAG_BLOCK * 16.0 else None
+        levels = (_scan_levels(np.exp(-decay)) if decay.size and cum[-1] > _LAG_BLOCK * 16.0
+                  else _lag_blocks(cum))                # the prefix scan's multipliers, or the blocks
         plan = (decay, -np.expm1(-decay), cum, levels)
     kept[key] = plan                                        # most recently used last (a dict keeps the order)
     if len(kept) > LAG_PLANS_KEPT:
@@ -213,13 +214,21 @@ def _lag_nonuniform(u: np.ndarray, dt: np.ndarray, tau: float, plan: tuple | Non
     if m and cum[-1] > _LAG_BLOCK * 16.0:  # many blocks (tau short against the record): the prefix scan
         out[1:] = _linear_scan(np.exp(-decay), b, prev) if levels is None else _apply_scan(levels, b, prev)
         return out
+    for s, e, grow, shrink in (_lag_blocks(cum) if levels is None else levels):
+        block = shrink * (prev + np.cumsum(grow * b[s:e]))
+        out[s + 1:e + 1] = block
+        prev = float(block[-1])
+    return out
+
+
+def _lag_blocks(cum: np.ndarray) -> list:
+    """``[(s, e, 1 / A_k, A_k)]`` of the blocks of :func:`_lag_nonuniform` (``A_k`` the product of the ``a``
+    within the block): they depend on the steps and ``tau`` alone (kept in a lag's plan)."""
+    out, s, m = [], 0, cum.size
     while s < m:
         base = cum[s - 1] if s else 0.0
         e = max(int(np.searchsorted(cum, base + _LAG_BLOCK, side="right")), s + 1)
         log_a = -(cum[s:e] - base)                       # log A_k within the block
-        scaled = np.cumsum(np.exp(-log_a) * b[s:e])
-        block = np.exp(log_a) * (prev + scaled)
-        out[s + 1:e + 1] = block
-        prev = float(block[-1])
+        out.append((s, e, np.exp(-log_a), np.exp(log_a)))
         s = e
     return out
