@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import pytest
 
-from camtube.model.core.fit import _blas_single_thread
 from camtube.model.core.threads import _thread_controller, one_blas_thread
 
 
@@ -14,7 +13,7 @@ def test_fits_run_blas_on_one_thread_with_a_kept_controller():
 
     assert _thread_controller() is _thread_controller()
     before = {lib["filepath"]: lib["num_threads"] for lib in threadpoolctl.threadpool_info()}
-    with _blas_single_thread():
+    with one_blas_thread():           # as fit() and diagnose() hold it
         inside = threadpoolctl.threadpool_info()
         with one_blas_thread():       # nested: still one, and the outer limit is back after it
             pass

@@ -130,16 +130,6 @@ class FitResult:
         return float(self.correlation[i, j])
 
 
-def _blas_single_thread():
-    """Limit BLAS to one thread while fitting, if threadpoolctl is installed.
-
-    The fit's linear algebra is tall and thin (n x p, p small): threads bring
-    nothing, and on a busy machine OpenBLAS threads waiting for a core make each
-    matrix-vector product a hundred times slower (see :mod:`camtube.model.core.threads`).
-    """
-    return one_blas_thread()
-
-
 def rmse_by_sample(data: Dataset, residuals: np.ndarray) -> dict[str, float]:
     """RMSE (deg) of ``residuals`` ``(n,)`` per sample of ``data``, in sample order."""
     r = np.asarray(residuals, float)
@@ -356,7 +346,7 @@ def fit(
         if not any(np.array_equal(x, u) for u in uniq):
             uniq.append(x)
 
-    with _blas_single_thread():
+    with one_blas_thread():   # tall, thin linear algebra: threads bring nothing (camtube.model.core.threads)
         best = None
         for xstart in uniq:
             if p:

@@ -514,7 +514,8 @@ def _search_fit(model: JointModel, data: Dataset, names: Sequence[str], values: 
     starts = fit_options.pop("starts", ())
     params = model.make_params(data, names, fixed, per_sample=per_sample)
     # held values stay held (per-sample copies held off, a baseline effect a stand-in holds off)
-    params = params.with_values({k: v for k, v in values.items() if k in params and not (k in fixed and k not in names)})
+    params = params.with_values({k: v for k, v in values.items()
+                                 if k in params and not (k in fixed and k not in names)})
     starts = [{k: v for k, v in st.items() if k in params} for st in starts]
     options = {"max_nfev": 100, "keep": 1, "tol": 1e-8, **fit_options}
     return fit(model, data, params=params, starts=[st for st in starts if st], **options)
@@ -891,6 +892,12 @@ class Search:
         kept = [f"{n}@{smp}" for n in eff.full_names() for smp in self.search.samples if f"{n}@{smp}" not in held]
         return self._fit_one(m, names, start, per_sample, held=held, grid=self.settings.grid, grid_names=kept)
 
+    def _chain_names(self, held: Mapping[str, float], new: Sequence[str], new_per_sample: Sequence[str]) -> tuple:
+        """``(fitted names, per-sample names)`` of the chain plus ``new`` (``new_per_sample`` of them per sample),
+        without the parameters ``held`` (a baseline effect a stand-in holds off)."""
+        ch = self.chain
+        return _drop_names(ch.names, held) + tuple(new), list(_drop_names(ch.per_sample, held)) + list(new_per_sample)
+
     def _baseline_off(self, eff: Effect) -> dict:
         """``{parameter: off value}`` of the baseline effects in the chain that ``eff`` may take the place of
         (:data:`BASELINE_STAND_INS`); empty when there is none."""
@@ -966,9 +973,9 @@ class Search:
             off = self._baseline_off(eff)
             if off:
                 # in the place of the baseline effect it may stand in for (that effect held at its off values)
-                f2, ho2, mse2 = self._fit_one(m, _drop_names(ch.names, off) + new, start,
-                                              list(_drop_names(ch.per_sample, off)), held=off, grid=s.grid,
-                                              grid_names=new, starts=[init] if init else ())
+                names, ps = self._chain_names(off, new, ())
+                f2, ho2, mse2 = self._fit_one(m, names, start, ps, held=off, grid=s.grid, grid_names=new,
+                                              starts=[init] if init else ())
                 if ho2 < ho or _off_at_bound(f, off):
                     f, ho, mse = f2, ho2, mse2
                     self.cand_held[(eff.name, ())] = off
@@ -977,14 +984,12 @@ class Search:
             for row in sorted([r for r in fits if r[2]], key=lambda r: r[4])[:PER_SAMPLE_TRIES]:
                 eff, m, new, f, ho, mse, _ = row
                 off = self.cand_held.get((eff.name, ()), {})   # a baseline effect it stands in for
-                names = _drop_names(ch.names, off) + new
-                ps = list(_drop_names(ch.per_sample, off)) + list(new)
+                names, ps = self._chain_names(off, new, new)
                 f2, ho2, mse2 = self._fit_one(m, names, f.params, ps, held=off)
                 off_all = self._baseline_off(eff)
                 if not off and _off_at_bound(f2, off_all):   # per sample, it takes the baseline effect's place
                     off = off_all
-                    names = _drop_names(ch.names, off) + new
-                    ps = list(_drop_names(ch.per_sample, off)) + list(new)
+                    names, ps = self._chain_names(off, new, new)
                     f2, ho2, mse2 = self._fit_one(m, names, f2.params, ps, held=off)
                 # in a sample that does not show the effect its copies are not resolved (a time constant on a
                 # bound, a stand-in for another effect): the effect fitted in the other samples only

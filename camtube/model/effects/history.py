@@ -132,15 +132,21 @@ def _lag_plan(data: Dataset, sl: slice, dt: np.ndarray, tau: float) -> tuple:
     key = (sl.start, sl.stop, tau)
     plan = kept.pop(key, None)
     if plan is None:
-        decay = np.maximum(dt, 0.0) / tau                    # -log a_k, k = 1 .. n-1
-        cum = np.cumsum(decay)
-        levels = (_scan_levels(np.exp(-decay)) if decay.size and cum[-1] > _LAG_BLOCK * 16.0
-                  else _lag_blocks(cum))                # the prefix scan's multipliers, or the blocks
-        plan = (decay, -np.expm1(-decay), cum, levels)
+        plan = _new_lag_plan(dt, tau)
     kept[key] = plan                                        # most recently used last (a dict keeps the order)
     if len(kept) > LAG_PLANS_KEPT:
         del kept[next(iter(kept))]
     return plan
+
+
+def _new_lag_plan(dt: np.ndarray, tau: float) -> tuple:
+    """``(gain, scan, levels)`` of :func:`_lag_nonuniform` for the steps ``dt`` and ``tau``: the gains ``1 - a_k``,
+    whether it runs the prefix scan (many blocks: ``tau`` short against the record), and then the scan's
+    :func:`_scan_levels`, else the :func:`_lag_blocks`."""
+    decay = np.maximum(dt, 0.0) / tau                    # -log a_k, k = 1 .. n-1
+    cum = np.cumsum(decay)
+    scan = bool(decay.size and cum[-1] > _LAG_BLOCK * 16.0)
+    return -np.expm1(-decay), scan, (_scan_levels(np.exp(-decay)) if scan else _lag_blocks(cum))
 
 
 #: Decay (in units of tau) spanned by one block of :func:`_lag_nonuniform`: exp(30) keeps the scaled sums far
@@ -148,28 +154,10 @@ def _lag_plan(data: Dataset, sl: slice, dt: np.ndarray, tau: float) -> tuple:
 _LAG_BLOCK = 30.0
 
 
-def _linear_scan(a: np.ndarray, b: np.ndarray, v0: float) -> np.ndarray:
-    """``v_k = a_k v_(k-1) + b_k`` (``v_(-1) = v0``) for ``0 <= a_k <= 1`` by a parallel prefix scan: ``log2 n``
-    passes of whole-array NumPy operations, each composing every step with the one ``d`` rows before it
-    (``(a2, b2) o (a1, b1) = (a2 a1, a2 b1 + b2)``, d = 1, 2, 4, ...); it stops early once every product of
-    ``a`` has underflowed (a short ``tau``: a few passes). No exponent grows, so nothing overflows.
-    Replaced a Python loop over every row (issue 19: 15 s of a 34 s diagnosis on a jittered 60,000-row file)."""
-    A = a.astype(float, copy=True)
-    B = b.astype(float, copy=True)
-    B[0] += A[0] * v0
-    A[0] = 0.0
-    d, n = 1, A.size
-    while d < n and A.any():
-        B[d:] += A[d:] * B[:-d]
-        A[d:] *= A[:-d]
-        A[:d] = 0.0
-        d *= 2
-    return B
-
-
 def _scan_levels(a: np.ndarray) -> tuple:
-    """``(a_0, [multiplier of each pass])`` of :func:`_linear_scan` for ``a``: they depend on ``a`` only, so a
-    lag with one ``tau`` computes them once (:func:`_apply_scan`)."""
+    """``(a_0, [multiplier of each pass])`` of the prefix scan :func:`_apply_scan` for ``a``: they depend on ``a``
+    alone, so a lag with one ``tau`` computes them once (kept in its plan). The passes stop once every product of
+    ``a`` has underflowed (a short ``tau``: a few passes)."""
     A = a.astype(float, copy=True)
     a0 = float(A[0]) if A.size else 0.0
     A[0:1] = 0.0
@@ -184,7 +172,11 @@ def _scan_levels(a: np.ndarray) -> tuple:
 
 
 def _apply_scan(levels: tuple, b: np.ndarray, v0: float) -> np.ndarray:
-    """:func:`_linear_scan` from its :func:`_scan_levels`: the same operations on ``b`` (the same numbers)."""
+    """``v_k = a_k v_(k-1) + b_k`` (``v_(-1) = v0``) for ``0 <= a_k <= 1`` by a parallel prefix scan, from the
+    :func:`_scan_levels` of ``a``: ``log2 n`` passes of whole-array NumPy operations, each composing every step
+    with the one ``d`` rows before it (``(a2, b2) o (a1, b1) = (a2 a1, a2 b1 + b2)``, d = 1, 2, 4, ...). No
+    exponent grows, so nothing overflows. Replaced a Python loop over every row (issue 19: 15 s of a 34 s
+    diagnosis on a jittered 60,000-row file)."""
     a0, mult = levels
     B = b.astype(float, copy=True)
     if B.size:
@@ -202,19 +194,15 @@ def _lag_nonuniform(u: np.ndarray, dt: np.ndarray, tau: float, plan: tuple | Non
     row). Within a block ``v_k = A_k (v_start + sum_j b_j / A_j)``, ``A_k`` the product of the ``a`` so far,
     computed through the cumulative sum of ``dt / tau``; a block ends once that sum has grown by
     :data:`_LAG_BLOCK`. Agrees with the row-by-row recursion to ~1e-14 relative."""
-    if plan is None:
-        decay = np.maximum(dt, 0.0) / tau                # -log a_k, k = 1 .. n-1
-        gain, cum, levels = -np.expm1(-decay), np.cumsum(decay), None
-    else:
-        decay, gain, cum, levels = plan
+    gain, scan, levels = _new_lag_plan(dt, tau) if plan is None else plan
     b = gain * u[1:]                                     # (1 - a_k) u_k
     out = np.empty_like(u)
     out[0] = u[0]
-    prev, s, m = float(u[0]), 0, decay.size
-    if m and cum[-1] > _LAG_BLOCK * 16.0:  # many blocks (tau short against the record): the prefix scan
-        out[1:] = _linear_scan(np.exp(-decay), b, prev) if levels is None else _apply_scan(levels, b, prev)
+    prev = float(u[0])
+    if scan:
+        out[1:] = _apply_scan(levels, b, prev)
         return out
-    for s, e, grow, shrink in (_lag_blocks(cum) if levels is None else levels):
+    for s, e, grow, shrink in levels:
         block = shrink * (prev + np.cumsum(grow * b[s:e]))
         out[s + 1:e + 1] = block
         prev = float(block[-1])
