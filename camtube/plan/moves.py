@@ -162,7 +162,7 @@ def job_moves(job, lo: int = 0, hi: int | None = None) -> Moves:
     j = np.arange(m) - np.repeat(row0 + 1 + foc, cnt)  # 0.. on cut rows, negative before
     fp, sp_ = first[pidx], size[pidx]
     vtx = np.where(j >= 0, fp + (j + 1) % sp_, fp)
-    laser = (kind == CUT) | (kind == LINK)
+    laser = np.isin(kind, BEAM_KINDS)
     zz = z[pidx]
     zz[row0] = z_prev
     v = pk.vertices[vtx]
