@@ -77,3 +77,22 @@ def test_a_bad_effect_definition_names_its_line_also_from_a_relative_path(tmp_pa
     for w in words:
         assert w in err, err
     assert "give a Python source file" not in err
+
+
+def test_a_broken_check_names_the_effect_and_its_file():
+    """An effect's ``check`` (its form against its signature) that raises or returns a non-string: one line."""
+    import numpy as np
+
+    from camtube.model.api import Effect, FitError, Param
+    from camtube.model.core.model import form_problem
+
+    def make(check):
+        return Effect(name="odd", stage="angle", params=(Param("b_deg", "deg", -5.0, 5.0, 0.1, "offset"),),
+                      apply=lambda c, a, p: a + p["b_deg"], check=check, source="odd.py")
+
+    assert form_problem(make(lambda d, pred: ""), None, np.zeros(3)) == ""
+    assert form_problem(make(lambda d, pred: "no plateau"), None, np.zeros(3)) == "no plateau"
+    with pytest.raises(FitError, match=r"effect 'odd' \(odd\.py\), check: ZeroDivisionError"):
+        form_problem(make(lambda d, pred: 1 / 0), None, np.zeros(3))
+    with pytest.raises(FitError, match="returned float, expected a string"):
+        form_problem(make(lambda d, pred: 0.5), None, np.zeros(3))

@@ -175,6 +175,10 @@ class Effect:
         Parameter values (short names) at which the effect does nothing, e.g. ``{"creep_mm": 0.0}``. With
         them the diagnosis can fit the effect in some samples only (held off in the others); empty: it
         cannot.
+    check : Callable[[Dataset, ndarray], str] | None
+        An optional test of the fitted form against its signature: ``check(data, predicted_deg)`` returns why
+        the data contradict the form (empty when they do not), e.g. a hard stop where the measured angle keeps
+        rising. A reason makes the diagnosis refuse the candidate, whatever its gain.
     """
 
     name: str
@@ -187,6 +191,7 @@ class Effect:
     history: bool = False
     source: str = ""
     off: Mapping = field(default_factory=dict, compare=False)
+    check: Callable | None = field(default=None, compare=False)
 
     def __post_init__(self):
         for st in self.stages:
@@ -259,6 +264,24 @@ def _call(effect: Effect, stage: str, ctx: Context, signal: np.ndarray, p: dict)
         raise FitError(f"{where()}, stage {stage}: returned shape {out.shape}, expected {signal.shape} "
                        "(one value per row)")
     return out
+
+
+def form_problem(effect: Effect, data, predicted_deg: np.ndarray) -> str:
+    """Why ``data`` contradict ``effect``'s fitted form (its ``check``; empty when they do not, or it has none).
+
+    A broken check in a user's file gets one line naming the effect, its file and the problem."""
+    if effect.check is None:
+        return ""
+    try:
+        reason = effect.check(data, predicted_deg)
+    except Exception as exc:  # noqa: BLE001 - a user's check may raise anything: report it with its file
+        if not effect.source:
+            raise
+        raise FitError(f"effect {effect.name!r} ({effect.source}), check: {type(exc).__name__}: {exc}") from None
+    if reason is not None and not isinstance(reason, str):
+        raise FitError(f"effect {effect.name!r}{f' ({effect.source})' if effect.source else ''}, check: returned "
+                       f"{type(reason).__name__}, expected a string (empty when the form holds)")
+    return reason or ""
 
 
 @dataclass(frozen=True)

@@ -99,7 +99,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from camtube.model.core.fit import FitResult, fit
-from camtube.model.core.model import Effect, FitError, JointModel
+from camtube.model.core.model import Effect, FitError, JointModel, form_problem
 from camtube.model.core.registry import Registry, builtin_registry
 from camtube.model.core.threads import one_blas_thread
 from camtube.model.data.csvfile import check_fittable
@@ -1046,6 +1046,10 @@ class Search:
         if new and not why:
             why += _resolution_problems(m, list(f.fitted), f.params, f.stderr, f.at_bound, self.data,
                                         s.modulus_range_gpa)
+        if new and not why:
+            reason = form_problem(eff, f.data, f.predicted)
+            if reason:
+                why.append(reason)
         # per-sample copies held off (absent in a sample), and a baseline effect a stand-in holds off
         held = dict(self.cand_held.get((eff.name, tuple(swap[0]) if swap else ()), {}))
         if not eff_ps:

@@ -687,6 +687,49 @@ def _hardstop(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
     return np.minimum(theta, math.radians(p["stop_deg"]))
 
 
+#: At least this many rows at the stop before its plateau is judged; and the measured angle's rise past the stop,
+#: as a share of its rise just below it, above which there is no plateau.
+PLATEAU_MIN_ROWS = 20
+PLATEAU_MAX_SLOPE_SHARE = 0.5
+
+
+def _within_slope(group: np.ndarray, x: np.ndarray, y: np.ndarray) -> float:
+    """Slope of ``y`` on ``x`` within groups (each group's own mean removed); nan without spread in ``x``."""
+    _, inv = np.unique(group, return_inverse=True)
+    n = np.bincount(inv).astype(float)
+    dx = x - (np.bincount(inv, x) / n)[inv]
+    dy = y - (np.bincount(inv, y) / n)[inv]
+    sxx = float(dx @ dx)
+    return float(dx @ dy) / sxx if sxx > 0 else math.nan
+
+
+def _hardstop_check(data: Dataset, predicted_deg: np.ndarray) -> str:
+    """A hard stop levels the measured angle off: refuse a stop past which it keeps rising with the stroke.
+
+    The rows at the stop are those at their sample's largest predicted angle (the clipped ones). Their measured
+    angle's slope against the stroke, within each cycle (a drift between cycles does not count), is compared with
+    the slope of the quarter of the other rows predicted highest, just below the stop.
+    """
+    pred = np.asarray(predicted_deg, float)
+    meas = np.asarray(data.angle_deg, float)
+    stroke = np.asarray(data.stroke_mm, float)
+    sample_id = np.unique(np.asarray(data.sample), return_inverse=True)[1]
+    group = sample_id * (int(np.max(data.cycle)) + 1) + np.asarray(data.cycle, int)
+    top = np.zeros(pred.size, bool)
+    for k in np.unique(sample_id):
+        rows = sample_id == k
+        top |= rows & (pred >= np.max(pred[rows]) - 1e-6)
+    below = ~top & (pred >= np.quantile(pred[~top], 0.75)) if (~top).any() else ~top
+    if top.sum() < PLATEAU_MIN_ROWS or below.sum() < PLATEAU_MIN_ROWS:
+        return ""
+    past, under = _within_slope(group[top], stroke[top], meas[top]), _within_slope(group[below], stroke[below],
+                                                                                     meas[below])
+    if math.isfinite(past) and math.isfinite(under) and under > 0 and past > PLATEAU_MAX_SLOPE_SHARE * under:
+        return (f"no plateau: past the stop the measured angle keeps rising with the stroke ({past:.3g} deg/mm, "
+                f"{under:.3g} deg/mm just below it)")
+    return ""
+
+
 HARDSTOP = Effect(
     name="hardstop", stage="kinematics",
     params=(Param("stop_deg", "deg", 1.0, 720.0,
@@ -695,6 +738,7 @@ HARDSTOP = Effect(
     apply=_hardstop,
     meaning="the notches close: beyond this angle the joint stops bending (hard stop)",
     signature="at high stroke the measured angle levels off while the model keeps rising",
+    check=_hardstop_check,
 )
 
 
