@@ -31,7 +31,9 @@ Method
    the floor. It is **trusted** when its new parameters are off their bounds
    with finite standard errors and the data can resolve them: time
    constants between three sample intervals and the record length, lengths
-   within the stroke span, ``E_t`` within ``modulus_range_gpa``. A candidate
+   within the stroke span, ``E_t`` within ``modulus_range_gpa``; and the
+   effect's own ``check`` of its form finds nothing the data contradict (a
+   hard stop must level the measured angle off). A candidate
    that fails a check is listed with the reason and never recommended.
    Among candidates that cannot be told apart, the lowest BIC leads, unless one with fewer parameters
    is within ``bic_threshold`` of it (then the simpler one leads).
@@ -60,7 +62,8 @@ Method
    per-sample version with unresolved copies never replaces the shared one. A
    replacement of an effect fitted per sample is fitted per sample too, and may take the
    replaced effect's place in the chain.
-   The next round retries only the candidates whose held-out RMSE fell by ``min_gain`` in this one.
+   The next round retries only the candidates whose held-out RMSE fell by ``min_gain`` in this one; once,
+   before the search gives up or when that leaves none, every effect not yet chosen is tried again.
 7. The search stops when the held-out RMSE is within ``stop_ratio`` of the
    noise floor (the held-out RMSE at full resolution: the all-rows RMSE times the
    held-out / in-sample ratio of the search rows, which see a coarser history)
@@ -1228,7 +1231,7 @@ class Search:
             if self.swaps_tried:
                 return True, False
             swaps_only = self.swaps_tried = True
-        if not self.pool:
+        if not self.pool and not self._retry_all():
             self.stop = "no candidate effects left"
             return True, False
         return False, swaps_only
@@ -1258,6 +1261,18 @@ class Search:
         self.retry_prev, self.retry_pool = self.rounds.pop(), again
         self.pool = self.pool + again
         return True
+
+    def _retry_all(self) -> bool:
+        """The pool narrowed to nothing (no effect but the one chosen helped the round before): once, a round with
+        every effect not yet chosen, as :meth:`_retry` runs before giving up (on a joint whose backbone relaxes
+        only ``relaxation`` helps the model as given; the tracker's offset it leaves shows once it is in). True
+        when there is such a round."""
+        if self.full_retry:
+            return False
+        self.full_retry = True
+        taken = {x.name for x in self.chain.chosen}
+        self.pool = [e for e in self.all_pool if e.name not in taken]
+        return bool(self.pool)
 
     def step(self) -> bool:
         """One pass of the search: the baseline, the stop rules, drops, a round of candidates, the all-rows
