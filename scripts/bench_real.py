@@ -131,6 +131,10 @@ HELDOUT6_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", 
 #: The seventh fresh held-out batch (issue 19, after `relaxation` and baseline stand-ins): a backbone beside a toe.
 HELDOUT7_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
                   ("backbone", "toe"), ("creep", "slack"), "friction"]
+#: The eighth fresh held-out batch (issue 19, after the hardstop's plateau check and the retry of an empty round): a
+#: backbone beside a slack tendon, friction at the guide beside a creeping tendon.
+HELDOUT8_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
+                  ("slack", "backbone"), ("friction", "creep"), "friction"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -145,7 +149,10 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            "bench-heldout6": (20261228, HELDOUT6_KINDS),
            # drawn once relaxation (the joint's backbone) and the baseline's stand-ins were settled (every batch
            # above had been looked at): a seed not used before, with a backbone beside a toe; run once
-           "bench-heldout7": (20261229, HELDOUT7_KINDS)}
+           "bench-heldout7": (20261229, HELDOUT7_KINDS),
+           # drawn once the hardstop's plateau check and the retry of an empty round were settled (every batch
+           # above had been looked at): a seed not used before, with two new pairs; run once
+           "bench-heldout8": (20261230, HELDOUT8_KINDS)}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
