@@ -481,7 +481,7 @@ def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Ins
     RMSE by :data:`MODEL_LAG_FALL`. Otherwise ``ins`` is returned as it is.
     """
     from camtube.model.core.fit import FitError, fit
-    from camtube.model.effects.builtin import _white_noise_sd
+    from camtube.model.core.noise import white_noise_sd
 
     lg = ins.lag
     if lg.given or lg.applied_ms or not math.isfinite(lg.se_ms) or not ins.rates_hz:
@@ -491,7 +491,7 @@ def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Ins
         return ins
     try:
         r0 = fit(model, ins.data, list(fit_names), fixed)
-        noise = min(_white_noise_sd(r0.residuals[sl]) for _, sl in ins.data.sample_slices())
+        noise = min(white_noise_sd(r0.residuals[sl]) for _, sl in ins.data.sample_slices())
         if not (noise > 0.0 and r0.rmse <= MODEL_LAG_MAX_RATIO * noise):
             return ins
         k0 = int(round(lg.lag_ms / dt_ms))

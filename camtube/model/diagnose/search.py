@@ -103,6 +103,7 @@ import numpy as np
 
 from camtube.model.core.fit import FitResult, fit
 from camtube.model.core.model import Effect, FitError, JointModel, form_problem
+from camtube.model.core.noise import ORDERS
 from camtube.model.core.registry import Registry, builtin_registry
 from camtube.model.core.threads import one_blas_thread
 from camtube.model.data.csvfile import check_fittable
@@ -323,8 +324,6 @@ class Diagnosis:
 
 # ----------------------------------------------------------------------------- pieces
 
-#: Orders of the differences and ``C(2k, k)``, the variance of a k-th difference of unit white noise.
-_ORDERS = ((2, 6.0), (3, 20.0), (4, 70.0))
 
 
 def _floor_estimates(parts: list) -> dict[tuple[str, int], float]:
@@ -337,7 +336,7 @@ def _floor_estimates(parts: list) -> dict[tuple[str, int], float]:
     the noise is not quite white or Gaussian or when the model's error leaks into the differences.
     """
     out: dict[tuple[str, int], float] = {}
-    for k, norm in _ORDERS:
+    for k, norm in ORDERS:
         ds = [np.diff(seg, k) for seg in parts if seg.size > k + 4]
         if not ds:
             continue

@@ -44,6 +44,7 @@ import numpy as np
 
 from camtube.design.geometry import backbone_angle_rad, centroid_mm
 from camtube.model.core.model import Context, Effect
+from camtube.model.core.noise import white_noise_sd
 from camtube.model.core.params import Param
 from camtube.model.data.dataset import Dataset
 from camtube.model.effects.history import first_order_lag, monotone_segments, play_operator  # noqa: F401
@@ -373,16 +374,6 @@ def local_force_N(ctx: Context) -> np.ndarray:
 
 
 
-def _white_noise_sd(x: np.ndarray) -> float:
-    """Standard deviation of the white noise on a smooth signal ``x`` (n,): robust, from high-order differences."""
-    best = math.inf
-    for k, norm in ((2, 6.0), (3, 20.0), (4, 70.0)):
-        if x.size > k + 4:
-            d = np.diff(x, k)
-            best = min(best, 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(norm))
-    return best if math.isfinite(best) else 0.0
-
-
 def _force_windows(data: Dataset) -> list:
     """Cached per Dataset: ``(slice, rows, sd_N)`` of each sample: the odd window of :func:`local_force_N` and
     the standard deviation of the noise left on the averaged force (white noise / sqrt(rows))."""
@@ -398,7 +389,7 @@ def _force_windows(data: Dataset) -> list:
                 dt = float(np.median(np.diff(t[sl])))
                 rows = int(round(window_s / dt)) if dt > 0 else 1
                 rows = max(rows - (1 - rows % 2), 1)  # odd: centred
-            hit.append((sl, rows, _white_noise_sd(f[sl]) / math.sqrt(rows)))
+            hit.append((sl, rows, white_noise_sd(f[sl]) / math.sqrt(rows)))
         data.cache.set("builtin.force_windows", hit)
     return hit
 
