@@ -1,0 +1,41 @@
+"""Independent pieces on the machine's cores: the same results as one after another."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from camtube.model.core import parallel
+from camtube.model.core.model import FitError
+
+
+def test_pieces_run_in_forked_workers_and_return_in_order():
+    big = np.arange(1_000_000, dtype=float)  # inherited by the workers, never pickled
+
+    def piece(i: int):
+        import os
+
+        return i, float(big[i::7].sum()), os.getpid()
+
+    got = parallel.map_forked(piece, 5)
+    assert [g[:2] for g in got] == [(i, float(big[i::7].sum())) for i in range(5)]
+    if parallel.cores() > 1:
+        import os
+
+        assert all(g[2] != os.getpid() for g in got)  # each ran in a worker, not here
+
+
+def test_an_error_in_a_piece_is_raised_as_in_a_loop():
+    def piece(i: int):
+        if i == 2:
+            raise FitError(f"piece {i} cannot be fitted")
+        return i
+
+    with pytest.raises(FitError, match="piece 2 cannot be fitted"):
+        parallel.map_forked(piece, 4)
+
+
+def test_one_core_or_one_piece_runs_here(monkeypatch):
+    import os
+
+    monkeypatch.setattr(parallel, "cores", lambda: 1)
+    assert parallel.map_forked(lambda i: (i, os.getpid()), 3) == [(i, os.getpid()) for i in range(3)]
