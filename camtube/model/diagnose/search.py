@@ -967,12 +967,18 @@ class Search:
         for eff in (pool if swap_all else ()):
             # instead of each effect of swappable only (the stop ratio is reached: nothing is to be added)
             fits += [self._instead(eff, old, ch.fit.params, True) for old in swappable]
-        for eff in (() if swap_all else pool):
+        adding = list(() if swap_all else pool)
+
+        def added(i: int):
+            """``adding[i]`` added to the chain and fitted: ``(fit without its model and rows, held-out RMSE, block
+            MSE, the baseline's values it holds off or None)`` (what crosses back from a worker)."""
+            eff = adding[i]
             m = ch.current.with_effects(list(ch.current.effects) + [eff])
             new = eff.full_names()
             start = m.initial_values(self.search, base=ch.fit.params)
             f, ho, mse = self._fit_one(m, ch.names + new, start, ch.per_sample, grid=s.grid, grid_names=new,
                                        starts=[init] if init else ())
+            held = None
             off = self._baseline_off(eff)
             if off:
                 # in the place of the baseline effect it may stand in for (that effect held at its off values)
@@ -980,9 +986,15 @@ class Search:
                 f2, ho2, mse2 = self._fit_one(m, names, start, ps, held=off, grid=s.grid, grid_names=new,
                                               starts=[init] if init else ())
                 if ho2 < ho or _off_at_bound(f, off):
-                    f, ho, mse = f2, ho2, mse2
-                    self.cand_held[(eff.name, ())] = off
-            fits.append([eff, m, new, f, ho, mse, ()])
+                    f, ho, mse, held = f2, ho2, mse2, off
+            return replace(f, model=None, data=None), ho, mse, held
+
+        # the candidates are independent: one per core (speed; the same fits as one after another)
+        for eff, (f, ho, mse, held) in zip(adding, map_forked(added, len(adding))):
+            m = ch.current.with_effects(list(ch.current.effects) + [eff])
+            if held is not None:
+                self.cand_held[(eff.name, ())] = held
+            fits.append([eff, m, eff.full_names(), replace(f, model=m, data=self.search), ho, mse, ()])
         if try_per_sample:
             for row in sorted([r for r in fits if r[2]], key=lambda r: r[4])[:PER_SAMPLE_TRIES]:
                 eff, m, new, f, ho, mse, _ = row
