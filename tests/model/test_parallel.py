@@ -39,3 +39,16 @@ def test_one_core_or_one_piece_runs_here(monkeypatch):
 
     monkeypatch.setattr(parallel, "cores", lambda: 1)
     assert parallel.map_forked(lambda i: (i, os.getpid()), 3) == [(i, os.getpid()) for i in range(3)]
+
+
+def test_a_worker_that_dies_leaves_the_pieces_to_this_process():
+    import os
+
+    parent = os.getpid()
+
+    def piece(i: int):
+        if os.getpid() != parent and i == 1:
+            os._exit(3)  # a worker killed mid-piece
+        return i * i
+
+    assert parallel.map_forked(piece, 3) == [0, 1, 4]

@@ -2,14 +2,17 @@
 
 :func:`map_forked` runs ``fn(0) .. fn(n - 1)`` in forked worker processes (each inherits the parent's memory,
 so ``fn`` may close over models, data and a user's effect files; only its result crosses back, pickled). Each
-worker runs BLAS on one thread, as the parent's fits do, so the numbers are those of the sequential run. Where
-``fork`` is not available (Windows, macOS' default) or there is one core, the pieces run in this process.
+worker runs BLAS on one thread, as the parent's fits do, so the numbers are those of the sequential run. Off
+Linux (Windows has no fork; on macOS a forked process may crash in the system's libraries, which is why Python
+spawns there) or with one core, the pieces run in this process.
 """
 from __future__ import annotations
 
 import multiprocessing
 import os
+import sys
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from typing import Callable, TypeVar
 
 T = TypeVar("T")
@@ -33,17 +36,20 @@ def _run(i: int):
 
 
 def map_forked(fn: Callable[[int], T], n: int) -> list[T]:
-    """``[fn(0), ..., fn(n - 1)]``, on up to :func:`cores` forked processes; in this process when fork is not
-    available, there is one core or one piece. An exception in a piece is raised here, as it would be in a loop
+    """``[fn(0), ..., fn(n - 1)]``, on up to :func:`cores` forked processes; in this process off Linux, with one
+    core or one piece. An exception in a piece is raised here, as it would be in a loop
     (the first piece's first)."""
     global _JOB
     workers = min(n, cores())
-    if workers < 2 or "fork" not in multiprocessing.get_all_start_methods() or _JOB is not None:
+    if workers < 2 or not sys.platform.startswith("linux") or _JOB is not None:
         return [fn(i) for i in range(n)]   # (and never nested: a worker runs its pieces in turn)
     _JOB = fn
     try:
         with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork")) as ex:
             futures = [ex.submit(_run, i) for i in range(n)]
             return [f.result() for f in futures]
+    except BrokenProcessPool:  # a worker died (killed, out of memory): the pieces again, here
+        pass
     finally:
         _JOB = None
+    return [fn(i) for i in range(n)]
