@@ -52,3 +52,12 @@ def test_a_worker_that_dies_leaves_the_pieces_to_this_process():
         return i * i
 
     assert parallel.map_forked(piece, 3) == [0, 1, 4]
+
+
+def test_camtube_workers_caps_the_cores(monkeypatch):
+    monkeypatch.setenv("CAMTUBE_WORKERS", "1")
+    assert parallel.cores() == 1
+    monkeypatch.setenv("CAMTUBE_WORKERS", "64")
+    assert parallel.cores() >= 1
+    monkeypatch.setenv("CAMTUBE_WORKERS", "many")  # not a count: ignored
+    assert parallel.cores() >= 1

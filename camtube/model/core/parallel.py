@@ -21,11 +21,13 @@ _JOB: Callable | None = None
 
 
 def cores() -> int:
-    """Cores this process may run on."""
+    """Cores this process may run on; at most ``CAMTUBE_WORKERS`` when that is set (``1``: one after another)."""
     try:
-        return len(os.sched_getaffinity(0))
+        n = len(os.sched_getaffinity(0))
     except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
+        n = os.cpu_count() or 1
+    cap = os.environ.get("CAMTUBE_WORKERS", "").strip()
+    return max(1, min(n, int(cap))) if cap.isdigit() else n
 
 
 def _run(i: int):
