@@ -122,7 +122,7 @@ def _slack(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
 
 
 SLACK = Effect(
-    name="slack", stage="stroke",
+    name="slack", stage="stroke", pure=True,
     params=(Param("deadband_mm", "mm", 0.0, 10.0, _slack_guess,
                   "motor stroke taken up before the tendon is taut", kind="length"),),
     apply=_slack,
@@ -139,7 +139,7 @@ def _play(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
 
 
 PLAY = Effect(
-    name="play", stage="stroke",
+    name="play", stage="stroke", pure=True,
     params=(Param("play_mm", "mm", 0.0, 10.0, lambda d, c: 0.02 * _stroke_span(d),
                   "lost motion between the motor and the tendon (full width of the play)", kind="length"),),
     apply=_play,
@@ -159,7 +159,7 @@ def _creep(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
 
 
 CREEP = Effect(
-    name="creep", stage="stroke",
+    name="creep", stage="stroke", pure=True,
     params=(Param("creep_mm", "mm", -5.0, 5.0, lambda d, c: 0.01 * _stroke_span(d),
                   "tendon lengthening reached after a long time (stroke lost)", kind="length"),
             Param("tau_s", "s", 1e-2, 1e7, lambda d, c: _duration(d) / 4.0,
@@ -209,7 +209,7 @@ def _creep_load(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
 
 
 CREEP_LOAD = Effect(
-    name="creep_load", stage="stroke",
+    name="creep_load", stage="stroke", pure=True,
     params=(Param("creep_mm", "mm", 0.0, 5.0, lambda d, c: 0.01 * _stroke_span(d),
                   f"tendon lengthening after {LOAD_TIME_REF_NS:g} N s of load (1 N carried for {LOAD_TIME_REF_NS:g} s)",
                   kind="length"),
@@ -233,7 +233,7 @@ def _friction(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
 
 
 FRICTION = Effect(
-    name="friction", stage="elongation",
+    name="friction", stage="elongation", pure=True,
     params=(Param("mu", "", -0.9, 0.9, 0.02,
                   "fraction by which the tendon's mean tension falls below (loading) or rises above "
                   "(unloading) the load cell"),),
@@ -253,7 +253,7 @@ def _capstan(ctx: Context, force: np.ndarray, p: dict) -> np.ndarray:
 
 
 CAPSTAN = Effect(
-    name="capstan", stage="force",
+    name="capstan", stage="force", pure=True,
     params=(Param("mu_wrap", "", -0.5, 3.0, 0.2,
                   "friction coefficient times the wrap angle (rad) of the guide: the joint-side tension is "
                   "exp(-mu_wrap) times the load cell's while pulling, exp(+mu_wrap) while releasing",
@@ -293,7 +293,7 @@ def _toe(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
 
 
 TOE = Effect(
-    name="toe", stage="elongation",
+    name="toe", stage="elongation", pure=True,
     params=(Param("toe_mm", "mm", 0.0, 5.0, lambda d, c: 0.05 * _stroke_span(d),
                   "elongation over which the tendon's fibres straighten (end of the toe region)",
                   kind="length"),),
@@ -571,7 +571,7 @@ def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
 
 
 TOE_SHAPE = Effect(
-    name="toe_shape", stage="elongation",
+    name="toe_shape", stage="elongation", pure=True,
     params=(Param("offset_mm", "mm", 1e-3, 5.0, lambda d, c: 0.03 * _stroke_span(d),
                   "mean elongation at which a fibre straightens: the linear part of the law is shifted by it",
                   log=True, kind="length"),
@@ -591,7 +591,7 @@ TOE_SHAPE = Effect(
 
 
 VISCOELASTIC = Effect(
-    name="viscoelastic", stage="elongation",
+    name="viscoelastic", stage="elongation", pure=True,
     params=(Param("ratio", "", 0.0, 20.0, 0.1,
                   "delayed compliance as a fraction of the instantaneous one (standard linear solid)",
                   starts=(0.05, 0.3, 1.5)),
@@ -612,7 +612,7 @@ def _series(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
 
 
 SERIES = Effect(
-    name="series", stage="elongation",
+    name="series", stage="elongation", pure=True,
     params=(Param("compliance_mm_per_N", "mm/N", 0.0, 10.0, 0.02,
                   "extra compliance in series with the tendon (sheath or tube compression)"),),
     apply=_series,
@@ -633,7 +633,7 @@ def _kerf(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
 
 
 KERF = Effect(
-    name="kerf", stage="kinematics",
+    name="kerf", stage="kinematics", pure=True,
     params=(Param("kerf_mm", "mm", -0.5, 0.5, 0.02,
                   "widening of the notch arc by the laser kerf (on the outer surface)"),),
     apply=_kerf,
@@ -652,7 +652,7 @@ def _flat(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
 
 
 FLAT_WALLS = Effect(
-    name="flat_walls", stage="kinematics", params=(), apply=_flat,
+    name="flat_walls", stage="kinematics", pure=True, params=(), apply=_flat,
     meaning="the notch walls are flat (one planar cut) rather than radial, so the backbone and the arm differ",
     signature="the residual is proportional to the angle (a gain error of the joint)",
     family="arm",
@@ -676,7 +676,7 @@ def _chords(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
 
 
 CHORDS = Effect(
-    name="chords", stage="kinematics", params=(), apply=_chords,
+    name="chords", stage="kinematics", pure=True, params=(), apply=_chords,
     meaning="the tendon crosses each notch as a straight chord, not an arc, so it shortens a little "
             "less than arm x angle",
     signature="a small residual growing with the angle squared",
@@ -688,7 +688,7 @@ def _hardstop(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
 
 
 HARDSTOP = Effect(
-    name="hardstop", stage="kinematics",
+    name="hardstop", stage="kinematics", pure=True,
     params=(Param("stop_deg", "deg", 1.0, 720.0,
                   lambda d, c: math.degrees(c.n_notches * c.geometry.closure_angle_rad),
                   "joint angle at which the notches close"),),
@@ -714,7 +714,7 @@ def _rest_angle(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
 
 
 REST_ANGLE = Effect(
-    name="rest_angle", stage="kinematics",
+    name="rest_angle", stage="kinematics", pure=True,
     params=(Param("rest_deg", "deg", 0.0, 20.0, 0.3,
                   "angle at which the unloaded joint stays bent (friction moment / bending stiffness)",
                   starts=(0.2, 1.0)),),
@@ -761,7 +761,7 @@ def _rest_floor(data: Dataset, theta: np.ndarray) -> np.ndarray:
 
 
 RELAXATION = Effect(
-    name="relaxation", stage="kinematics",
+    name="relaxation", stage="kinematics", pure=True,
     params=(Param("fraction", "", 0.0, 0.9, 0.05,
                   "share of the joint's angle its backbone's relaxing part holds when the tendon lets go "
                   "(k1 / (k + k1): the relaxing stiffness over the whole)", starts=(0.02, 0.1, 0.3)),
@@ -788,7 +788,7 @@ def _bias(ctx: Context, angle: np.ndarray, p: dict) -> np.ndarray:
 
 
 ANGLE_BIAS = Effect(
-    name="angle_bias", stage="angle",
+    name="angle_bias", stage="angle", pure=True,
     params=(Param("bias_deg", "deg", -90.0, 90.0, 0.0, "constant offset of the angle sensor"),),
     apply=_bias,
     meaning="the angle sensor (EM tracker) reads a constant offset",
@@ -802,7 +802,7 @@ def _zero(ctx: Context, force: np.ndarray, p: dict) -> np.ndarray:
 
 
 FORCE_ZERO = Effect(
-    name="force_zero", stage="force",
+    name="force_zero", stage="force", pure=True,
     params=(Param("zero_N", "N", -10.0, 10.0, 0.0, "load-cell reading at zero tension"),),
     apply=_zero,
     meaning="the load cell is not zeroed: it reads an offset at zero tension",
