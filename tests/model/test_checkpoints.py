@@ -98,3 +98,26 @@ def test_the_builtins_are_pure():
     from camtube.model.effects.builtin import BUILTIN_EFFECTS
 
     assert all(e.pure for e in BUILTIN_EFFECTS)
+
+
+def test_the_kept_force_lag_gives_the_fresh_numbers(bench):
+    """viscoelastic's lag of the force, kept per Dataset and force: the same numbers as a fresh evaluation for
+    every step, a new force (force_zero) or time constant computed anew."""
+    from camtube.model.effects import builtin
+
+    p, data = bench
+    kept, plain = _models(p, ["force_zero", "viscoelastic", "angle_bias"])
+    # ``plain`` keeps no checkpoints: its viscoelastic stage runs every time, on the kept lag of one Dataset
+    data = _fresh(data)
+    base = _start(p, kept, data)
+    steps = [base] + [dict(base, **{nm: base[nm] * (1 + 1e-7) + 1e-9}) for nm in base] + [base]
+    for v in steps:
+        want = builtin.first_order_lag(data, np.asarray(data.force_N, float) - v["force_zero.zero_N"],
+                                       v["viscoelastic.tau_s"])
+        assert np.array_equal(plain.predict(data, v), plain.predict(_fresh(data), v))
+        assert np.array_equal(kept.predict(data, v), plain.predict(_fresh(data), v))
+        ctx = kept.context(data, v)
+        ctx.force_N = np.asarray(data.force_N, float) - v["force_zero.zero_N"]
+        got = builtin.force_lag(ctx, v["viscoelastic.tau_s"])
+        assert np.array_equal(got, want) and not got.flags.writeable
+    assert 1 <= len(data.cache.get("builtin.force_lags")[1]) <= builtin.FORCE_LAGS_KEPT

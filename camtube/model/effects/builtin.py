@@ -307,8 +307,34 @@ TOE = Effect(
 )
 
 
+#: Lags of the force kept per Dataset and force (the most recently used), for ``viscoelastic``.
+FORCE_LAGS_KEPT = 4
+
+
+def force_lag(ctx: Context, tau_s: float) -> np.ndarray:
+    """:func:`first_order_lag` of the force (after the ``force`` stage) with ``tau_s``, kept per Dataset.
+
+    speed: a fit's finite-difference steps in every parameter but ``tau_s`` (E_t, the ratio, the stroke's
+    effects) lag the same force with the same time constant; the same computation gives the same numbers, so
+    it is reused (read-only). A force of other values starts afresh.
+    """
+    hit = ctx.data.cache.get("builtin.force_lags")
+    if hit is None or not _same_force(hit[0], ctx.force_N):
+        hit = ctx.data.cache.set("builtin.force_lags", (ctx.force_N, {}))
+    kept = hit[1]
+    key = float(tau_s)
+    lag = kept.pop(key, None)
+    if lag is None:
+        lag = first_order_lag(ctx.data, np.asarray(ctx.force_N, float), tau_s)
+        lag.setflags(write=False)
+    kept[key] = lag                                        # most recently used last (a dict keeps the order)
+    if len(kept) > FORCE_LAGS_KEPT:
+        del kept[next(iter(kept))]
+    return lag
+
+
 def _visco(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
-    lag = first_order_lag(ctx.data, np.asarray(ctx.force_N, float), p["tau_s"])
+    lag = force_lag(ctx, p["tau_s"])
     # while the delayed elongation exceeds the stroke the tendon is slack: the joint stays straight
     return np.minimum(elong + p["ratio"] * ctx.compliance_mm_per_N * lag, ctx.stroke_mm)
 
