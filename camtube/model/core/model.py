@@ -551,18 +551,20 @@ class _Checkpoints:
         was then; the stages after effect ``k - 1`` still to run); ``(0, None)``: nothing kept matches. This
         evaluation joins the kept ones as the most recent."""
         best, best_k = None, 0
-        bits = self.bits
+        bits, ends = self.bits, self.ends
         for other in self.kept:
-            if other.model != self.model:   # equal models (dataclass equality) run the same effects
-                continue
             ob = other.bits
+            # E_t first: its step, and every trial point of a fit, differ there (speed: nothing more to compare)
+            if ob[0] != bits[0] or len(ob) != len(bits):
+                continue
+            if other.model is not self.model and other.model != self.model:
+                continue   # equal models (dataclass equality) run the same effects
             if ob == bits:
-                k = len(self.ends)
+                k = len(ends)
             else:
-                m = next(i for i, (x, y) in enumerate(zip(bits, ob)) if x != y)
                 k = 0
-                for e in self.ends:
-                    if e > m:
+                for e in ends:
+                    if ob[:e] != bits[:e]:
                         break
                     k += 1
             while k and other.states[k - 1] is None:
