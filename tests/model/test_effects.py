@@ -282,3 +282,47 @@ def test_every_builtin_says_where_it_sits_on_the_bench():
     from camtube.model.report.diagnosis import SIDES
 
     assert set(BUILTINS) <= set(SIDES)
+
+
+def _lag_one_block_at_a_time(u, dt, tau_s):
+    """The blocks of the non-uniform lag summed one at a time (as before the table): the reference, to the bit."""
+    from camtube.model.effects.history import _LAG_BLOCK, _new_lag_plan
+
+    gain, scan, _ = _new_lag_plan(dt, tau_s)
+    assert not scan
+    cum = np.cumsum(np.maximum(dt, 0.0) / tau_s)
+    b = gain * u[1:]
+    out = np.empty_like(u)
+    out[0] = prev = float(u[0])
+    s, m = 0, cum.size
+    while s < m:
+        base = cum[s - 1] if s else 0.0
+        e = max(int(np.searchsorted(cum, base + _LAG_BLOCK, side="right")), s + 1)
+        log_a = -(cum[s:e] - base)
+        block = np.exp(log_a) * (prev + np.cumsum(np.exp(-log_a) * b[s:e]))
+        out[s + 1:e + 1] = block
+        prev = float(block[-1])
+        s = e
+    return out
+
+
+@pytest.mark.parametrize("tau_s", [0.2, 0.25, 0.3, 1.0, 50.0, 1e5])
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_the_lag_blocks_table_gives_the_blockwise_numbers_to_the_bit(tau_s, seed):
+    """The blocks summed in one table (rows of a cumulative sum) equal the blocks summed one at a time, to the bit,
+    on jittered steps with repeats and a long gap; a non-finite input takes the blockwise path."""
+    from camtube.model.effects.history import _lag_nonuniform, _new_lag_plan
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(2000, 3000))
+    dt = np.abs(0.02 + rng.normal(0.0, 0.004, n - 1))
+    dt[rng.integers(0, n - 1, 5)] = 0.0
+    dt[n // 3] = 40.0 * tau_s       # a gap of many time constants: a block of one step
+    u = np.sin(np.cumsum(np.r_[0.0, dt])) * 10 ** rng.uniform(-3, 3) + rng.normal(0.0, 0.1, n)
+    gain, scan, levels = _new_lag_plan(dt, tau_s)
+    assert not scan and (levels[1] is not None) == (tau_s <= 0.3)   # the table for short blocks only
+    np.testing.assert_array_equal(_lag_nonuniform(u, dt, tau_s), _lag_one_block_at_a_time(u, dt, tau_s))
+    bad = u.copy()
+    bad[n // 2] = np.inf
+    with np.errstate(invalid="ignore"):
+        np.testing.assert_array_equal(_lag_nonuniform(bad, dt, tau_s), _lag_one_block_at_a_time(bad, dt, tau_s))

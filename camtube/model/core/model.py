@@ -39,8 +39,10 @@ runs each sample with its own values (every effect already runs per sample).
 from __future__ import annotations
 
 import math
+import struct
 from dataclasses import dataclass, field, replace
-from typing import Callable, Mapping, Sequence
+from functools import cached_property
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -179,6 +181,11 @@ class Effect:
         An optional test of the fitted form against its signature: ``check(data, predicted_deg)`` returns why
         the data contradict the form (empty when they do not), e.g. a hard stop where the measured angle keeps
         rising. A reason makes the diagnosis refuse the candidate, whatever its gain.
+    pure : bool
+        Its functions are pure: the output depends on the signal, ``p`` and the context only (no state of
+        their own, ``ctx.cache`` unused) and the input signal is not modified. The model then keeps the
+        signals between the stages of recent evaluations and starts a new one from the last stage whose
+        inputs are equal to the bit (:func:`_checkpoints`; speed only). The built-ins are pure; default False.
     """
 
     name: str
@@ -192,6 +199,7 @@ class Effect:
     source: str = ""
     off: Mapping = field(default_factory=dict, compare=False)
     check: Callable | None = field(default=None, compare=False)
+    pure: bool = field(default=False, compare=False)
 
     def __post_init__(self):
         for st in self.stages:
@@ -458,10 +466,7 @@ class JointModel:
 
     def _predict(self, data: Dataset, values: Mapping[str, float]) -> np.ndarray:
         ctx = self.context(data, values)
-        by_stage: dict[str, list[Effect]] = {s: [] for s in STAGES}
-        for e in self.effects:
-            for st in e.stages:
-                by_stage[st].append(e)
+        seq, pure = self._chain
 
         def params_of(e: Effect) -> dict[str, float]:
             try:
@@ -469,28 +474,145 @@ class JointModel:
             except KeyError as exc:
                 raise FitError(f"no value for parameter {exc.args[0]!r} of effect {e.name!r}") from None
 
-        force = np.asarray(data.force_N, float)
-        for e in by_stage["force"]:
-            force = _call(e, "force", ctx, force, params_of(e))
-        ctx.force_N = force
-        stroke = np.asarray(data.stroke_mm, float)
-        for e in by_stage["stroke"]:
-            stroke = _call(e, "stroke", ctx, stroke, params_of(e))
-        ctx.stroke_mm = stroke
-        elong = force * ctx.compliance_mm_per_N
-        for e in by_stage["elongation"]:
-            elong = _call(e, "elongation", ctx, elong, params_of(e))
-        l_kin = stroke - elong
-        ctx.l_kin_mm = l_kin
-        arm = self.geometry.moment_arm_mm * float(values.get("arm_scale", 1.0))
-        ctx.arm_mm = arm
-        theta = l_kin / arm
-        for e in by_stage["kinematics"]:
-            theta = _call(e, "kinematics", ctx, theta, params_of(e))
-        angle = np.degrees(theta)
-        for e in by_stage["angle"]:
-            angle = _call(e, "angle", ctx, angle, params_of(e))
-        return angle
+        kept = None
+        if pure:
+            try:
+                kept = _Checkpoints(self, data, values, [params_of(e) for _, e in seq])
+            except FitError:  # a missing value: raised where the chain asks for it, as without the cache
+                kept = None
+        start, signal = (0, None) if kept is None else kept.resume(ctx)
+        first_stage = STAGES.index(seq[start - 1][0]) if start else 0
+        for si in range(first_stage, len(STAGES)):
+            st = STAGES[si]
+            if not (start and si == first_stage):
+                signal = self._enter(st, ctx, signal, values)
+            for k in range(start, len(seq)):
+                if seq[k][0] != st:
+                    break
+                e = seq[k][1]
+                signal = _call(e, st, ctx, signal, kept.params[k] if kept is not None else params_of(e))
+                start = k + 1
+                if kept is not None:
+                    kept.save(k, ctx, signal)
+        if kept is not None and kept.holds(signal):
+            return signal.copy()   # an array the model keeps is never handed out
+        return signal
+
+    @cached_property
+    def _chain(self) -> tuple:
+        """``(seq, pure)``: the effects in the order they run, ``(stage, effect)``, stage by stage and in the
+        model's order within a stage; whether they are all pure (then :class:`_Checkpoints` keeps their signals)."""
+        seq = tuple((st, e) for st in STAGES for e in self.effects if st in e.stages)
+        return seq, bool(seq) and all(e.pure for _, e in seq)
+
+    def _enter(self, stage: str, ctx: Context, signal, values: Mapping[str, float]) -> np.ndarray:
+        """The signal ``stage`` starts from, given the one the stage before ended with (and the context)."""
+        data = ctx.data
+        if stage == "force":
+            return np.asarray(data.force_N, float)
+        if stage == "stroke":
+            ctx.force_N = signal
+            return np.asarray(data.stroke_mm, float)
+        if stage == "elongation":
+            ctx.stroke_mm = signal
+            return ctx.force_N * ctx.compliance_mm_per_N
+        if stage == "kinematics":
+            l_kin = ctx.stroke_mm - signal
+            ctx.l_kin_mm = l_kin
+            arm = self.geometry.moment_arm_mm * float(values.get("arm_scale", 1.0))
+            ctx.arm_mm = arm
+            return l_kin / arm
+        return np.degrees(signal)
+
+
+# speed: the signals between the stages of recent evaluations of pure effects, kept per Dataset
+
+#: Evaluations whose stage signals are kept per Dataset (the most recently used): a finite-difference
+#: Jacobian steps one parameter (or one parameter's per-sample copies) at a time from one point, so the stages
+#: before the stepped effect see the same inputs as at that point.
+CHECKPOINTS_KEPT = 4
+
+
+class _Checkpoints:
+    """The kept stage signals of a Dataset for one evaluation of ``model`` at ``values``.
+
+    The signal after effect ``k`` of the chain (and the context's force, stroke, kinematic length and arm at
+    that moment) depends on the data, the model (geometry, notches, tendon radius, the effects), the base
+    values the context carries (E_t, L0; the arm's scale from the kinematics stage on) and the parameters of
+    effects ``0 .. k``: nothing else, when every effect is pure. These inputs are laid out as one vector of
+    floats in chain order, compared to the bit (their IEEE bit patterns) with the kept evaluations'; the
+    longest equal prefix gives the last effect whose output can be taken as it was (the same computation
+    gives the same numbers).
+    """
+
+    __slots__ = ("model", "params", "bits", "ends", "states", "kept")
+
+    def __init__(self, model: "JointModel", data: Dataset, values: Mapping[str, float], params: list[dict]):
+        self.model = model
+        self.params = params
+        vec = [float(values.get("E_t", DEFAULT_E_T_GPA)), float(values.get("L0", DEFAULT_L0_MM))]
+        ends = []
+        arm_added = False
+        for (st, e), p in zip(model._chain[0], params):
+            if not arm_added and st in ("kinematics", "angle"):
+                vec.append(float(values.get("arm_scale", 1.0)))
+                arm_added = True
+            vec.extend(p[q.name] for q in e.params)
+            ends.append(len(vec))
+        if not arm_added:   # the angle depends on the arm even when no effect comes after it
+            vec.append(float(values.get("arm_scale", 1.0)))
+        self.bits = struct.unpack(f"{len(vec)}q", struct.pack(f"{len(vec)}d", *vec))
+        self.ends = ends
+        self.states: list = [None] * len(ends)
+        kept = data.cache.get("model.checkpoints")
+        if kept is None:
+            kept = data.cache.set("model.checkpoints", [])
+        self.kept = kept
+
+    def resume(self, ctx: Context) -> tuple:
+        """``(k, signal)``: effects ``0 .. k-1`` already done, ``signal`` their output (the context set as it
+        was then; the stages after effect ``k - 1`` still to run); ``(0, None)``: nothing kept matches. This
+        evaluation joins the kept ones as the most recent."""
+        best, best_k = None, 0
+        bits, ends = self.bits, self.ends
+        for other in self.kept:
+            ob = other.bits
+            # E_t first: its step, and every trial point of a fit, differ there (speed: nothing more to compare)
+            if ob[0] != bits[0] or len(ob) != len(bits):
+                continue
+            if other.model is not self.model and other.model != self.model:
+                continue   # equal models (dataclass equality) run the same effects
+            if ob == bits:
+                k = len(ends)
+            else:
+                k = 0
+                for e in ends:
+                    if ob[:e] != bits[:e]:
+                        break
+                    k += 1
+            while k and other.states[k - 1] is None:
+                k -= 1
+            if k and k >= best_k:
+                best, best_k = other, k
+        kept = self.kept
+        if best is not None:
+            self.states[:best_k] = best.states[:best_k]
+            kept.remove(best)
+            kept.append(best)        # most recently used last
+        kept.append(self)
+        if len(kept) > CHECKPOINTS_KEPT:
+            del kept[0]
+        if best is None:
+            return 0, None
+        signal, ctx.force_N, ctx.stroke_mm, ctx.l_kin_mm, ctx.arm_mm = best.states[best_k - 1]
+        return best_k, signal
+
+    def save(self, k: int, ctx: Context, signal: np.ndarray) -> None:
+        self.states[k] = (signal, ctx.force_N, ctx.stroke_mm, ctx.l_kin_mm, ctx.arm_mm)
+
+    def holds(self, signal: np.ndarray) -> bool:
+        """Whether ``signal`` is one of the kept arrays (an effect may hand back its input unchanged)."""
+        return any(s is not None and s[0] is signal for s in self.states)
 
 
 # speed: per-sample views of a Dataset, cached on it (per-sample parameters run the model sample by sample)

@@ -142,7 +142,7 @@ def load_effect_file(path: str | Path) -> tuple[Effect, ...]:
     out: dict[str, Effect] = {}
     for e in found:
         if e.name not in out:
-            out[e.name] = e if e.source else replace(e, source=str(path))
+            out[e.name] = e if e.source else replace(e, source=str(path), pure=False)  # a file's copy: not vouched for
     return tuple(out.values())
 
 

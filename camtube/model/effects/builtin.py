@@ -123,7 +123,7 @@ def _slack(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
 
 
 SLACK = Effect(
-    name="slack", stage="stroke",
+    name="slack", stage="stroke", pure=True,
     params=(Param("deadband_mm", "mm", 0.0, 10.0, _slack_guess,
                   "motor stroke taken up before the tendon is taut", kind="length"),),
     apply=_slack,
@@ -140,7 +140,7 @@ def _play(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
 
 
 PLAY = Effect(
-    name="play", stage="stroke",
+    name="play", stage="stroke", pure=True,
     params=(Param("play_mm", "mm", 0.0, 10.0, lambda d, c: 0.02 * _stroke_span(d),
                   "lost motion between the motor and the tendon (full width of the play)", kind="length"),),
     apply=_play,
@@ -160,7 +160,7 @@ def _creep(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
 
 
 CREEP = Effect(
-    name="creep", stage="stroke",
+    name="creep", stage="stroke", pure=True,
     params=(Param("creep_mm", "mm", -5.0, 5.0, lambda d, c: 0.01 * _stroke_span(d),
                   "tendon lengthening reached after a long time (stroke lost)", kind="length"),
             Param("tau_s", "s", 1e-2, 1e7, lambda d, c: _duration(d) / 4.0,
@@ -210,7 +210,7 @@ def _creep_load(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
 
 
 CREEP_LOAD = Effect(
-    name="creep_load", stage="stroke",
+    name="creep_load", stage="stroke", pure=True,
     params=(Param("creep_mm", "mm", 0.0, 5.0, lambda d, c: 0.01 * _stroke_span(d),
                   f"tendon lengthening after {LOAD_TIME_REF_NS:g} N s of load (1 N carried for {LOAD_TIME_REF_NS:g} s)",
                   kind="length"),
@@ -234,7 +234,7 @@ def _friction(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
 
 
 FRICTION = Effect(
-    name="friction", stage="elongation",
+    name="friction", stage="elongation", pure=True,
     params=(Param("mu", "", -0.9, 0.9, 0.02,
                   "fraction by which the tendon's mean tension falls below (loading) or rises above "
                   "(unloading) the load cell"),),
@@ -254,7 +254,7 @@ def _capstan(ctx: Context, force: np.ndarray, p: dict) -> np.ndarray:
 
 
 CAPSTAN = Effect(
-    name="capstan", stage="force",
+    name="capstan", stage="force", pure=True,
     params=(Param("mu_wrap", "", -0.5, 3.0, 0.2,
                   "friction coefficient times the wrap angle (rad) of the guide: the joint-side tension is "
                   "exp(-mu_wrap) times the load cell's while pulling, exp(+mu_wrap) while releasing",
@@ -294,7 +294,7 @@ def _toe(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
 
 
 TOE = Effect(
-    name="toe", stage="elongation",
+    name="toe", stage="elongation", pure=True,
     params=(Param("toe_mm", "mm", 0.0, 5.0, lambda d, c: 0.05 * _stroke_span(d),
                   "elongation over which the tendon's fibres straighten (end of the toe region)",
                   kind="length"),),
@@ -308,8 +308,34 @@ TOE = Effect(
 )
 
 
+#: Lags of the force kept per Dataset and force (the most recently used), for ``viscoelastic``.
+FORCE_LAGS_KEPT = 4
+
+
+def force_lag(ctx: Context, tau_s: float) -> np.ndarray:
+    """:func:`first_order_lag` of the force (after the ``force`` stage) with ``tau_s``, kept per Dataset.
+
+    speed: a fit's finite-difference steps in every parameter but ``tau_s`` (E_t, the ratio, the stroke's
+    effects) lag the same force with the same time constant; the same computation gives the same numbers, so
+    it is reused (read-only). A force of other values starts afresh.
+    """
+    hit = ctx.data.cache.get("builtin.force_lags")
+    if hit is None or not _same_force(hit[0], ctx.force_N):
+        hit = ctx.data.cache.set("builtin.force_lags", (ctx.force_N, {}))
+    kept = hit[1]
+    key = float(tau_s)
+    lag = kept.pop(key, None)
+    if lag is None:
+        lag = first_order_lag(ctx.data, np.asarray(ctx.force_N, float), tau_s)
+        lag.setflags(write=False)
+    kept[key] = lag                                        # most recently used last (a dict keeps the order)
+    if len(kept) > FORCE_LAGS_KEPT:
+        del kept[next(iter(kept))]
+    return lag
+
+
 def _visco(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
-    lag = first_order_lag(ctx.data, np.asarray(ctx.force_N, float), p["tau_s"])
+    lag = force_lag(ctx, p["tau_s"])
     # while the delayed elongation exceeds the stroke the tendon is slack: the joint stays straight
     return np.minimum(elong + p["ratio"] * ctx.compliance_mm_per_N * lag, ctx.stroke_mm)
 
@@ -562,7 +588,7 @@ def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
 
 
 TOE_SHAPE = Effect(
-    name="toe_shape", stage="elongation",
+    name="toe_shape", stage="elongation", pure=True,
     params=(Param("offset_mm", "mm", 1e-3, 5.0, lambda d, c: 0.03 * _stroke_span(d),
                   "mean elongation at which a fibre straightens: the linear part of the law is shifted by it",
                   log=True, kind="length"),
@@ -582,7 +608,7 @@ TOE_SHAPE = Effect(
 
 
 VISCOELASTIC = Effect(
-    name="viscoelastic", stage="elongation",
+    name="viscoelastic", stage="elongation", pure=True,
     params=(Param("ratio", "", 0.0, 20.0, 0.1,
                   "delayed compliance as a fraction of the instantaneous one (standard linear solid)",
                   starts=(0.05, 0.3, 1.5)),
@@ -603,7 +629,7 @@ def _series(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
 
 
 SERIES = Effect(
-    name="series", stage="elongation",
+    name="series", stage="elongation", pure=True,
     params=(Param("compliance_mm_per_N", "mm/N", 0.0, 10.0, 0.02,
                   "extra compliance in series with the tendon (sheath or tube compression)"),),
     apply=_series,
@@ -624,7 +650,7 @@ def _kerf(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
 
 
 KERF = Effect(
-    name="kerf", stage="kinematics",
+    name="kerf", stage="kinematics", pure=True,
     params=(Param("kerf_mm", "mm", -0.5, 0.5, 0.02,
                   "widening of the notch arc by the laser kerf (on the outer surface)"),),
     apply=_kerf,
@@ -643,7 +669,7 @@ def _flat(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
 
 
 FLAT_WALLS = Effect(
-    name="flat_walls", stage="kinematics", params=(), apply=_flat,
+    name="flat_walls", stage="kinematics", pure=True, params=(), apply=_flat,
     meaning="the notch walls are flat (one planar cut) rather than radial, so the backbone and the arm differ",
     signature="the residual is proportional to the angle (a gain error of the joint)",
     family="arm",
@@ -667,7 +693,7 @@ def _chords(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
 
 
 CHORDS = Effect(
-    name="chords", stage="kinematics", params=(), apply=_chords,
+    name="chords", stage="kinematics", pure=True, params=(), apply=_chords,
     meaning="the tendon crosses each notch as a straight chord, not an arc, so it shortens a little "
             "less than arm x angle",
     signature="a small residual growing with the angle squared",
@@ -722,7 +748,7 @@ def _hardstop_check(data: Dataset, predicted_deg: np.ndarray) -> str:
 
 
 HARDSTOP = Effect(
-    name="hardstop", stage="kinematics",
+    name="hardstop", stage="kinematics", pure=True,
     params=(Param("stop_deg", "deg", 1.0, 720.0,
                   lambda d, c: math.degrees(c.n_notches * c.geometry.closure_angle_rad),
                   "joint angle at which the notches close"),),
@@ -749,7 +775,7 @@ def _rest_angle(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
 
 
 REST_ANGLE = Effect(
-    name="rest_angle", stage="kinematics",
+    name="rest_angle", stage="kinematics", pure=True,
     params=(Param("rest_deg", "deg", 0.0, 20.0, 0.3,
                   "angle at which the unloaded joint stays bent (friction moment / bending stiffness)",
                   starts=(0.2, 1.0)),),
@@ -796,7 +822,7 @@ def _rest_floor(data: Dataset, theta: np.ndarray) -> np.ndarray:
 
 
 RELAXATION = Effect(
-    name="relaxation", stage="kinematics",
+    name="relaxation", stage="kinematics", pure=True,
     params=(Param("fraction", "", 0.0, 0.9, 0.05,
                   "share of the joint's angle its backbone's relaxing part holds when the tendon lets go "
                   "(k1 / (k + k1): the relaxing stiffness over the whole)", starts=(0.02, 0.1, 0.3)),
@@ -823,7 +849,7 @@ def _bias(ctx: Context, angle: np.ndarray, p: dict) -> np.ndarray:
 
 
 ANGLE_BIAS = Effect(
-    name="angle_bias", stage="angle",
+    name="angle_bias", stage="angle", pure=True,
     params=(Param("bias_deg", "deg", -90.0, 90.0, 0.0, "constant offset of the angle sensor"),),
     apply=_bias,
     meaning="the angle sensor (EM tracker) reads a constant offset",
@@ -837,7 +863,7 @@ def _zero(ctx: Context, force: np.ndarray, p: dict) -> np.ndarray:
 
 
 FORCE_ZERO = Effect(
-    name="force_zero", stage="force",
+    name="force_zero", stage="force", pure=True,
     params=(Param("zero_N", "N", -10.0, 10.0, 0.0, "load-cell reading at zero tension"),),
     apply=_zero,
     meaning="the load cell is not zeroed: it reads an offset at zero tension",

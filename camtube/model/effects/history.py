@@ -202,16 +202,40 @@ def _lag_nonuniform(u: np.ndarray, dt: np.ndarray, tau: float, plan: tuple | Non
     if scan:
         out[1:] = _apply_scan(levels, b, prev)
         return out
-    for s, e, grow, shrink in levels:
+    blocks, table = levels
+    if table is not None:
+        # speed: every block's sums in one cumulative sum along the rows of a table (each row a block, the same
+        # sums in the same order); only the value carried from block to block is a (scalar) loop
+        pos, grow2, shrink2, last, shrink_last = table
+        x = np.zeros(grow2.size)
+        x[pos] = b
+        sums = np.cumsum(grow2 * x.reshape(grow2.shape), axis=1)
+        sums_last = sums.ravel()[last].tolist()
+        if all(map(math.isfinite, sums_last)):
+            starts = []
+            for sh, c in zip(shrink_last, sums_last):
+                starts.append(prev)
+                prev = sh * (prev + c)
+            out[1:] = (shrink2 * (np.array(starts)[:, None] + sums)).ravel()[pos]
+            return out
+    for s, e, grow, shrink in blocks:    # one block at a time (a non-finite sum: the padding would see it)
         block = shrink * (prev + np.cumsum(grow * b[s:e]))
         out[s + 1:e + 1] = block
         prev = float(block[-1])
     return out
 
 
-def _lag_blocks(cum: np.ndarray) -> list:
-    """``[(s, e, 1 / A_k, A_k)]`` of the blocks of :func:`_lag_nonuniform` (``A_k`` the product of the ``a``
-    within the block): they depend on the steps and ``tau`` alone (kept in a lag's plan)."""
+#: The table of :func:`_lag_blocks` is used when its blocks have at most this many rows on average (measured:
+#: below, the few NumPy calls on the table cost less than four per block; above, the per-block calls win).
+_TABLE_ROWS_PER_BLOCK = 600
+
+
+def _lag_blocks(cum: np.ndarray) -> tuple:
+    """``(blocks, table)``: ``[(s, e, 1 / A_k, A_k)]`` of the blocks of :func:`_lag_nonuniform` (``A_k`` the
+    product of the ``a`` within the block), and the same laid out as a table, one block a row (zeros after
+    its end): ``(flat positions of the rows' values, 1 / A_k, A_k, flat position of each block's last value,
+    [A_k at each block's end])``, None when the blocks are few, long or uneven. They depend on the steps and ``tau`` alone (kept
+    in a lag's plan)."""
     out, s, m = [], 0, cum.size
     while s < m:
         base = cum[s - 1] if s else 0.0
@@ -219,4 +243,17 @@ def _lag_blocks(cum: np.ndarray) -> list:
         log_a = -(cum[s:e] - base)                       # log A_k within the block
         out.append((s, e, np.exp(-log_a), np.exp(log_a)))
         s = e
-    return out
+    lengths = np.array([e - s for s, e, _, _ in out], np.intp)
+    width = int(lengths.max()) if out else 0
+    if len(out) < 3 or m > _TABLE_ROWS_PER_BLOCK * len(out) or len(out) * width > 1.5 * m:
+        return out, None   # few, long or uneven blocks: the NumPy calls per block cost less than the table
+    rows = np.repeat(np.arange(len(out)), lengths)
+    pos = rows * width + (np.arange(m) - np.repeat(np.array([s for s, _, _, _ in out], np.intp), lengths))
+    grow2 = np.zeros(len(out) * width)
+    shrink2 = np.zeros(len(out) * width)
+    grow2[pos] = np.concatenate([g for _, _, g, _ in out])
+    shrink2[pos] = np.concatenate([h for _, _, _, h in out])
+    last = np.arange(len(out)) * width + lengths - 1
+    table = (pos, grow2.reshape(len(out), width), shrink2.reshape(len(out), width), last,
+             [float(h[-1]) for _, _, _, h in out])
+    return out, table
