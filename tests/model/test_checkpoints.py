@@ -8,11 +8,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from camtube.design.loader import load_pattern
 from camtube.model.core.predict import model_for_pattern, pattern_values
 from camtube.model.core.registry import builtin_registry
-from camtube.model.sim.bench import Clock, Protocol, SampleBench, Tendon, Tracker, simulate_bench
-from tests.conftest import PATTERNS
+from tests.model.toe_bench import fresh, toe_bench
 
 CHAIN = ["force_zero", "creep_load", "viscoelastic", "toe_shape", "rest_angle", "relaxation", "hardstop",
          "angle_bias"]
@@ -20,17 +18,7 @@ CHAIN = ["force_zero", "creep_load", "viscoelastic", "toe_shape", "rest_angle", 
 
 @pytest.fixture(scope="module")
 def bench():
-    p = load_pattern(PATTERNS / "tube2.yaml")
-    rec = simulate_bench(p, SampleBench(tendon=Tendon(crimp_mm=0.2, crimp_shape=2.0),
-                                        tracker=Tracker(n_spikes=0, n_dropouts=0)),
-                         Protocol(n_cycles=3, ramp_s=2.0, dwell_s=1.0, rest_s=1.0, first_dwell_s=1.0),
-                         Clock(rate_hz=25.0), seed=3)
-    return p, rec.data
-
-
-def _fresh(data):
-    """The same rows with an empty cache."""
-    return data.take(np.ones(len(data), bool))
+    return toe_bench(seed=3)
 
 
 def _models(p, names=CHAIN):
@@ -54,7 +42,7 @@ def test_every_step_gives_the_fresh_numbers(bench):
     p, data = bench
     kept, plain = _models(p)
     assert kept._chain[1] and not plain._chain[1]
-    data = _fresh(data)
+    data = fresh(data)
     base = _start(p, kept, data)
     evals = [base]
     for nm in list(base):          # a finite-difference Jacobian: each parameter stepped alone from one point
@@ -66,7 +54,7 @@ def test_every_step_gives_the_fresh_numbers(bench):
     evals.append(dict(base, **{"rest_angle.rest_deg": 0.0}))
     for v in evals:
         got = kept.predict(data, v)
-        want = plain.predict(_fresh(data), v)
+        want = plain.predict(fresh(data), v)
         assert np.array_equal(got, want), v
     assert data.cache.get("model.checkpoints")
 
@@ -74,24 +62,24 @@ def test_every_step_gives_the_fresh_numbers(bench):
 def test_per_sample_values_and_models_built_anew(bench):
     p, data = bench
     kept, plain = _models(p)
-    data = _fresh(data)
+    data = fresh(data)
     base = _start(p, kept, data)
     base.update({f"relaxation.fraction@{s}": 0.1 + 0.05 * i for i, s in enumerate(data.samples)})
     for v in (base, dict(base, **{f"relaxation.fraction@{data.samples[0]}": 0.3}), base):
         again = model_for_pattern(p).with_effects(CHAIN, builtin_registry())   # an equal model, a new object
-        assert np.array_equal(again.predict(data, v), plain.predict(_fresh(data), v))
-        assert np.array_equal(kept.predict(data, v), plain.predict(_fresh(data), v))
+        assert np.array_equal(again.predict(data, v), plain.predict(fresh(data), v))
+        assert np.array_equal(kept.predict(data, v), plain.predict(fresh(data), v))
 
 
 def test_the_output_is_never_a_kept_array(bench):
     p, data = bench
     for names in (CHAIN, ["creep_load"], ["angle_bias"]):
         kept, plain = _models(p, names)
-        data = _fresh(data)
+        data = fresh(data)
         v = _start(p, kept, data)
         first = kept.predict(data, v)
         first[:] = np.nan                                 # a caller may write into what it got
-        assert np.array_equal(kept.predict(data, v), plain.predict(_fresh(data), v))
+        assert np.array_equal(kept.predict(data, v), plain.predict(fresh(data), v))
 
 
 def test_the_builtins_are_pure():
@@ -108,14 +96,14 @@ def test_the_kept_force_lag_gives_the_fresh_numbers(bench):
     p, data = bench
     kept, plain = _models(p, ["force_zero", "viscoelastic", "angle_bias"])
     # ``plain`` keeps no checkpoints: its viscoelastic stage runs every time, on the kept lag of one Dataset
-    data = _fresh(data)
+    data = fresh(data)
     base = _start(p, kept, data)
     steps = [base] + [dict(base, **{nm: base[nm] * (1 + 1e-7) + 1e-9}) for nm in base] + [base]
     for v in steps:
         want = builtin.first_order_lag(data, np.asarray(data.force_N, float) - v["force_zero.zero_N"],
                                        v["viscoelastic.tau_s"])
-        assert np.array_equal(plain.predict(data, v), plain.predict(_fresh(data), v))
-        assert np.array_equal(kept.predict(data, v), plain.predict(_fresh(data), v))
+        assert np.array_equal(plain.predict(data, v), plain.predict(fresh(data), v))
+        assert np.array_equal(kept.predict(data, v), plain.predict(fresh(data), v))
         ctx = kept.context(data, v)
         ctx.force_N = np.asarray(data.force_N, float) - v["force_zero.zero_N"]
         got = builtin.force_lag(ctx, v["viscoelastic.tau_s"])

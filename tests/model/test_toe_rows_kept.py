@@ -7,27 +7,15 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from camtube.design.loader import load_pattern
 from camtube.model.core.predict import model_for_pattern, pattern_values
 from camtube.model.core.registry import builtin_registry
 from camtube.model.effects import builtin
-from camtube.model.sim.bench import Clock, Protocol, SampleBench, Tendon, Tracker, simulate_bench
-from tests.conftest import PATTERNS
+from tests.model.toe_bench import fresh, toe_bench
 
 
 @pytest.fixture(scope="module")
 def bench():
-    p = load_pattern(PATTERNS / "tube2.yaml")
-    rec = simulate_bench(p, SampleBench(tendon=Tendon(crimp_mm=0.2, crimp_shape=2.0),
-                                        tracker=Tracker(n_spikes=0, n_dropouts=0)),
-                         Protocol(n_cycles=3, ramp_s=2.0, dwell_s=1.0, rest_s=1.0, first_dwell_s=1.0),
-                         Clock(rate_hz=25.0), seed=2)
-    return p, rec.data
-
-
-def _fresh(data):
-    """The same rows with an empty cache."""
-    return data.take(np.ones(len(data), bool))
+    return toe_bench(seed=2)
 
 
 def _values(p, model, data, **kw):
@@ -39,7 +27,7 @@ def _values(p, model, data, **kw):
 def test_a_law_evaluated_again_gives_the_fresh_numbers(bench):
     p, data = bench
     model = model_for_pattern(p).with_effects(["toe_shape", "rest_angle"], builtin_registry())
-    data = _fresh(data)
+    data = fresh(data)
     a = _values(p, model, data, **{"toe_shape.offset_mm": 0.15, "toe_shape.shape": 2.0})
     b = dict(a, **{"toe_shape.shape": 2.0 + 1e-8})
     c = dict(a, **{"rest_angle.rest_deg": 0.3})            # another effect's step: the law is reused
@@ -49,7 +37,7 @@ def test_a_law_evaluated_again_gives_the_fresh_numbers(bench):
     assert len(kept) == 3
     for k, v in (("a", a), ("b", b), ("c", c), ("d", d)):
         assert np.array_equal(model.predict(data, v), first[k])
-        assert np.array_equal(model.predict(_fresh(data), v), first[k])
+        assert np.array_equal(model.predict(fresh(data), v), first[k])
     assert not np.array_equal(first["a"], first["b"]) and not np.array_equal(first["a"], first["d"])
 
 
@@ -57,10 +45,10 @@ def test_a_new_force_starts_afresh(bench):
     """With a force-stage effect the law's input changes between evaluations: nothing is reused across it."""
     p, data = bench
     model = model_for_pattern(p).with_effects(["force_zero", "toe_shape"], builtin_registry())
-    data = _fresh(data)
+    data = fresh(data)
     for zero in (0.0, 0.02, 0.0):
         v = _values(p, model, data, **{"force_zero.zero_N": zero, "toe_shape.offset_mm": 0.15})
-        assert np.array_equal(model.predict(data, v), model.predict(_fresh(data), v))
+        assert np.array_equal(model.predict(data, v), model.predict(fresh(data), v))
 
 
 def test_the_least_recently_used_law_is_dropped(bench, monkeypatch):
@@ -69,7 +57,7 @@ def test_the_least_recently_used_law_is_dropped(bench, monkeypatch):
     model = model_for_pattern(p).with_effects(["toe_shape"], builtin_registry())
     # not pure: the model's own kept signals (test_checkpoints.py) would answer the repeated law before it
     model = replace(model, effects=tuple(replace(e, pure=False) for e in model.effects))
-    data = _fresh(data)
+    data = fresh(data)
     shapes = [1.5, 2.0, 2.5, 1.5, 3.0]      # 1.5 used again before 3.0 comes: 2.0 is dropped
     for k in shapes:
         model.predict(data, _values(p, model, data, **{"toe_shape.shape": k}))
