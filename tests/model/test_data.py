@@ -228,3 +228,16 @@ def test_derived_data_is_cached_on_the_dataset_not_in_module_tables():
     sub = d.take(np.array([True, True, True, False]))
     assert isinstance(sub.cache, Cache) and len(sub.cache) == 0 and sub.cache is not d.cache
     assert dataclasses.replace(d, stroke_mm=np.arange(4.0)).cache is not d.cache
+
+
+def test_recently_used_keeps_the_most_recent_and_computes_each_once():
+    from camtube.model.data.dataset import recently_used
+
+    store, calls = {}, []
+
+    def get(k):
+        return recently_used(store, k, lambda: calls.append(k) or k * 10, limit=2)
+
+    assert [get(1), get(2), get(1), get(3)] == [10, 20, 10, 30]   # 2, the least recently used, is dropped
+    assert list(store) == [1, 3] and calls == [1, 2, 3]
+    assert get(2) == 20 and calls == [1, 2, 3, 2]

@@ -56,6 +56,18 @@ class Cache:
         return f"Cache({sorted(self._data)})"
 
 
+def recently_used(store: dict, key: Any, compute: Callable[[], Any], limit: int) -> Any:
+    """``store[key]``, computed by ``compute()`` the first time; ``store`` keeps the ``limit`` most recently used
+    entries (a dict keeps its order: the most recently used last, the least recently used dropped first)."""
+    value = store.pop(key, None)
+    if value is None:
+        value = compute()
+    store[key] = value
+    if len(store) > limit:
+        del store[next(iter(store))]
+    return value
+
+
 @dataclass(frozen=True, eq=False)
 class Dataset:
     """Tendon stroke, force and joint angle over time.

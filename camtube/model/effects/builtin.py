@@ -46,7 +46,7 @@ from camtube.design.geometry import backbone_angle_rad, centroid_mm
 from camtube.model.core.model import Context, Effect
 from camtube.model.core.noise import white_noise_sd
 from camtube.model.core.params import Param
-from camtube.model.data.dataset import Dataset
+from camtube.model.data.dataset import Dataset, recently_used
 from camtube.model.effects.history import first_order_lag, monotone_segments, play_operator  # noqa: F401
 
 # ----------------------------------------------------------------------------- helpers
@@ -322,16 +322,15 @@ def force_lag(ctx: Context, tau_s: float) -> np.ndarray:
     hit = ctx.data.cache.get("builtin.force_lags")
     if hit is None or not _same_force(hit[0], ctx.force_N):
         hit = ctx.data.cache.set("builtin.force_lags", (ctx.force_N, {}))
-    kept = hit[1]
-    key = float(tau_s)
-    lag = kept.pop(key, None)
-    if lag is None:
-        lag = first_order_lag(ctx.data, np.asarray(ctx.force_N, float), tau_s)
-        lag.setflags(write=False)
-    kept[key] = lag                                        # most recently used last (a dict keeps the order)
-    if len(kept) > FORCE_LAGS_KEPT:
-        del kept[next(iter(kept))]
-    return lag
+    return recently_used(hit[1], float(tau_s),
+                         lambda: _read_only(first_order_lag(ctx.data, np.asarray(ctx.force_N, float), tau_s)),
+                         FORCE_LAGS_KEPT)
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    """``a``, no longer writable (a kept array is shared by every evaluation that reuses it)."""
+    a.setflags(write=False)
+    return a
 
 
 def _visco(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
@@ -441,16 +440,12 @@ def _toe_table(shape: float, x_min: float) -> tuple[np.ndarray, np.ndarray]:
     fit's trial steps come back to tables used a few evaluations before).
     """
     x_max = 2.0 ** math.ceil(math.log2(max(x_min, 1e-6)))
-    key = (float(shape), x_max)
-    hit = _TOE_TABLES.get(key)
-    if hit is None:
+
+    def fresh() -> tuple[np.ndarray, np.ndarray]:
         xg = x_max * (np.arange(TOE_GRID + 1) / TOE_GRID) ** 2
-        hit = _TOE_TABLES[key] = (xg, weibull_toe_force(xg, shape))
-        if len(_TOE_TABLES) > TOE_TABLES_KEPT:
-            del _TOE_TABLES[next(iter(_TOE_TABLES))]      # a dict keeps insertion order: the oldest first
-    else:
-        _TOE_TABLES[key] = _TOE_TABLES.pop(key)            # most recently used last
-    return hit
+        return xg, weibull_toe_force(xg, shape)
+
+    return recently_used(_TOE_TABLES, (float(shape), x_max), fresh, TOE_TABLES_KEPT)
 
 
 
@@ -546,15 +541,7 @@ def _kept_toe_rows(ctx: Context, f: np.ndarray, key: tuple, compute: Callable[[]
     hit = ctx.data.cache.get("builtin.toe_rows")
     if hit is None or hit[0] is not f:
         hit = ctx.data.cache.set("builtin.toe_rows", (f, {}))
-    kept = hit[1]
-    toe = kept.pop(key, None)
-    if toe is None:
-        toe = compute()
-        toe.setflags(write=False)
-    kept[key] = toe                                        # most recently used last (a dict keeps the order)
-    if len(kept) > TOE_ROWS_KEPT:
-        del kept[next(iter(kept))]
-    return toe
+    return recently_used(hit[1], key, lambda: _read_only(compute()), TOE_ROWS_KEPT)
 
 
 def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:

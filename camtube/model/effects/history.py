@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from camtube.model.data.dataset import Dataset
+from camtube.model.data.dataset import Dataset, recently_used
 
 # speed: derived per-Dataset data, cached (fits evaluate the model hundreds of times on the same rows)
 
@@ -126,17 +126,8 @@ def _lag_plan(data: Dataset, sl: slice, dt: np.ndarray, tau: float) -> tuple:
     """What :func:`_lag_nonuniform` computes from the steps and ``tau`` alone, kept per Dataset, sample and
     ``tau`` (speed: a fit's finite-difference steps in other parameters, and the two passes of ``relaxation``,
     use one ``tau`` many times; the same computation gives the same numbers)."""
-    kept = data.cache.get("history.lag_plans")
-    if kept is None:
-        kept = data.cache.set("history.lag_plans", {})
-    key = (sl.start, sl.stop, tau)
-    plan = kept.pop(key, None)
-    if plan is None:
-        plan = _new_lag_plan(dt, tau)
-    kept[key] = plan                                        # most recently used last (a dict keeps the order)
-    if len(kept) > LAG_PLANS_KEPT:
-        del kept[next(iter(kept))]
-    return plan
+    kept = data.cache.get_or("history.lag_plans", dict)
+    return recently_used(kept, (sl.start, sl.stop, tau), lambda: _new_lag_plan(dt, tau), LAG_PLANS_KEPT)
 
 
 def _new_lag_plan(dt: np.ndarray, tau: float) -> tuple:
