@@ -968,12 +968,12 @@ class Search:
             # instead of each effect of swappable only (the stop ratio is reached: nothing is to be added)
             fits += [self._instead(eff, old, ch.fit.params, True) for old in swappable]
         adding = list(() if swap_all else pool)
+        models = [ch.current.with_effects(list(ch.current.effects) + [eff]) for eff in adding]
 
         def added(i: int):
             """``adding[i]`` added to the chain and fitted: ``(fit without its model and rows, held-out RMSE, block
             MSE, the baseline's values it holds off or None)`` (what crosses back from a worker)."""
-            eff = adding[i]
-            m = ch.current.with_effects(list(ch.current.effects) + [eff])
+            eff, m = adding[i], models[i]
             new = eff.full_names()
             start = m.initial_values(self.search, base=ch.fit.params)
             f, ho, mse = self._fit_one(m, ch.names + new, start, ch.per_sample, grid=s.grid, grid_names=new,
@@ -990,8 +990,7 @@ class Search:
             return replace(f, model=None, data=None), ho, mse, held
 
         # the candidates are independent: one per core (speed; the same fits as one after another)
-        for eff, (f, ho, mse, held) in zip(adding, map_forked(added, len(adding))):
-            m = ch.current.with_effects(list(ch.current.effects) + [eff])
+        for eff, m, (f, ho, mse, held) in zip(adding, models, map_forked(added, len(adding))):
             if held is not None:
                 self.cand_held[(eff.name, ())] = held
             fits.append([eff, m, eff.full_names(), replace(f, model=m, data=self.search), ho, mse, ()])
@@ -1243,9 +1242,14 @@ class Search:
             if self.swaps_tried:
                 return True, False
             swaps_only = self.swaps_tried = True
-        if not self.pool and not self._retry_all():
-            self.stop = "no candidate effects left"
-            return True, False
+        if not self.pool:
+            # the round narrowed to nothing (no effect but the one chosen helped the round before): once, every
+            # effect not yet chosen (on a joint whose backbone relaxes only ``relaxation`` helps the model as
+            # given; the tracker's offset it leaves shows once it is in)
+            self.pool = self._left_out()
+            if not self.pool:
+                self.stop = "no candidate effects left"
+                return True, False
         return False, swaps_only
 
     def _no_swap(self, ranked, n_rejected: int) -> None:
@@ -1258,33 +1262,26 @@ class Search:
             self.notes_late.append(f"{', '.join(found)} in place of {old} explain the data as well (held-out RMSE "
                                    f"within {100 * EQUAL_HELDOUT:g} %): the data cannot tell them apart from {old}")
 
+    def _left_out(self) -> list[Effect]:
+        """The first time it is asked (once per search, the full retry): every effect neither chosen nor in the
+        pool; after that, none."""
+        if self.full_retry:
+            return []
+        self.full_retry = True
+        taken = {x.name for x in self.chain.chosen} | {x.name for x in self.pool}
+        return [e for e in self.all_pool if e.name not in taken]
+
     def _retry(self) -> bool:
         """Before giving up, run the round again with every effect not yet chosen (the pool was narrowed to the
         effects that helped the round before; one that explained nothing while a bigger effect dominated, play
         under a viscoelastic tendon, may be what is left). True when there is such a retry."""
-        if self.full_retry:
-            return False
-        self.full_retry = True
-        taken = {x.name for x in self.chain.chosen} | {x.name for x in self.pool}
-        again = [e for e in self.all_pool if e.name not in taken]
+        again = self._left_out()
         if not again:
             return False
         # only the effects left out are fitted; the round is recorded with both
         self.retry_prev, self.retry_pool = self.rounds.pop(), again
         self.pool = self.pool + again
         return True
-
-    def _retry_all(self) -> bool:
-        """The pool narrowed to nothing (no effect but the one chosen helped the round before): once, a round with
-        every effect not yet chosen, as :meth:`_retry` runs before giving up (on a joint whose backbone relaxes
-        only ``relaxation`` helps the model as given; the tracker's offset it leaves shows once it is in). True
-        when there is such a round."""
-        if self.full_retry:
-            return False
-        self.full_retry = True
-        taken = {x.name for x in self.chain.chosen}
-        self.pool = [e for e in self.all_pool if e.name not in taken]
-        return bool(self.pool)
 
     def step(self) -> bool:
         """One pass of the search: the baseline, the stop rules, drops, a round of candidates, the all-rows
