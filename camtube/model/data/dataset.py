@@ -12,6 +12,11 @@ import numpy as np
 
 #: Column of :attr:`Dataset.extra` that carries the stroke speed (mm/s) of the full record into a thinned copy.
 SPEED_COLUMN = "stroke_speed_mm_s"
+#: Column of :attr:`Dataset.extra` that carries the smoothed force (N) of the full record into a thinned copy.
+FORCE_SMOOTHED_COLUMN = "force_smoothed_N"
+#: Window (s) of the centred running mean :attr:`Dataset.force_smoothed_N`: long enough to average the load
+#: cell's white noise over several rows at 25-100 Hz, short against a ramp.
+FORCE_SMOOTHING_S = 0.1
 
 
 class Cache:
@@ -93,6 +98,8 @@ class Dataset:
     cache : Cache
         Derived data computed once per Dataset (speed: fits evaluate the model hundreds of times on the same
         rows); not part of the value (not compared, not passed on by ``take`` or ``dataclasses.replace``).
+    taken_from : tuple or None
+        ``(record, rows)`` when :meth:`take` made it: :meth:`rows_of_record`.
     """
 
     sample: np.ndarray
@@ -103,6 +110,8 @@ class Dataset:
     angle_deg: np.ndarray
     extra: dict = field(default_factory=dict)
     cache: Cache = field(default_factory=Cache, init=False, compare=False, repr=False)
+    #: ``(record, rows)`` when :meth:`take` made this Dataset (see :meth:`rows_of_record`); not part of the value
+    taken_from: tuple | None = field(default=None, init=False, compare=False, repr=False)
 
     def __len__(self) -> int:
         return int(self.stroke_mm.shape[0])
@@ -169,7 +178,7 @@ class Dataset:
         """(n,) float: the stroke's speed (mm/s, + loading): each row's step over its time step, per sample; 0
         where the stroke does not move (a dwell, a rest: :attr:`direction` keeps the last motion's sign there);
         the first row takes the second's. A column ``stroke_speed_mm_s`` in :attr:`extra` wins: a thinned copy
-        carries the speed of the full record there (:meth:`with_stroke_speed`), since steps between kept rows
+        carries the speed of the full record there (:meth:`with_full_rate_columns`), since steps between kept rows
         average over the dropped ones. Computed once per Dataset, read-only."""
         if SPEED_COLUMN in self.extra:
             return self.extra[SPEED_COLUMN]
@@ -192,12 +201,56 @@ class Dataset:
         return Dataset(self.sample, self.cycle, self.time_s, self.stroke_mm, self.force_N, self.angle_deg,
                        {**self.extra, SPEED_COLUMN: self.stroke_speed_mm_s})
 
+    @property
+    def force_smoothed_N(self) -> np.ndarray:
+        """(n,) float: the measured force, a centred running mean over :data:`FORCE_SMOOTHING_S` per sample (the
+        rows within half the window on either side, by the sample's median time step). A column
+        ``force_smoothed_N`` in :attr:`extra` wins: a thinned copy carries the full record's there
+        (:meth:`with_full_rate_columns`). Computed once per Dataset, read-only."""
+        if FORCE_SMOOTHED_COLUMN in self.extra:
+            return self.extra[FORCE_SMOOTHED_COLUMN]
+        hit = self.cache.get("dataset.force_smoothed")
+        if hit is not None:
+            return hit
+        f = np.asarray(self.force_N, float)
+        out = f.copy()
+        for _, sl in self.sample_slices():
+            x, dt = f[sl], np.diff(self.time_s[sl])
+            h = float(np.median(dt)) if dt.size else 0.0
+            half = int(round(FORCE_SMOOTHING_S / h)) // 2 if h > 0 else 0
+            if half == 0:
+                continue
+            csum = np.concatenate(([0.0], np.cumsum(x)))
+            i = np.arange(x.size)
+            lo, hi = np.clip(i - half, 0, x.size), np.clip(i + half + 1, 0, x.size)
+            out[sl] = (csum[hi] - csum[lo]) / (hi - lo)
+        out.setflags(write=False)
+        return self.cache.set("dataset.force_smoothed", out)
+
+    def with_full_rate_columns(self) -> "Dataset":
+        """This Dataset with the signals a thinned copy must take from the full record as columns (kept by
+        :meth:`take`): the stroke speed and the smoothed force."""
+        return Dataset(self.sample, self.cycle, self.time_s, self.stroke_mm, self.force_N, self.angle_deg,
+                       {**self.extra, SPEED_COLUMN: self.stroke_speed_mm_s,
+                        FORCE_SMOOTHED_COLUMN: self.force_smoothed_N})
+
     def take(self, mask: np.ndarray) -> "Dataset":
-        """Rows where ``mask`` (bool or index array) selects."""
-        return Dataset(
+        """Rows where ``mask`` (bool or index array) selects (the copy knows them: :meth:`rows_of_record`)."""
+        out = Dataset(
             self.sample[mask], self.cycle[mask], self.time_s[mask], self.stroke_mm[mask],
             self.force_N[mask], self.angle_deg[mask], {k: v[mask] for k, v in self.extra.items()},
         )
+        record, rows = self.rows_of_record()
+        mask = np.asarray(mask)
+        object.__setattr__(out, "taken_from", (record, rows[np.flatnonzero(mask) if mask.dtype == bool else mask]))
+        return out
+
+    def rows_of_record(self) -> tuple["Dataset", np.ndarray]:
+        """``(record, rows)``: the Dataset this one was taken from by :meth:`take` (through any number of takes:
+        a thinned copy, one sample's rows) and the indices of this one's rows in it; ``(self, arange)`` for one
+        that was not taken. A signal that needs every row of the record (a crossing between two kept rows) is
+        computed on the record and indexed."""
+        return self.taken_from if self.taken_from is not None else (self, np.arange(len(self)))
 
     def with_angle(self, angle_deg: np.ndarray) -> "Dataset":
         return Dataset(self.sample, self.cycle, self.time_s, self.stroke_mm, self.force_N,

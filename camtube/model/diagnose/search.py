@@ -121,8 +121,9 @@ GRID = 3
 BASELINE = ("rest_angle",)
 #: Candidates that may take a baseline effect's place: each is also fitted with that effect held at its ``off``
 #: values (a relaxing backbone holds the unloaded joint bent for a while, as friction holds it for good; where
-#: the relaxation explains the bent rest the constant rest angle goes to zero, on its bound).
-BASELINE_STAND_INS = {"rest_angle": ("relaxation",)}
+#: the relaxation explains the bent rest the constant rest angle goes to zero, on its bound; a carriage held by its
+#: rail holds the tendon taut and the joint bent while the motor rests at zero).
+BASELINE_STAND_INS = {"rest_angle": ("relaxation", "carriage_hold")}
 #: A chain of effects is recommended only when its all-rows RMSE is within this multiple of the noise floor.
 REACH_RATIO = 1.15
 #: A chain above :data:`REACH_RATIO` x the floor is still recommended (labelled a partial explanation) when it
@@ -423,8 +424,9 @@ def thin(data: Dataset, max_rows: int) -> Dataset:
     if max_rows <= 0 or n <= max_rows:
         return data
     k = int(math.ceil(n / max_rows))
-    # the speed of the full record (a step between kept rows averages over the dropped ones)
-    return data.with_stroke_speed().take(np.arange(0, n, k))
+    # the speed and the smoothed force of the full record (a step between kept rows averages over the dropped
+    # ones; a mean over the kept rows alone would keep more of the noise)
+    return data.with_full_rate_columns().take(np.arange(0, n, k))
 
 
 def cycle_blocks(data: Dataset, per_sample: int = 8) -> tuple[np.ndarray, np.ndarray]:
