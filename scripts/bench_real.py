@@ -39,7 +39,7 @@ FAMILIES = {
     "control": (set(), None),
     "toe": (TOES, None),
     "slack": ({"slack"}, None),
-    "lost motion": ({"slack", "play"}, None),
+    "lost motion": ({"slack", "play", "carriage_hold"}, None),  # the drive: a carriage its rail holds, or backlash
     "creep": ({"creep", "creep_load", "viscoelastic"}, None),  # a slow viscoelastic element and creep: known equivalents
     "backbone": ({"relaxation"}, None),  # the joint's backbone relaxing: `relaxation` (its set: the baseline's rest_angle)
     "zero drift": (set(), "time"),

@@ -271,3 +271,25 @@ def test_when_only_the_chosen_effect_helped_every_other_effect_is_tried_once_mor
     d = diagnose(model_for_pattern(tube1), data, ("E_t",), pattern_values(tube1))
     assert d.recommended[:1] == ("relaxation",) and len(d.recommended) > 1, (d.recommended, d.partial, d.stop)
     assert d.final.rmse_deg <= 1.15 * rec.floor_deg
+
+
+def test_a_carriage_its_rail_holds_is_recommended_first_as_lost_motion_in_the_drive(tube2):
+    """Lost motion in the drive, as the bench simulator makes it (its own time-stepped drive, no effect code):
+    below the rail's friction the carriage stays while the nut retreats, so the joint rests bent with the tendon
+    taut until the carriage lets go. Two samples with rails of different friction. `carriage_hold` is recommended
+    first (said to sit in the drive, not in the tendon), in the place of the baseline's rest angle, and the chain
+    ends within 1.15 x the true floor."""
+    from camtube.model.diagnose import diagnose
+    from camtube.model.report.diagnosis import diagnosis_text
+    from camtube.model.sim.bench import Backbone
+
+    def bench(friction_N):
+        return SampleBench(drive=Drive(backlash_mm=0.2, rail_friction_N=friction_N),
+                           backbone=Backbone(relax=((0.08, 3.0),)), tracker=QUIET)
+
+    pace = Protocol(n_cycles=16, ramp_s=3.0, dwell_s=2.0, rest_s=2.0, first_dwell_s=2.0)
+    rec = simulate_bench(tube2, (bench(0.17), bench(0.12)), pace, Clock(rate_hz=50.0, n_repeats=0), seed=11)
+    d = diagnose(model_for_pattern(tube2), rec.data, ("E_t",), pattern_values(tube2))
+    assert d.recommended[:1] == ("carriage_hold",), (d.recommended, d.partial, d.stop)
+    assert d.final.rmse_deg <= 1.15 * rec.floor_deg < d.waterfall[0].rmse_deg / 1.5
+    assert "sits in the drive" in diagnosis_text(d)

@@ -7,8 +7,9 @@ registry is made from (:func:`camtube.model.core.registry.builtin_registry`).
 from __future__ import annotations
 
 from camtube.model.effects.builtin import (  # noqa: F401
-    ANGLE_BIAS, BUILTIN_EFFECTS, BUILTINS, CHORDS, CREEP, FLAT_WALLS, FORCE_ZERO, FRICTION, HARDSTOP, KERF, PLAY,
+    ANGLE_BIAS, BUILTIN_EFFECTS, BUILTINS, CARRIAGE_HOLD, CHORDS, CREEP, FLAT_WALLS, FORCE_ZERO, FRICTION, HARDSTOP, KERF,
+    PLAY,
     SERIES, SLACK, TOE, TOE_SHAPE, VISCOELASTIC,
 )
 from camtube.model.effects.builtin import _flat_wall_ybar  # noqa: F401  (tests check it)
-from camtube.model.effects.history import first_order_lag, monotone_segments, play_operator  # noqa: F401
+from camtube.model.effects.history import carriage_hold, first_order_lag, monotone_segments, play_operator  # noqa: F401

@@ -9,6 +9,8 @@ name           stage       physics (parameters)
 =============  ==========  =====================================================
 slack          stroke      tendon slack: a deadband at low stroke (deadband_mm)
 play           stroke      lost motion in the drive, direction dependent (play_mm)
+carriage_hold  stroke      lost motion in the drive: the rail's friction holds the carriage while the tension
+                           is low, until it lets go (ratio: the friction over the tension held at rest)
 creep          stroke      tendon creep / drift over time (creep_mm, tau_s)
 creep_load     stroke      tendon creep under load: Findley's power law in the load-time integral
                            (creep_mm, exponent)
@@ -47,7 +49,9 @@ from camtube.model.core.model import Context, Effect
 from camtube.model.core.noise import white_noise_sd
 from camtube.model.core.params import Param
 from camtube.model.data.dataset import Dataset, recently_used
-from camtube.model.effects.history import first_order_lag, monotone_segments, play_operator  # noqa: F401
+from camtube.model.effects.history import (  # noqa: F401
+    carriage_hold, first_order_lag, monotone_segments, play_operator,
+)
 
 # ----------------------------------------------------------------------------- helpers
 
@@ -150,6 +154,77 @@ PLAY = Effect(
               "loading lags, unloading leads (a parallelogram loop)",
     history=True,
     off={"play_mm": 0.0},
+)
+
+
+def _bottom_tension_N(data: Dataset) -> float:
+    """The tension the tendon keeps while the motor stands at the bottom of its stroke (the 90th percentile over
+    the rows within 1 % of the stroke's span of its lowest, of those above five times the force's white noise
+    there and 0.01 N); 0 when it goes slack there (fewer than a tenth of those rows, or 20, keep a tension)."""
+    s = np.asarray(data.stroke_mm, float)
+    f = np.asarray(data.force_N, float)
+    if s.size == 0:
+        return 0.0
+    bottom = (s - s.min()) <= 0.01 * (float(np.ptp(s)) or 1.0)
+    noise = float(white_noise_sd(f[bottom])) if bottom.sum() > 10 else 0.0
+    held = f[bottom & (f > max(5.0 * noise, 0.01))]
+    return float(np.percentile(held, 90)) if held.size >= max(20, bottom.sum() // 10) else 0.0
+
+
+def held_tension_N(data: Dataset) -> np.ndarray:
+    """(n,) each sample's :func:`_bottom_tension_N`, on its rows (cached per Dataset)."""
+    def compute() -> np.ndarray:
+        out = np.zeros(len(data))
+        for _, sl in data.sample_slices():
+            out[sl] = _bottom_tension_N(data.take(np.arange(sl.start, sl.stop)))
+        out.setflags(write=False)
+        return out
+    return data.cache.get_or("builtin.held_tension", compute)
+
+
+def _carriage_hold(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
+    # The nut's gap is taken wider than the stroke the carriage is held at: where it is narrower the far flank
+    # pushes the carriage down with the motor, a form this effect leaves out (a gap that does not bind cannot be
+    # fitted: the rows do not depend on it). The lift of the carriage above the motor is added to the stroke this
+    # stage has so far (the drive is nearer the motor than the tendon's own slack or creep)
+    return stroke + carriage_lift_mm(ctx.data, p["ratio"])
+
+
+#: Lifts kept per record (the most recently used): a fit evaluates a few ratios many times.
+CARRIAGE_LIFTS_KEPT = 6
+
+
+def carriage_lift_mm(data: Dataset, ratio: float) -> np.ndarray:
+    """(n,) how far the held carriage stands above the motor (mm): :func:`carriage_hold` on the measured stroke,
+    its hold force ``ratio`` times each sample's :func:`held_tension_N`. Computed on the whole record ``data`` was
+    taken from (in a thinned copy the hold's start would fall between two kept rows, where the force bends as the
+    carriage sticks) and kept with it."""
+    record, rows = data.rows_of_record()
+    ratio = float(ratio)
+
+    def compute() -> np.ndarray:
+        s = np.asarray(record.stroke_mm, float)
+        return _read_only(carriage_hold(record, s, ratio * held_tension_N(record), math.inf) - s)
+
+    kept = record.cache.get_or("builtin.carriage_lifts", dict)
+    return recently_used(kept, ratio, compute, CARRIAGE_LIFTS_KEPT)[rows]
+
+
+CARRIAGE_HOLD = Effect(
+    name="carriage_hold", stage="stroke", pure=True,
+    params=(Param("ratio", "", 0.0, 3.0, 1.0,
+                  "the rail's friction (the tension below which it holds the carriage) over the tension the tendon "
+                  "keeps while the motor rests at the bottom of its stroke (each sample's own, from the data)",
+                  starts=(1.0, 1.03)),),
+    apply=_carriage_hold,
+    meaning="lost motion in the drive: the tendon pulls the carriage onto the nut's flank while its tension "
+            "exceeds the rail's friction; on unloading, below it, the rail holds the carriage (within the nut's "
+            "gap) while the motor goes on, so the tendon stays taut and the joint bent while the motor rests at "
+            "zero, until the carriage lets go and the tension drops",
+    signature="after each unloading the joint stays bent, the force at a constant level, while the stroke goes "
+              "to zero; then the force drops to zero at once and the joint straightens",
+    history=True,
+    off={"ratio": 0.0},
 )
 
 
@@ -859,7 +934,7 @@ FORCE_ZERO = Effect(
 )
 
 #: The built-in effects, in their documented order.
-BUILTIN_EFFECTS = (SLACK, PLAY, CREEP, CREEP_LOAD, FRICTION, CAPSTAN, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
+BUILTIN_EFFECTS = (SLACK, PLAY, CARRIAGE_HOLD, CREEP, CREEP_LOAD, FRICTION, CAPSTAN, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
                    HARDSTOP, REST_ANGLE, RELAXATION, ANGLE_BIAS, FORCE_ZERO)
 #: Built-in effect names in that order.
 BUILTINS = tuple(e.name for e in BUILTIN_EFFECTS)

@@ -248,3 +248,103 @@ def _lag_blocks(cum: np.ndarray) -> tuple:
     table = (pos, grow2.reshape(len(out), width), shrink2.reshape(len(out), width), last,
              [float(h[-1]) for _, _, _, h in out])
     return out, table
+
+
+#: A held carriage lets go when the smoothed force falls below this share of the hold force while the motor
+#: stands or pulls: the tendon's tension drops at once as the carriage slides back onto the nut's flank.
+RELEASE_SHARE = 0.5
+#: Once held, the carriage stays held while the smoothed force stays below this multiple of the hold force: the
+#: held tension creeps up to the rail's friction during a rest, within the cell's noise, and must not let go
+#: there (it lets go by :data:`RELEASE_SHARE`; a pull that catches the carriage up raises the force past it).
+HOLD_BAND = 1.2
+
+
+def _sticks(s: np.ndarray, f: np.ndarray, first_of_sample: np.ndarray, a: np.ndarray,
+            hold: np.ndarray) -> np.ndarray:
+    """Where the carriage stuck, for holds that start at rows ``a``: the stroke at which the force fell to
+    ``hold``, extrapolated along the unloading from the two rows before (the force there still follows the
+    stroke; past the stick it stays near ``hold``, so a line to row ``a`` would cut the corner, and more so the
+    fewer rows are kept), within the stroke of rows ``a`` and ``a - 1``; row ``a``'s stroke where there is no
+    crossing to follow (the record's or a sample's first row, or a force already at ``hold`` the row before)."""
+    p1 = np.maximum(a - 1, 0)
+    p2 = np.maximum(a - 2, 0)
+    crossed = (a > 0) & ~first_of_sample[a] & (f[p1] > hold)
+    along = crossed & (a >= 2) & ~first_of_sample[p1] & (f[p2] > f[p1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c_along = s[p1] + (s[p1] - s[p2]) * (f[p1] - hold) / (f[p2] - f[p1])
+        c_line = s[p1] + (s[a] - s[p1]) * (f[p1] - hold) / (f[p1] - f[a])
+    c = np.where(along, c_along, c_line)
+    c = np.clip(c, np.minimum(s[a], s[p1]), np.maximum(s[a], s[p1]))
+    return np.where(crossed, c, s[a])
+
+
+def carriage_hold(data: Dataset, stroke_mm: np.ndarray, hold_N: float | np.ndarray, gap_mm: float) -> np.ndarray:
+    """The carriage's position (mm) behind a nut with a gap ``gap_mm``, held by its rail below ``hold_N``.
+
+    While the tension (smoothed: :attr:`Dataset.force_smoothed_N`) exceeds ``hold_N`` the tendon pulls the
+    carriage onto the nut's flank: it follows the stroke. Once the tension falls to ``hold_N`` the rail holds it
+    where it is (where the tension fell to ``hold_N``: :func:`_sticks`, continuous in ``hold_N``), within the
+    gap: ``c_k = clip(c_(k-1), s_k, s_k + gap_mm)``. It lets go, back onto the flank (``c_k = s_k``), when the tension falls below :data:`RELEASE_SHARE` of ``hold_N`` while the motor
+    stands or pulls; it stays held while the tension stays below :data:`HOLD_BAND` x ``hold_N``. Per sample;
+    ``hold_N`` a number or one per row (a sample's own); ``gap_mm <= 0`` or ``hold_N <= 0``: the stroke itself.
+
+    Exact and vectorised: inside a run of held rows the recursion is a running minimum of
+    ``s + gap`` where the stroke falls and a running maximum of ``s`` where it rises or stands, so only the value
+    carried from one such piece to the next needs a scalar loop (as in :func:`play_operator`).
+    """
+    s = np.asarray(stroke_mm, float)
+    out = s.copy()
+    gap = float(gap_mm)
+    hold = np.broadcast_to(np.asarray(hold_N, float), s.shape)
+    if gap <= 0.0 or s.size == 0 or not np.any(hold > 0.0):
+        return out
+    gap = min(gap, float(np.ptp(s)) + 1.0)                 # a gap wider than the stroke never binds (and may be inf)
+    f = np.asarray(data.force_smoothed_N, float)
+    starts_of_samples = np.zeros(s.size, bool)
+    for _, sl in data.sample_slices():
+        if sl.stop > sl.start:
+            starts_of_samples[sl.start] = True
+    # held rows: in a run of rows below HOLD_BAND x hold_N, from its first row at or below hold_N on
+    band = (f <= HOLD_BAND * hold) & (hold > 0.0)
+    run = np.cumsum(band & ~(np.concatenate(([False], band[:-1])) & ~starts_of_samples))
+    seen = np.maximum.accumulate((f <= hold) + 2 * run) - 2 * run
+    low = band & (seen >= 1)
+    ds = np.diff(s, prepend=s[:1])
+    up = ds >= 0.0
+    prev_low = np.concatenate(([False], low[:-1])) & ~starts_of_samples
+    entry = low & ~prev_low                               # the first row of a held run
+    prev_f = np.concatenate(([np.inf], f[:-1]))
+    release = low & prev_low & up & (f < RELEASE_SHARE * hold) & (prev_f >= RELEASE_SHARE * hold)
+    prev_up = np.concatenate(([True], up[:-1]))
+    turn = low & prev_low & (up != prev_up)
+    rows = np.flatnonzero(low)
+    if rows.size == 0:
+        return out
+    first = np.flatnonzero(entry | release | turn)        # every piece starts at one of these rows
+    piece = np.searchsorted(first, rows, side="right") - 1
+    lo_s = np.minimum.reduceat(s[rows], np.searchsorted(rows, first))
+    hi_s = np.maximum.reduceat(s[rows], np.searchsorted(rows, first))
+    # the value each piece starts from: a stick, the stroke (let go), or what the piece before ended with (a scalar
+    # loop over the pieces only)
+    fresh = np.where(entry[first], _sticks(s, f, starts_of_samples, first, hold[first]), s[first]).tolist()
+    restart = (entry[first] | release[first]).tolist()
+    rise = up[first].tolist()
+    los, his = lo_s.tolist(), hi_s.tolist()
+    begin = [0.0] * first.size
+    c = 0.0
+    for j in range(first.size):
+        if restart[j]:
+            c = fresh[j]
+        begin[j] = c
+        c = max(c, his[j]) if rise[j] else min(c, los[j] + gap)
+    begin = np.asarray(begin)
+    # the rows: a running maximum (rising) or minimum (falling) within each piece, offset per piece so that
+    # one accumulate over all held rows never carries a value from one piece into the next
+    sr = s[rows]
+    span = float(sr.max() - sr.min()) + gap + 1.0
+    rising = up[first][piece]
+    cmax = np.maximum.accumulate(sr + piece * span) - piece * span
+    cmin = np.minimum.accumulate(sr + gap - piece * span) + piece * span
+    b = begin[piece]
+    out[rows] = np.where(rising, np.maximum(b, cmax), np.minimum(b, cmin))
+    return out

@@ -226,6 +226,9 @@ SIDES = {
              "differs)",
     "play": "drive (lost motion between the motor and the carriage) or a tendon that slips at the guide; a "
             "displacement gauge on the carriage would tell",
+    "carriage_hold": "drive (the rail's friction holds the carriage within the nut's gap while the tendon's tension "
+                     "is low: lost motion between the motor and the carriage, not in the tendon); a displacement "
+                     "gauge on the carriage would measure it",
     "toe": "tendon (its fibres straighten one after another)",
     "toe_shape": "tendon (its fibres straighten one after another)",
     "creep": "tendon (it lengthens under load); a drifting load-cell zero also grows with time: re-zero the load "

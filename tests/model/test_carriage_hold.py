@@ -1,0 +1,98 @@
+"""``carriage_hold``: lost motion in the drive, a carriage that its rail's friction holds within the nut's gap."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from camtube.model.data.dataset import Dataset
+from camtube.model.effects.history import HOLD_BAND, RELEASE_SHARE, carriage_hold
+
+
+def _rows(stroke, force, rate_hz=100.0, samples=("S1",)):
+    n = len(stroke) // len(samples)
+    t = np.tile(np.arange(n) / rate_hz, len(samples))
+    smp = np.repeat(np.array(samples), n)
+    return Dataset(stroke_mm=np.asarray(stroke, float), force_N=np.asarray(force, float),
+                   angle_deg=np.zeros(len(stroke)), time_s=t, cycle=np.ones(len(stroke), int), sample=smp)
+
+
+def _by_rows(data, s, hold, gap):
+    """The law row by row (the reference the vectorised operator is checked against)."""
+    f = np.asarray(data.force_smoothed_N, float)
+    out = s.copy()
+    for _, sl in data.sample_slices():
+        low_prev, seen, c = False, False, 0.0
+        for k in range(sl.start, sl.stop):
+            first = k == sl.start
+            in_band = f[k] <= HOLD_BAND * hold
+            seen = in_band and ((seen and not first and f[k - 1] <= HOLD_BAND * hold) or f[k] <= hold)
+            if not seen:
+                c, low_prev = s[k], False
+                continue
+            if not low_prev:                                   # held from here: where the force fell to hold_N
+                if first or f[k - 1] <= hold:
+                    c = s[k]
+                elif k - 2 >= sl.start and f[k - 2] > f[k - 1]:    # along the unloading from the two rows before
+                    c = s[k - 1] + (s[k - 1] - s[k - 2]) * (f[k - 1] - hold) / (f[k - 2] - f[k - 1])
+                else:
+                    c = s[k - 1] + (s[k] - s[k - 1]) * (f[k - 1] - hold) / (f[k - 1] - f[k])
+                c = min(max(c, min(s[k], s[k - 1])), max(s[k], s[k - 1])) if not first else c
+                c = min(max(c, s[k]), s[k] + gap)
+            elif s[k] >= s[k - 1] and f[k] < RELEASE_SHARE * hold <= f[k - 1]:
+                c = s[k]                                       # let go: back onto the flank
+            else:
+                c = min(max(c, s[k]), s[k] + gap)
+            out[k] = c
+            low_prev = True
+    return out
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_vectorised_hold_is_the_law_row_by_row(seed):
+    rng = np.random.default_rng(seed)
+    n = 3000
+    t = np.arange(n) / 100.0
+    stroke = np.clip(1.2 * np.sin(2 * np.pi * t / rng.uniform(3, 8)) + rng.uniform(-0.3, 0.3), 0.0, None)
+    force = 1.5 * stroke + rng.normal(0, 0.05, n) + rng.uniform(0, 0.2) * (stroke == 0)
+    force[rng.integers(0, n, 40)] = 0.0                     # releases
+    data = _rows(np.concatenate([stroke, stroke[::-1]]), np.concatenate([force, force[::-1]]), samples=("S1", "S2"))
+    s = np.asarray(data.stroke_mm, float)
+    for hold, gap in ((0.15, 0.2), (0.3, 0.05), (0.05, 1.0)):
+        np.testing.assert_allclose(carriage_hold(data, s, hold, gap), _by_rows(data, s, hold, gap), atol=1e-12)
+
+
+def test_a_carriage_held_at_the_bottom_keeps_the_tendon_taut_until_it_lets_go():
+    # unload from 1 mm to 0 over 1 s; the tension falls with the stroke through the hold force 0.32 N at 0.16 mm,
+    # then stays at 0.2 N (held); at 2.0 s it drops to zero (let go)
+    t = np.arange(0, 3.0, 0.01)
+    s = np.clip(1.0 - t, 0.0, None)
+    f = np.where(s > 0.1, 2.0 * s, 0.2)
+    f[t >= 2.0] = 0.0
+    data = _rows(s, f)
+    c = carriage_hold(data, s, 0.32, 0.5)
+    held = (t > 0.85) & (t < 1.95)
+    assert np.allclose(c[held], 0.16, atol=1e-9)              # the carriage stays where the tension fell to 0.32 N
+    assert np.all(c[t >= 2.05] == s[t >= 2.05])               # let go: on the flank again
+    assert np.all(c[t < 0.83] == s[t < 0.83])                 # pulled onto the flank above the hold force
+    small_gap = carriage_hold(data, s, 0.32, 0.04)             # the nut's far flank pushes it down
+    assert np.allclose(small_gap[(t >= 1.0) & (t < 1.95)], 0.04, atol=1e-9)
+
+
+def test_off_and_no_held_rows_give_the_stroke_itself():
+    t = np.arange(0, 3.0, 0.01)
+    s = np.clip(1.0 - np.abs(t - 1.5), 0.0, None)
+    data = _rows(s, 2.0 * s)
+    assert np.array_equal(carriage_hold(data, s, 0.2, 0.0), s)
+    assert np.array_equal(carriage_hold(data, s, 0.0, 0.3), s)
+    # a tension that never falls to the hold force: the carriage follows the stroke
+    assert np.array_equal(carriage_hold(_rows(s, 2.0 * s + 0.5), s, 0.2, 0.3), s)
+
+
+def test_the_held_position_moves_continuously_with_the_hold_force():
+    t = np.arange(0, 2.0, 0.01)
+    s = np.clip(1.0 - t, 0.0, None)
+    f = 2.0 * s + 0.1
+    data = _rows(s, f)
+    a = carriage_hold(data, s, 0.3, 1.0)[-1]
+    b = carriage_hold(data, s, 0.3 + 1e-6, 1.0)[-1]
+    assert 0 < b - a < 1e-5                                   # no step: a fit can move the hold force
