@@ -219,3 +219,17 @@ def test_an_empty_output_path_is_refused_not_taken_for_the_working_directory(tmp
     r = camtube(*cmd, cwd=tmp_path)
     assert r.returncode == 2 and "Traceback" not in r.stderr and "fix:" in r.stderr
     assert listing(tmp_path) == []
+
+
+@pytest.mark.parametrize("where", ["pattern", "set", "goal"])
+def test_yaml_nested_too_deeply_is_a_yaml_error_not_a_recursion_traceback(tmp_path, where):
+    deep = "[" * 3000 + "]" * 3000
+    if where == "set":
+        r = camtube("design", TUBE1, "--set", f"notch.width={deep}")
+        assert r.returncode == 2 and "Traceback" not in r.stderr and "RecursionError" not in r.stderr, r.stderr
+        return
+    f = tmp_path / "f.yaml"
+    f.write_text(f"a: {deep}\n")
+    r = camtube("design", str(f)) if where == "pattern" else camtube("synthesize", str(f), "-o", str(tmp_path / "o.yaml"))
+    assert_refused(r, str(f), "nested too deeply", "fix: remove the runaway brackets")
+    assert listing(tmp_path) == ["f.yaml"]
