@@ -233,3 +233,17 @@ def test_yaml_nested_too_deeply_is_a_yaml_error_not_a_recursion_traceback(tmp_pa
     r = camtube("design", str(f)) if where == "pattern" else camtube("synthesize", str(f), "-o", str(tmp_path / "o.yaml"))
     assert_refused(r, str(f), "nested too deeply", "fix: remove the runaway brackets")
     assert listing(tmp_path) == ["f.yaml"]
+
+
+@pytest.mark.parametrize("value,words", [("1e400", ("notch.count", "must be finite")),
+                                         (".nan", ("notch.count", "must be finite")),
+                                         ("1" + "0" * 400, ("notch.count", "out of range", "401 digits"))])
+def test_an_infinite_nan_or_huge_count_is_refused_not_a_crash(value, words):
+    assert_refused(camtube("design", TUBE1, "--set", f"notch.count={value}"), *words)
+
+
+@pytest.mark.parametrize("value", ["-0.5", ".nan", "[1,2]"])
+def test_a_refused_notch_width_is_not_also_called_missing(value):
+    r = camtube("design", TUBE1, "--set", f"notch.width={value}")
+    assert_refused(r, "notch.width")
+    assert "required key is missing" not in r.stderr

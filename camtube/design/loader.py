@@ -193,12 +193,17 @@ class _Reader:
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             self.issue(key, "expected a number", v, f.allowed(), "write a plain number (no units)")
             return None
-        if integer and (isinstance(v, float) and not float(v).is_integer()):
-            self.issue(key, "expected a whole number", v, f.allowed(), f"use {round(v)}")
+        try:
+            x = float(v)
+        except OverflowError:  # an integer of hundreds of digits
+            self.issue(key, "out of range", f"a number of {len(str(abs(v)))} digits", f.allowed(),
+                       "bring it inside the allowed range")
             return None
-        x = float(v)
         if not math.isfinite(x):
             self.issue(key, "must be finite", v, f.allowed(), "write a finite number")
+            return None
+        if integer and (isinstance(v, float) and not x.is_integer()):
+            self.issue(key, "expected a whole number", v, f.allowed(), f"use {round(v)}")
             return None
         lo_bad = x <= f.lo if f.lo_open else x < f.lo
         hi_bad = x >= f.hi if f.hi_open else x > f.hi
@@ -266,7 +271,8 @@ def _check_notch_lists(r: _Reader, gen: dict) -> None:
             r.issue(f"notch.{key}", f"has {len(values)} values for notch.count = {count}", len(values),
                     f"{need} values ({'one per gap between notches' if extra else 'one per notch'}, from the tip)",
                     f"give {need} values or set notch.count to match")
-        if scalar and not values and gen.get(scalar) is None and not (scalar == "spacing" and count == 1):
+        if (scalar and not values and gen.get(scalar) is None and not (scalar == "spacing" and count == 1)
+                and not any(i.key == f"notch.{scalar}" for i in r.issues)):  # given but refused: said already
             r.issue(f"notch.{scalar}", "required key is missing", None, SCHEMA["notch"][scalar].allowed(),
                     f"add '{scalar}: <value>' or a per-notch list '{key}: [...]'")
 
