@@ -247,3 +247,13 @@ def test_a_refused_notch_width_is_not_also_called_missing(value):
     r = camtube("design", TUBE1, "--set", f"notch.width={value}")
     assert_refused(r, "notch.width")
     assert "required key is missing" not in r.stderr
+
+
+@pytest.mark.parametrize("name", ["../../etc/x", "runs/tube4", "a\\\\b", "..", "[a, b]"])
+def test_a_pattern_name_that_is_not_a_plain_file_name(tmp_path, name):
+    """``name:`` names the output files: a folder in it was a ValueError traceback from the writer."""
+    p = tmp_path / "p.yaml"
+    p.write_text(f"name: {name}\n" + pattern_text().split("\n", 1)[1])
+    r = camtube("toolpath", str(p), "-o", str(tmp_path / "o"), "-q")
+    assert_refused(r, f"{p}:1", "name:", "fix:")
+    assert listing(tmp_path) == ["p.yaml"]

@@ -296,6 +296,19 @@ def build_settings(raw: dict, file: str | None = None) -> tuple[Tube, Process, T
             Rules(rl["min_backbone_arc"], rl["min_web"], rl["max_strain"], rl["max_stroke"]))
 
 
+def check_name(r: _Reader, name) -> None:
+    """``name:`` names the output files (NAME.ngc, NAME.job.json, ...): one plain file name, no folders."""
+    if name is None:
+        return
+    if isinstance(name, (dict, list, tuple)):
+        r.issue("name", "expected a text", name, "a plain file name (letters, digits, '-', '_', '.')",
+                "write e.g. name: tube2")
+    elif any(c in str(name) for c in "/\\\0") or str(name).strip() in (".", ".."):
+        r.issue("name", "names the output files (NAME.ngc, NAME.job.json, ...), so it must be a plain file name",
+                name, "letters, digits, '-', '_', '.'; no '/' or '\\'", "drop the folder part, e.g. name: tube2 "
+                "(choose the folder with -o)")
+
+
 def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = None, name: str | None = None) -> Loaded:
     """Validate raw YAML data and build a checked :class:`Pattern`.
 
@@ -317,6 +330,7 @@ def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = Non
     if gen and gen.get("layout") == "directions" and not gen.get("directions_deg") and not gen.get("angles_deg"):
         r.issue("notch.directions_deg", "layout 'directions' needs a list of angles", None,
                 "a non-empty list of angles in deg", "add e.g. directions_deg: [0, 90, 180, 270]")
+    check_name(r, raw.get("name"))
     if not has_notch and not extra:
         r.issue("notch", "the pattern has no notches", None, "a 'notch:' generator or a 'cuts:' list",
                 "add a 'notch:' section")
