@@ -182,6 +182,12 @@ def cmd_fit(args: argparse.Namespace) -> int:
             vals = [v.stroke_mm for (s, _), v in slack.items() if s == smp]
             if vals:
                 print(f"slack of sample {smp}: {min(vals):.3f}-{max(vals):.3f} mm over {len(vals)} cycle(s)")
+    bad = result.unidentified
+    if bad:  # refused before --json/--plot: no file holds values that are not estimates
+        raise FitError(f"{args.data}: these rows cannot identify " + "; ".join(f"{k}: {v}" for k, v in bad.items())
+                       + "; the values above are not estimates (no --json/--plot written); fix: hold them "
+                       "(--fix NAME=VALUE), drop the effect, or select rows where they matter (e.g. --cycles all "
+                       "--branch both --no-deadband)")
     meta = {"pattern": pattern.name, "data": str(args.data),
             "selection": {"cycles": args.cycles, "branch": args.branch, "deadband": bool(args.deadband)}}
     if args.json:
@@ -194,11 +200,6 @@ def cmd_fit(args: argparse.Namespace) -> int:
             full = remove_deadband(raw, args.deadband_threshold)
         png = fit_png(result, full, title=f"{pattern.name}: model vs measurement ({sel})")
         print(f"wrote {write_atomic(args.plot, png)}")
-    bad = result.unidentified
-    if bad:
-        raise FitError("these rows cannot identify " + "; ".join(f"{k}: {v}" for k, v in bad.items())
-                       + "; the values above are not estimates. Fix: hold them (--fix NAME=VALUE), drop the "
-                       "effect, or select rows where they matter (e.g. --cycles all --branch both --no-deadband)")
     return 0
 
 

@@ -112,6 +112,16 @@ def test_fit_of_an_unidentifiable_parameter_exits_2_and_names_it(data_csv, tmp_p
     assert main(["model", "fit", str(f), "--pattern", TUBE2, "-q", "--fit", "none"]) == 0
 
 
+def test_an_unidentified_fit_writes_no_json_or_plot(data_csv, tmp_path, capsys):
+    """Exit 2 leaves nothing behind: the JSON and the plot of values that are not estimates were written."""
+    f = _variant(data_csv, tmp_path / "noforce.csv", force_N="0.0")
+    js, png = tmp_path / "f.json", tmp_path / "f.png"
+    err = _fails_cleanly(["model", "fit", str(f), "--pattern", TUBE2, "-q", "--json", str(js), "--plot", str(png)],
+                         capsys, f"{f}: these rows cannot identify", "fix: hold them")
+    assert len(err.strip().splitlines()) == 1, err
+    assert not js.exists() and not png.exists()
+
+
 def test_unidentified_names_parameters_at_a_bound():
     from camtube.design.loader import load_pattern
     from camtube.model.core.fit import fit
