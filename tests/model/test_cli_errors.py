@@ -199,3 +199,20 @@ def test_fix_of_one_samples_copy_holds_it(data_csv, capsys):
     assert abs(free["params"]["slack.deadband_mm@1"]["value"] - 0.05) < 0.005
     assert held["params"]["slack.deadband_mm@2"]["value"] != 0.02
     assert held["rmse_deg"] > 1.05 * free["rmse_deg"]
+
+
+def test_diagnose_of_a_constant_time_column_says_why_one_row_is_left(data_csv, tmp_path, capsys):
+    """Every stamp repeated: all rows but one are set aside. Before: 'the selected rows: column 'stroke_mm'
+    never changes', naming neither the file nor the time column."""
+    f = _variant(data_csv, tmp_path / "t0.csv", time_s="0.0")
+    err = _fails_cleanly(["model", "diagnose", str(f), "--pattern", TUBE2, "-q", "--candidates", "slack"], capsys,
+                         str(f), "rows left after dropping or setting aside", "repeated time stamp",
+                         "check the time_s column", "fix:")
+    assert len(err.strip().splitlines()) == 1 and "the selected rows" not in err, err
+
+
+def test_too_few_rows_for_the_parameters_says_what_to_do(data_csv, tmp_path, capsys):
+    f = tmp_path / "few.csv"
+    f.write_text("".join(open(data_csv).readlines()[:4]))
+    _fails_cleanly(["model", "fit", str(f), "--pattern", TUBE2, "-q", "--fit", "E_t,L0,arm_scale", "--no-deadband",
+                    "--cycles", "all", "--branch", "both"], capsys, "3 data rows cannot fit 3 parameters", "fix:")

@@ -286,9 +286,11 @@ def fit(
     n = int(sel.sum())
     p = len(names)
     if n == 0:
-        raise FitError("no data rows to fit (check the cycle, branch and deadband selection)")
+        raise FitError("no data rows to fit; fix: check the cycle, branch and deadband selection (--cycles, "
+                       "--branch, --no-deadband)")
     if n <= p:
-        raise FitError(f"{n} data rows cannot fit {p} parameters")
+        raise FitError(f"{n} data rows cannot fit {p} parameters; fix: give more rows (--cycles all, --branch "
+                       "both, a longer record) or fit fewer parameters (--fix NAME=VALUE)")
     lo = np.array([params[nm].lo for nm in names], float)
     hi = np.array([params[nm].hi for nm in names], float)
     if np.any(lo >= hi):
