@@ -49,6 +49,7 @@ def _fails_cleanly(argv, capsys, *words):
     ("--speed", "0", "--speed"), ("--rate", "0", "--rate"), ("--rate", "1e9", "2,000,000"),
     ("--slack", "-0.1", "--slack"), ("--slack", "9", "--slack"), ("--modulus", "0", "--modulus"),
     ("--samples", "0", "--samples"), ("--cycles", "0", "--cycles"),
+    ("--seed", "-1", "--seed"),  # was a ValueError traceback from numpy
 ])
 def test_synth_refuses_nonsense_and_writes_nothing(tmp_path, capsys, opt, value, word):
     out = tmp_path / "x.csv"
@@ -216,3 +217,16 @@ def test_too_few_rows_for_the_parameters_says_what_to_do(data_csv, tmp_path, cap
     f.write_text("".join(open(data_csv).readlines()[:4]))
     _fails_cleanly(["model", "fit", str(f), "--pattern", TUBE2, "-q", "--fit", "E_t,L0,arm_scale", "--no-deadband",
                     "--cycles", "all", "--branch", "both"], capsys, "3 data rows cannot fit 3 parameters", "fix:")
+
+
+@pytest.mark.parametrize("argv", [["fit", "--set-aside"], ["diagnose", "--candidates", "slack"]])
+def test_a_lag_that_is_not_a_number_is_refused(data_csv, capsys, argv):
+    """--lag-ms nan was a ValueError traceback from the lag shift."""
+    err = _fails_cleanly(["model", argv[0], str(data_csv), "--pattern", TUBE2, "-q", *argv[1:], "--lag-ms", "nan"],
+                         capsys, "--lag-ms nan", "fix:")
+    assert len(err.strip().splitlines()) == 1, err
+
+
+def test_synth_errors_say_the_fix(tmp_path, capsys):
+    _fails_cleanly(["model", "synth", "--pattern", TUBE2, "-o", str(tmp_path / "x.csv"), "-q", "--samples", "0"],
+                   capsys, "fix: give a value in that range")

@@ -149,6 +149,8 @@ def test_ingest_command_writes_the_measurement_file_and_the_report(tmp_path, cap
     (["--map", "daq.time_unit=s"], "fix: daq.time_unit: ms"),
     (["--map", "daq.force=load"], "no column 'load' for the value"),
     (["--map", "tracker.tip=0C"], "no tool '0C' for the tip"),
+    (["--max-lag", "-1"], "--max-lag -1.0: the largest clock offset must be"),  # was a ValueError traceback
+    (["--max-lag", "nan"], "fix: give e.g. --max-lag 5"),
 ])
 def test_ingest_refuses_wrong_units_and_signs_in_one_line(tmp_path, capsys, extra, message):
     assert main(_argv(tmp_path, *extra)) == 2
