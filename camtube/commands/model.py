@@ -139,6 +139,13 @@ def cmd_fit(args: argparse.Namespace) -> int:
 
     check_suffix(args.json, (".json",), "--json")
     check_suffix(args.plot, (".png",), "--plot")
+    if not 0 <= args.starts <= 50:
+        raise DataError(f"--starts {args.starts}: allowed 0..50 grid points per parameter; fix: e.g. --starts 3 "
+                        "(0: one start)")
+    t = args.deadband_threshold
+    if t is not None and not (0 < t < 360):
+        raise DataError(f"--deadband-threshold {t}: the smallest angle rise that counts as motion must be > 0 and "
+                        "< 360 deg; fix: e.g. --deadband-threshold 0.5, or leave it out for max(0.5, 4 x noise)")
     pattern = load_from_args(args).pattern
     reg, _ = build_registry(args.effect_file)
     model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects)])

@@ -230,3 +230,13 @@ def test_a_lag_that_is_not_a_number_is_refused(data_csv, capsys, argv):
 def test_synth_errors_say_the_fix(tmp_path, capsys):
     _fails_cleanly(["model", "synth", "--pattern", TUBE2, "-o", str(tmp_path / "x.csv"), "-q", "--samples", "0"],
                    capsys, "fix: give a value in that range")
+
+
+@pytest.mark.parametrize("opt,value", [("--starts", "-1"), ("--starts", "100000"), ("--deadband-threshold", "-1"),
+                                       ("--deadband-threshold", "nan")])
+def test_fit_options_out_of_range_are_refused(data_csv, tmp_path, capsys, opt, value):
+    """Before: accepted silently (a negative --starts meant one start; a negative or NaN threshold was used)."""
+    js = tmp_path / "f.json"
+    err = _fails_cleanly(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", opt, value, "--json", str(js)],
+                         capsys, f"{opt} ", "fix:")
+    assert len(err.strip().splitlines()) == 1 and not js.exists(), err
