@@ -242,7 +242,7 @@ def cmd_ingest(args: argparse.Namespace) -> int:
         raise DataError(f"-o {args.output}: is a directory; fix: name the measurement CSV to write")
     check_writable_dir(Path(args.output).absolute().parent)
     if args.report:
-        check_output_dir(args.report)
+        check_output_dir(args.report, "--report")
     bench = load_bench_map(args.bench, args.map_overrides)
     first = args.tracker or args.angle_log
     ing = ingest_files(first, args.daq, args.motor, bench, args.sample, max_lag_s=args.max_lag,

@@ -213,7 +213,8 @@ def test_an_angle_log_in_radians_is_refused_until_the_map_says_so(tmp_path, caps
 def test_a_report_path_that_is_a_file_is_refused_before_any_work(tmp_path, capsys):
     (tmp_path / "rep").write_text("x")
     assert main(_argv(tmp_path, "--report", str(tmp_path / "rep"))) == 2
-    assert "is a file" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "is a file" in err and "but --report names the output directory" in err, err
     assert not (tmp_path / "d.csv").exists()
 
 
