@@ -140,14 +140,25 @@ def outputs(loaded: Loaded, request: Request, progress: Progress = NO_PROGRESS):
         # the estimate on the first dialect's machine, computed once here: the G-code header and the
         # job file of that machine read the same one from the job's cache
         est = job_estimate(job, dialects[0])
-        files.update(toolpath_streams(job, dialects, progress))  # the exporter table, walked
+        _add_outputs(files, toolpath_streams(job, dialects, progress))  # the exporter table, walked
     if request.what in (BUILD, CAD):
         from camtube.cad.outputs import cad_outputs
 
         o = request.cad
         cad = cad_outputs(pattern, job, step=o.step, pictures=o.pictures, segments=o.segments, kerf_mm=o.kerf_mm)
-        files.update(cad.files)
+        _add_outputs(files, cad.files)
     return files, job, est, cad
+
+
+def _add_outputs(files: dict, more: dict) -> None:
+    """Add ``more`` to ``files``; two outputs of one name (a G-code suffix such as ``.job.json``) are refused."""
+    from camtube.errors import CamtubeError
+
+    clash = sorted(set(files) & set(more))
+    if clash:
+        raise CamtubeError(f"{clash[0]}: two outputs of this command would have this file name; fix: give the "
+                           "machine profile a G-code suffix of its own (e.g. suffix: .ngc)")
+    files.update(more)
 
 
 def run(loaded: Loaded, outdir: str | os.PathLike, request: Request, progress: Progress = NO_PROGRESS,

@@ -46,9 +46,22 @@ StrictLoader.add_implicit_resolver(
     list("-+.0123456789"))
 
 
+class TooDeepError(yaml.YAMLError):
+    """YAML nested deeper than the parser can follow (PyYAML recurses once per level)."""
+
+    problem = "nested too deeply (thousands of levels of '[', '{' or indentation)"
+    problem_mark = None
+
+    def __str__(self) -> str:
+        return self.problem
+
+
 def parse_yaml(text: str):
-    """``text`` parsed with :class:`StrictLoader` (raises ``yaml.YAMLError``)."""
-    return yaml.load(text, Loader=StrictLoader)  # noqa: S506 (a SafeLoader subclass)
+    """``text`` parsed with :class:`StrictLoader` (raises ``yaml.YAMLError``, also for nesting too deep to parse)."""
+    try:
+        return yaml.load(text, Loader=StrictLoader)  # noqa: S506 (a SafeLoader subclass)
+    except RecursionError:
+        raise TooDeepError() from None
 
 
 def read_yaml_file(path: str | os.PathLike, what: str, fix: str | Callable[[], str]) -> tuple[object, str]:
@@ -86,7 +99,8 @@ def read_yaml_file(path: str | os.PathLike, what: str, fix: str | Callable[[], s
         mark = getattr(exc, "problem_mark", None)
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
         fix_ = ("keep one of the two (a later key would silently replace the earlier one)" if "given twice" in problem
-                else "fix the syntax at the line shown")
+                else "remove the runaway brackets or indentation (the file's keys nest a few levels)"
+                if isinstance(exc, TooDeepError) else "fix the syntax at the line shown")
         raise PatternError([Issue("yaml", f"not valid YAML: {problem}", None, "YAML mapping", fix_, file,
                                   mark.line + 1 if mark else None)]) from None
     return raw, text
@@ -97,7 +111,7 @@ def line_map(text: str) -> dict[str, int]:
     out: dict[str, int] = {}
     try:
         root = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.YAMLError:
+    except (yaml.YAMLError, RecursionError):
         return out
 
     def walk(node, prefix):

@@ -219,3 +219,41 @@ def test_an_empty_output_path_is_refused_not_taken_for_the_working_directory(tmp
     r = camtube(*cmd, cwd=tmp_path)
     assert r.returncode == 2 and "Traceback" not in r.stderr and "fix:" in r.stderr
     assert listing(tmp_path) == []
+
+
+@pytest.mark.parametrize("where", ["pattern", "set", "goal"])
+def test_yaml_nested_too_deeply_is_a_yaml_error_not_a_recursion_traceback(tmp_path, where):
+    deep = "[" * 3000 + "]" * 3000
+    if where == "set":
+        r = camtube("design", TUBE1, "--set", f"notch.width={deep}")
+        assert r.returncode == 2 and "Traceback" not in r.stderr and "RecursionError" not in r.stderr, r.stderr
+        return
+    f = tmp_path / "f.yaml"
+    f.write_text(f"a: {deep}\n")
+    r = camtube("design", str(f)) if where == "pattern" else camtube("synthesize", str(f), "-o", str(tmp_path / "o.yaml"))
+    assert_refused(r, str(f), "nested too deeply", "fix: remove the runaway brackets")
+    assert listing(tmp_path) == ["f.yaml"]
+
+
+@pytest.mark.parametrize("value,words", [("1e400", ("notch.count", "must be finite")),
+                                         (".nan", ("notch.count", "must be finite")),
+                                         ("1" + "0" * 400, ("notch.count", "out of range", "401 digits"))])
+def test_an_infinite_nan_or_huge_count_is_refused_not_a_crash(value, words):
+    assert_refused(camtube("design", TUBE1, "--set", f"notch.count={value}"), *words)
+
+
+@pytest.mark.parametrize("value", ["-0.5", ".nan", "[1,2]"])
+def test_a_refused_notch_width_is_not_also_called_missing(value):
+    r = camtube("design", TUBE1, "--set", f"notch.width={value}")
+    assert_refused(r, "notch.width")
+    assert "required key is missing" not in r.stderr
+
+
+@pytest.mark.parametrize("name", ["../../etc/x", "runs/tube4", "a\\\\b", "..", "[a, b]"])
+def test_a_pattern_name_that_is_not_a_plain_file_name(tmp_path, name):
+    """``name:`` names the output files: a folder in it was a ValueError traceback from the writer."""
+    p = tmp_path / "p.yaml"
+    p.write_text(f"name: {name}\n" + pattern_text().split("\n", 1)[1])
+    r = camtube("toolpath", str(p), "-o", str(tmp_path / "o"), "-q")
+    assert_refused(r, f"{p}:1", "name:", "fix:")
+    assert listing(tmp_path) == ["p.yaml"]

@@ -65,3 +65,13 @@ def test_a_slit_drawing_builds_and_its_kerf_is_verified(tmp_path):
     for c in res.job.design:
         assert not c.closed
         assert design_region(c, kerf).area == pytest.approx(c.length_mm * kerf + math.pi * (kerf / 2) ** 2, rel=1e-3)
+
+
+def test_two_outputs_of_one_name_are_refused_not_one_silently_lost():
+    from camtube.errors import CamtubeError
+    from camtube.pipeline import _add_outputs
+
+    files = {"t.job.json": b"job"}
+    with pytest.raises(CamtubeError, match=r"t\.job\.json: two outputs .* fix: give the machine profile"):
+        _add_outputs(files, {"t.job.json": iter(["G0"])})
+    assert files == {"t.job.json": b"job"}

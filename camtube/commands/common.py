@@ -101,12 +101,12 @@ def cad_options(args: argparse.Namespace):
                       kerf_mm=args.kerf)
 
 
-def check_output_dir(path: str) -> None:
+def check_output_dir(path: str, option: str = "-o") -> None:
     """Refuse, before any work, an output directory that names a file or cannot be written."""
     from camtube.io import check_writable_dir
 
     if os.path.exists(path) and not os.path.isdir(path):
-        raise CamtubeError(f"{path}: is a file, but -o names the output directory; fix: give a directory "
+        raise CamtubeError(f"{path}: is a file, but {option} names the output directory; fix: give a directory "
                            "(new or existing)")
     check_writable_dir(path)
 

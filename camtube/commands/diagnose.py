@@ -67,6 +67,22 @@ def register(model_sub) -> None:
     d.set_defaults(func=cmd_diagnose)
 
 
+def _rows_left(args: argparse.Namespace, meas, ins) -> str:
+    """The rows the diagnosis is left with, in words, and why the others were dropped or set aside (for an error
+    about them: a reversed or constant time column leaves one row, which is then 'a stroke that never changes')."""
+    why = []
+    if meas.missing_lines.size:
+        why.append(f"{meas.missing_lines.size} with a missing value")
+    if meas.backward_lines.size:
+        why.append(f"{meas.backward_lines.size} whose time_s goes backwards")
+    why += [f"{len(idx)} with a {reason}" for reason, idx in ins.aside.items() if len(idx)]
+    if not why:
+        return f"{args.data} (cycles {args.cycles})"
+    total = len(ins.data) + int(meas.missing_lines.size + meas.backward_lines.size) + int((~ins.kept).sum())
+    return (f"{args.data} (cycles {args.cycles}; {len(ins.data)} of {total} rows left after dropping or setting "
+            f"aside {', '.join(why)}: check the time_s column)")
+
+
 def fit_command_prefix(args: argparse.Namespace, instruments=None) -> str:
     """The ``camtube model fit`` command selecting the same rows and files as this diagnosis (with the rows
     the instruments' check set aside, and its lag, when it found any)."""
@@ -97,7 +113,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     from camtube.io import write_atomic
     from camtube.model.core.build import build_registry, check_suffix, fitted_and_held, parse_assignments, split_names
     from camtube.model.core.predict import model_for_pattern, pattern_values
-    from camtube.model.data import read_measurements, select_cycles
+    from camtube.model.data import check_fittable, read_measurements, select_cycles
     from camtube.model.diagnose import diagnose
     from camtube.model.diagnose.instruments import check_instruments, confirm_lag
     from camtube.model.report.diagnosis import diagnosis_json, diagnosis_text, write_report
@@ -114,6 +130,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     rows = select_cycles(meas.data, args.cycles)
     ins = check_instruments(rows, lag_ms=args.lag_ms, dropped=meas.summary(),
                             n_dropped=int(meas.missing_lines.size + meas.backward_lines.size))
+    check_fittable(ins.data, _rows_left(args, meas, ins))
     fit_names, held = fitted_and_held(model, args.fit_params, args.fix, with_effects=False)
     fixed = pattern_values(pattern)
     fixed.update(held)

@@ -139,6 +139,13 @@ def cmd_fit(args: argparse.Namespace) -> int:
 
     check_suffix(args.json, (".json",), "--json")
     check_suffix(args.plot, (".png",), "--plot")
+    if not 0 <= args.starts <= 50:
+        raise DataError(f"--starts {args.starts}: allowed 0..50 grid points per parameter; fix: e.g. --starts 3 "
+                        "(0: one start)")
+    t = args.deadband_threshold
+    if t is not None and not (0 < t < 360):
+        raise DataError(f"--deadband-threshold {t}: the smallest angle rise that counts as motion must be > 0 and "
+                        "< 360 deg; fix: e.g. --deadband-threshold 0.5, or leave it out for max(0.5, 4 x noise)")
     pattern = load_from_args(args).pattern
     reg, _ = build_registry(args.effect_file)
     model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects)])
@@ -182,6 +189,12 @@ def cmd_fit(args: argparse.Namespace) -> int:
             vals = [v.stroke_mm for (s, _), v in slack.items() if s == smp]
             if vals:
                 print(f"slack of sample {smp}: {min(vals):.3f}-{max(vals):.3f} mm over {len(vals)} cycle(s)")
+    bad = result.unidentified
+    if bad:  # refused before --json/--plot: no file holds values that are not estimates
+        raise FitError(f"{args.data}: these rows cannot identify " + "; ".join(f"{k}: {v}" for k, v in bad.items())
+                       + "; the values above are not estimates (no --json/--plot written); fix: hold them "
+                       "(--fix NAME=VALUE), drop the effect, or select rows where they matter (e.g. --cycles all "
+                       "--branch both --no-deadband)")
     meta = {"pattern": pattern.name, "data": str(args.data),
             "selection": {"cycles": args.cycles, "branch": args.branch, "deadband": bool(args.deadband)}}
     if args.json:
@@ -194,11 +207,6 @@ def cmd_fit(args: argparse.Namespace) -> int:
             full = remove_deadband(raw, args.deadband_threshold)
         png = fit_png(result, full, title=f"{pattern.name}: model vs measurement ({sel})")
         print(f"wrote {write_atomic(args.plot, png)}")
-    bad = result.unidentified
-    if bad:
-        raise FitError("these rows cannot identify " + "; ".join(f"{k}: {v}" for k, v in bad.items())
-                       + "; the values above are not estimates. Fix: hold them (--fix NAME=VALUE), drop the "
-                       "effect, or select rows where they matter (e.g. --cycles all --branch both --no-deadband)")
     return 0
 
 
@@ -234,7 +242,7 @@ def cmd_ingest(args: argparse.Namespace) -> int:
         raise DataError(f"-o {args.output}: is a directory; fix: name the measurement CSV to write")
     check_writable_dir(Path(args.output).absolute().parent)
     if args.report:
-        check_output_dir(args.report)
+        check_output_dir(args.report, "--report")
     bench = load_bench_map(args.bench, args.map_overrides)
     first = args.tracker or args.angle_log
     ing = ingest_files(first, args.daq, args.motor, bench, args.sample, max_lag_s=args.max_lag,

@@ -193,12 +193,17 @@ class _Reader:
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             self.issue(key, "expected a number", v, f.allowed(), "write a plain number (no units)")
             return None
-        if integer and (isinstance(v, float) and not float(v).is_integer()):
-            self.issue(key, "expected a whole number", v, f.allowed(), f"use {round(v)}")
+        try:
+            x = float(v)
+        except OverflowError:  # an integer of hundreds of digits
+            self.issue(key, "out of range", f"a number of {len(str(abs(v)))} digits", f.allowed(),
+                       "bring it inside the allowed range")
             return None
-        x = float(v)
         if not math.isfinite(x):
             self.issue(key, "must be finite", v, f.allowed(), "write a finite number")
+            return None
+        if integer and (isinstance(v, float) and not x.is_integer()):
+            self.issue(key, "expected a whole number", v, f.allowed(), f"use {round(v)}")
             return None
         lo_bad = x <= f.lo if f.lo_open else x < f.lo
         hi_bad = x >= f.hi if f.hi_open else x > f.hi
@@ -266,7 +271,8 @@ def _check_notch_lists(r: _Reader, gen: dict) -> None:
             r.issue(f"notch.{key}", f"has {len(values)} values for notch.count = {count}", len(values),
                     f"{need} values ({'one per gap between notches' if extra else 'one per notch'}, from the tip)",
                     f"give {need} values or set notch.count to match")
-        if scalar and not values and gen.get(scalar) is None and not (scalar == "spacing" and count == 1):
+        if (scalar and not values and gen.get(scalar) is None and not (scalar == "spacing" and count == 1)
+                and not any(i.key == f"notch.{scalar}" for i in r.issues)):  # given but refused: said already
             r.issue(f"notch.{scalar}", "required key is missing", None, SCHEMA["notch"][scalar].allowed(),
                     f"add '{scalar}: <value>' or a per-notch list '{key}: [...]'")
 
@@ -290,6 +296,19 @@ def build_settings(raw: dict, file: str | None = None) -> tuple[Tube, Process, T
             Rules(rl["min_backbone_arc"], rl["min_web"], rl["max_strain"], rl["max_stroke"]))
 
 
+def check_name(r: _Reader, name) -> None:
+    """``name:`` names the output files (NAME.ngc, NAME.job.json, ...): one plain file name, no folders."""
+    if name is None:
+        return
+    if isinstance(name, (dict, list, tuple)):
+        r.issue("name", "expected a text", name, "a plain file name (letters, digits, '-', '_', '.')",
+                "write e.g. name: tube2")
+    elif any(c in str(name) for c in "/\\\0") or str(name).strip() in (".", ".."):
+        r.issue("name", "names the output files (NAME.ngc, NAME.job.json, ...), so it must be a plain file name",
+                name, "letters, digits, '-', '_', '.'; no '/' or '\\'", "drop the folder part, e.g. name: tube2 "
+                "(choose the folder with -o)")
+
+
 def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = None, name: str | None = None) -> Loaded:
     """Validate raw YAML data and build a checked :class:`Pattern`.
 
@@ -311,6 +330,7 @@ def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = Non
     if gen and gen.get("layout") == "directions" and not gen.get("directions_deg") and not gen.get("angles_deg"):
         r.issue("notch.directions_deg", "layout 'directions' needs a list of angles", None,
                 "a non-empty list of angles in deg", "add e.g. directions_deg: [0, 90, 180, 270]")
+    check_name(r, raw.get("name"))
     if not has_notch and not extra:
         r.issue("notch", "the pattern has no notches", None, "a 'notch:' generator or a 'cuts:' list",
                 "add a 'notch:' section")

@@ -200,6 +200,10 @@ class MachineProfile:
 
 
 # ---------------------------------------------------------------- validation
+#: Suffixes of the other files a build writes beside the G-code (NAME.job.json, ...): not a G-code suffix.
+OWN_SUFFIXES = (".design.dxf", ".toolpath.dxf", ".job.json", ".design.step", ".design.stl", ".ascut.stl",
+                ".verify.txt", ".verify.json", ".tube.png", ".unrolled.png")
+
 _LIMIT_KEYS = ("max_velocity", "max_acceleration")
 _LASER_KEYS = ("gate_output", "power_output", "frequency_output", "spindle", "s_per_watt", "gating", "dose_output",
                "radius_output")
@@ -229,7 +233,11 @@ class _Checker:
                 self.add(f"{prefix}{k}", "unknown key", None, ", ".join(allowed), _hint(k, allowed))
 
     def number(self, v, key, lo=0.0, strict=True, integer=False):
-        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+        ok = isinstance(v, (int, float)) and not isinstance(v, bool)
+        try:
+            ok = ok and math.isfinite(v)
+        except OverflowError:  # an integer of hundreds of digits
+            ok, v = False, f"a number of {len(str(abs(v)))} digits"
         if ok and integer and float(v) != int(v):
             ok = False
         if ok and (v <= lo if strict else v < lo):
@@ -378,8 +386,13 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
     dec = ck.number(m.get("decimals", 6), "decimals", 0, strict=False, integer=True)
     fdec = ck.number(m.get("feed_decimals", 3), "feed_decimals", 0, strict=False, integer=True)
     suffix = m.get("suffix", ".ngc" if dialect == "linuxcnc" else ".nc")
-    if not (isinstance(suffix, str) and suffix.startswith(".") and len(suffix) > 1):
-        ck.add("suffix", "must be a file suffix starting with a dot", suffix, ".ngc, .nc, ...", "e.g. suffix: .ngc")
+    if not (isinstance(suffix, str) and suffix.startswith(".") and suffix.strip(".")
+            and not any(c in suffix for c in "/\\\0")):
+        ck.add("suffix", "must be a file suffix starting with a dot (no folder)", suffix, ".ngc, .nc, ...",
+               "e.g. suffix: .ngc")
+    elif suffix.lower() in OWN_SUFFIXES:
+        ck.add("suffix", "is the suffix of another file camtube writes beside the G-code (one would "
+               "overwrite the other)", suffix, "not one of " + ", ".join(OWN_SUFFIXES), "e.g. suffix: .ngc")
     desc = m.get("description", "")
     if not isinstance(desc, str):
         ck.add("description", "must be text", desc, "text", "quote it")

@@ -11,7 +11,7 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from camtube.design.loader import Reader
+from camtube.design.loader import Reader, check_name
 from camtube.design.pattern import Tendon, Tube
 from camtube.design.schema import INF, POS, Field
 from camtube.errors import Issue, PatternError
@@ -219,6 +219,7 @@ def build_goal(raw: dict, file: str | None = None, lines: dict[str, int] | None 
     if not isinstance(process, (str, dict)):
         r.issue("process", "expected a process file name or a mapping", process,
                 "a name such as femto-polyimide.yaml, or process keys", "write e.g. 'process: femto-polyimide.yaml'")
+    check_name(r, raw.get("name"))
     if r.issues:
         raise PatternError(r.issues)
     if not tube["inner_radius"] < tube["outer_radius"]:

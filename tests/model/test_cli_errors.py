@@ -49,6 +49,7 @@ def _fails_cleanly(argv, capsys, *words):
     ("--speed", "0", "--speed"), ("--rate", "0", "--rate"), ("--rate", "1e9", "2,000,000"),
     ("--slack", "-0.1", "--slack"), ("--slack", "9", "--slack"), ("--modulus", "0", "--modulus"),
     ("--samples", "0", "--samples"), ("--cycles", "0", "--cycles"),
+    ("--seed", "-1", "--seed"),  # was a ValueError traceback from numpy
 ])
 def test_synth_refuses_nonsense_and_writes_nothing(tmp_path, capsys, opt, value, word):
     out = tmp_path / "x.csv"
@@ -110,6 +111,16 @@ def test_fit_of_an_unidentifiable_parameter_exits_2_and_names_it(data_csv, tmp_p
     assert "--fix" in err
     # the same fit with E_t held is fine
     assert main(["model", "fit", str(f), "--pattern", TUBE2, "-q", "--fit", "none"]) == 0
+
+
+def test_an_unidentified_fit_writes_no_json_or_plot(data_csv, tmp_path, capsys):
+    """Exit 2 leaves nothing behind: the JSON and the plot of values that are not estimates were written."""
+    f = _variant(data_csv, tmp_path / "noforce.csv", force_N="0.0")
+    js, png = tmp_path / "f.json", tmp_path / "f.png"
+    err = _fails_cleanly(["model", "fit", str(f), "--pattern", TUBE2, "-q", "--json", str(js), "--plot", str(png)],
+                         capsys, f"{f}: these rows cannot identify", "fix: hold them")
+    assert len(err.strip().splitlines()) == 1, err
+    assert not js.exists() and not png.exists()
 
 
 def test_unidentified_names_parameters_at_a_bound():
@@ -189,3 +200,43 @@ def test_fix_of_one_samples_copy_holds_it(data_csv, capsys):
     assert abs(free["params"]["slack.deadband_mm@1"]["value"] - 0.05) < 0.005
     assert held["params"]["slack.deadband_mm@2"]["value"] != 0.02
     assert held["rmse_deg"] > 1.05 * free["rmse_deg"]
+
+
+def test_diagnose_of_a_constant_time_column_says_why_one_row_is_left(data_csv, tmp_path, capsys):
+    """Every stamp repeated: all rows but one are set aside. Before: 'the selected rows: column 'stroke_mm'
+    never changes', naming neither the file nor the time column."""
+    f = _variant(data_csv, tmp_path / "t0.csv", time_s="0.0")
+    err = _fails_cleanly(["model", "diagnose", str(f), "--pattern", TUBE2, "-q", "--candidates", "slack"], capsys,
+                         str(f), "rows left after dropping or setting aside", "repeated time stamp",
+                         "check the time_s column", "fix:")
+    assert len(err.strip().splitlines()) == 1 and "the selected rows" not in err, err
+
+
+def test_too_few_rows_for_the_parameters_says_what_to_do(data_csv, tmp_path, capsys):
+    f = tmp_path / "few.csv"
+    f.write_text("".join(open(data_csv).readlines()[:4]))
+    _fails_cleanly(["model", "fit", str(f), "--pattern", TUBE2, "-q", "--fit", "E_t,L0,arm_scale", "--no-deadband",
+                    "--cycles", "all", "--branch", "both"], capsys, "3 data rows cannot fit 3 parameters", "fix:")
+
+
+@pytest.mark.parametrize("argv", [["fit", "--set-aside"], ["diagnose", "--candidates", "slack"]])
+def test_a_lag_that_is_not_a_number_is_refused(data_csv, capsys, argv):
+    """--lag-ms nan was a ValueError traceback from the lag shift."""
+    err = _fails_cleanly(["model", argv[0], str(data_csv), "--pattern", TUBE2, "-q", *argv[1:], "--lag-ms", "nan"],
+                         capsys, "--lag-ms nan", "fix:")
+    assert len(err.strip().splitlines()) == 1, err
+
+
+def test_synth_errors_say_the_fix(tmp_path, capsys):
+    _fails_cleanly(["model", "synth", "--pattern", TUBE2, "-o", str(tmp_path / "x.csv"), "-q", "--samples", "0"],
+                   capsys, "fix: give a value in that range")
+
+
+@pytest.mark.parametrize("opt,value", [("--starts", "-1"), ("--starts", "100000"), ("--deadband-threshold", "-1"),
+                                       ("--deadband-threshold", "nan")])
+def test_fit_options_out_of_range_are_refused(data_csv, tmp_path, capsys, opt, value):
+    """Before: accepted silently (a negative --starts meant one start; a negative or NaN threshold was used)."""
+    js = tmp_path / "f.json"
+    err = _fails_cleanly(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", opt, value, "--json", str(js)],
+                         capsys, f"{opt} ", "fix:")
+    assert len(err.strip().splitlines()) == 1 and not js.exists(), err

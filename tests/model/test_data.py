@@ -110,6 +110,30 @@ def test_time_backwards_is_checked_per_sample_only():
     assert d.samples == ["A", "B"]
 
 
+@pytest.mark.parametrize("lines, line, words", [
+    (GOOD[1:], 1, ["no header line", "holds numbers", "fix: add a first line naming the columns"]),
+    (GOOD[:2] + ["A,1e30,0.1,0.1,0.2,1.0"] + GOOD[3:], 3, ["cycle", "from 1 to 10^9", "'1e30'", "fix:"]),
+    ([HEADER + ",cycle"] + [r + ",1" for r in GOOD[1:]], 1, ["duplicate", "fix: keep one column of each name"]),
+    ([HEADER], 1, ["no data rows", "fix: add the measurements"]),
+])
+def test_csv_mistakes_that_lacked_a_fix_or_passed(tmp_path, lines, line, words):
+    """Before: a file without a header was 'duplicate column(s) 1' (no fix), a cycle of 1e30 was read as a
+    garbage integer with a RuntimeWarning, and these lines had no fix."""
+    path = tmp_path / "bad.csv"
+    path.write_text(_csv(lines))
+    with pytest.raises(DataError) as err:
+        load_csv(path)
+    msg = str(err.value)
+    assert f"{path}:{line}:" in msg and "\n" not in msg, msg
+    for w in words:
+        assert w in msg, msg
+
+
+def test_a_missing_file_says_what_to_do(tmp_path):
+    with pytest.raises(DataError, match="no such measurement file; fix: check the path"):
+        load_csv(tmp_path / "missing.csv")
+
+
 def test_empty_and_missing_files(tmp_path):
     (tmp_path / "e.csv").write_text("\n# nothing\n")
     with pytest.raises(DataError, match="empty"):

@@ -96,3 +96,57 @@ def test_a_broken_check_names_the_effect_and_its_file():
         form_problem(make(lambda d, pred: 1 / 0), None, np.zeros(3))
     with pytest.raises(FitError, match="returned float, expected a string"):
         form_problem(make(lambda d, pred: 0.5), None, np.zeros(3))
+
+
+# mistakes that were a traceback (a string returned), a silent wrong result (complex numbers cast to real,
+# a second effect of the same name ignored), a bare exit status (sys.exit in the file) or a line without a fix
+@pytest.mark.parametrize("body,words", [
+    ('    return "abc"', ["returned str 'abc', not numbers", "fix: return one number per row"]),
+    ('    return x + 1j', ["returned complex numbers", "fix: return one number per row"]),
+    ('    return x[:3]', ["returned shape (3,)", "fix: return one number per row"]),
+    ('    raise SystemExit(5)', ["called sys.exit()", "fix: correct the effect's function"]),
+    ('    raise ValueError("bad")', ["ValueError: bad", "fix: correct the effect's function"]),
+    ('    return x * np.nan', ["non-finite angle", "fix: an effect returned NaN or inf", "broken ("]),
+])
+def test_a_wrong_return_or_exit_in_apply_is_one_line_with_a_fix(tmp_path, capsys, data_csv, body, words):
+    f = tmp_path / "eff.py"
+    f.write_text(HEAD + body + TAIL, encoding="utf-8")
+    code = main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--effect-file", str(f),
+                 "--effects", "broken"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert "Traceback" not in err and len(err.splitlines()) == 1, err
+    for w in words:
+        assert w in err, err
+
+
+@pytest.mark.parametrize("text,words", [
+    ("import sys\nsys.exit(3)\n", [":2:", "it called sys.exit()", "fix: correct the file at that line"]),
+    ("raise RuntimeError('boom')\n", [":1:", "RuntimeError: boom", "fix:"]),
+    ("x = 1\n", ["defines no Effect", "fix: add one"]),
+    (HEAD + "    return x" + TAIL + "\nAGAIN = Effect(name='broken', stage='stroke', params=(), apply=_apply)\n",
+     ["two different effects named 'broken'", "fix: give each Effect a name of its own"]),
+    (HEAD + "    return x" + TAIL.replace('0.0, 2.0, 1.0', '2.0, 0.0, 1.0'),
+     ["parameter 'gain' has lo 2 > hi 0", "fix: swap them"]),
+])
+def test_a_file_that_exits_raises_or_defines_nothing_usable(tmp_path, capsys, data_csv, text, words):
+    f = tmp_path / "eff.py"
+    f.write_text(text, encoding="utf-8")
+    code = main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--effect-file", str(f)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert "Traceback" not in err and len(err.splitlines()) == 1 and str(f) in err, err
+    for w in words:
+        assert w in err, err
+
+
+@pytest.mark.parametrize("which,words", [("missing", ["no such effect file", "fix:"]),
+                                         ("dir", ["not a file", "fix:"]),
+                                         ("csv", ["cannot import the effect file", "fix:"])])
+def test_an_effect_file_path_that_is_no_python_file(tmp_path, capsys, data_csv, which, words):
+    path = {"missing": tmp_path / "nope.py", "dir": tmp_path, "csv": data_csv}[which]
+    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--effect-file", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and str(path) in err, err
+    for w in words:
+        assert w in err, err

@@ -149,6 +149,8 @@ def test_ingest_command_writes_the_measurement_file_and_the_report(tmp_path, cap
     (["--map", "daq.time_unit=s"], "fix: daq.time_unit: ms"),
     (["--map", "daq.force=load"], "no column 'load' for the value"),
     (["--map", "tracker.tip=0C"], "no tool '0C' for the tip"),
+    (["--max-lag", "-1"], "--max-lag -1.0: the largest clock offset must be"),  # was a ValueError traceback
+    (["--max-lag", "nan"], "fix: give e.g. --max-lag 5"),
 ])
 def test_ingest_refuses_wrong_units_and_signs_in_one_line(tmp_path, capsys, extra, message):
     assert main(_argv(tmp_path, *extra)) == 2
@@ -211,7 +213,8 @@ def test_an_angle_log_in_radians_is_refused_until_the_map_says_so(tmp_path, caps
 def test_a_report_path_that_is_a_file_is_refused_before_any_work(tmp_path, capsys):
     (tmp_path / "rep").write_text("x")
     assert main(_argv(tmp_path, "--report", str(tmp_path / "rep"))) == 2
-    assert "is a file" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "is a file" in err and "but --report names the output directory" in err, err
     assert not (tmp_path / "d.csv").exists()
 
 

@@ -76,6 +76,7 @@ limits: {max_strain: 0.04}
     (("goal:", "goal:\n  distribution: tipfirst"), ["goal.distribution", "did you mean 'tip_first'"]),
     (("goal:", "goal:\n  curve: [2, 4]\n  curve_length: 10"), ["goal.bends[0].bend_deg", "30.00"]),
     (("limits:", "limit:"), ["did you mean 'limits'"]),
+    (("tube:", "name: runs/tube4\ntube:"), ["name", "must be a plain file name", ":1:", "runs/tube4"]),
 ])
 def test_goal_mistakes_one_line_each(tmp_path, edit, words):
     g = tmp_path / "g.yaml"

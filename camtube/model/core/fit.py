@@ -286,14 +286,17 @@ def fit(
     n = int(sel.sum())
     p = len(names)
     if n == 0:
-        raise FitError("no data rows to fit (check the cycle, branch and deadband selection)")
+        raise FitError("no data rows to fit; fix: check the cycle, branch and deadband selection (--cycles, "
+                       "--branch, --no-deadband)")
     if n <= p:
-        raise FitError(f"{n} data rows cannot fit {p} parameters")
+        raise FitError(f"{n} data rows cannot fit {p} parameters; fix: give more rows (--cycles all, --branch "
+                       "both, a longer record) or fit fewer parameters (--fix NAME=VALUE)")
     lo = np.array([params[nm].lo for nm in names], float)
     hi = np.array([params[nm].hi for nm in names], float)
     if np.any(lo >= hi):
         bad = [nm for nm, a, b in zip(names, lo, hi) if a >= b]
-        raise FitError(f"empty bounds for {', '.join(bad)}: lo must be < hi")
+        raise FitError(f"empty bounds for {', '.join(bad)}: lo must be < hi; fix: widen the Param's range in "
+                       "its effect, or hold it with --fix NAME=VALUE")
     span = hi - lo
     values = params.values
 
@@ -319,8 +322,10 @@ def fit(
     r0 = residual(x0)
     if not np.all(np.isfinite(r0)):
         k = int(np.flatnonzero(sel)[np.flatnonzero(~np.isfinite(r0))[0]])
+        users = [f"{e.name} ({e.source})" for e in getattr(model, "effects", ()) if e.source]
+        who = f"an effect returned NaN or inf (check {', '.join(users)})" if users else "check the effects' values"
         raise FitError(f"the model gives a non-finite angle at row {k} with the starting values "
-                       f"{ {nm: start[nm] for nm in names} }")
+                       f"{ {nm: start[nm] for nm in names} }; fix: {who}, or start elsewhere with --init NAME=VALUE")
 
     def guarded(x: np.ndarray) -> np.ndarray:
         return finite_residual(residual(x))

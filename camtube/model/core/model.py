@@ -212,6 +212,10 @@ class Effect:
         elif len(self.stages) > 1:
             raise ValueError(f"effect {self.name!r} acts on {len(self.stages)} stages: give apply as "
                              "{stage: function}")
+        for q in self.params:
+            if q.lo > q.hi:
+                raise ValueError(f"effect {self.name!r}: parameter {q.name!r} has lo {q.lo:g} > hi {q.hi:g}; "
+                                 "fix: swap them (Param(name, unit, lo, hi, init))")
         unknown = [k for k in self.off if k not in {p.name for p in self.params}]
         if unknown:
             raise ValueError(f"effect {self.name!r}: off names unknown parameter(s) {', '.join(unknown)}")
@@ -260,18 +264,34 @@ def _call(effect: Effect, stage: str, ctx: Context, signal: np.ndarray, p: dict)
         out = effect.function(stage)(ctx, signal, p)
     except KeyError as exc:
         raise FitError(f"{where(exc)}, stage {stage}: asked for parameter {exc.args[0]!r}, but its params are "
-                       f"{', '.join(repr(q.name) for q in effect.params) or 'none'}") from None
+                       f"{', '.join(repr(q.name) for q in effect.params) or 'none'}; fix: use one of those names "
+                       "or add a Param of that name") from None
     except FitError:
         raise
-    except Exception as exc:  # noqa: BLE001 - a user's effect may raise anything: report it with its line
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 - a user's effect may raise anything: report it with its line
         if not effect.source:
             raise
-        raise FitError(f"{where(exc)}, stage {stage}: {type(exc).__name__}: {exc}") from None
-    out = np.asarray(out, float)
+        what = "called sys.exit()" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}"
+        raise FitError(f"{where(exc)}, stage {stage}: {what}; fix: correct the effect's function at that "
+                       "line") from None
+    shape_fix = f"fix: return one number per row (an array shaped like the {stage} signal it was given)"
+    if np.iscomplexobj(out):
+        raise FitError(f"{where()}, stage {stage}: returned complex numbers; {shape_fix}")
+    try:
+        out = np.asarray(out, float)
+    except (TypeError, ValueError):
+        raise FitError(f"{where()}, stage {stage}: returned {type(out).__name__} {_short(out)}, not numbers; "
+                       f"{shape_fix}") from None
     if out.shape != signal.shape:
         raise FitError(f"{where()}, stage {stage}: returned shape {out.shape}, expected {signal.shape} "
-                       "(one value per row)")
+                       f"(one value per row); {shape_fix}")
     return out
+
+
+def _short(value) -> str:
+    """``repr(value)``, cut to 40 characters (a user's wrong return value, in a one-line message)."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def form_problem(effect: Effect, data, predicted_deg: np.ndarray) -> str:

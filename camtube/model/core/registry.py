@@ -40,7 +40,8 @@ class Registry(Mapping):
         for e in self.effects:
             if e.name in seen and seen[e.name] is not e:
                 raise EffectError(f"two different effects are named {e.name!r}"
-                                  + (f" ({seen[e.name].source or 'built-in'} and {e.source or 'built-in'})"))
+                                  + (f" ({seen[e.name].source or 'built-in'} and {e.source or 'built-in'})")
+                                  + "; fix: rename the effect of your file (Effect(name=...))")
             seen[e.name] = e
         object.__setattr__(self, "effects", tuple(seen.values()))
 
@@ -69,7 +70,8 @@ class Registry(Mapping):
             return self[name]
         hint = difflib.get_close_matches(name, list(self), n=1)
         raise EffectError(f"unknown effect {name!r}" + (f"; did you mean {hint[0]!r}?" if hint else "")
-                          + f" (known: {', '.join(sorted(self))})")
+                          + f" (known: {', '.join(sorted(self))}); fix: use a known name, or load the file that "
+                          "defines it with --effect-file")
 
 
 @functools.lru_cache(maxsize=1)
@@ -111,10 +113,12 @@ def load_effect_file(path: str | Path) -> tuple[Effect, ...]:
     """
     path = Path(path)
     if not path.is_file():
-        raise EffectError(f"{path}: no such effect file" if not path.exists() else f"{path}: not a file")
+        raise EffectError(f"{path}: no such effect file; fix: check the path of the .py file" if not path.exists()
+                          else f"{path}: not a file; fix: give the path of the effect's .py file")
     spec = importlib.util.spec_from_file_location(f"camtube_user_effect_{path.stem}", path)
     if spec is None or spec.loader is None:
-        raise EffectError(f"{path}: cannot import the effect file (is it a .py file?)")
+        raise EffectError(f"{path}: cannot import the effect file (is it a .py file?); fix: give a Python "
+                          "file named NAME.py (see docs/diagnose.md)")
     mod = importlib.util.module_from_spec(spec)
     bucket: list[Effect] = []
     token = _COLLECTING.set(bucket)
@@ -126,7 +130,7 @@ def load_effect_file(path: str | Path) -> tuple[Effect, ...]:
                               "(UTF-8 text; see docs/diagnose.md)") from None
         raise EffectError(f"{path}:{exc.lineno}: cannot load the effect file: {exc.msg}; fix: correct the Python "
                           "at that line") from None
-    except Exception as exc:  # noqa: BLE001 - a user's file may raise anything; report it with its line
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 - a user's file may raise anything; report it with its line
         import traceback
 
         here = path.resolve()
@@ -135,12 +139,17 @@ def load_effect_file(path: str | Path) -> tuple[Effect, ...]:
             raise EffectError(f"{path}: cannot load the effect file: {exc}; fix: give a Python source file "
                               "(UTF-8 text; see docs/diagnose.md)") from None
         line = f":{tb[-1].lineno}" if tb else ""
-        raise EffectError(f"{path}{line}: cannot load the effect file: {type(exc).__name__}: {exc}") from None
+        what = "it called sys.exit()" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}"
+        fix = "" if "; fix:" in str(exc) else "; fix: correct the file at that line (importing it must only define effects)"
+        raise EffectError(f"{path}{line}: cannot load the effect file: {what}{fix}") from None
     finally:
         _COLLECTING.reset(token)
     found = list(bucket) + [v for v in vars(mod).values() if isinstance(v, Effect)]
     out: dict[str, Effect] = {}
     for e in found:
+        if e.name in out and out[e.name] is not e and out[e.name] != e:
+            raise EffectError(f"{path}: defines two different effects named {e.name!r}; fix: give each Effect "
+                              "a name of its own (or delete the older one)")
         if e.name not in out:
             out[e.name] = e if e.source else replace(e, source=str(path), pure=False)  # a file's copy: not vouched for
     return tuple(out.values())
@@ -153,7 +162,8 @@ def registry_with_files(paths: Iterable[str | Path], base: Registry | None = Non
     for p in paths:
         effs = load_effect_file(p)
         if not effs:
-            raise EffectError(f"{p}: defines no Effect (a module-level Effect(...) object is needed)")
+            raise EffectError(f"{p}: defines no Effect (a module-level Effect(...) object is needed); fix: add one, "
+                              "e.g. start from `camtube model effect new NAME`")
         added += list(effs)
     return reg.with_effects(added), tuple(added)
 

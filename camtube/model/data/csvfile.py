@@ -17,6 +17,8 @@ from camtube.model.data.dataset import Dataset
 COLUMNS = ("sample", "cycle", "time_s", "stroke_mm", "force_N", "angle_deg")
 _FLOAT_COLS = ("time_s", "stroke_mm", "force_N", "angle_deg")
 _FORMATS = {"time_s": "%.4f", "stroke_mm": "%.6f", "force_N": "%.6f", "angle_deg": "%.5f"}
+#: Largest cycle number read (a billion cycles; beyond, the number cannot be a count of cycles).
+MAX_CYCLE = 1e9
 
 
 # ----------------------------------------------------------------------------- loading
@@ -49,6 +51,14 @@ def _to_float(col: tuple, name: str, lines: np.ndarray, source: str, finite: boo
             raise _err(source, int(lines[k]), f"column {name!r} is {col[k].strip()!r}",
                        "NaN/inf are not measurements: drop the row or fill the gap")
     return arr
+
+
+def _is_number(cell: str) -> bool:
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
 
 
 def _check_separator(header: list[str], source: str, line: int) -> None:
@@ -138,9 +148,13 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
     if header is None:
         raise _err(source, None, "no header line: the file is empty",
                    f"the first line must name the columns: {', '.join(COLUMNS)}")
+    if len(header) > 1 and sum(map(_is_number, header)) >= len(header) - 1:  # a data row (its sample may be a name)
+        raise _err(source, header_line, f"no header line: the first line holds numbers ({', '.join(header[:3])}"
+                   f"{', ...' if len(header) > 3 else ''})", f"add a first line naming the columns: {', '.join(COLUMNS)}")
     dup = sorted({c for c in header if header.count(c) > 1})
     if dup:
-        raise _err(source, header_line, f"duplicate column(s) {', '.join(dup)}")
+        raise _err(source, header_line, f"duplicate column(s) {', '.join(dup)}",
+                   "keep one column of each name (rename or delete the copy)")
     missing = [c for c in COLUMNS if c not in header]
     if missing:
         hints = []
@@ -159,7 +173,8 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
                    f"missing column(s) {', '.join(missing)} (found: {', '.join(header)})",
                    "; ".join(hints) if hints else f"the header must contain {', '.join(COLUMNS)}")
     if not rows:
-        raise _err(source, header_line, "no data rows after the header")
+        raise _err(source, header_line, "no data rows after the header",
+                   "add the measurements, one row per sample time, below the header")
 
     ln = np.asarray(lines, dtype=np.int64)
     cols = dict(zip(header, zip(*rows)))
@@ -168,11 +183,11 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
     if empty.size:
         raise _err(source, int(ln[empty[0]]), "column 'sample' is empty", "give every row a sample id")
     cyc_f = _to_float(cols["cycle"], "cycle", ln, source)
-    bad = np.flatnonzero((cyc_f != np.round(cyc_f)) | (cyc_f < 1))
+    bad = np.flatnonzero((cyc_f != np.round(cyc_f)) | (cyc_f < 1) | (cyc_f > MAX_CYCLE))
     if bad.size:
         k = int(bad[0])
-        raise _err(source, int(ln[k]), f"column 'cycle' must be a whole number >= 1, got {cols['cycle'][k].strip()!r}",
-                   "number the cycles 1, 2, 3, ...")
+        raise _err(source, int(ln[k]), f"column 'cycle' must be a whole number from 1 to 10^9, got "
+                   f"{cols['cycle'][k].strip()!r}", "number the cycles 1, 2, 3, ...")
     num = {c: _to_float(cols[c], c, ln, source, finite=strict) for c in _FLOAT_COLS}
     missing_lines = np.zeros(0, np.int64)
     if not strict:
@@ -258,13 +273,15 @@ def _read_text(path: Path) -> str:
     try:
         text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
-        raise DataError(f"{path}: no such measurement file") from None
+        raise DataError(f"{path}: no such measurement file; fix: check the path of the CSV file") from None
     except IsADirectoryError:
         raise DataError(f"{path}: is a directory, not a measurement file; fix: name the CSV file") from None
     except PermissionError:
-        raise DataError(f"{path}: cannot read the measurement file (permission denied)") from None
+        raise DataError(f"{path}: cannot read the measurement file (permission denied); fix: make it readable "
+                        f"(chmod u+r) or copy it somewhere you can read") from None
     except OSError as exc:
-        raise DataError(f"{path}: cannot read the measurement file ({exc.strerror or exc})") from None
+        raise DataError(f"{path}: cannot read the measurement file ({exc.strerror or exc}); fix: give a readable "
+                        "CSV file") from None
     except UnicodeDecodeError as exc:
         raise DataError(f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start}); fix: give the "
                         "measurement CSV (save it as UTF-8 text)") from None

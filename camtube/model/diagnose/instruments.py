@@ -40,6 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from camtube.errors import DataError
 from camtube.model.core.threads import one_blas_thread
 from camtube.model.data.dataset import Dataset
 
@@ -391,6 +392,9 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     -------
     Instruments
     """
+    if lag_ms is not None and not math.isfinite(lag_ms):
+        raise DataError(f"--lag-ms {lag_ms}: the angle channel's lag must be a finite number of ms; fix: give e.g. "
+                        "--lag-ms 20, or 0 for none")
     slices = data.sample_slices()
     aside: dict[str, np.ndarray] = {}
     rep = np.zeros(len(data), bool)

@@ -170,6 +170,9 @@ def ingest(tracker: TrackerLog | Series, daq: Series, motor: Series, bench: Benc
         A unit or sign that cannot be right (one line naming the file, the column and the fix), logs that
         do not overlap, no frame with both coils tracked.
     """
+    if max_lag_s is not None and not (max_lag_s > 0 and max_lag_s < float("inf")):
+        raise DataError(f"--max-lag {max_lag_s}: the largest clock offset must be a finite number of seconds > 0; "
+                        "fix: give e.g. --max-lag 5, or leave it out to consider any offset")
     if isinstance(tracker, Series):
         bend, t0, flagged, tip, base = _angle_from_log(tracker, bench)
     else:

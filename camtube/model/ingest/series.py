@@ -244,11 +244,11 @@ def load_bench_map(path: str | Path | None, overrides: list[str] = ()) -> BenchM
         import yaml
 
         from camtube.model.ingest.ndi import read_text
-        from camtube.yamltext import StrictLoader
+        from camtube.yamltext import parse_yaml
 
         source = str(path)
         try:
-            doc = yaml.load(read_text(path, "bench map"), Loader=StrictLoader) or {}
+            doc = parse_yaml(read_text(path, "bench map")) or {}
         except yaml.YAMLError as exc:
             mark = getattr(exc, "problem_mark", None)
             where = f"{path}:{mark.line + 1}" if mark else str(path)

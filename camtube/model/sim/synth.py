@@ -65,7 +65,7 @@ def rows_per_cycle(max_stroke_mm: float, speed_mm_s: float, rate_hz: float, dwel
 
 def check_arguments(n_samples: int, n_cycles: int, noise_angle_deg: float, noise_force_N: float, *,
                     modulus_gpa: float | None, max_stroke_mm: float, speed_mm_s: float, rate_hz: float,
-                    slack_mm: float, stiffness_spread: float = 0.1, dwell_s: float = 0.0) -> None:
+                    slack_mm: float, stiffness_spread: float = 0.1, dwell_s: float = 0.0, seed: int = 0) -> None:
     """Refuse generator settings that make no physical sense or an absurd file.
 
     Raises
@@ -74,7 +74,7 @@ def check_arguments(n_samples: int, n_cycles: int, noise_angle_deg: float, noise
         Naming the setting (with its command-line option), the value and the allowed range.
     """
     def bad(name: str, value, allowed: str) -> DataError:
-        return DataError(f"{name} = {value!r}: allowed {allowed}")
+        return DataError(f"{name} = {value!r}: allowed {allowed}; fix: give a value in that range")
 
     checks = (
         (n_samples >= 1, "samples (--samples)", n_samples, ">= 1"),
@@ -92,6 +92,7 @@ def check_arguments(n_samples: int, n_cycles: int, noise_angle_deg: float, noise
         (modulus_gpa is None or (math.isfinite(modulus_gpa) and modulus_gpa > 0), "tendon modulus (--modulus)",
          modulus_gpa, "> 0 GPa"),
         (0 <= stiffness_spread < 1, "stiffness spread", stiffness_spread, "0 <= spread < 1"),
+        (seed is None or 0 <= seed < 2 ** 63, "random seed (--seed)", seed, "a whole number >= 0"),
     )
     for ok, name, value, allowed in checks:
         if not ok:
@@ -165,7 +166,7 @@ def synthesize(
     smax = pattern.rules.max_stroke_mm if max_stroke_mm is None else max_stroke_mm
     check_arguments(n_samples, n_cycles, noise_angle_deg, noise_force_N, modulus_gpa=modulus_gpa,
                     max_stroke_mm=smax, speed_mm_s=speed_mm_s, rate_hz=rate_hz, slack_mm=slack_mm,
-                    stiffness_spread=stiffness_spread)
+                    stiffness_spread=stiffness_spread, seed=seed)
     rng = np.random.default_rng(seed)
     g = pattern_geometry(pattern).first
     e_t = pattern.tendon.modulus_gpa if modulus_gpa is None else modulus_gpa
