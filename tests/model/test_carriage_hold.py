@@ -21,12 +21,15 @@ def _by_rows(data, s, hold, gap):
     f = np.asarray(data.force_smoothed_N, float)
     out = s.copy()
     for _, sl in data.sample_slices():
-        low_prev, seen, c = False, False, 0.0
+        low_prev, seen, gone, c = False, False, False, 0.0
         for k in range(sl.start, sl.stop):
             first = k == sl.start
-            in_band = f[k] <= HOLD_BAND * hold
-            seen = in_band and ((seen and not first and f[k - 1] <= HOLD_BAND * hold) or f[k] <= hold)
-            if not seen:
+            if f[k] > HOLD_BAND * hold:                        # pulled onto the flank: a new run may start
+                seen = gone = False
+            else:
+                seen = seen or f[k] <= hold
+                gone = gone or f[k] < RELEASE_SHARE * hold     # let go: on the flank for the rest of the run
+            if not seen or gone or f[k] > HOLD_BAND * hold:
                 c, low_prev = s[k], False
                 continue
             if not low_prev:                                   # held from here: where the force fell to hold_N
@@ -38,8 +41,6 @@ def _by_rows(data, s, hold, gap):
                     c = s[k - 1] + (s[k] - s[k - 1]) * (f[k - 1] - hold) / (f[k - 1] - f[k])
                 c = min(max(c, min(s[k], s[k - 1])), max(s[k], s[k - 1])) if not first else c
                 c = min(max(c, s[k]), s[k] + gap)
-            elif s[k] >= s[k - 1] and f[k] < RELEASE_SHARE * hold <= f[k - 1]:
-                c = s[k]                                       # let go: back onto the flank
             else:
                 c = min(max(c, s[k]), s[k] + gap)
             out[k] = c
@@ -91,7 +92,7 @@ def test_off_and_no_held_rows_give_the_stroke_itself():
 def test_the_held_position_moves_continuously_with_the_hold_force():
     t = np.arange(0, 2.0, 0.01)
     s = np.clip(1.0 - t, 0.0, None)
-    f = 2.0 * s + 0.1
+    f = 2.0 * s + 0.2                                         # held at 0.2 N, above half the hold force
     data = _rows(s, f)
     a = carriage_hold(data, s, 0.3, 1.0)[-1]
     b = carriage_hold(data, s, 0.3 + 1e-6, 1.0)[-1]

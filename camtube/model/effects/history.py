@@ -250,8 +250,9 @@ def _lag_blocks(cum: np.ndarray) -> tuple:
     return out, table
 
 
-#: A held carriage lets go when the smoothed force falls below this share of the hold force while the motor
-#: stands or pulls: the tendon's tension drops at once as the carriage slides back onto the nut's flank.
+#: A held carriage lets go when the smoothed force falls below this share of the hold force: the tendon's tension
+#: drops at once as the carriage slides back onto the nut's flank (or, with the motor still going down, the nut's
+#: far flank pushes the carriage down with it: the gap this law takes as wider than the stroke held)
 RELEASE_SHARE = 0.5
 #: Once held, the carriage stays held while the smoothed force stays below this multiple of the hold force: the
 #: held tension creeps up to the rail's friction during a rest, within the cell's noise, and must not let go
@@ -284,8 +285,9 @@ def carriage_hold(data: Dataset, stroke_mm: np.ndarray, hold_N: float | np.ndarr
     While the tension (smoothed: :attr:`Dataset.force_smoothed_N`) exceeds ``hold_N`` the tendon pulls the
     carriage onto the nut's flank: it follows the stroke. Once the tension falls to ``hold_N`` the rail holds it
     where it is (where the tension fell to ``hold_N``: :func:`_sticks`, continuous in ``hold_N``), within the
-    gap: ``c_k = clip(c_(k-1), s_k, s_k + gap_mm)``. It lets go, back onto the flank (``c_k = s_k``), when the tension falls below :data:`RELEASE_SHARE` of ``hold_N`` while the motor
-    stands or pulls; it stays held while the tension stays below :data:`HOLD_BAND` x ``hold_N``. Per sample;
+    gap: ``c_k = clip(c_(k-1), s_k, s_k + gap_mm)``. It lets go, back onto the flank (``c_k = s_k``), when the
+    tension falls below :data:`RELEASE_SHARE` of ``hold_N``, and stays there until the tension has risen past
+    :data:`HOLD_BAND` x ``hold_N`` (the next pull); it stays held while the tension stays below that. Per sample;
     ``hold_N`` a number or one per row (a sample's own); ``gap_mm <= 0`` or ``hold_N <= 0``: the stroke itself.
 
     Exact and vectorised: inside a run of held rows the recursion is a running minimum of
@@ -308,26 +310,25 @@ def carriage_hold(data: Dataset, stroke_mm: np.ndarray, hold_N: float | np.ndarr
     band = (f <= HOLD_BAND * hold) & (hold > 0.0)
     run = np.cumsum(band & ~(np.concatenate(([False], band[:-1])) & ~starts_of_samples))
     seen = np.maximum.accumulate((f <= hold) + 2 * run) - 2 * run
-    low = band & (seen >= 1)
+    # ... until the force falls below RELEASE_SHARE x hold_N: let go, on the flank for the rest of the run
+    gone = np.maximum.accumulate((f < RELEASE_SHARE * hold) + 2 * run) - 2 * run
+    low = band & (seen >= 1) & (gone < 1)
     ds = np.diff(s, prepend=s[:1])
     up = ds >= 0.0
     prev_low = np.concatenate(([False], low[:-1])) & ~starts_of_samples
     entry = low & ~prev_low                               # the first row of a held run
-    prev_f = np.concatenate(([np.inf], f[:-1]))
-    release = low & prev_low & up & (f < RELEASE_SHARE * hold) & (prev_f >= RELEASE_SHARE * hold)
     prev_up = np.concatenate(([True], up[:-1]))
     turn = low & prev_low & (up != prev_up)
     rows = np.flatnonzero(low)
     if rows.size == 0:
         return out
-    first = np.flatnonzero(entry | release | turn)        # every piece starts at one of these rows
+    first = np.flatnonzero(entry | turn)                  # every piece starts at one of these rows
     piece = np.searchsorted(first, rows, side="right") - 1
     lo_s = np.minimum.reduceat(s[rows], np.searchsorted(rows, first))
     hi_s = np.maximum.reduceat(s[rows], np.searchsorted(rows, first))
-    # the value each piece starts from: a stick, the stroke (let go), or what the piece before ended with (a scalar
-    # loop over the pieces only)
-    fresh = np.where(entry[first], _sticks(s, f, starts_of_samples, first, hold[first]), s[first]).tolist()
-    restart = (entry[first] | release[first]).tolist()
+    # the value each piece starts from: a stick, or what the piece before ended with (a scalar loop over the pieces)
+    fresh = _sticks(s, f, starts_of_samples, first, hold[first]).tolist()
+    restart = entry[first].tolist()
     rise = up[first].tolist()
     los, his = lo_s.tolist(), hi_s.tolist()
     begin = [0.0] * first.size
