@@ -135,6 +135,8 @@ HELDOUT7_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", 
 #: backbone beside a slack tendon, friction at the guide beside a creeping tendon.
 HELDOUT8_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
                   ("slack", "backbone"), ("friction", "creep"), "friction"]
+HELDOUT9_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
+                  ("lost motion", "toe"), ("creep", "lost motion"), "friction"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -152,7 +154,10 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            "bench-heldout7": (20261229, HELDOUT7_KINDS),
            # drawn once the hardstop's plateau check and the retry of an empty round were settled (every batch
            # above had been looked at): a seed not used before, with two new pairs; run once
-           "bench-heldout8": (20261230, HELDOUT8_KINDS)}
+           "bench-heldout8": (20261230, HELDOUT8_KINDS),
+           # drawn once carriage_hold (lost motion in the drive) was settled (every batch above had been looked
+           # at): a seed not used before, with lost motion beside a toe and beside a creeping tendon; run once
+           "bench-heldout9": (20261231, HELDOUT9_KINDS)}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
