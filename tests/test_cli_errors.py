@@ -135,3 +135,9 @@ def test_failed_verification_is_not_success(tmp_path):
 def test_bad_option_values(tmp_path, opt, value):
     assert_refused(camtube("cad", TUBE1, "-q", "-o", str(tmp_path / "c"), opt, value), opt)
     assert listing(tmp_path) == []
+
+
+def test_calibration_without_stroke_says_the_fix():
+    """Before: '...forward model: fix: add --stroke MM' (a colon, not '; fix:')."""
+    r = camtube("design", TUBE1, "--calibration", "cal.json", "-q")
+    assert_refused(r, "--calibration", "; fix: add --stroke MM")

@@ -103,7 +103,7 @@ def cmd_design(args: argparse.Namespace) -> int:
         raise CamtubeError(f"--stroke {args.stroke:g}: the tendon stroke must be >= 0 and < 1000 mm; fix: give a "
                            "stroke in mm, e.g. --stroke 1.5")
     if args.calibration and args.stroke is None:
-        raise CamtubeError("--calibration is used by the forward model: fix: add --stroke MM")
+        raise CamtubeError("--calibration is used by the forward model; fix: add --stroke MM")
     loaded = load_from_args(args)
     mech = None
     if args.stroke is not None:

@@ -121,8 +121,17 @@ def _diagnose(args: argparse.Namespace) -> int:
     check_suffix(args.json, (".json",), "--json")
     if args.report is not None and Path(args.report).exists() and not Path(args.report).is_dir():
         raise DataError(f"--report {args.report}: is a file; the report is a directory (index.html and PNGs)")
-    if args.max_rows < 0 or args.max_effects < 0:
-        raise DataError("--max-rows and --max-effects must be >= 0")
+    for opt, v, eg in (("--max-rows", args.max_rows, "4000 (0 = all rows)"), ("--max-effects", args.max_effects, "4")):
+        if v < 0:
+            raise DataError(f"{opt} {v}: must be >= 0; fix: e.g. {opt} {eg}")
+    try:
+        lo, hi = (float(v) for v in args.modulus_range.split(","))
+    except ValueError:
+        raise DataError(f"--modulus-range {args.modulus_range!r}: not LO,HI; fix: give two numbers in GPa, "
+                        "e.g. --modulus-range 1,300") from None
+    if not 0 < lo < hi < float("inf"):
+        raise DataError(f"--modulus-range {args.modulus_range!r}: need finite 0 < LO < HI (GPa); fix: e.g. "
+                        "--modulus-range 1,300")
     pattern = load_from_args(args).pattern
     reg, _ = build_registry(args.effect_file)
     model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects)])
@@ -137,12 +146,6 @@ def _diagnose(args: argparse.Namespace) -> int:
     ins = confirm_lag(ins, model, fixed, fit_names)
     rows = ins.data
     cands = [reg.get_effect(c) for c in split_names(args.candidates)] or None
-    try:
-        lo, hi = (float(v) for v in args.modulus_range.split(","))
-    except ValueError:
-        raise DataError(f"--modulus-range {args.modulus_range!r}: use LO,HI in GPa, e.g. 1,300") from None
-    if not 0 < lo < hi:
-        raise DataError(f"--modulus-range {args.modulus_range!r}: need 0 < LO < HI (GPa)")
     d = diagnose(model, rows, fit_names, fixed, candidates=cands,
                  max_rows=args.max_rows, max_effects=args.max_effects, registry=reg,
                  stop_ratio=1.15 if args.stop_rule else None, modulus_range_gpa=(lo, hi),

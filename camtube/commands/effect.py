@@ -46,10 +46,11 @@ def cmd_effect_new(args: argparse.Namespace) -> int:
     elif args.follows:
         text = starter_source(args.name, None, stage=args.stage, follows=args.follows)
     else:
-        raise DataError("give --from DIAG.json, or --follows VARIABLE (and optionally --stage)")
+        raise DataError("model effect new: nothing to start from; fix: give --from DIAG.json, or --follows VARIABLE "
+                        "(and optionally --stage)")
     out = Path(args.output or f"{args.name}.py")
     if out.exists() and not args.overwrite:
-        raise DataError(f"{out} exists; use --overwrite or -o OTHER.py")
+        raise DataError(f"{out}: exists; fix: add --overwrite to replace it, or -o OTHER.py")
     print(f"wrote {write_atomic(out, text)}")
     print(f"use it: camtube model diagnose DATA.csv --pattern PATTERN --effect-file {out}")
     return 0

@@ -240,3 +240,69 @@ def test_fit_options_out_of_range_are_refused(data_csv, tmp_path, capsys, opt, v
     err = _fails_cleanly(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", opt, value, "--json", str(js)],
                          capsys, f"{opt} ", "fix:")
     assert len(err.strip().splitlines()) == 1 and not js.exists(), err
+
+
+def _one_line_with_fix(argv, capsys, *words):
+    """Exit 2 and exactly one stderr line that names ``words`` and ends with '; fix: ...'."""
+    err = _fails_cleanly(argv, capsys, *words)
+    lines = [x for x in err.splitlines() if x.strip()]
+    assert len(lines) == 1 and "; fix: " in lines[0], err
+    return lines[0]
+
+
+@pytest.mark.parametrize("cmd,tail,words", [
+    ("fit", ["--cycles", "abc"], ["'abc'"]), ("fit", ["--cycles", "99"], ["'99'", "1-3"]),
+    ("diagnose", ["--cycles", "abc"], ["'abc'"]),
+    ("fit", ["--fit", "nosuch"], ["--fit nosuch"]), ("fit", ["--fix", "nosuch=1"], ["--fix nosuch"]),
+    ("fit", ["--per-sample", "nosuch"], ["--per-sample nosuch"]), ("fit", ["--init", "E_t@zz=1"], ["--init E_t@zz"]),
+    ("diagnose", ["--fit", "nosuch"], ["--fit nosuch"]),
+    ("fit", ["--fix", "E_t"], ["--fix 'E_t'"]), ("fit", ["--init", "E_t=abc"], ["--init 'E_t=abc'"]),
+    ("diagnose", ["--max-rows", "-1"], ["--max-rows -1"]), ("diagnose", ["--max-effects", "-1"], ["--max-effects -1"]),
+    ("diagnose", ["--modulus-range", "abc"], ["--modulus-range 'abc'"]),
+    ("diagnose", ["--modulus-range", "5,1"], ["--modulus-range '5,1'"]),
+    ("fit", ["--json", "{tmp}/f.txt"], ["--json", ".json"]), ("diagnose", ["--json", "{tmp}/f.txt"], [".json"]),
+    ("fit", ["--plot", "{tmp}/f.jpg"], ["--plot", ".png"]),
+])
+def test_fit_and_diagnose_mistakes_say_the_fix(data_csv, tmp_path, capsys, cmd, tail, words):
+    """Before: these lines had no '; fix: ...' (and the unknown-parameter line did not name the option)."""
+    tail = [a.replace("{tmp}", str(tmp_path)) for a in tail]
+    _one_line_with_fix(["model", cmd, str(data_csv), "--pattern", TUBE2, "-q", *tail], capsys, *words)
+    assert not list(tmp_path.iterdir())
+
+
+def test_synth_suffix_mistake_says_the_fix(tmp_path, capsys):
+    _one_line_with_fix(["model", "synth", "--pattern", TUBE2, "-q", "-o", str(tmp_path / "x.txt")], capsys,
+                       "x.txt", "fix: e.g. --output x.csv")
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("tail,words", [
+    ([], ["--from DIAG.json"]), (["--from", "{tmp}/nosuch.json"], ["nosuch.json", "no such diagnosis file"]),
+    (["--from", "{tmp}/bad.json"], ["bad.json", "not a diagnosis JSON"]),
+    (["--from", "{tmp}/empty.json"], ["empty.json", "no 'unexplained' section"]),
+    (["--follows", "stroke", "-o", "{tmp}/old.py"], ["old.py", "exists", "--overwrite"]),
+    (["--follows", "angle", "--stage", "force"], ["--stage force"]),
+])
+def test_effect_new_mistakes_say_the_fix(tmp_path, capsys, monkeypatch, tail, words):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "bad.json").write_text("x")
+    (tmp_path / "empty.json").write_text("{}")
+    (tmp_path / "old.py").write_text("mine")
+    tail = [a.replace("{tmp}", str(tmp_path)) for a in tail]
+    _one_line_with_fix(["model", "effect", "new", "drive", *tail], capsys, *words)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.json", "empty.json", "old.py"]
+    assert (tmp_path / "old.py").read_text() == "mine"
+
+
+@pytest.mark.parametrize("tail,words", [
+    (["--tracker", "{tmp}/nosuch.csv"], ["nosuch.csv", "no such tracker export"]),
+    (["--tracker", "{data}", "--map", "nosuch=1"], ["--map 'nosuch=1'", "SECTION.NAME"]),
+    (["--tracker", "{data}", "--bench", "{tmp}/bad.yaml"], ["bad.yaml:2", "not valid YAML"]),
+])
+def test_ingest_mistakes_say_the_fix(data_csv, tmp_path, capsys, tail, words):
+    (tmp_path / "bad.yaml").write_text("tracker: [\n")
+    tail = [a.replace("{tmp}", str(tmp_path)).replace("{data}", str(data_csv)) for a in tail]
+    out = tmp_path / "o.csv"
+    _one_line_with_fix(["model", "ingest", *tail, "--daq", str(data_csv), "--motor", str(data_csv), "-o", str(out)],
+                       capsys, *words)
+    assert not out.exists()

@@ -34,7 +34,7 @@ def parse_assignments(items: Iterable[str], option: str = "--fix") -> dict[str, 
         except ValueError:
             sep = ""
         if not sep or not name.strip():
-            raise FitError(f"{option} {it!r}: use NAME=VALUE with a number, e.g. {option} L0=70")
+            raise FitError(f"{option} {it!r}: use NAME=VALUE with a number; fix: e.g. {option} L0=70")
     return out
 
 
@@ -136,6 +136,7 @@ def check_suffix(path: str | None, suffixes: tuple[str, ...], option: str) -> No
     p = Path(path)
     if p.suffix.lower() not in suffixes:
         raise DataError(f"{option} {path}: writes {suffixes[0][1:].upper()}, so the file must end in "
-                        f"{' or '.join(suffixes)} (got {p.suffix or 'no suffix'!r})")
+                        f"{' or '.join(suffixes)} (got {p.suffix or 'no suffix'!r}); "
+                        f"fix: e.g. {option.split('/')[-1]} {p.with_suffix(suffixes[0]).name}")
     if p.is_dir():
         raise DataError(f"{option} {path}: is a directory; fix: name a file")

@@ -425,14 +425,16 @@ class JointModel:
             elif nm in self.effect_names():
                 ps += [f"{nm}.{p.name}" for p in next(e for e in self.effects if e.name == nm).params]
             else:
-                raise unknown_parameter(nm, known + list(self.effect_names()))
+                raise unknown_parameter(nm, known + list(self.effect_names()), "--per-sample")
         samples = data.samples
-        for nm in list(fit) + list(fixed) + list(initial) + list(bounds):
-            base, smp = split_name(nm)
-            if base not in specs:
-                raise unknown_parameter(base, known)
-            if smp is not None and smp not in samples:
-                raise FitError(f"parameter {nm!r}: the data have no sample {smp!r} (samples: {', '.join(samples)})")
+        for option, names in (("--fit", fit), ("--fix", fixed), ("--init", initial), ("bounds", bounds)):
+            for nm in names:
+                base, smp = split_name(nm)
+                if base not in specs:
+                    raise unknown_parameter(base, known, option)
+                if smp is not None and smp not in samples:
+                    raise FitError(f"{option} {nm}: the data have no sample {smp!r} (samples: {', '.join(samples)}); "
+                                   "fix: use NAME@SAMPLE with one of these samples")
         start = self.initial_values(data, base={k: v for k, v in fixed.items() if "@" not in k})
         start.update({k: float(v) for k, v in initial.items() if "@" not in k})
         want = {split_name(n)[0] for n in fit}
@@ -647,9 +649,11 @@ def _sample_views(data: Dataset) -> list:
     return hit
 
 
-def unknown_parameter(name: str, known: Sequence[str]) -> FitError:
+def unknown_parameter(name: str, known: Sequence[str], option: str = "") -> FitError:
+    """The error for a parameter name the model does not have (``option``: where it was given, e.g. ``--fit``)."""
     import difflib
 
     hint = difflib.get_close_matches(name, list(known), n=1)
-    return FitError(f"unknown model parameter {name!r}" + (f"; did you mean {hint[0]!r}?" if hint else "")
-                    + f" (this model has: {', '.join(known)})")
+    return FitError((f"{option} {name}: " if option else "") + f"unknown model parameter {name!r}" + (f"; did you mean {hint[0]!r}?" if hint else "")
+                    + f" (this model has: {', '.join(known)}); fix: use one of these names (an effect's as NAME.param), "
+                    "or add its effect with --effects")

@@ -82,7 +82,7 @@ def parse_cycles(spec: str | None) -> CycleSpec:
                 ranges.append((lo_i, hi_i))
                 continue
         raise DataError(f"cycle selection {spec!r}: cannot read {item!r}; "
-                        "use all, last, last20, 5, 31-50, 2- or -10 (comma lists allowed)")
+                        "fix: use all, last, last20, 5, 31-50, 2- or -10 (comma lists allowed)")
     return CycleSpec(tuple(ranges), tuple(last), everything, text)
 
 
@@ -99,7 +99,7 @@ def select_cycles(data: Dataset, spec: str | CycleSpec | None) -> Dataset:
     if len(data) and not m.any():
         cyc = np.asarray(data.cycle)
         raise DataError(f"cycle selection {cs.text!r} matches no rows; the data have cycles "
-                        f"{int(cyc.min())}-{int(cyc.max())}")
+                        f"{int(cyc.min())}-{int(cyc.max())}; fix: select cycles in that range, e.g. --cycles all")
     return data if m.all() else data.take(m)
 
 

@@ -291,7 +291,7 @@ def read_text(path: str | Path, what: str) -> str:
     try:
         return path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
-        raise DataError(f"{path}: no such {what}") from None
+        raise DataError(f"{path}: no such {what}; fix: give the path of an existing {what}") from None
     except IsADirectoryError:
         raise DataError(f"{path}: is a directory, not a {what}; fix: name the file") from None
     except UnicodeDecodeError as exc:

@@ -209,11 +209,12 @@ def bench_map_from_dict(doc: dict, source: str = "<bench map>", overrides: list[
         raise DataError(f"{source}: the bench map must be a mapping of tracker/daq/motor; fix: see docs/bench.md")
     for item in overrides:
         if "=" not in item:
-            raise DataError(f"--map {item!r}: expected KEY=VALUE, e.g. daq.N_per_V=2.2")
+            raise DataError(f"--map {item!r}: expected KEY=VALUE; fix: e.g. --map daq.N_per_V=2.2")
         k, v = item.split("=", 1)
         parts = k.strip().split(".")
         if len(parts) != 2:
-            raise DataError(f"--map {item!r}: the key must be SECTION.NAME, e.g. motor.gear_ratio")
+            raise DataError(f"--map {item!r}: the key must be SECTION.NAME; fix: e.g. --map motor.gear_ratio=64 "
+                            "(sections: tracker, daq, motor, angle)")
         doc.setdefault(parts[0], {})[parts[1]] = v
     base = BenchMap()
     sections = {}
@@ -252,7 +253,8 @@ def load_bench_map(path: str | Path | None, overrides: list[str] = ()) -> BenchM
         except yaml.YAMLError as exc:
             mark = getattr(exc, "problem_mark", None)
             where = f"{path}:{mark.line + 1}" if mark else str(path)
-            raise DataError(f"{where}: not valid YAML ({getattr(exc, 'problem', exc)})") from None
+            raise DataError(f"{where}: not valid YAML ({getattr(exc, 'problem', exc)}); fix: correct the bench map "
+                            "there (a mapping of tracker/daq/motor keys, see docs/bench.md)") from None
     return bench_map_from_dict(doc, source, list(overrides))
 
 

@@ -58,7 +58,8 @@ def _to_stage(stage: str) -> str:
 
 def _ident(name: str) -> str:
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name or "") or keyword.iskeyword(name):
-        raise DataError(f"effect name {name!r}: use letters, digits and _ (a Python identifier), e.g. drive_error")
+        raise DataError(f"effect name {name!r}: not a Python identifier (letters, digits and _, not starting "
+                        "with a digit); fix: e.g. drive_error")
     return name
 
 
@@ -85,17 +86,18 @@ def starter_source(name: str, unexplained: dict | None = None, *, stage: str | N
     u = dict(unexplained or {})
     var = follows or u.get("leading") or (u.get("follows") or [None])[0]
     if var is None:
-        raise DataError("no variable to follow: give --follows VARIABLE (one of " + ", ".join(VARIABLES)
+        raise DataError("no variable to follow; fix: give --follows VARIABLE (one of " + ", ".join(VARIABLES)
                         + ") or a diagnosis JSON whose 'unexplained' section names one")
     if var not in VARIABLES:
-        raise DataError(f"--follows {var!r}: not a variable; use one of {', '.join(VARIABLES)}")
+        raise DataError(f"--follows {var!r}: not a variable; fix: use one of {', '.join(VARIABLES)}")
     per = next((p for p in u.get("periodic") or [] if p.get("variable") == var), None)
     stage = stage or (u.get("stage") if u.get("leading") == var and u.get("stage") else None) \
         or DEFAULT_STAGE[var]
     if stage not in STAGES:
-        raise DataError(f"--stage {stage!r}: use one of {', '.join(STAGES)}")
+        raise DataError(f"--stage {stage!r}: not a stage; fix: use one of {', '.join(STAGES)}")
     if var == "angle" and stage not in ("kinematics", "angle"):
-        raise DataError(f"the angle is known only from the kinematics stage on; use --stage kinematics, not {stage}")
+        raise DataError(f"--stage {stage} with --follows angle: the angle is known only from the kinematics stage "
+                        "on; fix: use --stage kinematics (or angle)")
     shape = "periodic" if per else (u.get("shape") if u.get("leading") == var and u.get("shape") else
                                     ("step" if var in ("first_cycle", "direction", "sample") else "linear"))
     sig, _ = SIGNAL[stage]
@@ -222,14 +224,16 @@ def starter_from_json(name: str, path: str | Path, *, stage: str | None = None,
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
-        raise DataError(f"{path}: no such diagnosis file (write one with camtube model diagnose ... --json)") from None
+        raise DataError(f"{path}: no such diagnosis file; fix: write one with camtube model diagnose ... --json "
+                        f"{path.name}") from None
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise DataError(f"{path}: not a diagnosis JSON ({exc})") from None
+        raise DataError(f"{path}: not a diagnosis JSON ({exc}); fix: give the file camtube model diagnose "
+                        "... --json wrote") from None
     if not isinstance(doc, dict) or "unexplained" not in doc:
-        raise DataError(f"{path}: no 'unexplained' section (write it with this version of camtube model diagnose "
-                        f"--json), or give --stage and --follows")
+        raise DataError(f"{path}: no 'unexplained' section; fix: write it with this version of camtube model "
+                        f"diagnose --json, or give --stage and --follows")
     u = doc["unexplained"]
     if u is None and follows is None:
-        raise DataError(f"{path}: the diagnosis left nothing unexplained (unexplained: null); give --follows to "
+        raise DataError(f"{path}: the diagnosis left nothing unexplained (unexplained: null); fix: give --follows to "
                         f"start an effect anyway")
     return starter_source(name, u, stage=stage, follows=follows)
