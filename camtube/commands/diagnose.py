@@ -114,6 +114,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     from camtube.model.core.build import build_registry, check_suffix, fitted_and_held, parse_assignments, split_names
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import check_fittable, read_measurements, select_cycles
+    from camtube.model.data.csvfile import check_force_identifies
     from camtube.model.diagnose import diagnose
     from camtube.model.diagnose.instruments import check_instruments, confirm_lag
     from camtube.model.report.diagnosis import diagnosis_json, diagnosis_text, write_report
@@ -134,18 +135,19 @@ def _diagnose(args: argparse.Namespace) -> int:
                         "--modulus-range 1,300")
     pattern = load_from_args(args).pattern
     reg, _ = build_registry(args.effect_file)
-    model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects)])
+    model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects, "--effects")])
     meas = read_measurements(args.data, strict=args.strict)
     rows = select_cycles(meas.data, args.cycles)
     ins = check_instruments(rows, lag_ms=args.lag_ms, dropped=meas.summary(),
                             n_dropped=int(meas.missing_lines.size + meas.backward_lines.size))
     check_fittable(ins.data, _rows_left(args, meas, ins))
     fit_names, held = fitted_and_held(model, args.fit_params, args.fix, with_effects=False)
+    check_force_identifies(ins.data, args.data, fit_names)
     fixed = pattern_values(pattern)
     fixed.update(held)
     ins = confirm_lag(ins, model, fixed, fit_names)
     rows = ins.data
-    cands = [reg.get_effect(c) for c in split_names(args.candidates)] or None
+    cands = [reg.get_effect(c) for c in split_names(args.candidates, "--candidates")] or None
     d = diagnose(model, rows, fit_names, fixed, candidates=cands,
                  max_rows=args.max_rows, max_effects=args.max_effects, registry=reg,
                  stop_ratio=1.15 if args.stop_rule else None, modulus_range_gpa=(lo, hi),

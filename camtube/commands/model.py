@@ -134,6 +134,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from camtube.model.core.fit import FitError, fit
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import check_fittable, find_slack, load_csv, prepare, remove_deadband, select_cycles
+    from camtube.model.data.csvfile import check_time_varies
     from camtube.errors import DataError
     from camtube.model.report.fit import fit_json, fit_text
 
@@ -148,12 +149,13 @@ def cmd_fit(args: argparse.Namespace) -> int:
                         "< 360 deg; fix: e.g. --deadband-threshold 0.5, or leave it out for max(0.5, 4 x noise)")
     pattern = load_from_args(args).pattern
     reg, _ = build_registry(args.effect_file)
-    model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects)])
+    model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects, "--effects")])
     if args.set_aside:
         from camtube.model.data import read_measurements
         from camtube.model.diagnose.instruments import check_instruments
 
         meas = read_measurements(args.data)
+        check_time_varies(meas.data, args.data)
         if meas.summary():
             print(meas.summary())
         ins = check_instruments(select_cycles(meas.data, args.cycles), lag_ms=args.lag_ms or 0.0)
@@ -164,13 +166,14 @@ def cmd_fit(args: argparse.Namespace) -> int:
         if args.lag_ms:
             raise DataError("--lag-ms needs --set-aside (the instruments' check that corrects it)")
         raw = load_csv(args.data)
+        check_time_varies(raw, args.data)
         rows = prepare(raw, args.cycles, args.branch, args.deadband, args.deadband_threshold)
     check_fittable(rows, f"{args.data} (cycles {args.cycles}, {args.branch} branch)")
     names, held = fitted_and_held(model, args.fit_params, args.fix)
     fixed = pattern_values(pattern)
     fixed.update(held)
     init = parse_assignments(args.init, "--init")
-    params = model.make_params(rows, names, fixed, initial=init, per_sample=split_names(args.per_sample))
+    params = model.make_params(rows, names, fixed, initial=init, per_sample=split_names(args.per_sample, "--per-sample"))
     warn = history_warning(model, args.branch, min((len(set(rows.cycle[sl].tolist()))
                                                     for _, sl in rows.sample_slices()), default=0),
                            params.varying)

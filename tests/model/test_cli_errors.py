@@ -306,3 +306,43 @@ def test_ingest_mistakes_say_the_fix(data_csv, tmp_path, capsys, tail, words):
     _one_line_with_fix(["model", "ingest", *tail, "--daq", str(data_csv), "--motor", str(data_csv), "-o", str(out)],
                        capsys, *words)
     assert not out.exists()
+
+
+@pytest.mark.parametrize("cmd,tail,words", [
+    ("fit", ["--fit", ""], ["--fit ''", "empty list"]), ("fit", ["--fit", ","], ["--fit ','", "empty name"]),
+    ("fit", ["--effects", "slack,slack"], ["--effects 'slack,slack'", "slack twice"]),
+    ("fit", ["--effects", ","], ["--effects ','", "empty name"]),
+    ("fit", ["--effects", "slack", "--per-sample", "slack,slack"], ["--per-sample", "slack twice"]),
+    ("diagnose", ["--effects", "slack,,play"], ["--effects", "empty name"]),
+    ("diagnose", ["--candidates", "play,play"], ["--candidates", "play twice"]),
+    ("diagnose", ["--modulus-range", "1,inf"], ["--modulus-range '1,inf'"]),
+    ("diagnose", ["--modulus-range", "nan,5"], ["--modulus-range 'nan,5'"]),
+])
+def test_empty_or_repeated_names_and_an_infinite_range_are_refused(data_csv, tmp_path, capsys, cmd, tail, words):
+    """Before: accepted silently (an empty --fit fitted nothing, a repeated effect was added once, inf kept)."""
+    js = tmp_path / "o.json"
+    _one_line_with_fix(["model", cmd, str(data_csv), "--pattern", TUBE2, "-q", *tail, "--json", str(js)],
+                       capsys, *words)
+    assert not js.exists()
+
+
+@pytest.mark.parametrize("extra", [[], ["--set-aside"]])
+def test_fit_of_a_constant_time_column_is_refused_like_diagnose(data_csv, tmp_path, capsys, extra):
+    """Before: model fit ignored time_s and fitted; model diagnose refused the same file."""
+    f = _variant(data_csv, tmp_path / "t1.csv", time_s="1.0")
+    js = tmp_path / "o.json"
+    _one_line_with_fix(["model", "fit", str(f), "--pattern", TUBE2, "-q", *extra, "--json", str(js)], capsys,
+                       str(f), "'time_s' never changes")
+    assert not js.exists()
+
+
+def test_diagnose_of_zero_force_is_refused_like_fit(data_csv, tmp_path, capsys):
+    """Before: model diagnose ran on a file whose force is all zero (exit 0, a 'recommendation'); model fit
+    refused it. Held E_t, the file is fine."""
+    f = _variant(data_csv, tmp_path / "noforce.csv", force_N="0.0")
+    js = tmp_path / "o.json"
+    _one_line_with_fix(["model", "diagnose", str(f), "--pattern", TUBE2, "-q", "--json", str(js)], capsys,
+                       str(f), "cannot identify E_t", "'force_N'", "--fix E_t=")
+    assert not js.exists()
+    assert main(["model", "diagnose", str(f), "--pattern", TUBE2, "-q", "--fix", "E_t=3", "--candidates", "slack",
+                 "--max-rows", "300", "--no-per-sample"]) == 0

@@ -12,15 +12,36 @@ from camtube.model.core.model import FitError, JointModel
 from camtube.model.core.registry import Registry, registry_with_files
 
 
-def split_names(text: str | None) -> list[str]:
-    """``'a, b,none'`` -> ``['a', 'b']`` (comma list; 'none' means nothing)."""
-    return [t.strip() for t in (text or "").split(",") if t.strip() and t.strip().lower() != "none"]
+#: An example value per option, for the fix of a malformed name list.
+_LIST_EXAMPLES = {"--fit": "E_t,arm_scale (or --fit none: fit nothing)", "--effects": "slack,play",
+                  "--candidates": "slack,play", "--per-sample": "slack,play"}
+
+
+def split_names(text: str | None, option: str | None = None, *, empty_ok: bool = True) -> list[str]:
+    """``'a, b,none'`` -> ``['a', 'b']`` (comma list; 'none' means nothing).
+
+    With ``option`` (the command-line option the list came from) the list is checked: an empty name
+    (``'a,,b'``, ``','``), a name given twice, or, unless ``empty_ok``, an empty list raise
+    :class:`FitError` naming the option.
+    """
+    items = [t.strip() for t in (text or "").split(",")]
+    if option is not None and text is not None:
+        fix = f"fix: e.g. {option} {_LIST_EXAMPLES.get(option, 'NAME1,NAME2')}"
+        if not text.strip():
+            if not empty_ok:
+                raise FitError(f"{option} {text!r}: an empty list of names; {fix}")
+        elif not all(items):
+            raise FitError(f"{option} {text!r}: an empty name (a comma too many); {fix}")
+        twice = sorted({t for t in items if items.count(t) > 1})
+        if twice:
+            raise FitError(f"{option} {text!r}: names {', '.join(twice)} twice; fix: name each once, {fix[5:]}")
+    return [t for t in items if t and t.lower() != "none"]
 
 
 def fit_param_names(model: JointModel, text: str | None = None, base: Sequence[str] = ("E_t",)) -> list[str]:
     """Parameters to fit: the ``--fit`` list, or by default ``base`` and every parameter of the model's effects."""
     if text is not None:
-        return split_names(text)
+        return split_names(text, "--fit", empty_ok=False)
     return list(dict.fromkeys(list(base) + [n for e in model.effects for n in e.full_names()]))
 
 

@@ -304,6 +304,35 @@ def check_fittable(data: Dataset, what: str = "the selected rows") -> None:
                             "is actuated (check the file and the --cycles selection)")
 
 
+def check_time_varies(data: Dataset, what: str) -> None:
+    """Refuse a file whose ``time_s`` column holds one stamp only (``model diagnose`` sets such rows aside).
+
+    Raises
+    ------
+    DataError
+        Naming ``what`` (the file), the column and its value.
+    """
+    t = np.asarray(data.time_s, float)
+    if t.size > 1 and float(np.ptp(t)) == 0.0:
+        raise DataError(f"{what}: column 'time_s' never changes (every value is {float(t[0]):g} s): the rows have "
+                        "no order in time; fix: check the time_s column (it must count the seconds of the log)")
+
+
+def check_force_identifies(data: Dataset, what: str, fitted) -> None:
+    """Refuse fitting ``E_t`` to rows whose force is zero throughout (E_t acts only through the force).
+
+    Raises
+    ------
+    DataError
+        Naming ``what`` (the file), the column and the fix.
+    """
+    f = np.asarray(data.force_N, float)
+    if "E_t" in fitted and f.size and not np.any(f):
+        raise DataError(f"{what}: these rows cannot identify E_t: column 'force_N' is 0 N in every row (E_t acts "
+                        "only through the force); fix: hold it (--fix E_t=VALUE), or give rows with the measured "
+                        "force")
+
+
 def format_csv(data: Dataset) -> str:
     """CSV text of ``data``: the required columns, then extra columns (deterministic, ``\\n`` endings).
 
