@@ -346,3 +346,15 @@ def test_diagnose_of_zero_force_is_refused_like_fit(data_csv, tmp_path, capsys):
     assert not js.exists()
     assert main(["model", "diagnose", str(f), "--pattern", TUBE2, "-q", "--fix", "E_t=3", "--candidates", "slack",
                  "--max-rows", "300", "--no-per-sample"]) == 0
+
+
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+def test_an_absurd_angle_gives_the_one_line_without_numpy_warnings(data_csv, tmp_path, cmd):
+    """Every angle 1e300: before, numpy's 'overflow encountered' RuntimeWarnings were printed with the error."""
+    f = _variant(data_csv, tmp_path / "huge.csv", angle_deg="1e300")
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    r = subprocess.run([sys.executable, "-m", "camtube", "model", cmd, str(f), "--pattern", TUBE2, "-q"],
+                       cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+    lines = [x for x in r.stderr.splitlines() if x.strip()]
+    assert r.returncode == 2 and len(lines) == 1, r.stderr
+    assert "'angle_deg' never changes" in lines[0] and "; fix: " in lines[0], r.stderr

@@ -139,6 +139,7 @@ def _noise(signal: np.ndarray) -> float:
     return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / math.sqrt(6.0))
 
 
+@np.errstate(over="ignore", invalid="ignore")  # an absurd value (angle 1e300) overflows: inf, and no warning
 def _hinge_sse(cand: np.ndarray, s: np.ndarray, y: np.ndarray) -> np.ndarray:
     """SSE of the best ``b + k max(s - s0, 0)`` (k > 0) for each knee ``s0`` in ``cand`` ``(c,)``."""
     h = np.clip(s[None, :] - cand[:, None], 0.0, None)  # (c, m)

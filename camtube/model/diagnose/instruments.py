@@ -267,6 +267,7 @@ def _lag_design(data: Dataset) -> list:
     return out
 
 
+@np.errstate(over="ignore", invalid="ignore")  # an absurd value (angle 1e300) overflows: inf, and no warning
 def _lag_sse(data: Dataset, design: list, shift: int, rows: np.ndarray) -> float:
     """Residual sum of squares of the angle ``shift`` rows later, regressed on the force regressors
     (:func:`_lag_design`), over ``rows`` (index array)."""
@@ -290,6 +291,7 @@ def _lag_of(data: Dataset, design: list, rows: np.ndarray, lo: int, hi: int) -> 
     return _lag_scan(data, design, rows, lo, hi)[0]
 
 
+@np.errstate(over="ignore", invalid="ignore")  # an absurd value (angle 1e300) overflows: inf, and no warning
 def _lag_scan(data: Dataset, design: list, rows: np.ndarray, lo: int, hi: int) -> tuple[float, bool, float]:
     """``(lag in rows, interior minimum?, relative fall of the residual RMS from no shift to the best)``."""
     shifts = np.arange(lo, hi + 1)
@@ -427,6 +429,7 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     return Instruments(shifted, data, aside, kept, rates, notes, lag, dropped, n_dropped)
 
 
+@np.errstate(over="ignore", invalid="ignore")  # an absurd value (angle 1e300) overflows: inf, and no warning
 def with_aside(ins: Instruments, predicted_deg: np.ndarray, floor_deg: float) -> tuple[float, float, int]:
     """Errors over the rows kept *and* the rows set aside (spikes, repeated stamps).
 
