@@ -150,3 +150,25 @@ def test_an_effect_file_path_that_is_no_python_file(tmp_path, capsys, data_csv, 
     assert len(err.splitlines()) == 1 and str(path) in err, err
     for w in words:
         assert w in err, err
+
+
+@pytest.mark.parametrize("old,new,words", [
+    ('name="broken"', 'name="lead screw!"', ["'lead screw!'", "not a Python identifier", "fix: e.g. name='lead_screw'"]),
+    ('Param("gain"', 'Param("gain x"', ["parameter 'gain x'", "not a Python identifier", "fix: e.g. Param('gain_x'"]),
+])
+def test_an_effect_or_parameter_name_that_is_not_an_identifier_is_refused(tmp_path, capsys, data_csv, old, new,
+                                                                           words):
+    """Before: accepted, though the name cannot be written NAME.param on the command line."""
+    src = HEAD + "    return x * p[\"gain\"]\n" + TAIL.replace(old, new)
+    f = tmp_path / "eff.py"
+    f.write_text(src, encoding="utf-8")
+    js = tmp_path / "o.json"
+    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--effect-file", str(f),
+                 "--json", str(js)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "Traceback" not in err and len(err.splitlines()) == 1, err
+    line = src.splitlines().index(next(ln for ln in src.splitlines() if ln.startswith("BROKEN = "))) + 1
+    assert f"{f}:{line}:" in err, err
+    for w in words:
+        assert w in err, err
+    assert not js.exists()

@@ -148,6 +148,14 @@ class Context:
         return out
 
 
+def _identifier(text) -> str:
+    """``'lead screw!'`` -> ``'lead_screw'``: a suggestion for a name that is not an identifier."""
+    import re
+
+    s = re.sub(r"\W+", "_", str(text)).strip("_") or "my_effect"
+    return s if s.isidentifier() else f"e_{s}"
+
+
 @dataclass(frozen=True)
 class Effect:
     """A named physical effect added to the base model.
@@ -202,6 +210,16 @@ class Effect:
     pure: bool = field(default=False, compare=False)
 
     def __post_init__(self):
+        # names are written NAME.param (and NAME.param@SAMPLE) on the command line: identifiers only
+        if not (isinstance(self.name, str) and self.name.isidentifier()):
+            raise ValueError(f"effect {self.name!r}: the name is not a Python identifier (letters, digits and _, "
+                             "not starting with a digit; it is written NAME.param on the command line); fix: e.g. "
+                             f"name={_identifier(self.name)!r}")
+        for q in self.params:
+            if not (isinstance(q.name, str) and q.name.isidentifier()):
+                raise ValueError(f"effect {self.name!r}: parameter {q.name!r} is not a Python identifier (it is "
+                                 f"written {self.name}.PARAM on the command line); fix: e.g. "
+                                 f"Param({_identifier(q.name)!r}, ...)")
         for st in self.stages:
             if st not in STAGES:
                 raise ValueError(f"effect {self.name!r}: stage must be one of {STAGES}, not {st!r}")
