@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import csv
 import os
+from pathlib import Path
 import re
 import subprocess
 import sys
@@ -357,4 +358,26 @@ def test_an_absurd_angle_gives_the_one_line_without_numpy_warnings(data_csv, tmp
                        cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
     lines = [x for x in r.stderr.splitlines() if x.strip()]
     assert r.returncode == 2 and len(lines) == 1, r.stderr
-    assert "'angle_deg' never changes" in lines[0] and "; fix: " in lines[0], r.stderr
+    # refused as it is read (it used to be "'angle_deg' never changes", found after the fit's arithmetic)
+    assert "'angle_deg' holds '1e300'" in lines[0] and ":2: " in lines[0] and "; fix: " in lines[0], r.stderr
+
+
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+def test_a_huge_angle_that_varies_is_refused_with_its_line_not_a_traceback(data_csv, tmp_path, cmd):
+    """Angles scaled by 1e298 (they vary): an OverflowError traceback in the fit before."""
+    text = Path(data_csv).read_text().splitlines()
+    head = text[0].split(",")
+    k = head.index("angle_deg")
+    rows = []
+    for line in text[1:]:
+        cells = line.split(",")
+        cells[k] = repr(float(cells[k]) * 1e298)
+        rows.append(",".join(cells))
+    f = tmp_path / "scaled.csv"
+    f.write_text("\n".join([text[0]] + rows) + "\n")
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    r = subprocess.run([sys.executable, "-m", "camtube", "model", cmd, str(f), "--pattern", TUBE2, "-q"],
+                       cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+    lines = [x for x in r.stderr.splitlines() if x.strip()]
+    assert r.returncode == 2 and len(lines) == 1 and "Traceback" not in r.stderr, r.stderr
+    assert "'angle_deg' holds" in lines[0] and "beyond" in lines[0] and "; fix: " in lines[0], r.stderr

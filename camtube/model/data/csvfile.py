@@ -19,6 +19,9 @@ _FLOAT_COLS = ("time_s", "stroke_mm", "force_N", "angle_deg")
 _FORMATS = {"time_s": "%.4f", "stroke_mm": "%.6f", "force_N": "%.6f", "angle_deg": "%.5f"}
 #: Largest cycle number read (a billion cycles; beyond, the number cannot be a count of cycles).
 MAX_CYCLE = 1e9
+#: Largest magnitude read in a measured column (time in s, stroke in mm, force in N, angle in deg): beyond it a
+#: value is a unit or export mistake, and the arithmetic of a fit would overflow.
+MAX_VALUE = {"time_s": 1e9, "stroke_mm": 1e6, "force_N": 1e6, "angle_deg": 1e6}
 
 
 # ----------------------------------------------------------------------------- loading
@@ -189,6 +192,13 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
         raise _err(source, int(ln[k]), f"column 'cycle' must be a whole number from 1 to 10^9, got "
                    f"{cols['cycle'][k].strip()!r}", "number the cycles 1, 2, 3, ...")
     num = {c: _to_float(cols[c], c, ln, source, finite=strict) for c in _FLOAT_COLS}
+    for c, v in num.items():
+        with np.errstate(invalid="ignore"):
+            huge = np.flatnonzero(np.abs(v) > MAX_VALUE[c])
+        if huge.size:
+            k = int(huge[0])
+            raise _err(source, int(ln[k]), f"column {c!r} holds {cols[c][k].strip()!r}, beyond {MAX_VALUE[c]:g} "
+                       f"in magnitude: no bench measures that", f"check the column's unit and export ({c})")
     missing_lines = np.zeros(0, np.int64)
     if not strict:
         bad = ~np.all([np.isfinite(v) for v in num.values()], axis=0)
