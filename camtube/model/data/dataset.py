@@ -196,11 +196,6 @@ class Dataset:
         out.setflags(write=False)
         return self.cache.set("dataset.stroke_speed", out)
 
-    def with_stroke_speed(self) -> "Dataset":
-        """This Dataset with its stroke speed as the column ``stroke_speed_mm_s`` (kept by :meth:`take`)."""
-        return Dataset(self.sample, self.cycle, self.time_s, self.stroke_mm, self.force_N, self.angle_deg,
-                       {**self.extra, SPEED_COLUMN: self.stroke_speed_mm_s})
-
     @property
     def force_smoothed_N(self) -> np.ndarray:
         """(n,) float: the measured force, a centred running mean over :data:`FORCE_SMOOTHING_S` per sample (the
@@ -241,8 +236,7 @@ class Dataset:
             self.force_N[mask], self.angle_deg[mask], {k: v[mask] for k, v in self.extra.items()},
         )
         record, rows = self.rows_of_record()
-        mask = np.asarray(mask)
-        object.__setattr__(out, "taken_from", (record, rows[np.flatnonzero(mask) if mask.dtype == bool else mask]))
+        object.__setattr__(out, "taken_from", (record, rows[mask]))
         return out
 
     def rows_of_record(self) -> tuple["Dataset", np.ndarray]:

@@ -157,12 +157,11 @@ PLAY = Effect(
 )
 
 
-def _bottom_tension_N(data: Dataset) -> float:
-    """The tension the tendon keeps while the motor stands at the bottom of its stroke (the 90th percentile over
-    the rows within 1 % of the stroke's span of its lowest, of those above five times the force's white noise
-    there and 0.01 N); 0 when it goes slack there (fewer than a tenth of those rows, or 20, keep a tension)."""
-    s = np.asarray(data.stroke_mm, float)
-    f = np.asarray(data.force_N, float)
+def _bottom_tension_N(s: np.ndarray, f: np.ndarray) -> float:
+    """The tension the tendon keeps while the motor stands at the bottom of its stroke ``s`` (the 90th percentile
+    of the force ``f`` over the rows within 1 % of the stroke's span of its lowest, of those above five times the
+    force's white noise there and 0.01 N); 0 when it goes slack there (fewer than a tenth of those rows, or 20,
+    keep a tension). One sample's rows."""
     if s.size == 0:
         return 0.0
     bottom = (s - s.min()) <= 0.01 * (float(np.ptp(s)) or 1.0)
@@ -174,9 +173,10 @@ def _bottom_tension_N(data: Dataset) -> float:
 def held_tension_N(data: Dataset) -> np.ndarray:
     """(n,) each sample's :func:`_bottom_tension_N`, on its rows (cached per Dataset)."""
     def compute() -> np.ndarray:
+        s, f = np.asarray(data.stroke_mm, float), np.asarray(data.force_N, float)
         out = np.zeros(len(data))
         for _, sl in data.sample_slices():
-            out[sl] = _bottom_tension_N(data.take(np.arange(sl.start, sl.stop)))
+            out[sl] = _bottom_tension_N(s[sl], f[sl])
         out.setflags(write=False)
         return out
     return data.cache.get_or("builtin.held_tension", compute)

@@ -324,8 +324,9 @@ def carriage_hold(data: Dataset, stroke_mm: np.ndarray, hold_N: float | np.ndarr
         return out
     first = np.flatnonzero(entry | turn)                  # every piece starts at one of these rows
     piece = np.searchsorted(first, rows, side="right") - 1
-    lo_s = np.minimum.reduceat(s[rows], np.searchsorted(rows, first))
-    hi_s = np.maximum.reduceat(s[rows], np.searchsorted(rows, first))
+    at = np.searchsorted(rows, first)                     # where each piece starts among the held rows
+    lo_s = np.minimum.reduceat(s[rows], at)
+    hi_s = np.maximum.reduceat(s[rows], at)
     # the value each piece starts from: a stick, or what the piece before ended with (a scalar loop over the pieces)
     fresh = _sticks(s, f, starts_of_samples, first, hold[first]).tolist()
     restart = entry[first].tolist()
