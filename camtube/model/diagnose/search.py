@@ -1350,26 +1350,36 @@ class Search:
 
         def alone(i: int):
             """Sample ``i`` diagnosed alone: ``None`` when it cannot be fitted, else (partial, recommended, the
-            final parameters when something is recommended)."""
+            final parameters when something is recommended, what each recommended step explains: its rows times
+            the fall of the mean squared error)."""
             sub = data.take(np.asarray(data.sample) == samples[i])
             try:
                 d_s = Search(self.given_model, sub, sub_settings, candidates=list(self.all_pool),
                              registry=self.registry).run()
             except FitError:
                 return None
-            return tuple(d_s.partial), list(d_s.recommended), dict(d_s.final.params) if d_s.recommended else {}
+            rmse = [w.rmse_deg for w in d_s.waterfall]
+            explained = {e: len(sub) * (a * a - b * b) for e, a, b in zip(d_s.recommended, rmse, rmse[1:])}
+            return (tuple(d_s.partial), list(d_s.recommended), dict(d_s.final.params) if d_s.recommended else {},
+                    explained)
 
         # the samples' searches are independent: one per core (speed; the same results as one after another)
         found = map_forked(alone, len(samples))
         chains: dict[str, list[str]] = {}
         inits: dict[str, dict] = {}
+        explained: dict[str, float] = {}
         for smp, got in zip(samples, found):
             if got is None:
                 return False
-            partial, chains[smp], inits[smp] = got
+            partial, chains[smp], inits[smp], gains = got
             if partial:  # stand-ins that leave that sample unexplained: no answer to combine
                 return False
-        union = list(dict.fromkeys(e for smp in samples for e in chains[smp]))
+            for e, g in gains.items():
+                explained[e] = explained.get(e, 0.0) + g
+        # the union in the order of what each effect explains in its samples, most first: the waterfall then says
+        # what to add first (with one sample's effects first, a shared parameter, E_t, bent by the other sample's
+        # misfit leaves the first steps explaining nothing)
+        union = sorted(dict.fromkeys(e for smp in samples for e in chains[smp]), key=lambda e: -explained[e])
         if not union or all(chains[smp] == chains[samples[0]] for smp in samples):
             return False
         effects = [self.registry[e] for e in union if e not in {x.name for x in ch.model.effects}]
