@@ -259,6 +259,43 @@ def test_relaxation_follows_a_joint_with_a_relaxing_backbone(tube1):
                                kin, atol=1e-12)
 
 
+def test_relaxation2_follows_a_backbone_with_a_fast_and_a_slow_arm(tube1):
+    """A backbone of a spring and two Maxwell arms (a fast and a slow one), stepped in time by hand: unloaded, the
+    joint stands at the arms' shares of their relaxed angles and creeps back, quickly and then over cycles. The
+    effect's two-pass lags stay within 2 % of that free angle's scale; one arm alone is `relaxation` to the bit."""
+    dt = 0.01
+    t = np.arange(0.0, 80.0, dt)
+    stroke = np.interp(t % 20.0, [0, 5, 10, 15, 20], [0.0, 2.0, 2.0, 0.0, 0.0])  # pull, dwell, release, rest
+    data = _data(stroke, time=t)
+    vals = pattern_values(tube1)
+    kin = model_for_pattern(tube1).predict(data, vals)
+    model = model_for_pattern(tube1, ["relaxation2"])
+    for c1, tau1, c2, ratio in ((0.1, 1.5, 0.1, 20.0), (0.2, 2.0, 0.15, 10.0)):
+        got = model.predict(data, vals | {"relaxation2.fraction": c1, "relaxation2.tau_s": tau1,
+                                          "relaxation2.slow_fraction": c2, "relaxation2.slow_ratio": ratio})
+        r1 = r2 = 0.0
+        ref = np.empty(t.size)
+        for k in range(t.size):
+            ref[k] = max(kin[k], c1 * r1 + c2 * r2)
+            a1, a2 = math.exp(-dt / tau1), math.exp(-dt / (tau1 * ratio))
+            r1 = a1 * r1 + (1.0 - a1) * ref[k]
+            r2 = a2 * r2 + (1.0 - a2) * ref[k]
+        assert np.abs(got - ref).max() < 0.02 * (c1 + c2) * kin.max()
+        # the slow arm holds the rest up long after the fast one has let go: more than one arm can
+        late_rest = (t % 20.0) > 19.0
+        one = model_for_pattern(tube1, ["relaxation"]).predict(data, vals | {"relaxation.fraction": c1,
+                                                                             "relaxation.tau_s": tau1})
+        assert np.all(got[late_rest & (t > 20.0)] > one[late_rest & (t > 20.0)] + 0.2 * c2 * kin.max() * 0.5)
+    # the slow arm off: relaxation, to the bit
+    v = {"relaxation2.fraction": 0.3, "relaxation2.tau_s": 2.0, "relaxation2.slow_fraction": 0.0,
+         "relaxation2.slow_ratio": 10.0}
+    np.testing.assert_array_equal(model.predict(data, vals | v),
+                                  model_for_pattern(tube1, ["relaxation"]).predict(
+                                      data, vals | {"relaxation.fraction": 0.3, "relaxation.tau_s": 2.0}))
+    # both off: the paper's model
+    np.testing.assert_allclose(model.predict(data, vals | v | {"relaxation2.fraction": 0.0}), kin, atol=1e-12)
+
+
 def test_a_thinned_record_keeps_the_speed_of_the_full_one():
     """Steps between kept rows average over the dropped ones; the thinned copy carries the full record's speed."""
     from camtube.model.diagnose.search import thin

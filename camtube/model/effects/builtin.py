@@ -40,7 +40,7 @@ the stroke (one NumPy call per stroke reversal); the linear filter of
 from __future__ import annotations
 
 import math
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -856,15 +856,31 @@ def _relaxation(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
     c = min(max(p["fraction"], 0.0), 0.99)
     if c <= 0.0:
         return theta
+    return _relaxed(ctx, theta, ((c, p["tau_s"]),))
+
+
+def _relaxed(ctx: Context, theta: np.ndarray, arms: Sequence[tuple[float, float]]) -> np.ndarray:
+    """The joint's angle with relaxing arms ``arms`` ((share, time constant s), ...) of its backbone: each arm's
+    relaxed angle follows the angle the joint holds above its rest (by a first-order lag); unloaded, the joint
+    stands at its rest plus the shares times them. Two passes: the second lets the arms follow the slack joint's
+    own recovery (one arm's slack phases then decay by (1 - c) / tau, as the standard linear solid's do)."""
     th = np.asarray(theta, float)
     floor = _rest_floor(ctx.data, th)
-    # the arm's relaxed angle follows the angle the joint holds above its rest (by a first-order lag); unloaded,
-    # the joint stands at its rest plus c times it. Two passes: the second lets the arm follow the slack joint's
-    # own recovery (the slack phases' decay is then (1 - c) / tau, as it is for the standard linear solid)
     held = np.maximum(th, floor)
     for _ in range(2):
-        held = np.maximum(th, floor + c * first_order_lag(ctx.data, held - floor, p["tau_s"]))
+        above = held - floor
+        lagged = [c * first_order_lag(ctx.data, above, tau) for c, tau in arms]
+        held = np.maximum(th, floor + (lagged[0] if len(lagged) == 1 else sum(lagged[1:], lagged[0])))
     return held
+
+
+def _relaxation2(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
+    c1 = min(max(p["fraction"], 0.0), 0.99)
+    c2 = min(max(p["slow_fraction"], 0.0), 0.99)
+    if c1 + c2 > 0.99:  # the relaxing parts together are less than the whole backbone
+        c1, c2 = 0.99 * c1 / (c1 + c2), 0.99 * c2 / (c1 + c2)
+    arms = tuple((c, tau) for c, tau in ((c1, p["tau_s"]), (c2, p["tau_s"] * p["slow_ratio"])) if c > 0.0)
+    return _relaxed(ctx, theta, arms) if arms else theta
 
 
 def _rest_floor(data: Dataset, theta: np.ndarray) -> np.ndarray:
@@ -904,6 +920,31 @@ RELAXATION = Effect(
 )
 
 
+RELAXATION2 = Effect(
+    name="relaxation2", stage="kinematics", pure=True,
+    params=(Param("fraction", "", 0.0, 0.9, 0.1,
+                  "share of the joint's angle the backbone's fast relaxing arm holds when the tendon lets go",
+                  starts=(0.1, 0.3)),
+            Param("tau_s", "s", 1e-2, 1e5, lambda d, c: _period(d) / 8.0,
+                  "relaxation time of the fast arm (the joint's quick return while the tendon is slack)", log=True,
+                  kind="time"),
+            Param("slow_fraction", "", 0.0, 0.9, 0.1,
+                  "share of the joint's angle the slow arm holds when the tendon lets go", starts=(0.1,)),
+            Param("slow_ratio", "", 2.0, 1e3, 10.0,
+                  "the slow arm's relaxation time over the fast arm's (its return over many cycles)", log=True,
+                  starts=(10.0,))),
+    apply=_relaxation2,
+    family="backbone",
+    meaning="viscoelastic backbone relaxing on two time scales (a spring with two relaxing arms, as polymers have "
+            "a spectrum of relaxation times): unloaded, the joint stands at the shares of the angle it held that "
+            "its fast and slow arms keep, and creeps back quickly, then over many cycles",
+    signature="as relaxation's, but the joint's return after the unloading is fast at first and then slow: the "
+              "rest angle drifts over cycles while each rest starts with a quick decay",
+    history=True,
+    off={"fraction": 0.0, "slow_fraction": 0.0},
+)
+
+
 # ----------------------------------------------------------------------------- measurement stages
 
 def _bias(ctx: Context, angle: np.ndarray, p: dict) -> np.ndarray:
@@ -935,6 +976,6 @@ FORCE_ZERO = Effect(
 
 #: The built-in effects, in their documented order.
 BUILTIN_EFFECTS = (SLACK, PLAY, CARRIAGE_HOLD, CREEP, CREEP_LOAD, FRICTION, CAPSTAN, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
-                   HARDSTOP, REST_ANGLE, RELAXATION, ANGLE_BIAS, FORCE_ZERO)
+                   HARDSTOP, REST_ANGLE, RELAXATION, RELAXATION2, ANGLE_BIAS, FORCE_ZERO)
 #: Built-in effect names in that order.
 BUILTINS = tuple(e.name for e in BUILTIN_EFFECTS)

@@ -250,6 +250,9 @@ SIDES = {
                   "displacement gauge on the carriage would tell",
     "relaxation": "joint (its polymer backbone relaxes; the tendon's own creep lengthens it under load instead, "
                   "and shows while it pulls: a dwell with the tendon slack, the joint filmed, tells)",
+    "relaxation2": "joint (its polymer backbone relaxes on a fast and a slow time scale; the tendon's own creep "
+                   "lengthens it under load instead, and shows while it pulls: a long dwell with the tendon slack, "
+                   "the joint filmed, tells)",
     "hardstop": "joint (the notches close)",
     "kerf": "joint geometry", "flat_walls": "joint geometry", "chords": "joint geometry",
 }
