@@ -41,7 +41,7 @@ FAMILIES = {
     "slack": ({"slack"}, None),
     "lost motion": ({"slack", "play", "carriage_hold"}, None),  # the drive: a carriage its rail holds, or backlash
     "creep": ({"creep", "creep_load", "viscoelastic"}, None),  # a slow viscoelastic element and creep: known equivalents
-    "backbone": ({"relaxation"}, None),  # the joint's backbone relaxing: `relaxation` (its set: the baseline's rest_angle)
+    "backbone": ({"relaxation", "relaxation2"}, None),  # the backbone relaxing: one arm or two (its set: the baseline's rest_angle)
     "zero drift": (set(), "time"),
     "lag": (set(), None),
     "friction": ({"friction", "capstan"}, None),  # one family: friction at the guide
