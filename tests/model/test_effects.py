@@ -226,16 +226,21 @@ def test_capstan_gives_the_mean_tension_of_a_tendon_wrapping_a_guide(tube1):
                                model_for_pattern(tube1).predict(data, vals), atol=1e-12)
 
 
+def _pull_dwell_rest(pattern, seconds: float, dt: float):
+    """``(t, data, values, paper model's angle)`` of 20 s cycles: pull 5 s, dwell 5 s, release 5 s, rest 5 s."""
+    t = np.arange(0.0, seconds, dt)
+    stroke = np.interp(t % 20.0, [0, 5, 10, 15, 20], [0.0, 2.0, 2.0, 0.0, 0.0])
+    data = _data(stroke, time=t)
+    vals = pattern_values(pattern)
+    return t, data, vals, model_for_pattern(pattern).predict(data, vals)
+
+
 def test_relaxation_follows_a_joint_with_a_relaxing_backbone(tube1):
     """A backbone of a spring k and a Maxwell arm (k1, tau), stepped in time by hand: while the tendon is taut the
     joint follows it; once the tendon goes slack the joint stands at k1 / (k + k1) of the arm's relaxed angle and
     creeps back. The effect's two-pass lag stays within 2 % of that free angle's scale."""
     dt = 0.01
-    t = np.arange(0.0, 60.0, dt)
-    stroke = np.interp(t % 20.0, [0, 5, 10, 15, 20], [0.0, 2.0, 2.0, 0.0, 0.0])  # pull, dwell, release, rest
-    data = _data(stroke, time=t)
-    vals = pattern_values(tube1)
-    kin = model_for_pattern(tube1).predict(data, vals)
+    t, data, vals, kin = _pull_dwell_rest(tube1, 60.0, dt)
     model = model_for_pattern(tube1, ["relaxation"])
     for c, tau_s, tol in ((0.1, 3.0, 0.005), (0.3, 2.0, 0.02)):
         got = model.predict(data, vals | {"relaxation.fraction": c, "relaxation.tau_s": tau_s})
@@ -264,11 +269,7 @@ def test_relaxation2_follows_a_backbone_with_a_fast_and_a_slow_arm(tube1):
     joint stands at the arms' shares of their relaxed angles and creeps back, quickly and then over cycles. The
     effect's two-pass lags stay within 2 % of that free angle's scale; one arm alone is `relaxation` to the bit."""
     dt = 0.01
-    t = np.arange(0.0, 80.0, dt)
-    stroke = np.interp(t % 20.0, [0, 5, 10, 15, 20], [0.0, 2.0, 2.0, 0.0, 0.0])  # pull, dwell, release, rest
-    data = _data(stroke, time=t)
-    vals = pattern_values(tube1)
-    kin = model_for_pattern(tube1).predict(data, vals)
+    t, data, vals, kin = _pull_dwell_rest(tube1, 80.0, dt)
     model = model_for_pattern(tube1, ["relaxation2"])
     for c1, tau1, c2, ratio in ((0.1, 1.5, 0.1, 20.0), (0.2, 2.0, 0.15, 10.0)):
         got = model.predict(data, vals | {"relaxation2.fraction": c1, "relaxation2.tau_s": tau1,
