@@ -111,7 +111,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     from camtube.commands.common import load_from_args
     from camtube.errors import DataError
     from camtube.io import write_atomic
-    from camtube.model.core.build import build_registry, check_suffix, fitted_and_held, parse_assignments, split_names
+    from camtube.model.core.build import build_registry, check_suffix, fitted_and_held, parse_in_range, split_names
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import check_fittable, read_measurements, select_cycles
     from camtube.model.data.csvfile import check_force_identifies
@@ -136,6 +136,9 @@ def _diagnose(args: argparse.Namespace) -> int:
     pattern = load_from_args(args).pattern
     reg, _ = build_registry(args.effect_file)
     model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects, "--effects")])
+    # every parameter the model or a candidate has (its range), checked before the data are read
+    specs = {**{f"{e.name}.{q.name}": q for e in reg.values() for q in e.params}, **model.param_specs}
+    init = parse_in_range(args.init, "--init", specs)
     meas = read_measurements(args.data, strict=args.strict)
     rows = select_cycles(meas.data, args.cycles)
     ins = check_instruments(rows, lag_ms=args.lag_ms, dropped=meas.summary(),
@@ -151,7 +154,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     d = diagnose(model, rows, fit_names, fixed, candidates=cands,
                  max_rows=args.max_rows, max_effects=args.max_effects, registry=reg,
                  stop_ratio=1.15 if args.stop_rule else None, modulus_range_gpa=(lo, hi),
-                 per_sample=args.per_sample, init=parse_assignments(args.init, "--init"),
+                 per_sample=args.per_sample, init=init,
                  baseline=None if args.baseline else ())
     d = dataclasses.replace(d, instruments=ins)
     prefix = fit_command_prefix(args, ins)

@@ -129,7 +129,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from camtube.commands.common import load_from_args
     from camtube.io import write_atomic
     from camtube.model.core.build import (
-        build_registry, fitted_and_held, history_warning, parse_assignments, split_names,
+        build_registry, fitted_and_held, history_warning, parse_in_range, split_names,
     )
     from camtube.model.core.fit import FitError, fit
     from camtube.model.core.predict import model_for_pattern, pattern_values
@@ -172,7 +172,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     names, held = fitted_and_held(model, args.fit_params, args.fix)
     fixed = pattern_values(pattern)
     fixed.update(held)
-    init = parse_assignments(args.init, "--init")
+    init = parse_in_range(args.init, "--init", model.param_specs)
     params = model.make_params(rows, names, fixed, initial=init, per_sample=split_names(args.per_sample, "--per-sample"))
     warn = history_warning(model, args.branch, min((len(set(rows.cycle[sl].tolist()))
                                                     for _, sl in rows.sample_slices()), default=0),

@@ -327,6 +327,25 @@ def test_empty_or_repeated_names_and_an_infinite_range_are_refused(data_csv, tmp
     assert not js.exists()
 
 
+@pytest.mark.parametrize("cmd,tail,words", [
+    ("fit", ["--effects", "relaxation2", "--init", "relaxation2.slow_fraction=nan"],
+     ["--init relaxation2.slow_fraction=nan", "0..0.9;"]),
+    ("fit", ["--init", "E_t=inf"], ["--init E_t=inf", "0.5..500 GPa"]),
+    ("fit", ["--effects", "relaxation", "--init", "relaxation.fraction=7"], ["relaxation.fraction=7", "0..0.9"]),
+    ("diagnose", ["--init", "E_t=nan"], ["--init E_t=nan", "0.5..500 GPa"]),
+    ("diagnose", ["--init", "creep.tau_s=-3"], ["--init creep.tau_s=-3", "0.01..1e+07 s"]),
+    ("diagnose", ["--init", "mine.x=inf"], ["--init mine.x=inf", "not a finite number"]),
+])
+def test_an_init_value_outside_its_parameter_range_is_refused(data_csv, tmp_path, capsys, cmd, tail, words):
+    """Before: a NaN start was a ValueError traceback ('Initial guess is outside of provided bounds') in fit and
+    diagnose, and inf or 7 for a share of at most 0.9 were taken. --init is checked as --fix is (a candidate's
+    parameters too, in diagnose), before the data are read."""
+    js = tmp_path / "o.json"
+    _one_line_with_fix(["model", cmd, str(data_csv), "--pattern", TUBE2, "-q", *tail, "--json", str(js)],
+                       capsys, *words)
+    assert not js.exists()
+
+
 @pytest.mark.parametrize("extra", [[], ["--set-aside"]])
 def test_fit_of_a_constant_time_column_is_refused_like_diagnose(data_csv, tmp_path, capsys, extra):
     """Before: model fit ignored time_s and fitted; model diagnose refused the same file."""

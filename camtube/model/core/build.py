@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from typing import Iterable, Sequence
+from typing import Iterable, Mapping, Sequence
 
 from camtube.model.core.model import FitError, JointModel
 from camtube.model.core.registry import Registry, registry_with_files
@@ -67,14 +67,28 @@ def parse_fix(items: Iterable[str], model: JointModel | None = None) -> dict[str
     FitError
         A malformed item, or a value outside the bounds the parameter declares (named with its unit).
     """
-    out = parse_assignments(items, "--fix")
-    if model is not None:
-        specs = model.param_specs
-        for name, value in out.items():
-            sp = specs.get(name.split("@")[0])
-            if sp is not None and not (sp.lo <= value <= sp.hi and math.isfinite(value)):
-                raise FitError(f"--fix {name}={value:g}: outside the range {name} can take, {sp.lo:g}..{sp.hi:g} "
-                               f"{sp.unit}; fix: give a value in that range")
+    return parse_in_range(items, "--fix", model.param_specs if model is not None else None)
+
+
+def parse_in_range(items: Iterable[str], option: str, specs: Mapping | None = None) -> dict[str, float]:
+    """``NAME=VALUE`` items of ``option`` (``--fix``, ``--init``) -> ``{name: value}``: every value a finite number,
+    and within the bounds of its parameter where ``specs`` (full name -> :class:`Param`) knows it.
+
+    Raises
+    ------
+    FitError
+        A malformed item, a value that is not finite, or one outside its parameter's bounds (named with its unit).
+    """
+    out = parse_assignments(items, option)
+    for name, value in out.items():
+        sp = (specs or {}).get(name.split("@")[0])
+        if sp is not None and not (sp.lo <= value <= sp.hi and math.isfinite(value)):
+            unit = f" {sp.unit}" if sp.unit else ""
+            raise FitError(f"{option} {name}={value:g}: outside the range {name} can take, {sp.lo:g}..{sp.hi:g}{unit}; "
+                           "fix: give a value in that range")
+        if not math.isfinite(value):
+            raise FitError(f"{option} {name}={value:g}: not a finite number; fix: give a number, e.g. {option} "
+                           f"{name}=1")
     return out
 
 
