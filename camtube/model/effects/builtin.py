@@ -870,7 +870,7 @@ def _relaxed(ctx: Context, theta: np.ndarray, arms: Sequence[tuple[float, float]
     for _ in range(2):
         above = held - floor
         lagged = [c * first_order_lag(ctx.data, above, tau) for c, tau in arms]
-        held = np.maximum(th, floor + (lagged[0] if len(lagged) == 1 else sum(lagged[1:], lagged[0])))
+        held = np.maximum(th, floor + sum(lagged[1:], lagged[0]))   # one arm: lagged[0] itself
     return held
 
 
