@@ -1350,8 +1350,9 @@ class Search:
 
         def alone(i: int):
             """Sample ``i`` diagnosed alone: ``None`` when it cannot be fitted, else (partial, recommended, the
-            final parameters when something is recommended, what each recommended step explains: its rows times
-            the fall of the mean squared error)."""
+            baseline effects that joined and are in force (not held off by a stand-in), the final parameters when
+            something joined, what each recommended step explains: its rows times the fall of the mean squared
+            error)."""
             sub = data.take(np.asarray(data.sample) == samples[i])
             try:
                 d_s = Search(self.given_model, sub, sub_settings, candidates=list(self.all_pool),
@@ -1360,18 +1361,21 @@ class Search:
                 return None
             rmse = [w.rmse_deg for w in d_s.waterfall]
             explained = {e: len(sub) * (a * a - b * b) for e, a, b in zip(d_s.recommended, rmse, rmse[1:])}
-            return (tuple(d_s.partial), list(d_s.recommended), dict(d_s.final.params) if d_s.recommended else {},
-                    explained)
+            base = [b for b in d_s.baseline
+                    if not all(n in d_s.held for n in self.registry[b].full_names())]
+            return (tuple(d_s.partial), list(d_s.recommended), base,
+                    dict(d_s.final.params) if d_s.recommended or base else {}, explained)
 
         # the samples' searches are independent: one per core (speed; the same results as one after another)
         found = map_forked(alone, len(samples))
         chains: dict[str, list[str]] = {}
+        bases: dict[str, list[str]] = {}
         inits: dict[str, dict] = {}
         explained: dict[str, float] = {}
         for smp, got in zip(samples, found):
             if got is None:
                 return False
-            partial, chains[smp], inits[smp], gains = got
+            partial, chains[smp], bases[smp], inits[smp], gains = got
             if partial:  # stand-ins that leave that sample unexplained: no answer to combine
                 return False
             for e, g in gains.items():
@@ -1380,19 +1384,28 @@ class Search:
         # what to add first (with one sample's effects first, a shared parameter, E_t, bent by the other sample's
         # misfit leaves the first steps explaining nothing)
         union = sorted(dict.fromkeys(e for smp in samples for e in chains[smp]), key=lambda e: -explained[e])
-        if not union or all(chains[smp] == chains[samples[0]] for smp in samples):
+        if not union or all(chains[smp] == chains[samples[0]] and bases[smp] == bases[samples[0]]
+                            for smp in samples):
             return False
-        effects = [self.registry[e] for e in union if e not in {x.name for x in ch.model.effects}]
+        have = {x.name for x in ch.model.effects}
+        effects = [self.registry[e] for e in union if e not in have]
+        # a baseline effect that joined in some samples alone (a joint resting bent after a slack tendon, beside
+        # a sample whose backbone relaxes instead) joins here in those samples, held off in the others: without
+        # it the union leaves the samples that needed it far from the floor
+        base_new = [self.registry[b] for b in dict.fromkeys(b for smp in samples for b in bases[smp])
+                    if b not in have and b not in union]
         if not effects:
             return False
-        m = ch.model.with_effects(list(ch.model.effects) + effects)
+        base_model = ch.model.with_effects(list(ch.model.effects) + base_new) if base_new else ch.model
+        m = base_model.with_effects(list(base_model.effects) + effects)
         names = _names_for(m, s.fit_params)
-        ps = [n for e in effects for n in e.full_names()]
+        ps = [n for e in base_new + effects for n in e.full_names()]
         start = m.initial_values(data)
+        shows = {smp: set(chains[smp]) | set(bases[smp]) for smp in samples}
         held = {}
-        for e in effects:
+        for e in base_new + effects:
             for smp in samples:
-                if e.name not in chains[smp] and e.off:
+                if e.name not in shows[smp] and e.off:
                     for p in e.params:
                         nm = f"{e.name}.{p.name}"
                         held[f"{nm}@{smp}"] = float(e.off[p.name]) if p.name in e.off else float(start[nm])
@@ -1407,10 +1420,11 @@ class Search:
                 or _resolution_problems(m, list(r.fitted), r.params, r.stderr, r.at_bound, data, s.modulus_range_gpa)):
             return False
         old_held, self.held = self.held, held
+        first = (self.chain_steps(base_model, [], [0], r.params, ps) if base_new else ch.steps[:1])
         order = None
         for perm in itertools.permutations(effects):
-            inter = self.chain_steps(ch.model, list(perm), range(1, len(perm)), r.params, ps)
-            if _each_lower([ch.steps[0].rmse_deg] + [x.rmse_deg for x in inter] + [r.rmse]):
+            inter = self.chain_steps(base_model, list(perm), range(1, len(perm)), r.params, ps)
+            if _each_lower([first[0].rmse_deg] + [x.rmse_deg for x in inter] + [r.rmse]):
                 order = list(perm)
                 break
         if order is None:
@@ -1418,15 +1432,24 @@ class Search:
             return False
         r2 = r
         if order != effects:  # effects of one stage compose in the model's order: refit in the chain's order
-            m = ch.model.with_effects(list(ch.model.effects) + order)
+            m = base_model.with_effects(list(base_model.effects) + order)
             r2 = refit_all_rows(m, data, names, fixed, {k: v for k, v in r.params.items() if k in r.fitted}, s.grid,
                                 per_sample=ps)
+        if base_new:  # what the baseline effects add to the union: the union refitted without them
+            without = self.chain_steps(ch.model, order, [len(order)], r2.params, ps)[0]
+            for b in base_new:
+                self.baseline_gain[b.name] = (tuple(e.name for e in order), without.rmse_deg, r2.rmse)
+                self.baseline_added.append(b.name)
+                self.pending = [e for e in self.pending if e.name != b.name]
+        ch.model = base_model
         ch.current, ch.names, ch.per_sample, ch.all_rows, ch.chosen = m, names, ps, r2, order
-        ch.steps = ch.steps[:1] + inter + [_step(r2, ps, {k: v for k, v in r.params.items() if k in r.fitted})]
+        ch.steps = first + inter + [_step(r2, ps, {k: v for k, v in r.params.items() if k in r.fitted})]
         self.recommended = [e.name for e in order]
         self._refit_search(r2.params)
-        shows = "; ".join(f"{smp} shows {', '.join(chains[smp]) or 'nothing'}" for smp in samples)
-        self.notes_late.append(f"each sample diagnosed alone: {shows}; fitted so, each effect held off in the "
+        said = "; ".join(f"{smp} shows {', '.join(chains[smp]) or 'nothing'}"
+                         + (f" (with the baseline's {', '.join(bases[smp])})" if bases[smp] and base_new else "")
+                         for smp in samples)
+        self.notes_late.append(f"each sample diagnosed alone: {said}; fitted so, each effect held off in the "
                                "samples that do not show it")
         return True
 
@@ -1523,6 +1546,7 @@ class Search:
                          {k: self.chosen_round[k] for k in recommended or partial if k in self.chosen_round},
                          self.given, tuple(self.baseline_added), self.baseline_gain, tuple(self.dropped), label,
                          held={k: v for k, v in self.held.items() if k.split(".")[0] in set(recommended)
+                               or ("@" in k and recommended and k.split(".")[0] in set(self.baseline_added))
                                or set(BASELINE_STAND_INS.get(k.split(".")[0], ())) & set(recommended)})
 
 

@@ -203,9 +203,9 @@ def baseline_lines(d: Diagnosis) -> list[str]:
     out: list[str] = []
     for name in d.baseline:
         e = d.catalog.get(name)
-        vals = "; ".join(f"{name}.{p.name} = "
-                         f"{_pm(d.final.params[f'{name}.{p.name}'], d.final.stderr.get(f'{name}.{p.name}', math.inf), p.unit)}"
-                         for p in (e.params if e else ()) if f"{name}.{p.name}" in d.final.params)
+        vals = "; ".join(_baseline_value(d, f"{name}.{p.name}", p.unit) for p in (e.params if e else ())
+                         if f"{name}.{p.name}" in d.final.params
+                         or any(k.startswith(f"{name}.{p.name}@") for k in d.final.params))
         out.append(f"baseline: {name} joins the model, as a property of this joint rather than missing physics: "
                    f"{e.meaning if e else name}; {vals}")
         chain, before, after = d.baseline_gain.get(name, ((), d.given.rmse_deg, base.rmse_deg))
@@ -215,6 +215,17 @@ def baseline_lines(d: Diagnosis) -> list[str]:
     out.append("  the recommended steps below start from the model with it, and the command includes it "
                "(--no-baseline: try it as an ordinary candidate instead)")
     return out
+
+
+def _baseline_value(d: Diagnosis, full: str, unit: str) -> str:
+    """``name = value +- error`` of a baseline parameter in the final model; per sample when it is fitted so
+    (a sample that does not show it: held at its off value)."""
+    ps = [(k.split("@", 1)[1], k) for k in d.final.params if k.startswith(full + "@")]
+    if not ps:
+        return f"{full} = {_pm(d.final.params[full], d.final.stderr.get(full, math.inf), unit)}"
+    return ", ".join(f"{k} = " + (f"{d.held[k]:g} (held: {smp} does not show it)" if k in d.held
+                                  else _pm(d.final.params[k], d.final.stderr.get(k, math.inf), unit))
+                     for smp, k in ps)
 
 
 #: Where each built-in effect sits on the bench, and what the data cannot tell it from (with the measurement
