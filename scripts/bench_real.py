@@ -200,6 +200,10 @@ def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
         lag_ok = (ins.lag.applied_ms > 0 and abs(ins.lag.applied_ms - benches[0].tracker.lag_ms)
                   <= max(3.0 * ins.lag.se_ms, 0.2 * benches[0].tracker.lag_ms))
         ok = lag_ok and (not rec_list or final <= 1.15 * floor_true)
+    elif kinds[0] == "zero drift" and ins.rezeroed:
+        # an instrument property read at the rests and corrected (as a lag is): nothing of the creep family (the
+        # tendon side it would otherwise be taken for), and what the bench's other mechanisms leave explained
+        ok = not set(rec_list) & FAMILIES["creep"][0] and (not rec_list or final <= 1.15 * floor_true)
     elif not right:
         ok = not rec_list
     else:
@@ -212,8 +216,8 @@ def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
     u = unexplained_report.of_diagnosis(d)
     left = (u.get("follows") or ["-"])[0] if u else "-"
     want = FAMILIES[kinds[0]][1]
-    if want is not None:  # the library lacks it: nothing of a wrong family, and what is left follows `want`
-        ok = ok and left == want
+    if want is not None and not (kinds[0] == "zero drift" and ins.rezeroed):
+        ok = ok and left == want  # the library lacks it: nothing of a wrong family, and what is left follows `want`
     out = dict(name=name, tube=tube, rate=rate, rows=len(rec.data), first=first, recommended=rec_list,
                partial=list(d.partial), explanation=d.explanation, base=d.waterfall[0].rmse_deg, final=final, floor_est=d.noise_floor_deg,
                floor_true=floor_true, floor_ok=floor_ok, left=left, lag_true=lag_true, lag_est=ins.lag.lag_ms,
@@ -226,7 +230,9 @@ def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
               f"{(d.partial_steps[-1].rmse_deg / floor_true) if d.partial else float('nan'):.2f} x) | floor est "
               f"{d.noise_floor_deg:.3f} true {floor_true:.3f} ({'ok' if floor_ok else 'OFF'}) | lag {lag_true:.0f} -> "
               f"{ins.lag.lag_ms:.1f}+-{ins.lag.se_ms:.1f} ms (applied {ins.lag.applied_ms:.1f}) | left follows {left} | aside {ins.n_aside} "
-              f"(spikes {len(rec.spike_rows)}), dropped {meas.missing_lines.size} | {'RIGHT' if ok else 'wrong'} | "
+              f"(spikes {len(rec.spike_rows)}), dropped {meas.missing_lines.size}"
+              f"{' | rezeroed ' + ','.join(s for s, z in ins.zeros.items() if z.applied) if ins.rezeroed else ''}"
+              f" | {'RIGHT' if ok else 'wrong'} | "
               f"{t1 - t0:.1f}+{t2 - t1:.1f} s", flush=True)
     return out
 

@@ -62,6 +62,9 @@ def register(model_sub) -> None:
     d.add_argument("--lag-ms", type=float, default=None, metavar="MS",
                    help="lag of the angle channel behind stroke and force (ms) to correct (default: estimated "
                         "from the data and corrected when resolved; 0 = none)")
+    d.add_argument("--no-rezero", dest="rezero", action="store_false",
+                   help="keep the force as read where the load cell's zero drifts (default: re-zero it at every rest, "
+                        "motor at zero and tendon slack, when the rests show a smooth drift from a zeroed cell)")
     d.add_argument("--json", metavar="OUT.json", help="write the diagnosis as JSON")
     d.add_argument("--report", metavar="DIR", help="write an HTML report with PNG plots into DIR")
     d.set_defaults(func=cmd_diagnose)
@@ -90,8 +93,11 @@ def fit_command_prefix(args: argparse.Namespace, instruments=None) -> str:
     for o in args.overrides:
         parts += ["--set", o]
     parts += ["--cycles", args.cycles, "--branch", "both", "--no-deadband"]
-    if instruments is not None and (instruments.n_aside or instruments.n_dropped or instruments.lag.applied_ms):
+    if instruments is not None and (instruments.n_aside or instruments.n_dropped or instruments.lag.applied_ms
+                                    or instruments.rezeroed):
         parts += ["--set-aside", "--lag-ms", f"{instruments.lag.applied_ms:.6g}"]
+        if instruments.rezeroed:
+            parts += ["--rezero"]
     for f in args.effect_file:
         parts += ["--effect-file", f]
     for f in args.fix:
@@ -142,7 +148,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     meas = read_measurements(args.data, strict=args.strict)
     rows = select_cycles(meas.data, args.cycles)
     ins = check_instruments(rows, lag_ms=args.lag_ms, dropped=meas.summary(),
-                            n_dropped=int(meas.missing_lines.size + meas.backward_lines.size))
+                            n_dropped=int(meas.missing_lines.size + meas.backward_lines.size), rezero=args.rezero)
     check_fittable(ins.data, _rows_left(args, meas, ins))
     fit_names, held = fitted_and_held(model, args.fit_params, args.fix, with_effects=False)
     check_force_identifies(ins.data, args.data, fit_names)

@@ -65,6 +65,9 @@ def register(sub) -> None:
                         "stamp, set aside spikes and repeated stamps, and correct the angle's lag (--lag-ms)")
     f.add_argument("--lag-ms", type=float, default=0.0, metavar="MS",
                    help="with --set-aside: lag of the angle channel to correct (ms; default 0)")
+    f.add_argument("--rezero", action="store_true",
+                   help="with --set-aside: re-zero the force at every rest where the load cell's zero drifts, as "
+                        "model diagnose does")
     f.add_argument("--json", metavar="OUT.json", help="write the summary as JSON")
     f.add_argument("--plot", metavar="OUT.png", help="write angle and residual vs stroke (PNG)")
     f.set_defaults(func=cmd_fit)
@@ -158,13 +161,19 @@ def cmd_fit(args: argparse.Namespace) -> int:
         check_time_varies(meas.data, args.data)
         if meas.summary():
             print(meas.summary())
-        ins = check_instruments(select_cycles(meas.data, args.cycles), lag_ms=args.lag_ms or 0.0)
+        ins = check_instruments(select_cycles(meas.data, args.cycles), lag_ms=args.lag_ms or 0.0,
+                                rezero=args.rezero)
         print("; ".join(ins.lines()[:1] + ins.lines()[-1:]))
+        for line in ins.lines():
+            if line.startswith("load cell zero: at") and "corrected, the force re-zeroed" in line:
+                print(line.replace("(--no-rezero to keep it)", "(--rezero)"))
         raw = ins.data
         rows = prepare(raw, "all", args.branch, args.deadband, args.deadband_threshold)
     else:
         if args.lag_ms:
             raise DataError("--lag-ms needs --set-aside (the instruments' check that corrects it)")
+        if args.rezero:
+            raise DataError("--rezero needs --set-aside (the instruments' check that re-zeroes the force)")
         raw = load_csv(args.data)
         check_time_varies(raw, args.data)
         rows = prepare(raw, args.cycles, args.branch, args.deadband, args.deadband_threshold)

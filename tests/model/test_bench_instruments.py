@@ -5,6 +5,7 @@ library; the artefacts it puts in (spike rows, dropouts, the tracker's lag, its 
 """
 from __future__ import annotations
 
+import argparse
 import json
 import math
 
@@ -12,6 +13,7 @@ import numpy as np
 import pytest
 
 from camtube.commands import main
+from camtube.commands.diagnose import fit_command_prefix
 from camtube.design.loader import load_pattern
 from camtube.model.core.fit import fit
 from camtube.model.core.predict import model_for_pattern, pattern_values
@@ -301,3 +303,82 @@ def test_a_carriage_its_rail_holds_is_recommended_first_as_lost_motion_in_the_dr
     assert d.recommended[:1] == ("carriage_hold",), (d.recommended, d.partial, d.stop)
     assert d.final.rmse_deg <= 1.15 * rec.floor_deg < d.waterfall[0].rmse_deg / 1.5
     assert "sits in the drive" in diagnosis_text(d)
+
+
+def _drifting_zero(tube2, drift_N_per_h: float, offset_N: float = 0.0, seed: int = 7):
+    """A 12-cycle bench file at 25 Hz whose sample S1's load cell zero drifts (S2's is steady)."""
+    from dataclasses import replace
+
+    from camtube.model.sim.bench import LoadCell
+
+    slow = Protocol(n_cycles=12, ramp_s=6.0, dwell_s=2.0, rest_s=3.0, first_dwell_s=4.0)
+    s1 = SampleBench(load_cell=LoadCell(drift_N_per_h=drift_N_per_h), tracker=QUIET)
+    rec = simulate_bench(tube2, (s1, SampleBench(tracker=QUIET)), slow, Clock(rate_hz=25.0, n_repeats=0), seed=seed)
+    if offset_N:
+        m = rec.data.sample == "S1"
+        rec = replace(rec, data=rec.data.with_force(rec.data.force_N + offset_N * m))
+    return rec
+
+
+def test_a_drifting_load_cell_zero_is_read_at_the_rests_and_corrected(tube2, tmp_path, capsys):
+    """The tendon is slack at every rest, so the force there is the load cell's zero: a drift of the zero is found
+    (within 20 % of the truth), corrected at every rest in that sample only, said, and carried into the fit
+    command (--rezero), which then gives the diagnosis's own fit."""
+    rec = _drifting_zero(tube2, 2.0)
+    t1 = rec.data.time_s[rec.data.sample == "S1"]
+    true_change = 2.0 * (t1[-1] - t1[0]) / 3600.0
+    ins = check_instruments(rec.data)
+    z1, z2 = ins.zeros["S1"], ins.zeros["S2"]
+    assert z1.applied and not z2.applied and not z2.drifts
+    assert z1.change_N == pytest.approx(true_change, rel=0.2), (z1.change_N, true_change)
+    rest = (ins.data.sample == "S1") & (ins.data.stroke_mm == 0.0)
+    assert abs(float(np.median(ins.data.force_N[rest]))) < 0.1 * true_change
+    assert abs(float(np.median(rec.data.force_N[(rec.data.sample == "S1") & (rec.data.stroke_mm == 0.0)]))) > 0.3 * true_change
+    # the same file as read: the command line says it and carries it into the fit command
+    path = tmp_path / "zero.csv"
+    path.write_text(format_csv(rec.data))
+    js = tmp_path / "d.json"
+    assert main(["model", "diagnose", str(path), "--pattern", str(TUBE2), "-q", "--json", str(js)]) == 0
+    out = capsys.readouterr().out
+    assert "load cell zero: at S1's rests (motor at zero, tendon slack)" in out and "corrected" in out
+    got = json.loads(js.read_text())
+    assert got["instruments"]["load_cell_zero"]["S1"]["rezeroed"] is True
+    assert got["instruments"]["load_cell_zero"]["S2"]["rezeroed"] is False
+    assert not set(got["recommended"]) & {"creep", "creep_load", "viscoelastic", "force_zero"}, got["recommended"]
+    assert "--rezero" in fit_command_prefix(argparse.Namespace(data=str(path), pattern=str(TUBE2), overrides=[],
+                                                               cycles="all", effect_file=[], fix=[]),
+                                            check_instruments(read_measurements(path).data)).split()
+    fj = tmp_path / "f.json"
+    fit_cmd = ["model", "fit", str(path), "--pattern", str(TUBE2), "--set-aside", "--rezero", "--cycles", "all",
+               "--branch", "both", "--no-deadband",
+               "--effects", ",".join(got["final"]["effects"]), "--json", str(fj)]
+    assert main(fit_cmd) == 0
+    assert "the force re-zeroed at every rest (--rezero)" in capsys.readouterr().out
+    assert json.loads(fj.read_text())["rmse_deg"] == pytest.approx(got["final"]["rmse_deg"], rel=1e-3)
+    assert main([a for a in fit_cmd if a != "--rezero"]) == 0   # without --rezero: the drift stays in the force
+    capsys.readouterr()
+    assert json.loads(fj.read_text())["rmse_deg"] > 2.0 * got["final"]["rmse_deg"]
+    # --no-rezero keeps the force as read, and says so
+    assert main(["model", "diagnose", str(path), "--pattern", str(TUBE2), "-q", "--no-rezero", "--no-per-sample",
+                 "--max-effects", "0"]) == 0
+    out = capsys.readouterr().out
+    assert "not corrected (--no-rezero)" in out and "--rezero" not in out.replace("--no-rezero", "")
+
+
+def test_a_force_that_stays_at_rest_is_not_taken_for_the_zero(tube2):
+    """A carriage its rail holds keeps the tendon taut at every rest (lost motion in the drive): the force there is
+    tension, not the load cell's zero; a cell not zeroed before the test reads an offset at the first rests. Neither
+    is re-zeroed, and each is said."""
+    held = simulate_bench(tube2, SampleBench(drive=Drive(backlash_mm=0.2, rail_friction_N=0.3), tracker=QUIET),
+                          Protocol(n_cycles=10, ramp_s=4.0, dwell_s=1.0, rest_s=2.0, first_dwell_s=2.0),
+                          Clock(rate_hz=50.0, n_repeats=0), seed=2)
+    ins = check_instruments(held.data)
+    assert not any(z.applied for z in ins.zeros.values())
+    assert ins.zeros["S1"].held and ins.zeros["S1"].start_N > 0.1
+    assert any(line.startswith("load cell at rest: S1's force stays at") and "lost motion in the drive" in line
+               for line in ins.lines()), ins.lines()
+    off = _drifting_zero(tube2, 2.0, offset_N=0.08)
+    ins = check_instruments(off.data)
+    assert ins.zeros["S1"].drifts and not ins.zeros["S1"].zeroed and not ins.zeros["S1"].applied
+    assert np.array_equal(ins.data.force_N, off.data.force_N[ins.kept])
+    assert any("not corrected, the cell does not read zero at the first rests" in line for line in ins.lines())

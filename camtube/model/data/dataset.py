@@ -249,3 +249,7 @@ class Dataset:
     def with_angle(self, angle_deg: np.ndarray) -> "Dataset":
         return Dataset(self.sample, self.cycle, self.time_s, self.stroke_mm, self.force_N,
                        np.asarray(angle_deg, float), self.extra)
+
+    def with_force(self, force_N: np.ndarray) -> "Dataset":
+        return Dataset(self.sample, self.cycle, self.time_s, self.stroke_mm, np.asarray(force_N, float),
+                       self.angle_deg, self.extra)

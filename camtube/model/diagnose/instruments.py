@@ -36,7 +36,7 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -87,6 +87,162 @@ class Lag:
     model_rmse_deg: tuple = ()
 
 
+#: The load cell's zero, read at the rests: a drift is corrected when it exceeds this many standard errors ...
+ZERO_Z = 5.0
+#: ... the rests scatter about its line by at most this share of it (a zero drifts smoothly; a tendon held taut at
+#: some rests and not at others does not) ...
+ZERO_SMOOTH = 0.25
+#: ... and the first rests read within this share of it (plus two scatters) of zero: the cell was zeroed before the
+#: test, so a force that stays at rest is a taut tendon (or an offset the model's force_zero takes), not a drift.
+ZERO_START = 0.25
+#: Fewest rests (runs of rows at the bottom of the stroke) a sample needs for its zero to be read.
+MIN_RESTS = 6
+
+
+@dataclass(frozen=True, eq=False)
+class Zero:
+    """The load cell's reading at the rests (motor at the bottom of its stroke, tendon slack), one sample.
+
+    Attributes
+    ----------
+    n_rests : int
+    start_N, end_N : float
+        The median reading of the first and of the last three rests.
+    change_N, se_N : float
+        The change of the line through the rests' readings over the sample's record, and its standard error.
+    scatter_N : float
+        The rests' scatter about that line.
+    row_noise_N : float
+        The load cell's noise from row to row at rest.
+    applied : bool
+        Corrected: the force re-zeroed at every rest (:func:`rezero_force`).
+    """
+
+    n_rests: int
+    start_N: float
+    end_N: float
+    change_N: float
+    se_N: float
+    scatter_N: float
+    row_noise_N: float
+    applied: bool = False
+
+    @property
+    def drifts(self) -> bool:
+        """A drift resolved beyond :data:`ZERO_Z` standard errors and the cell's row noise."""
+        return abs(self.change_N) > ZERO_Z * self.se_N and abs(self.change_N) > self.row_noise_N
+
+    @property
+    def smooth(self) -> bool:
+        return self.scatter_N <= ZERO_SMOOTH * abs(self.change_N)
+
+    @property
+    def zeroed(self) -> bool:
+        return abs(self.start_N) <= ZERO_START * abs(self.change_N) + 2.0 * self.scatter_N
+
+    @property
+    def held(self) -> bool:
+        """The force stays well above the cell's noise at rest, steadily: a taut tendon (or an offset)."""
+        return abs(self.start_N) > 5.0 * self.row_noise_N and not self.drifts
+
+
+def _rests(data: Dataset, sl: slice) -> list[np.ndarray]:
+    """Rows (indices into ``data``) of each rest of one sample: the later half of each run of at least 6 rows at
+    the bottom of the stroke (within 0.1 % of its span), where the tendon has gone slack and the guide let go."""
+    s = data.stroke_mm[sl]
+    if s.size < 2:
+        return []
+    lo, hi = float(np.min(s)), float(np.max(s))
+    idx = np.flatnonzero(s <= lo + 1e-3 * (hi - lo) + 1e-12) + sl.start
+    runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if idx.size else []
+    return [r[r.size // 2:] for r in runs if r.size >= 6]
+
+
+def read_zero(data: Dataset) -> dict:
+    """``{sample: Zero}``: the load cell's reading at each sample's rests (samples with too few rests left out)."""
+    out = {}
+    for smp, sl in data.sample_slices():
+        rests = _rests(data, sl)
+        if len(rests) < MIN_RESTS:
+            continue
+        z = np.array([float(np.median(data.force_N[r])) for r in rests])
+        t = np.array([float(np.median(data.time_s[r])) for r in rests])
+        dt = t - t.mean()
+        sxx = float(dt @ dt)
+        if sxx <= 0.0:
+            continue
+        b = float(dt @ (z - z.mean())) / sxx
+        resid = z - z.mean() - b * dt
+        scatter = float(np.sqrt(resid @ resid / max(z.size - 2, 1)))
+        span = float(t[-1] - t[0])
+        steps = np.concatenate([np.diff(data.force_N[r]) for r in rests])
+        noise = float(1.4826 * np.median(np.abs(steps - np.median(steps))) / math.sqrt(2.0)) if steps.size else 0.0
+        out[smp] = Zero(z.size, float(np.median(z[:3])), float(np.median(z[-3:])), b * span,
+                        scatter / math.sqrt(sxx) * span, scatter, noise)
+    return out
+
+
+def rezero_force(data: Dataset, zeros: dict) -> tuple[Dataset, dict]:
+    """``data`` with the force re-zeroed at every rest in the samples whose zero drifts (smoothly, from a cell
+    zeroed before the test: :class:`Zero`), and ``zeros`` with ``applied`` set. The zero between two rests is
+    interpolated in time (each rest's reading the median of it and its neighbours'), held before the first and after
+    the last."""
+    force = data.force_N.copy()
+    out = dict(zeros)
+    for smp, sl in data.sample_slices():
+        zr = zeros.get(smp)
+        if zr is None or not (zr.drifts and zr.smooth and zr.zeroed):
+            continue
+        rests = _rests(data, sl)
+        z = np.array([float(np.median(data.force_N[r])) for r in rests])
+        t = np.array([float(np.median(data.time_s[r])) for r in rests])
+        zs = np.array([float(np.median(z[max(i - 1, 0):i + 2])) for i in range(z.size)])
+        force[sl] = data.force_N[sl] - np.interp(data.time_s[sl], t, zs)
+        out[smp] = Zero(zr.n_rests, zr.start_N, zr.end_N, zr.change_N, zr.se_N, zr.scatter_N, zr.row_noise_N, True)
+    if not any(z.applied for z in out.values()):
+        return data, out
+    return data.with_force(force), out
+
+
+def zero_lines(zeros: dict, enabled: bool) -> list[str]:
+    """The load cell's zero at the rests, one sentence per finding."""
+    if not zeros:
+        return []
+    out = []
+    fixed = {s: z for s, z in zeros.items() if z.applied}
+    for smp, z in fixed.items():
+        out.append(f"load cell zero: at {smp}'s rests (motor at zero, tendon slack) the force moves from "
+                   f"{z.start_N:.3g} to {z.end_N:.3g} N, a drift of {z.change_N:+.3g} N over the record "
+                   f"({abs(z.change_N) / max(z.se_N, 1e-300):.0f} standard errors): the load cell's zero drifts (an "
+                   "instrument's, not the tendon's: creep lengthens the tendon and leaves the force at rest at zero); "
+                   "corrected, the force re-zeroed at every rest (--no-rezero to keep it)")
+    for smp, z in zeros.items():
+        if z.applied:
+            continue
+        if z.drifts and not enabled:
+            out.append(f"load cell zero: at {smp}'s rests the force moves from {z.start_N:.3g} to {z.end_N:.3g} N "
+                       f"({z.change_N:+.3g} N): not corrected (--no-rezero)")
+        elif z.drifts and not z.smooth:
+            out.append(f"load cell zero: at {smp}'s rests (motor at zero) the force changes from rest to rest "
+                       f"({z.scatter_N:.3g} N about its trend of {z.change_N:+.3g} N): not a drifting zero; a tendon held "
+                       "taut at some rests (a carriage its rail holds within the nut's gap: lost motion in the drive) "
+                       "would do it; not corrected")
+        elif z.drifts:
+            out.append(f"load cell zero: at {smp}'s rests (motor at zero) the force reads {z.start_N:.3g} N at the start "
+                       f"and {z.end_N:.3g} N at the end: not corrected, the cell does not read zero at the first rests "
+                       "(a tendon held taut at rest, a preload, or a cell not zeroed); re-zero it with the tendon "
+                       "unloaded before and after the test to tell")
+        elif z.held:
+            out.append(f"load cell at rest: {smp}'s force stays at {z.start_N:.3g} N at every rest with the motor at "
+                       "zero: the tendon is held taut at rest (a carriage its rail holds within the nut's gap: lost "
+                       "motion in the drive; a preload), or the cell is not zeroed; a displacement gauge on the "
+                       "carriage, or a reading with the tendon unhooked, tells")
+    if not out:
+        out.append("load cell zero: steady at the rests (" + ", ".join(
+            f"{smp} {z.start_N:.2g} to {z.end_N:.2g} N" for smp, z in zeros.items()) + "): none to correct")
+    return out
+
+
 @dataclass(frozen=True, eq=False)
 class Instruments:
     """What the instruments did (:func:`check_instruments`).
@@ -120,6 +276,13 @@ class Instruments:
     lag: Lag
     dropped: str = ""
     n_dropped: int = 0
+    zeros: dict = field(default_factory=dict)
+    rezero: bool = True
+
+    @property
+    def rezeroed(self) -> bool:
+        """The force was re-zeroed at the rests in some sample."""
+        return any(z.applied for z in self.zeros.values())
 
     @property
     def n_aside(self) -> int:
@@ -138,6 +301,7 @@ class Instruments:
             out.append(f"set aside before fitting: none of {n_raw} rows (no spikes, no repeated time stamps)")
         out.append("sampling: " + ", ".join(f"{s} {r:.4g} Hz" for s, r in self.rates_hz.items()))
         out.extend(self.rate_changes)
+        out.extend(zero_lines(self.zeros, self.rezero))
         lg = self.lag
         if lg.given:
             out.append(f"angle lag: {lg.lag_ms:.4g} ms as given (--lag-ms); the angle is read {lg.applied_ms:.4g} ms "
@@ -378,7 +542,7 @@ def shift_angle(data: Dataset, lag_ms: float) -> tuple[Dataset, np.ndarray, floa
 
 
 def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str = "", n_dropped: int = 0,
-                      ) -> Instruments:
+                      rezero: bool = True) -> Instruments:
     """Find the instruments' artefacts, set them aside, estimate (or apply) the angle's lag.
 
     Parameters
@@ -389,6 +553,8 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
         The angle channel's lag (ms) to correct; ``None``: estimate it and correct it when it is resolved.
     dropped, n_dropped : str, int
         The reader's line on dropped rows and their count (stated in the findings).
+    rezero : bool
+        Re-zero the force at the rests where the load cell's zero drifts (:func:`rezero_force`); False: read it only.
 
     Returns
     -------
@@ -411,6 +577,9 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     kept = ~(rep | sa | sf)
     clean = data.take(kept)
     rates, notes = _rates(clean)
+    zeros = read_zero(clean)
+    if rezero:
+        clean, zeros = rezero_force(clean, zeros)
     if lag_ms is not None:
         lag = Lag(float(lag_ms), 0.0, given=True, applied_ms=float(lag_ms))  # whole rows below
     else:
@@ -426,7 +595,7 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     kept[idx[~k2]] = False
     if (~k2).any():
         aside["end of record after the lag shift"] = idx[~k2]
-    return Instruments(shifted, data, aside, kept, rates, notes, lag, dropped, n_dropped)
+    return Instruments(shifted, data, aside, kept, rates, notes, lag, dropped, n_dropped, zeros, rezero)
 
 
 @np.errstate(over="ignore", invalid="ignore")  # an absurd value (angle 1e300) overflows: inf, and no warning
@@ -515,7 +684,8 @@ def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Ins
         return ins
     if not best[1] or best[0] > (1.0 - MODEL_LAG_FALL) * r0.rmse:
         return ins
-    new = check_instruments(ins.raw, lag_ms=best[1], dropped=ins.dropped, n_dropped=ins.n_dropped)
+    new = check_instruments(ins.raw, lag_ms=best[1], dropped=ins.dropped, n_dropped=ins.n_dropped,
+                            rezero=ins.rezero)
     return Instruments(new.data, new.raw, new.aside, new.kept, new.rates_hz, new.rate_changes,
                        Lag(lg.lag_ms, lg.se_ms, False, new.lag.applied_ms, lg.fall, (r0.rmse, best[0])),
-                       new.dropped, new.n_dropped)
+                       new.dropped, new.n_dropped, new.zeros, new.rezero)

@@ -172,7 +172,11 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
             "rows_set_aside": {k: int(len(v)) for k, v in ins.aside.items()},
             "rates_hz": {k: _num(v) for k, v in ins.rates_hz.items()}, "rate_changes": list(ins.rate_changes),
             "lag_ms": _num(ins.lag.lag_ms), "lag_se_ms": _num(ins.lag.se_ms), "lag_given": bool(ins.lag.given),
-            "lag_applied_ms": _num(ins.lag.applied_ms)}
+            "lag_applied_ms": _num(ins.lag.applied_ms),
+            "load_cell_zero": {smp: {"rests": z.n_rests, "start_N": _num(z.start_N), "end_N": _num(z.end_N),
+                                     "change_N": _num(z.change_N), "change_se_N": _num(z.se_N),
+                                     "scatter_N": _num(z.scatter_N), "rezeroed": bool(z.applied)}
+                               for smp, z in ins.zeros.items()}}
     out["replaced"] = [{"effects": list(old), "by": new} for old, new in d.replaced]
     out["dropped"] = list(d.dropped)
     out["waterfall"] = [{"effects": list(s.effects), "rmse_deg": _num(s.rmse_deg),
@@ -307,11 +311,15 @@ def answer_lines(d: Diagnosis) -> list[str]:
         out.append("answer: nothing the library has explains the misfit; the built-ins that lower it ("
                    + ", ".join(d.partial) + f") leave {_times(d.partial_steps[-1].rmse_deg, floor)} the noise floor "
                    "and are not recommended (see 'partial' and 'unexplained')")
+    elif steps[0].rmse_deg > REACH_RATIO * floor:
+        out.append(f"answer: nothing the library has explains the misfit: the model stays at "
+                   f"{_times(steps[0].rmse_deg, floor)} the noise floor ({steps[0].rmse_deg:.3f} vs {floor:.3f} deg) "
+                   "and no built-in effect lowers it reliably (see 'unexplained')")
     else:
         out.append(f"answer: nothing to add: the model is at {_times(steps[0].rmse_deg, floor)} the noise floor "
                    f"({steps[0].rmse_deg:.3f} vs {floor:.3f} deg)")
     u = unexplained_report.of_diagnosis(d)
-    if u is not None and (d.recommended or d.partial):
+    if u is not None and (d.recommended or d.partial or steps[0].rmse_deg > REACH_RATIO * floor):
         follows = ", ".join(u["follows"][:2]) if u.get("follows") else "nothing in particular (noise-like)"
         out.append(f"  left: {100 * u['share']:.0f} % of the final error is above the noise floor; it follows "
                    f"{follows}; carried by sample(s) {', '.join(u.get('samples') or []) or 'alike'}")

@@ -134,10 +134,12 @@ class Backbone:
 
 @dataclass(frozen=True)
 class Tracker:
-    """EM tracker: lag, noise, spikes, dropouts."""
+    """EM tracker: lag, noise, spikes, dropouts, and a zero that drifts (``drift_deg_per_h``: the reading's offset
+    grows with the time since the record began, as a tracker's field and sensor warm up)."""
 
     noise_deg: float = 0.15
     lag_ms: float = 0.0
+    drift_deg_per_h: float = 0.0
     n_spikes: int = 8
     spike_deg: tuple = (3.0, 9.0)
     n_dropouts: int = 4
@@ -378,7 +380,7 @@ def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | 
         tr, lc = b.tracker, b.load_cell
         # the tracker reports the bend it saw lag_ms ago
         seen = np.interp(t_true - tr.lag_ms * 1e-3, t_true, theta)
-        angle = np.degrees(seen) + rng.normal(0.0, tr.noise_deg, n)
+        angle = np.degrees(seen) + rng.normal(0.0, tr.noise_deg, n) + tr.drift_deg_per_h * t_true / 3600.0
         k_sp = np.sort(rng.choice(np.arange(5, n - 5), tr.n_spikes, replace=False)) if tr.n_spikes else np.zeros(0, int)
         angle[k_sp] += rng.choice([-1.0, 1.0], k_sp.size) * rng.uniform(*tr.spike_deg, k_sp.size)
         k_dr = []

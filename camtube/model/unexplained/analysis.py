@@ -75,7 +75,9 @@ HINTS = {
     ("direction", False): ("a hysteresis of another form (friction or play)", "stroke"),
     ("cycle", False): ("a change from cycle to cycle (wear, ratcheting)", "stroke"),
     ("first_cycle", False): ("a permanent set in the first cycle (the tendon seats or yields once)", "stroke"),
-    ("time", False): ("a drift of the tendon length in time", "stroke"),
+    ("time", False): ("a drift in time (of the tendon's length, or of an instrument's zero: the tracker's angle or the "
+                      "load cell's force; the straight joint measured at rest and the load cell re-zeroed unloaded, "
+                      "before and after the test, tell which)", "stroke"),
     ("sample", False): ("per-sample parameters (camtube model fit --per-sample NAMES)", "angle"),
 }
 FOLDS = 5
