@@ -1394,16 +1394,22 @@ class Search:
         # it the union leaves the samples that needed it far from the floor
         base_new = [self.registry[b] for b in dict.fromkeys(b for smp in samples for b in bases[smp])
                     if b not in have and b not in union]
+        # one that joined the joint search (shared) but is in force in some samples alone only (a stand-in holds
+        # it off in the others): per sample, held off where it is not in force (shared, a rest angle one sample
+        # needs bends the other sample's relaxation to its bounds)
+        base_split = [e for e in ch.model.effects if e.name in self.baseline_added
+                      and any(e.name in bases[smp] for smp in samples)
+                      and not all(e.name in bases[smp] for smp in samples)]
         if not effects:
             return False
         base_model = ch.model.with_effects(list(ch.model.effects) + base_new) if base_new else ch.model
         m = base_model.with_effects(list(base_model.effects) + effects)
         names = _names_for(m, s.fit_params)
-        ps = [n for e in base_new + effects for n in e.full_names()]
+        ps = [n for e in base_split + base_new + effects for n in e.full_names()]
         start = m.initial_values(data)
         shows = {smp: set(chains[smp]) | set(bases[smp]) for smp in samples}
         held = {}
-        for e in base_new + effects:
+        for e in base_split + base_new + effects:
             for smp in samples:
                 if e.name not in shows[smp] and e.off:
                     for p in e.params:
@@ -1420,7 +1426,7 @@ class Search:
                 or _resolution_problems(m, list(r.fitted), r.params, r.stderr, r.at_bound, data, s.modulus_range_gpa)):
             return False
         old_held, self.held = self.held, held
-        first = (self.chain_steps(base_model, [], [0], r.params, ps) if base_new else ch.steps[:1])
+        first = (self.chain_steps(base_model, [], [0], r.params, ps) if base_new or base_split else ch.steps[:1])
         order = None
         for perm in itertools.permutations(effects):
             inter = self.chain_steps(base_model, list(perm), range(1, len(perm)), r.params, ps)
@@ -1447,7 +1453,8 @@ class Search:
         self.recommended = [e.name for e in order]
         self._refit_search(r2.params)
         said = "; ".join(f"{smp} shows {', '.join(chains[smp]) or 'nothing'}"
-                         + (f" (with the baseline's {', '.join(bases[smp])})" if bases[smp] and base_new else "")
+                         + (f" (with the baseline's {', '.join(bases[smp])})"
+                            if bases[smp] and (base_new or base_split) else "")
                          for smp in samples)
         self.notes_late.append(f"each sample diagnosed alone: {said}; fitted so, each effect held off in the "
                                "samples that do not show it")
