@@ -1334,19 +1334,11 @@ class Search:
         self.clock["search"] = time.perf_counter()
         return self.result()
 
-    def try_sample_wise(self) -> bool:
-        """When the chain leaves the error above :data:`REACH_RATIO` x the floor and there are several samples:
-        diagnose each sample alone; when each is explained (something recommended, or nothing to add) and they
-        show different effects, fit the union with each effect held off
-        (at its ``off`` values) in the samples that do not show it, and take it as the chain when it lowers the
-        all-rows error and BIC with every parameter resolved and a waterfall that lowers at every step. Two
-        samples that each need a different first effect defeat the joint greedy search (a stand-in that
-        serves both wins its first round); one sample at a time does not. True when the chain changed."""
-        ch, s, data = self.chain, self.settings, self.data
-        samples = list(data.samples)
-        if not s.per_sample or len(samples) < 2 or ch.all_rows.rmse <= REACH_RATIO * self.floor:
-            return False
-        sub_settings = replace(s, per_sample=False)
+    def _samples_alone(self, samples: Sequence[str]):
+        """Each sample diagnosed alone (one per core): ``(recommended, baseline effects in force, final parameters,
+        what each effect explains)`` each by sample, or None when a sample cannot be fitted or is left partial
+        (stand-ins that leave it unexplained: no answer to combine)."""
+        data, sub_settings = self.data, replace(self.settings, per_sample=False)
 
         def alone(i: int):
             """Sample ``i`` diagnosed alone: ``None`` when it cannot be fitted, else (partial, recommended, the
@@ -1374,12 +1366,30 @@ class Search:
         explained: dict[str, float] = {}
         for smp, got in zip(samples, found):
             if got is None:
-                return False
+                return None
             partial, chains[smp], bases[smp], inits[smp], gains = got
-            if partial:  # stand-ins that leave that sample unexplained: no answer to combine
-                return False
+            if partial:
+                return None
             for e, g in gains.items():
                 explained[e] = explained.get(e, 0.0) + g
+        return chains, bases, inits, explained
+
+    def try_sample_wise(self) -> bool:
+        """When the chain leaves the error above :data:`REACH_RATIO` x the floor and there are several samples:
+        diagnose each sample alone; when each is explained (something recommended, or nothing to add) and they
+        show different effects, fit the union with each effect held off
+        (at its ``off`` values) in the samples that do not show it, and take it as the chain when it lowers the
+        all-rows error and BIC with every parameter resolved and a waterfall that lowers at every step. Two
+        samples that each need a different first effect defeat the joint greedy search (a stand-in that
+        serves both wins its first round); one sample at a time does not. True when the chain changed."""
+        ch, s, data = self.chain, self.settings, self.data
+        samples = list(data.samples)
+        if not s.per_sample or len(samples) < 2 or ch.all_rows.rmse <= REACH_RATIO * self.floor:
+            return False
+        got = self._samples_alone(samples)
+        if got is None:
+            return False
+        chains, bases, inits, explained = got
         # the union in the order of what each effect explains in its samples, most first: the waterfall then says
         # what to add first (with one sample's effects first, a shared parameter, E_t, bent by the other sample's
         # misfit leaves the first steps explaining nothing)
