@@ -158,3 +158,25 @@ def test_row_mask_fits_only_the_selected_rows(tube2):
     assert held.residuals.shape == (len(rows),)  # predictions for the held-out rows too
     other = held.residuals[~mask]
     assert math.sqrt(np.mean(other**2)) < 2 * held.rmse
+
+
+def test_a_parameter_the_data_do_not_see_leaves_the_others_errors_finite(tube2):
+    """A parameter that changes nothing gets an infinite standard error, the others keep theirs (the covariance of
+    the directions the data see). Before, 0 x inf in the pseudo-inverse made every error infinite, so one unseen
+    copy of a per-sample parameter (a nut's gap that never binds in one sample) condemned the whole fit."""
+    unseen = Effect(
+        name="test_unseen", stage="angle",
+        params=(Param("bias_deg", "deg", -10.0, 10.0, 0.0, "sensor zero"),
+                Param("nothing", "", 0.0, 1.0, 0.5, "a parameter the output does not depend on")),
+        apply=lambda ctx, angle, p: angle + p["bias_deg"],
+        meaning="a zero offset and a parameter that does nothing", signature="constant residual",
+    )
+    data = synthesize(tube2, n_cycles=2, slack_mm=0.0, seed=3)
+    data = data.with_angle(data.angle_deg + 1.7)
+    r = fit(model_for_pattern(tube2, [unseen]), data, ("E_t", "test_unseen.bias_deg", "test_unseen.nothing"),
+            pattern_values(tube2) | {"E_t": 15.0})
+    assert math.isinf(r.stderr["test_unseen.nothing"])
+    assert 0.0 < r.stderr["E_t"] < 0.1 and 0.0 < r.stderr["test_unseen.bias_deg"] < 0.1, r.stderr
+    ref = fit(model_for_pattern(tube2, [_bias_effect()]), data, ("E_t", "test_bias.bias_deg"),
+              pattern_values(tube2) | {"E_t": 15.0})
+    assert r.stderr["E_t"] == pytest.approx(ref.stderr["E_t"], rel=1e-3)

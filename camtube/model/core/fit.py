@@ -380,10 +380,11 @@ def fit(
             s2 = sse / (n - p)
             _, sv, vt = np.linalg.svd(jac, full_matrices=False)
             tol_sv = sv.max() * max(jac.shape) * np.finfo(float).eps if sv.size else 0.0
-            inv = np.where(sv > tol_sv, 1.0 / np.where(sv > tol_sv, sv, 1.0) ** 2, np.inf)
-            with np.errstate(invalid="ignore"):
-                cov = (vt.T * inv) @ vt * s2
-            # a direction the data cannot see: infinite variance along it
+            # the covariance of the directions the data see (a pseudo-inverse: an unseen direction's 1/sv^2 as an
+            # infinity would turn every entry into nan through 0 x inf, and every parameter's error infinite) ...
+            inv = np.where(sv > tol_sv, 1.0 / np.where(sv > tol_sv, sv, 1.0) ** 2, 0.0)
+            cov = (vt.T * inv) @ vt * s2
+            # ... and a direction the data cannot see: infinite variance along it, for the parameters it moves
             for k in np.flatnonzero(~(sv > tol_sv)):
                 dirn = np.abs(vt[k]) > 1e-12
                 cov[np.ix_(dirn, dirn)] = np.inf
