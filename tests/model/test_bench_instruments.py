@@ -382,3 +382,52 @@ def test_a_force_that_stays_at_rest_is_not_taken_for_the_zero(tube2):
     assert ins.zeros["S1"].drifts and not ins.zeros["S1"].zeroed and not ins.zeros["S1"].applied
     assert np.array_equal(ins.data.force_N, off.data.force_N[ins.kept])
     assert any("not corrected, the cell does not read zero at the first rests" in line for line in ins.lines())
+
+
+def test_a_carriage_held_within_a_gap_that_binds_is_lost_motion_in_the_drive(tube2):
+    """A nut's gap narrower than the stroke at which the rail holds the carriage: the far flank pushes the held
+    carriage down with the motor, so the joint rests bent by what the gap keeps, the tendon taut (sample 1, 0.11 mm
+    and 0.18 N). carriage_hold leaves that out and the joint's rest angle or relaxation took its place; they hold
+    the joint bent with the tendon slack, which the force at rest contradicts. carriage_gap is recommended first
+    and the chain ends at the floor; the joint's effects are refused, saying why."""
+    from camtube.model.diagnose import diagnose
+    from camtube.model.sim.bench import Backbone
+
+    def bench(gap_mm, friction_N):
+        return SampleBench(drive=Drive(backlash_mm=gap_mm, rail_friction_N=friction_N),
+                           backbone=Backbone(relax=((0.05, 3.0),)), tracker=QUIET)
+
+    pace = Protocol(n_cycles=16, ramp_s=3.0, dwell_s=2.0, rest_s=2.0, first_dwell_s=2.0)
+    rec = simulate_bench(tube2, (bench(0.11, 0.18), bench(0.13, 0.12)), pace, Clock(rate_hz=50.0, n_repeats=0),
+                         seed=11)
+    d = diagnose(model_for_pattern(tube2), rec.data, ("E_t",), pattern_values(tube2))
+    assert d.recommended[:1] == ("carriage_gap",), (d.recommended, d.partial, d.stop_reason)
+    assert d.final.rmse_deg <= 1.15 * rec.floor_deg
+    gap = [v for k, v in d.final.params.items() if k.startswith("carriage_gap.gap_mm@S1")]
+    assert gap and gap[0] == pytest.approx(0.11, rel=0.15), d.final.params
+    refused = {c.effect: c.why for c in d.candidates if "the tendon is taut at rest" in c.why}
+    assert {"relaxation", "relaxation2"} & set(refused), {c.effect: c.why for c in d.candidates}
+
+
+def test_the_joint_resting_bent_by_itself_is_refused_where_the_force_at_rest_stays():
+    """rest_angle's and the relaxations' check: a joint held bent at the rests while the force there stays well
+    above zero is a taut tendon, not a joint resting by itself; the same joint with the force at zero passes."""
+    from camtube.model.effects.builtin import REST_ANGLE, _rest_angle_check
+    from camtube.model.data.dataset import Dataset
+
+    t = np.arange(0.0, 60.0, 0.02)
+    stroke = np.clip(np.sin(2 * np.pi * t / 10.0), 0.0, None) * 2.0   # pulls and rests at zero, 6 cycles
+    rng = np.random.default_rng(0)
+    force = 2.0 * stroke + rng.normal(0.0, 0.005, t.size)
+    pred = np.where(stroke == 0.0, 1.5, 10.0 * stroke)                  # the effect holds the joint bent at rest
+    n = t.size
+    base = dict(sample=np.full(n, "S1", dtype=object), cycle=(t // 10).astype(int) + 1, time_s=t, stroke_mm=stroke,
+                angle_deg=pred)
+    slack = Dataset(force_N=force, **base)
+    taut = Dataset(force_N=np.where(stroke == 0.0, force + 0.15, force), **base)
+    assert _rest_angle_check(slack, pred) == ""
+    why = _rest_angle_check(taut, pred)
+    assert why.startswith("in S1 it holds the joint bent at rest (1.5 deg) while the force there stays at 0.1")
+    assert "the tendon is taut at rest" in why
+    assert REST_ANGLE.check is _rest_angle_check
+    assert _rest_angle_check(taut, np.where(stroke == 0.0, 0.0, pred)) == ""   # not held bent: nothing to refuse

@@ -97,3 +97,26 @@ def test_the_held_position_moves_continuously_with_the_hold_force():
     a = carriage_hold(data, s, 0.3, 1.0)[-1]
     b = carriage_hold(data, s, 0.3 + 1e-6, 1.0)[-1]
     assert 0 < b - a < 1e-5                                   # no step: a fit can move the hold force
+
+
+def test_carriage_gap_is_carriage_hold_within_the_nut_s_gap():
+    """The built-in carriage_gap lifts the stroke as carriage_hold does while the gap does not bind, and by at most
+    the gap where it does (the far flank pushes the held carriage down with the motor)."""
+    from camtube.model.core.registry import builtin_registry
+    from camtube.model.effects.builtin import carriage_lift_mm, held_tension_N
+
+    t = np.arange(0, 3.0, 0.01)
+    s = np.clip(1.0 - t, 0.0, None)
+    f = np.where(s > 0.1, 2.0 * s, 0.2)
+    f[t >= 2.0] = 0.0
+    data = _rows(s, f)
+    assert held_tension_N(data)[0] == pytest.approx(0.2)
+    wide = carriage_lift_mm(data, 1.6, 10.0)
+    assert np.array_equal(wide, carriage_lift_mm(data, 1.6))          # carriage_hold's lift: the gap never binds
+    assert wide.max() == pytest.approx(0.16, abs=1e-9)
+    narrow = carriage_lift_mm(data, 1.6, 0.04)
+    assert narrow.max() == pytest.approx(0.04, abs=1e-9) and np.all(narrow <= wide + 1e-12)
+    reg = builtin_registry()
+    gap, hold = reg["carriage_gap"], reg["carriage_hold"]
+    assert gap.family == hold.family == "drive" and gap.off == {"ratio": 0.0}
+    assert [p.name for p in gap.params] == ["ratio", "gap_mm"]

@@ -61,6 +61,19 @@ class Cache:
         return f"Cache({sorted(self._data)})"
 
 
+def rest_runs(data: "Dataset", sl: slice, min_rows: int = 6) -> list[np.ndarray]:
+    """Rows (indices into ``data``) of each rest of one sample (``sl``): the later half of each run of at least
+    ``min_rows`` rows at the bottom of the stroke (within 0.1 % of its span), where the tendon has gone slack (or
+    is held) and the guide has let go."""
+    s = data.stroke_mm[sl]
+    if s.size < 2:
+        return []
+    lo, hi = float(np.min(s)), float(np.max(s))
+    idx = np.flatnonzero(s <= lo + 1e-3 * (hi - lo) + 1e-12) + sl.start
+    runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if idx.size else []
+    return [r[r.size // 2:] for r in runs if r.size >= min_rows]
+
+
 def recently_used(store: dict, key: Any, compute: Callable[[], Any], limit: int) -> Any:
     """``store[key]``, computed by ``compute()`` the first time; ``store`` keeps the ``limit`` most recently used
     entries (a dict keeps its order: the most recently used last, the least recently used dropped first)."""

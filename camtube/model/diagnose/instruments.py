@@ -42,7 +42,7 @@ import numpy as np
 
 from camtube.errors import DataError
 from camtube.model.core.threads import one_blas_thread
-from camtube.model.data.dataset import Dataset
+from camtube.model.data.dataset import Dataset, rest_runs
 
 #: A row this many robust scales from its running median is a spike.
 SPIKE_Z = 8.0
@@ -146,23 +146,11 @@ class Zero:
         return abs(self.start_N) > 5.0 * self.row_noise_N and not self.drifts
 
 
-def _rests(data: Dataset, sl: slice) -> list[np.ndarray]:
-    """Rows (indices into ``data``) of each rest of one sample: the later half of each run of at least 6 rows at
-    the bottom of the stroke (within 0.1 % of its span), where the tendon has gone slack and the guide let go."""
-    s = data.stroke_mm[sl]
-    if s.size < 2:
-        return []
-    lo, hi = float(np.min(s)), float(np.max(s))
-    idx = np.flatnonzero(s <= lo + 1e-3 * (hi - lo) + 1e-12) + sl.start
-    runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if idx.size else []
-    return [r[r.size // 2:] for r in runs if r.size >= 6]
-
-
 def read_zero(data: Dataset) -> dict:
     """``{sample: Zero}``: the load cell's reading at each sample's rests (samples with too few rests left out)."""
     out = {}
     for smp, sl in data.sample_slices():
-        rests = _rests(data, sl)
+        rests = rest_runs(data, sl)
         if len(rests) < MIN_RESTS:
             continue
         z = np.array([float(np.median(data.force_N[r])) for r in rests])
@@ -193,7 +181,7 @@ def rezero_force(data: Dataset, zeros: dict) -> tuple[Dataset, dict]:
         zr = zeros.get(smp)
         if zr is None or not (zr.drifts and zr.smooth and zr.zeroed):
             continue
-        rests = _rests(data, sl)
+        rests = rest_runs(data, sl)
         z = np.array([float(np.median(data.force_N[r])) for r in rests])
         t = np.array([float(np.median(data.time_s[r])) for r in rests])
         zs = np.array([float(np.median(z[max(i - 1, 0):i + 2])) for i in range(z.size)])

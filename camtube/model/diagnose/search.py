@@ -123,7 +123,7 @@ BASELINE = ("rest_angle",)
 #: values (a relaxing backbone holds the unloaded joint bent for a while, as friction holds it for good; where
 #: the relaxation explains the bent rest the constant rest angle goes to zero, on its bound; a carriage held by its
 #: rail holds the tendon taut and the joint bent while the motor rests at zero).
-BASELINE_STAND_INS = {"rest_angle": ("relaxation", "relaxation2", "carriage_hold")}
+BASELINE_STAND_INS = {"rest_angle": ("relaxation", "relaxation2", "carriage_hold", "carriage_gap")}
 #: A chain of effects is recommended only when its all-rows RMSE is within this multiple of the noise floor.
 REACH_RATIO = 1.15
 #: A chain above :data:`REACH_RATIO` x the floor is still recommended (labelled a partial explanation) when it

@@ -7,7 +7,7 @@ registry is made from (:func:`camtube.model.core.registry.builtin_registry`).
 from __future__ import annotations
 
 from camtube.model.effects.builtin import (  # noqa: F401
-    ANGLE_BIAS, BUILTIN_EFFECTS, BUILTINS, CARRIAGE_HOLD, CHORDS, CREEP, FLAT_WALLS, FORCE_ZERO, FRICTION, HARDSTOP, KERF,
+    ANGLE_BIAS, BUILTIN_EFFECTS, BUILTINS, CARRIAGE_GAP, CARRIAGE_HOLD, CHORDS, CREEP, FLAT_WALLS, FORCE_ZERO, FRICTION, HARDSTOP, KERF,
     PLAY,
     SERIES, SLACK, TOE, TOE_SHAPE, VISCOELASTIC,
 )

@@ -11,6 +11,8 @@ slack          stroke      tendon slack: a deadband at low stroke (deadband_mm)
 play           stroke      lost motion in the drive, direction dependent (play_mm)
 carriage_hold  stroke      lost motion in the drive: the rail's friction holds the carriage while the tension
                            is low, until it lets go (ratio: the friction over the tension held at rest)
+carriage_gap   stroke      the same within a nut's gap that binds: the far flank pushes the held carriage down
+                           with the motor (ratio, gap_mm)
 creep          stroke      tendon creep / drift over time (creep_mm, tau_s)
 creep_load     stroke      tendon creep under load: Findley's power law in the load-time integral
                            (creep_mm, exponent)
@@ -48,7 +50,7 @@ from camtube.design.geometry import backbone_angle_rad, centroid_mm
 from camtube.model.core.model import Context, Effect
 from camtube.model.core.noise import white_noise_sd
 from camtube.model.core.params import Param
-from camtube.model.data.dataset import Dataset, recently_used
+from camtube.model.data.dataset import Dataset, recently_used, rest_runs
 from camtube.model.effects.history import (  # noqa: F401
     carriage_hold, first_order_lag, monotone_segments, play_operator,
 )
@@ -194,20 +196,20 @@ def _carriage_hold(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
 CARRIAGE_LIFTS_KEPT = 6
 
 
-def carriage_lift_mm(data: Dataset, ratio: float) -> np.ndarray:
+def carriage_lift_mm(data: Dataset, ratio: float, gap_mm: float = math.inf) -> np.ndarray:
     """(n,) how far the held carriage stands above the motor (mm): :func:`carriage_hold` on the measured stroke,
-    its hold force ``ratio`` times each sample's :func:`held_tension_N`. Computed on the whole record ``data`` was
-    taken from (in a thinned copy the hold's start would fall between two kept rows, where the force bends as the
-    carriage sticks) and kept with it."""
+    its hold force ``ratio`` times each sample's :func:`held_tension_N`, within the nut's gap ``gap_mm``. Computed
+    on the whole record ``data`` was taken from (in a thinned copy the hold's start would fall between two kept
+    rows, where the force bends as the carriage sticks) and kept with it."""
     record, rows = data.rows_of_record()
-    ratio = float(ratio)
+    ratio, gap = float(ratio), float(gap_mm)
 
     def compute() -> np.ndarray:
         s = np.asarray(record.stroke_mm, float)
-        return _read_only(carriage_hold(record, s, ratio * held_tension_N(record), math.inf) - s)
+        return _read_only(carriage_hold(record, s, ratio * held_tension_N(record), gap) - s)
 
     kept = record.cache.get_or("builtin.carriage_lifts", dict)
-    return recently_used(kept, ratio, compute, CARRIAGE_LIFTS_KEPT)[rows]
+    return recently_used(kept, (ratio, gap), compute, CARRIAGE_LIFTS_KEPT)[rows]
 
 
 CARRIAGE_HOLD = Effect(
@@ -217,12 +219,41 @@ CARRIAGE_HOLD = Effect(
                   "keeps while the motor rests at the bottom of its stroke (each sample's own, from the data)",
                   starts=(1.0, 1.03)),),
     apply=_carriage_hold,
+    family="drive",
     meaning="lost motion in the drive: the tendon pulls the carriage onto the nut's flank while its tension "
             "exceeds the rail's friction; on unloading, below it, the rail holds the carriage (within the nut's "
             "gap) while the motor goes on, so the tendon stays taut and the joint bent while the motor rests at "
             "zero, until the carriage lets go and the tension drops",
     signature="after each unloading the joint stays bent, the force at a constant level, while the stroke goes "
               "to zero; then the force drops to zero at once and the joint straightens",
+    history=True,
+    off={"ratio": 0.0},
+)
+
+
+def _carriage_gap(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
+    # carriage_hold with the nut's gap fitted: held at rest above the motor by at most the gap (the far flank
+    # pushes it down with the motor beyond that), and on the next pull the motor takes the gap up first
+    return stroke + carriage_lift_mm(ctx.data, p["ratio"], p["gap_mm"])
+
+
+CARRIAGE_GAP = Effect(
+    name="carriage_gap", stage="stroke", pure=True,
+    params=(Param("ratio", "", 0.0, 3.0, 1.0,
+                  "the rail's friction (the tension below which it holds the carriage) over the tension the tendon "
+                  "keeps while the motor rests at the bottom of its stroke (each sample's own, from the data)",
+                  starts=(1.0, 1.03)),
+            Param("gap_mm", "mm", 0.001, 2.0, lambda d, c: 0.05 * _stroke_span(d),
+                  "the gap of the nut's lug: how far the held carriage can stand above the motor", kind="length")),
+    apply=_carriage_gap,
+    family="drive",
+    meaning="lost motion in the drive, within a gap that binds: the tendon pulls the carriage onto the nut's "
+            "flank while its tension exceeds the rail's friction; on unloading, below it, the rail holds the "
+            "carriage while the motor goes on, until the nut's far flank, a gap away, pushes it down with the "
+            "motor; the joint rests bent by what the gap keeps, and the next pull first takes the gap up",
+    signature="after each unloading the joint stays bent and the force at a constant level while the motor "
+              "rests at zero (the carriage a gap above it); the next pull moves the motor through the gap before "
+              "the joint follows",
     history=True,
     off={"ratio": 0.0},
 )
@@ -836,6 +867,38 @@ def _rest_angle(ctx: Context, theta: np.ndarray, p: dict) -> np.ndarray:
     return out
 
 
+#: The joint held bent at rest by at least this (deg) and the force at rest at least this many times the load
+#: cell's row noise (and :data:`TAUT_AT_REST_N`) above zero: the tendon is taut at rest, which contradicts friction in
+#: the joint (it leaves the tendon slack).
+BENT_AT_REST_DEG = 0.1
+TAUT_AT_REST_NOISE = 5.0
+TAUT_AT_REST_N = 0.01
+
+
+def _rest_angle_check(data: Dataset, predicted_deg: np.ndarray) -> str:
+    """Friction in the joint (``rest_angle``) and its backbone's relaxation (``relaxation``, ``relaxation2``) hold
+    the joint bent while the tendon goes slack: refuse such an effect in a sample whose force stays well above zero
+    at the rests (motor at the bottom of its stroke) where the effect holds the joint bent (a taut tendon there: a
+    carriage its rail holds, lost motion in the drive)."""
+    pred = np.asarray(predicted_deg, float)
+    force = np.asarray(data.force_N, float)
+    for smp, sl in data.sample_slices():
+        runs = rest_runs(data, sl)
+        if len(runs) < 3:
+            continue
+        rows = np.concatenate(runs)
+        steps = np.concatenate([np.diff(force[r]) for r in runs])
+        noise = 1.4826 * float(np.median(np.abs(steps - np.median(steps)))) / math.sqrt(2.0) if steps.size else 0.0
+        held_N, bent_deg = float(np.median(force[rows])), float(np.median(pred[rows]))
+        if bent_deg >= BENT_AT_REST_DEG and held_N > max(TAUT_AT_REST_NOISE * noise, TAUT_AT_REST_N):
+            return (f"in {smp} it holds the joint bent at rest ({bent_deg:.2g} deg) while the force there stays at "
+                    f"{held_N:.3g} N: the tendon is taut at rest, not slack as a joint resting bent by itself (its "
+                    "friction, its backbone's relaxation) leaves it; a "
+                    "carriage its rail holds keeps it so (carriage_hold, carriage_gap: lost motion in the drive), or "
+                    "the load cell was not zeroed")
+    return ""
+
+
 REST_ANGLE = Effect(
     name="rest_angle", stage="kinematics", pure=True,
     params=(Param("rest_deg", "deg", 0.0, 20.0, 0.3,
@@ -844,6 +907,7 @@ REST_ANGLE = Effect(
     apply=_rest_angle,
     family="rest",
     off={"rest_deg": 0.0},
+    check=_rest_angle_check,
     meaning="friction in the joint (or a permanent set): once loaded, the joint's spring returns it only until "
             "its moment equals the friction, so the unloaded joint rests bent at rest_deg while the tendon "
             "goes slack",
@@ -909,6 +973,7 @@ RELAXATION = Effect(
                   log=True, kind="time")),
     apply=_relaxation,
     family="backbone",
+    check=_rest_angle_check,
     meaning="viscoelastic backbone (a spring with a relaxing arm, standard linear solid): while the tendon pulls, "
             "the joint follows the tendon and the force carries the backbone's relaxation; when the tendon goes "
             "slack the joint does not spring straight but stands at a share of the angle it held, and creeps "
@@ -935,6 +1000,7 @@ RELAXATION2 = Effect(
                   starts=(10.0,))),
     apply=_relaxation2,
     family="backbone",
+    check=_rest_angle_check,
     meaning="viscoelastic backbone relaxing on two time scales (a spring with two relaxing arms, as polymers have "
             "a spectrum of relaxation times): unloaded, the joint stands at the shares of the angle it held that "
             "its fast and slow arms keep, and creeps back quickly, then over many cycles",
@@ -975,7 +1041,7 @@ FORCE_ZERO = Effect(
 )
 
 #: The built-in effects, in their documented order.
-BUILTIN_EFFECTS = (SLACK, PLAY, CARRIAGE_HOLD, CREEP, CREEP_LOAD, FRICTION, CAPSTAN, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
+BUILTIN_EFFECTS = (SLACK, PLAY, CARRIAGE_HOLD, CARRIAGE_GAP, CREEP, CREEP_LOAD, FRICTION, CAPSTAN, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
                    HARDSTOP, REST_ANGLE, RELAXATION, RELAXATION2, ANGLE_BIAS, FORCE_ZERO)
 #: Built-in effect names in that order.
 BUILTINS = tuple(e.name for e in BUILTIN_EFFECTS)

@@ -244,6 +244,9 @@ SIDES = {
     "carriage_hold": "drive (the rail's friction holds the carriage within the nut's gap while the tendon's tension "
                      "is low: lost motion between the motor and the carriage, not in the tendon); a displacement "
                      "gauge on the carriage would measure it",
+    "carriage_gap": "drive (the rail's friction holds the carriage while the tendon's tension is low, and the nut's "
+                    "far flank, a gap away, pushes it down with the motor: lost motion between the motor and the "
+                    "carriage, not in the tendon); a displacement gauge on the carriage would measure it",
     "toe": "tendon (its fibres straighten one after another)",
     "toe_shape": "tendon (its fibres straighten one after another)",
     "creep": "tendon (it lengthens under load); a drifting load-cell zero also grows with time: re-zero the load "
