@@ -204,9 +204,10 @@ def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
                   <= max(3.0 * ins.lag.se_ms, 0.2 * benches[0].tracker.lag_ms))
         ok = lag_ok and (not rec_list or final <= 1.15 * floor_true)
     elif kinds[0] == "zero drift" and ins.rezeroed:
-        # an instrument property read at the rests and corrected (as a lag is): nothing of the creep family (the
-        # tendon side it would otherwise be taken for), and what the bench's other mechanisms leave explained
-        ok = not set(rec_list) & FAMILIES["creep"][0] and (not rec_list or final <= 1.15 * floor_true)
+        # an instrument property read at the rests and corrected (as a lag is); what the bench's other mechanisms
+        # leave is explained to the floor (its own mild creep among them: once the drift is gone, a creep that
+        # shows is the tendon's, as in a lag file)
+        ok = not rec_list or final <= 1.15 * floor_true
     elif not right:
         ok = not rec_list
     else:
