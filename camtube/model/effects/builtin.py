@@ -193,7 +193,7 @@ def _carriage_hold(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
 
 
 #: Lifts kept per record (the most recently used): a fit evaluates a few ratios many times.
-CARRIAGE_LIFTS_KEPT = 6
+CARRIAGE_LIFTS_KEPT = 12
 
 
 def carriage_lift_mm(data: Dataset, ratio: float, gap_mm: float = math.inf) -> np.ndarray:
@@ -203,13 +203,24 @@ def carriage_lift_mm(data: Dataset, ratio: float, gap_mm: float = math.inf) -> n
     rows, where the force bends as the carriage sticks) and kept with it."""
     record, rows = data.rows_of_record()
     ratio, gap = float(ratio), float(gap_mm)
-
-    def compute() -> np.ndarray:
-        s = np.asarray(record.stroke_mm, float)
-        return _read_only(carriage_hold(record, s, ratio * held_tension_N(record), gap) - s)
-
     kept = record.cache.get_or("builtin.carriage_lifts", dict)
-    return recently_used(kept, (ratio, gap), compute, CARRIAGE_LIFTS_KEPT)[rows]
+    alone = record.cache.get_or("builtin.sample_records", dict)
+    out = np.zeros(rows.size)
+    # per sample (speed: a fit with per-sample values evaluates one sample at a time, and the law runs per sample)
+    for smp, sl in record.sample_slices():
+        inside = (rows >= sl.start) & (rows < sl.stop)
+        if not inside.any():
+            continue
+
+        def compute(sl=sl, smp=smp) -> np.ndarray:
+            sub = alone.get(smp)
+            if sub is None:
+                sub = alone[smp] = record.take(np.arange(sl.start, sl.stop))
+            s = np.asarray(sub.stroke_mm, float)
+            return _read_only(carriage_hold(sub, s, ratio * held_tension_N(sub), gap) - s)
+
+        out[inside] = recently_used(kept, (smp, ratio, gap), compute, CARRIAGE_LIFTS_KEPT)[rows[inside] - sl.start]
+    return out
 
 
 CARRIAGE_HOLD = Effect(
