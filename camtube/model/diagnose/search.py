@@ -1430,8 +1430,8 @@ class Search:
             init.update({f"{k}@{smp}": v for k, v in inits[smp].items()
                          if "@" not in k and k in ps and f"{k}@{smp}" not in held})
         fixed = {**self.fixed, **held}
-        r = refit_all_rows(m, data, names, fixed, init, s.grid, per_sample=ps, max_nfev=CHECK_MAX_NFEV)
-        if (r.nfev >= CHECK_MAX_NFEV or not r.rmse < ch.all_rows.rmse
+        r = refit_all_rows(m, data, names, fixed, init, s.grid, per_sample=ps, max_nfev=4 * CHECK_MAX_NFEV)
+        if (r.nfev >= 4 * CHECK_MAX_NFEV or not r.rmse < ch.all_rows.rmse
                 or not r.bic < ch.all_rows.bic - s.bic_threshold
                 or _resolution_problems(m, list(r.fitted), r.params, r.stderr, r.at_bound, data, s.modulus_range_gpa)):
             return False
