@@ -171,9 +171,10 @@ def cmd_fit(args: argparse.Namespace) -> int:
         rows = prepare(raw, "all", args.branch, args.deadband, args.deadband_threshold)
     else:
         if args.lag_ms:
-            raise DataError("--lag-ms needs --set-aside (the instruments' check that corrects it)")
+            raise DataError("--lag-ms needs --set-aside (the instruments' check that corrects it); fix: add --set-aside")
         if args.rezero:
-            raise DataError("--rezero needs --set-aside (the instruments' check that re-zeroes the force)")
+            raise DataError("--rezero needs --set-aside (the instruments' check that re-zeroes the force); fix: add "
+                            "--set-aside")
         raw = load_csv(args.data)
         check_time_varies(raw, args.data)
         rows = prepare(raw, args.cycles, args.branch, args.deadband, args.deadband_threshold)

@@ -263,6 +263,7 @@ def _one_line_with_fix(argv, capsys, *words):
     ("diagnose", ["--modulus-range", "5,1"], ["--modulus-range '5,1'"]),
     ("fit", ["--json", "{tmp}/f.txt"], ["--json", ".json"]), ("diagnose", ["--json", "{tmp}/f.txt"], [".json"]),
     ("fit", ["--plot", "{tmp}/f.jpg"], ["--plot", ".png"]),
+    ("fit", ["--rezero"], ["--rezero", "--set-aside"]), ("fit", ["--lag-ms", "20"], ["--lag-ms", "--set-aside"]),
 ])
 def test_fit_and_diagnose_mistakes_say_the_fix(data_csv, tmp_path, capsys, cmd, tail, words):
     """Before: these lines had no '; fix: ...' (and the unknown-parameter line did not name the option)."""
