@@ -249,11 +249,12 @@ SIDES = {
                     "carriage, not in the tendon); a displacement gauge on the carriage would measure it",
     "toe": "tendon (its fibres straighten one after another)",
     "toe_shape": "tendon (its fibres straighten one after another)",
-    "creep": "tendon (it lengthens under load); a drifting load-cell zero also grows with time: re-zero the load "
-             "cell with the tendon unloaded after the test, or hold a long dwell at zero stroke, to tell",
+    "creep": "tendon (it lengthens under load); a drifting load-cell zero also grows with time: the rests at zero "
+             "stroke show it (the instruments' line on the load cell's zero), and so does a re-zero with the tendon "
+             "unloaded after the test",
     "creep_load": "tendon (it lengthens while it carries load, and does not recover at rest); a drifting "
-                  "load-cell zero grows with time instead: re-zero the load cell with the tendon unloaded after "
-                  "the test, or hold a long dwell at zero stroke, to tell",
+                  "load-cell zero grows with time instead: the rests at zero stroke show it (the instruments' line "
+                  "on the load cell's zero), and so does a re-zero with the tendon unloaded after the test",
     "viscoelastic": "tendon (delayed compliance); the joint's own relaxation does not show here (the measured "
                     "force carries it)",
     "friction": "tendon (friction at the guide or in a sheath)",
