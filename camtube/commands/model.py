@@ -171,7 +171,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
         rows = prepare(raw, "all", args.branch, args.deadband, args.deadband_threshold)
     else:
         if args.lag_ms:
-            raise DataError("--lag-ms needs --set-aside (the instruments' check that corrects it); fix: add --set-aside")
+            raise DataError("--lag-ms needs --set-aside (the instruments' check that corrects it); fix: add "
+                            "--set-aside")
         if args.rezero:
             raise DataError("--rezero needs --set-aside (the instruments' check that re-zeroes the force); fix: add "
                             "--set-aside")

@@ -212,14 +212,14 @@ def zero_lines(zeros: dict, enabled: bool) -> list[str]:
                        f"({z.change_N:+.3g} N): not corrected (--no-rezero)")
         elif z.drifts and not z.smooth:
             out.append(f"load cell zero: at {smp}'s rests (motor at zero) the force changes from rest to rest "
-                       f"({z.scatter_N:.3g} N about its trend of {z.change_N:+.3g} N): not a drifting zero; a tendon held "
-                       "taut at some rests (a carriage its rail holds within the nut's gap: lost motion in the drive) "
-                       "would do it; not corrected")
+                       f"({z.scatter_N:.3g} N about its trend of {z.change_N:+.3g} N): not a drifting zero; a "
+                       "tendon held taut at some rests (a carriage its rail holds within the nut's gap: lost motion "
+                       "in the drive) would do it; not corrected")
         elif z.drifts:
-            out.append(f"load cell zero: at {smp}'s rests (motor at zero) the force reads {z.start_N:.3g} N at the start "
-                       f"and {z.end_N:.3g} N at the end: not corrected, the cell does not read zero at the first rests "
-                       "(a tendon held taut at rest, a preload, or a cell not zeroed); re-zero it with the tendon "
-                       "unloaded before and after the test to tell")
+            out.append(f"load cell zero: at {smp}'s rests (motor at zero) the force reads {z.start_N:.3g} N at the "
+                       f"start and {z.end_N:.3g} N at the end: not corrected, the cell does not read zero at the "
+                       "first rests (a tendon held taut at rest, a preload, or a cell not zeroed); re-zero it with "
+                       "the tendon unloaded before and after the test to tell")
         elif z.held:
             out.append(f"load cell at rest: {smp}'s force stays at {z.start_N:.3g} N at every rest with the motor at "
                        "zero: the tendon is held taut at rest (a carriage its rail holds within the nut's gap: lost "
