@@ -5,6 +5,7 @@ module only holds the value type every model function takes.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -72,6 +73,28 @@ def rest_runs(data: "Dataset", sl: slice, min_rows: int = 6) -> list[np.ndarray]
     idx = np.flatnonzero(s <= lo + 1e-3 * (hi - lo) + 1e-12) + sl.start
     runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if idx.size else []
     return [r[r.size // 2:] for r in runs if r.size >= min_rows]
+
+
+@dataclass(frozen=True, eq=False)
+class Rests:
+    """One sample's rests (:func:`rest_runs`) as the load cell read them: ``runs`` (rows of each), the median time
+    and force of each (``time_s``, ``force_N``), and the cell's row-to-row noise there (``row_noise_N``:
+    ``1.4826 MAD(diff force) / sqrt 2`` over the rests' rows; 0 without rows)."""
+
+    runs: list
+    time_s: np.ndarray
+    force_N: np.ndarray
+    row_noise_N: float
+
+
+def rests_of(data: "Dataset", sl: slice) -> Rests:
+    """:class:`Rests` of one sample (``sl``) of ``data``."""
+    runs = rest_runs(data, sl)
+    f, t = np.asarray(data.force_N, float), np.asarray(data.time_s, float)
+    steps = np.concatenate([np.diff(f[r]) for r in runs]) if runs else np.zeros(0)
+    noise = float(1.4826 * np.median(np.abs(steps - np.median(steps))) / math.sqrt(2.0)) if steps.size else 0.0
+    return Rests(runs, np.array([float(np.median(t[r])) for r in runs]),
+                 np.array([float(np.median(f[r])) for r in runs]), noise)
 
 
 def recently_used(store: dict, key: Any, compute: Callable[[], Any], limit: int) -> Any:

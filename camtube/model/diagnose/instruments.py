@@ -36,13 +36,13 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from camtube.errors import DataError
 from camtube.model.core.threads import one_blas_thread
-from camtube.model.data.dataset import Dataset, rest_runs
+from camtube.model.data.dataset import Dataset, Rests, rests_of
 
 #: A row this many robust scales from its running median is a spike.
 SPIKE_Z = 8.0
@@ -116,6 +116,8 @@ class Zero:
         The load cell's noise from row to row at rest.
     applied : bool
         Corrected: the force re-zeroed at every rest (:func:`rezero_force`).
+    rests : Rests or None
+        The readings it was read from (kept for :func:`rezero_force`).
     """
 
     n_rests: int
@@ -126,6 +128,7 @@ class Zero:
     scatter_N: float
     row_noise_N: float
     applied: bool = False
+    rests: Rests | None = None
 
     @property
     def drifts(self) -> bool:
@@ -150,11 +153,10 @@ def read_zero(data: Dataset) -> dict:
     """``{sample: Zero}``: the load cell's reading at each sample's rests (samples with too few rests left out)."""
     out = {}
     for smp, sl in data.sample_slices():
-        rests = rest_runs(data, sl)
-        if len(rests) < MIN_RESTS:
+        rests = rests_of(data, sl)
+        if len(rests.runs) < MIN_RESTS:
             continue
-        z = np.array([float(np.median(data.force_N[r])) for r in rests])
-        t = np.array([float(np.median(data.time_s[r])) for r in rests])
+        z, t = rests.force_N, rests.time_s
         dt = t - t.mean()
         sxx = float(dt @ dt)
         if sxx <= 0.0:
@@ -163,10 +165,8 @@ def read_zero(data: Dataset) -> dict:
         resid = z - z.mean() - b * dt
         scatter = float(np.sqrt(resid @ resid / max(z.size - 2, 1)))
         span = float(t[-1] - t[0])
-        steps = np.concatenate([np.diff(data.force_N[r]) for r in rests])
-        noise = float(1.4826 * np.median(np.abs(steps - np.median(steps))) / math.sqrt(2.0)) if steps.size else 0.0
         out[smp] = Zero(z.size, float(np.median(z[:3])), float(np.median(z[-3:])), b * span,
-                        scatter / math.sqrt(sxx) * span, scatter, noise)
+                        scatter / math.sqrt(sxx) * span, scatter, rests.row_noise_N, rests=rests)
     return out
 
 
@@ -181,12 +181,10 @@ def rezero_force(data: Dataset, zeros: dict) -> tuple[Dataset, dict]:
         zr = zeros.get(smp)
         if zr is None or not (zr.drifts and zr.smooth and zr.zeroed):
             continue
-        rests = rest_runs(data, sl)
-        z = np.array([float(np.median(data.force_N[r])) for r in rests])
-        t = np.array([float(np.median(data.time_s[r])) for r in rests])
+        z, t = zr.rests.force_N, zr.rests.time_s
         zs = np.array([float(np.median(z[max(i - 1, 0):i + 2])) for i in range(z.size)])
         force[sl] = data.force_N[sl] - np.interp(data.time_s[sl], t, zs)
-        out[smp] = Zero(zr.n_rests, zr.start_N, zr.end_N, zr.change_N, zr.se_N, zr.scatter_N, zr.row_noise_N, True)
+        out[smp] = replace(zr, applied=True)
     if not any(z.applied for z in out.values()):
         return data, out
     return data.with_force(force), out

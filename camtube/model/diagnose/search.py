@@ -139,6 +139,10 @@ PER_SAMPLE_TRIES = 4
 #: Solver steps (per start) a candidate's refit on all rows may take: one that needs more has a direction the
 #: data barely resolve (an effect that trades with E_t); the refits of accepted candidates take 4-20.
 CHECK_MAX_NFEV = 60
+#: Solver steps (per start) the refit of the samples' union may take (:meth:`Search.try_sample_wise`): a union of
+#: several effects fitted per sample from each sample's own values converges slower than one candidate (a five-effect
+#: union: 64 steps).
+UNION_MAX_NFEV = 4 * CHECK_MAX_NFEV
 #: Before stopping, this many of the first round's best candidates are tried in place of each chosen effect.
 SWAP_TRIES = 3
 #: Significant digits of the start values printed with ``--init`` (and used by the diagnosis itself).
@@ -1430,8 +1434,8 @@ class Search:
             init.update({f"{k}@{smp}": v for k, v in inits[smp].items()
                          if "@" not in k and k in ps and f"{k}@{smp}" not in held})
         fixed = {**self.fixed, **held}
-        r = refit_all_rows(m, data, names, fixed, init, s.grid, per_sample=ps, max_nfev=4 * CHECK_MAX_NFEV)
-        if (r.nfev >= 4 * CHECK_MAX_NFEV or not r.rmse < ch.all_rows.rmse
+        r = refit_all_rows(m, data, names, fixed, init, s.grid, per_sample=ps, max_nfev=UNION_MAX_NFEV)
+        if (r.nfev >= UNION_MAX_NFEV or not r.rmse < ch.all_rows.rmse
                 or not r.bic < ch.all_rows.bic - s.bic_threshold
                 or _resolution_problems(m, list(r.fitted), r.params, r.stderr, r.at_bound, data, s.modulus_range_gpa)):
             return False

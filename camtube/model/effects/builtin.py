@@ -50,7 +50,7 @@ from camtube.design.geometry import backbone_angle_rad, centroid_mm
 from camtube.model.core.model import Context, Effect
 from camtube.model.core.noise import white_noise_sd
 from camtube.model.core.params import Param
-from camtube.model.data.dataset import Dataset, recently_used, rest_runs
+from camtube.model.data.dataset import Dataset, recently_used, rests_of
 from camtube.model.effects.history import (  # noqa: F401
     carriage_hold, first_order_lag, monotone_segments, play_operator,
 )
@@ -894,14 +894,12 @@ def _rest_angle_check(data: Dataset, predicted_deg: np.ndarray) -> str:
     pred = np.asarray(predicted_deg, float)
     force = np.asarray(data.force_N, float)
     for smp, sl in data.sample_slices():
-        runs = rest_runs(data, sl)
-        if len(runs) < 3:
+        rests = rests_of(data, sl)
+        if len(rests.runs) < 3:
             continue
-        rows = np.concatenate(runs)
-        steps = np.concatenate([np.diff(force[r]) for r in runs])
-        noise = 1.4826 * float(np.median(np.abs(steps - np.median(steps)))) / math.sqrt(2.0) if steps.size else 0.0
+        rows = np.concatenate(rests.runs)
         held_N, bent_deg = float(np.median(force[rows])), float(np.median(pred[rows]))
-        if bent_deg >= BENT_AT_REST_DEG and held_N > max(TAUT_AT_REST_NOISE * noise, TAUT_AT_REST_N):
+        if bent_deg >= BENT_AT_REST_DEG and held_N > max(TAUT_AT_REST_NOISE * rests.row_noise_N, TAUT_AT_REST_N):
             return (f"in {smp} it holds the joint bent at rest ({bent_deg:.2g} deg) while the force there stays at "
                     f"{held_N:.3g} N: the tendon is taut at rest, not slack as a joint resting bent by itself (its "
                     "friction, its backbone's relaxation) leaves it; a "
