@@ -155,7 +155,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects, "--effects")])
     if args.set_aside:
         from camtube.model.data import read_measurements
-        from camtube.model.diagnose.instruments import check_instruments
+        from camtube.model.diagnose.instruments import check_instruments, zero_lines
 
         meas = read_measurements(args.data)
         check_time_varies(meas.data, args.data)
@@ -164,9 +164,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
         ins = check_instruments(select_cycles(meas.data, args.cycles), lag_ms=args.lag_ms or 0.0,
                                 rezero=args.rezero)
         print("; ".join(ins.lines()[:1] + ins.lines()[-1:]))
-        for line in ins.lines():
-            if line.startswith("load cell zero: at") and "corrected, the force re-zeroed" in line:
-                print(line.replace("(--no-rezero to keep it)", "(--rezero)"))
+        for line in zero_lines({smp: z for smp, z in ins.zeros.items() if z.applied}, True, "--rezero"):
+            print(line)
         raw = ins.data
         rows = prepare(raw, "all", args.branch, args.deadband, args.deadband_threshold)
     else:

@@ -190,8 +190,9 @@ def rezero_force(data: Dataset, zeros: dict) -> tuple[Dataset, dict]:
     return data.with_force(force), out
 
 
-def zero_lines(zeros: dict, enabled: bool) -> list[str]:
-    """The load cell's zero at the rests, one sentence per finding."""
+def zero_lines(zeros: dict, enabled: bool, option: str = "--no-rezero to keep it") -> list[str]:
+    """The load cell's zero at the rests, one sentence per finding (``option``: how the user turns the correction
+    off, or asked for it)."""
     if not zeros:
         return []
     out = []
@@ -201,7 +202,7 @@ def zero_lines(zeros: dict, enabled: bool) -> list[str]:
                    f"{z.start_N:.3g} to {z.end_N:.3g} N, a drift of {z.change_N:+.3g} N over the record "
                    f"({abs(z.change_N) / max(z.se_N, 1e-300):.0f} standard errors): the load cell's zero drifts (an "
                    "instrument's, not the tendon's: creep lengthens the tendon and leaves the force at rest at zero); "
-                   "corrected, the force re-zeroed at every rest (--no-rezero to keep it)")
+                   f"corrected, the force re-zeroed at every rest ({option})")
     for smp, z in zeros.items():
         if z.applied:
             continue
