@@ -38,6 +38,7 @@ runs each sample with its own values (every effect already runs per sample).
 """
 from __future__ import annotations
 
+import inspect
 import math
 import struct
 from dataclasses import dataclass, field, replace
@@ -188,7 +189,9 @@ class Effect:
     check : Callable[[Dataset, ndarray], str] | None
         An optional test of the fitted form against its signature: ``check(data, predicted_deg)`` returns why
         the data contradict the form (empty when they do not), e.g. a hard stop where the measured angle keeps
-        rising. A reason makes the diagnosis refuse the candidate, whatever its gain.
+        rising. A reason makes the diagnosis refuse the candidate, whatever its gain. A check that also takes a
+        keyword ``effects`` gets the fitted model's effects (a tuple of :class:`Effect`, this one included): what
+        the rest of the model already explains (a taut tendon at rest that a drive effect holds).
     pure : bool
         Its functions are pure: the output depends on the signal, ``p`` and the context only (no state of
         their own, ``ctx.cache`` unused) and the input signal is not modified. The model then keeps the
@@ -312,14 +315,20 @@ def _short(value) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
-def form_problem(effect: Effect, data, predicted_deg: np.ndarray) -> str:
+def form_problem(effect: Effect, data, predicted_deg: np.ndarray, effects: Sequence[Effect] = ()) -> str:
     """Why ``data`` contradict ``effect``'s fitted form (its ``check``; empty when they do not, or it has none).
 
+    ``effects``: the fitted model's effects, given to a check that takes them (keyword ``effects``).
     A broken check in a user's file gets one line naming the effect, its file and the problem."""
     if effect.check is None:
         return ""
     try:
-        reason = effect.check(data, predicted_deg)
+        takes = "effects" in inspect.signature(effect.check).parameters
+    except (TypeError, ValueError):  # a builtin or a callable without a signature: two arguments
+        takes = False
+    try:
+        reason = effect.check(data, predicted_deg, effects=tuple(effects)) if takes else \
+            effect.check(data, predicted_deg)
     except Exception as exc:  # noqa: BLE001 - a user's check may raise anything: report it with its file
         if not effect.source:
             raise

@@ -1067,7 +1067,7 @@ class Search:
             why += _resolution_problems(m, list(f.fitted), f.params, f.stderr, f.at_bound, self.data,
                                         s.modulus_range_gpa)
         if new and not why:
-            reason = form_problem(eff, f.data, f.predicted)
+            reason = form_problem(eff, f.data, f.predicted, m.effects)
             if reason:
                 why.append(reason)
         # per-sample copies held off (absent in a sample), and a baseline effect a stand-in holds off

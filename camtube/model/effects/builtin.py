@@ -886,11 +886,15 @@ TAUT_AT_REST_NOISE = 5.0
 TAUT_AT_REST_N = 0.01
 
 
-def _rest_angle_check(data: Dataset, predicted_deg: np.ndarray) -> str:
+def _rest_angle_check(data: Dataset, predicted_deg: np.ndarray, effects: Sequence[Effect] = ()) -> str:
     """Friction in the joint (``rest_angle``) and its backbone's relaxation (``relaxation``, ``relaxation2``) hold
     the joint bent while the tendon goes slack: refuse such an effect in a sample whose force stays well above zero
     at the rests (motor at the bottom of its stroke) where the effect holds the joint bent (a taut tendon there: a
-    carriage its rail holds, lost motion in the drive)."""
+    carriage its rail holds, lost motion in the drive). Where the model already has the drive's effect (``effects``
+    of family ``drive``: carriage_hold, carriage_gap), that effect holds the tendon taut at rest and the joint's own
+    resting effects may stand beside it (a backbone relaxes whatever holds the tendon)."""
+    if any(e.family == "drive" for e in effects):
+        return ""
     pred = np.asarray(predicted_deg, float)
     force = np.asarray(data.force_N, float)
     for smp, sl in data.sample_slices():
