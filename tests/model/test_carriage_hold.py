@@ -24,15 +24,19 @@ def _by_rows(data, s, hold, gap):
         low_prev, seen, gone, c = False, False, False, 0.0
         for k in range(sl.start, sl.stop):
             first = k == sl.start
+            slip = False
             if f[k] > HOLD_BAND * hold:                        # pulled onto the flank: a new run may start
                 seen = gone = False
             else:
                 seen = seen or f[k] <= hold
-                gone = gone or f[k] < RELEASE_SHARE * hold     # let go: on the flank for the rest of the run
-            if not seen or gone or f[k] > HOLD_BAND * hold:
+                slip = not gone and f[k] < RELEASE_SHARE * hold    # slips onto the flank, held there again
+                gone = gone or slip
+            if not seen or f[k] > HOLD_BAND * hold:
                 c, low_prev = s[k], False
                 continue
-            if not low_prev:                                   # held from here: where the force fell to hold_N
+            if slip:
+                c = s[k]
+            elif not low_prev:                                 # held from here: where the force fell to hold_N
                 if first or f[k - 1] <= hold:
                     c = s[k]
                 elif k - 2 >= sl.start and f[k - 2] > f[k - 1]:    # along the unloading from the two rows before
@@ -77,6 +81,28 @@ def test_a_carriage_held_at_the_bottom_keeps_the_tendon_taut_until_it_lets_go():
     assert np.all(c[t < 0.83] == s[t < 0.83])                 # pulled onto the flank above the hold force
     small_gap = carriage_hold(data, s, 0.32, 0.04)             # the nut's far flank pushes it down
     assert np.allclose(small_gap[(t >= 1.0) & (t < 1.95)], 0.04, atol=1e-9)
+
+
+def test_a_carriage_that_slips_onto_the_flank_is_held_there_again():
+    # held at 0.16 mm (the tension fell to 0.32 N there, then stays at 0.2 N); at 0.95 s, the motor at 0.05 mm, the
+    # tension crept past the rail's friction and the carriage slipped onto the nut's flank (the force drops to zero);
+    # the rail holds it there while the motor goes on to zero, so the next pull first takes that 0.05 mm up
+    t = np.arange(0, 4.0, 0.01)
+    s = np.clip(1.0 - t, 0.0, None)
+    s[t >= 2.5] = t[t >= 2.5] - 2.5                            # the next pull from 2.5 s
+    f = np.where(s > 0.1, 2.0 * s, 0.2)
+    f[(t >= 0.95) & (t < 2.6)] = 0.0
+    f[t >= 2.6] = np.maximum(2.0 * (s[t >= 2.6] - 0.05), 0.0)
+    data = _rows(s, f)
+    c = carriage_hold(data, s, 0.32, 0.5)
+    assert np.allclose(c[(t > 0.85) & (t < 0.9)], 0.16, atol=1e-9)
+    # the slip: where the (smoothed) force falls below half the hold force, on the motor's way from 0.1 to 0.04 mm
+    k = int(np.flatnonzero((t > 0.85) & (np.asarray(data.force_smoothed_N) < RELEASE_SHARE * 0.32))[0])
+    assert 0.04 <= s[k] <= 0.1
+    assert np.allclose(c[k:250], s[k], atol=1e-9)                   # held where it slipped to, the motor below
+    pull = (t >= 2.5) & (s <= s[k])
+    assert np.allclose(c[pull], s[k], atol=1e-9)                    # the pull takes that gap up first
+    assert np.all(c[t >= 2.7] == s[t >= 2.7])                       # then the carriage follows the nut
 
 
 def test_off_and_no_held_rows_give_the_stroke_itself():

@@ -310,9 +310,13 @@ def carriage_hold(data: Dataset, stroke_mm: np.ndarray, hold_N: float | np.ndarr
     band = (f <= HOLD_BAND * hold) & (hold > 0.0)
     run = np.cumsum(band & ~(np.concatenate(([False], band[:-1])) & ~starts_of_samples))
     seen = np.maximum.accumulate((f <= hold) + 2 * run) - 2 * run
-    # ... until the force falls below RELEASE_SHARE x hold_N: let go, on the flank for the rest of the run
+    # ... where the force falls below RELEASE_SHARE x hold_N the carriage slips back onto the nut's flank (c = s: the
+    # tension crept past the rail's friction as the backbone recovered) and the rail holds it there again: the
+    # motor's further travel down opens the gap anew (within the same run of rows)
     gone = np.maximum.accumulate((f < RELEASE_SHARE * hold) + 2 * run) - 2 * run
-    low = band & (seen >= 1) & (gone < 1)
+    low = band & (seen >= 1)
+    prev_gone = np.concatenate(([0], gone[:-1]))
+    slip = low & (gone >= 1) & ((prev_gone < 1) | starts_of_samples | (run != np.concatenate(([0], run[:-1]))))
     ds = np.diff(s, prepend=s[:1])
     up = ds >= 0.0
     prev_low = np.concatenate(([False], low[:-1])) & ~starts_of_samples
@@ -322,14 +326,14 @@ def carriage_hold(data: Dataset, stroke_mm: np.ndarray, hold_N: float | np.ndarr
     rows = np.flatnonzero(low)
     if rows.size == 0:
         return out
-    first = np.flatnonzero(entry | turn)                  # every piece starts at one of these rows
+    first = np.flatnonzero(entry | turn | slip)           # every piece starts at one of these rows
     piece = np.searchsorted(first, rows, side="right") - 1
     at = np.searchsorted(rows, first)                     # where each piece starts among the held rows
     lo_s = np.minimum.reduceat(s[rows], at)
     hi_s = np.maximum.reduceat(s[rows], at)
     # the value each piece starts from: a stick, or what the piece before ended with (a scalar loop over the pieces)
-    fresh = _sticks(s, f, starts_of_samples, first, hold[first]).tolist()
-    restart = entry[first].tolist()
+    fresh = np.where(slip[first], s[first], _sticks(s, f, starts_of_samples, first, hold[first])).tolist()
+    restart = (entry | slip)[first].tolist()
     rise = up[first].tolist()
     los, his = lo_s.tolist(), hi_s.tolist()
     begin = [0.0] * first.size
