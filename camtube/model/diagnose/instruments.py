@@ -92,6 +92,10 @@ ZERO_Z = 5.0
 #: ... the rests scatter about its line by at most this share of it (a zero drifts smoothly; a tendon held taut at
 #: some rests and not at others does not) ...
 ZERO_SMOOTH = 0.25
+#: ... and no step from one rest to the next (each the median of it and its neighbours) exceeds this share of it: a
+#: zero drifts a little each cycle (at most 0.22 of the whole drift in one step on the bench batches), while a
+#: carriage its rail holds at some rests puts the tendon's held tension at rest in one step (0.63-1.05 of it)
+ZERO_JUMP = 0.4
 #: ... and the first rests read within this share of it (plus two scatters) of zero: the cell was zeroed before the
 #: test, so a force that stays at rest is a taut tendon (or an offset the model's force_zero takes), not a drift.
 ZERO_START = 0.25
@@ -112,6 +116,8 @@ class Zero:
         The change of the line through the rests' readings over the sample's record, and its standard error.
     scatter_N : float
         The rests' scatter about that line.
+    jump_N : float
+        The largest step from one rest's reading to the next (each the median of it and its neighbours).
     row_noise_N : float
         The load cell's noise from row to row at rest.
     applied : bool
@@ -127,6 +133,7 @@ class Zero:
     se_N: float
     scatter_N: float
     row_noise_N: float
+    jump_N: float = 0.0
     applied: bool = False
     rests: Rests | None = None
 
@@ -137,7 +144,7 @@ class Zero:
 
     @property
     def smooth(self) -> bool:
-        return self.scatter_N <= ZERO_SMOOTH * abs(self.change_N)
+        return self.scatter_N <= ZERO_SMOOTH * abs(self.change_N) and self.jump_N <= ZERO_JUMP * abs(self.change_N)
 
     @property
     def zeroed(self) -> bool:
@@ -147,6 +154,11 @@ class Zero:
     def held(self) -> bool:
         """The force stays well above the cell's noise at rest, steadily: a taut tendon (or an offset)."""
         return abs(self.start_N) > 5.0 * self.row_noise_N and not self.drifts
+
+
+def _rest_medians(z: np.ndarray) -> np.ndarray:
+    """Each rest's reading as the median of it and its neighbours' (one odd rest does not move the zero)."""
+    return np.array([float(np.median(z[max(i - 1, 0):i + 2])) for i in range(z.size)])
 
 
 def read_zero(data: Dataset) -> dict:
@@ -165,8 +177,9 @@ def read_zero(data: Dataset) -> dict:
         resid = z - z.mean() - b * dt
         scatter = float(np.sqrt(resid @ resid / max(z.size - 2, 1)))
         span = float(t[-1] - t[0])
+        jump = float(np.max(np.abs(np.diff(_rest_medians(z))))) if z.size > 1 else 0.0
         out[smp] = Zero(z.size, float(np.median(z[:3])), float(np.median(z[-3:])), b * span,
-                        scatter / math.sqrt(sxx) * span, scatter, rests.row_noise_N, rests=rests)
+                        scatter / math.sqrt(sxx) * span, scatter, rests.row_noise_N, jump, rests=rests)
     return out
 
 
@@ -181,9 +194,7 @@ def rezero_force(data: Dataset, zeros: dict) -> tuple[Dataset, dict]:
         zr = zeros.get(smp)
         if zr is None or not (zr.drifts and zr.smooth and zr.zeroed):
             continue
-        z, t = zr.rests.force_N, zr.rests.time_s
-        zs = np.array([float(np.median(z[max(i - 1, 0):i + 2])) for i in range(z.size)])
-        force[sl] = data.force_N[sl] - np.interp(data.time_s[sl], t, zs)
+        force[sl] = data.force_N[sl] - np.interp(data.time_s[sl], zr.rests.time_s, _rest_medians(zr.rests.force_N))
         out[smp] = replace(zr, applied=True)
     if not any(z.applied for z in out.values()):
         return data, out
@@ -211,7 +222,8 @@ def zero_lines(zeros: dict, enabled: bool, option: str = "--no-rezero to keep it
                        f"({z.change_N:+.3g} N): not corrected (--no-rezero)")
         elif z.drifts and not z.smooth:
             out.append(f"load cell zero: at {smp}'s rests (motor at zero) the force changes from rest to rest "
-                       f"({z.scatter_N:.3g} N about its trend of {z.change_N:+.3g} N): not a drifting zero; a "
+                       f"({z.scatter_N:.3g} N about its trend of {z.change_N:+.3g} N, up to {z.jump_N:.3g} N from one "
+                       "rest to the next): not a drifting zero; a "
                        "tendon held taut at some rests (a carriage its rail holds within the nut's gap: lost motion "
                        "in the drive) would do it; not corrected")
         elif z.drifts:
