@@ -96,6 +96,10 @@ def test_a_broken_check_names_the_effect_and_its_file():
         form_problem(make(lambda d, pred: 1 / 0), None, np.zeros(3))
     with pytest.raises(FitError, match="returned float, expected a string"):
         form_problem(make(lambda d, pred: 0.5), None, np.zeros(3))
+    # a check that takes the keyword ``effects`` gets the fitted model's effects (one that does not, two arguments)
+    seen = []
+    eff = make(lambda d, pred, effects=(): seen.append(tuple(e.name for e in effects)) or "")
+    assert form_problem(eff, None, np.zeros(3), (eff,)) == "" and seen == [("odd",)]
 
 
 # mistakes that were a traceback (a string returned), a silent wrong result (complex numbers cast to real,
