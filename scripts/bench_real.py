@@ -156,6 +156,10 @@ HELDOUT10_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 #: anew, and a tracker whose zero drifts (an instrument's artefact the library has no form for).
 HELDOUT11_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
                    ("toe", "slack"), ("creep", "slack"), ("creep", "lost motion"), "friction", "tracker drift"]
+#: The twelfth fresh held-out batch (issue 19, after the carriage's slip held again, the resting effects beside the
+#: drive and the zero's step test): lost motion alone twice, beside a toe and beside a creeping tendon, a zero drift.
+HELDOUT12_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "creep", "backbone",
+                   "zero drift", "lag", ("lost motion", "toe"), ("creep", "lost motion"), "friction", "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -178,7 +182,9 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            # at): a seed not used before, with lost motion beside a toe and beside a creeping tendon; run once
            "bench-heldout9": (20261231, HELDOUT9_KINDS), "bench-heldout10": (20270115, HELDOUT10_KINDS),
            # drawn once the changes of the session after bench-heldout10 were settled (every batch above looked at)
-           "bench-heldout11": (20270203, HELDOUT11_KINDS)}
+           "bench-heldout11": (20270203, HELDOUT11_KINDS),
+           # drawn once the changes of the session after bench-heldout11 were settled (every batch above looked at)
+           "bench-heldout12": (20270311, HELDOUT12_KINDS)}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
