@@ -58,6 +58,10 @@ def test_lost_motion_in_the_drive_holds_the_carriage_once_the_tension_falls_belo
     assert np.all(loose.tension_cell_true_N[rest] <= 0.3 + 1e-9)
     # before the first pull nothing is held: both start straight
     assert loose.angle_true_deg[0] == pytest.approx(0.0, abs=1e-9)
+    # the record keeps where the carriage stood: on the nut's flank or within its gap above the motor, held up at rest
+    lift = loose.carriage_true_mm - d.stroke_mm
+    assert lift.min() >= -1e-6 and lift.max() <= 0.2 + 1e-6
+    assert lift[rest].min() > 0.05 and np.abs(free.carriage_true_mm - d.stroke_mm).max() < 1e-6
 
 
 def test_spikes_and_repeated_stamps_are_set_aside_exactly(tube2):

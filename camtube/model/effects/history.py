@@ -250,9 +250,10 @@ def _lag_blocks(cum: np.ndarray) -> tuple:
     return out, table
 
 
-#: A held carriage lets go when the smoothed force falls below this share of the hold force: the tendon's tension
-#: drops at once as the carriage slides back onto the nut's flank (or, with the motor still going down, the nut's
-#: far flank pushes the carriage down with it: the gap this law takes as wider than the stroke held)
+#: A held carriage slips when the smoothed force falls below this share of the hold force: the tendon's tension
+#: drops at once as the carriage slides back onto the nut's flank (the held tension crept past the rail's friction as
+#: the backbone recovered), where the rail holds it again (or, with the motor still going down, the nut's far flank
+#: pushes the carriage down with it: carriage_hold takes the gap as wider than the stroke held)
 RELEASE_SHARE = 0.5
 #: Once held, the carriage stays held while the smoothed force stays below this multiple of the hold force: the
 #: held tension creeps up to the rail's friction during a rest, within the cell's noise, and must not let go
@@ -285,9 +286,11 @@ def carriage_hold(data: Dataset, stroke_mm: np.ndarray, hold_N: float | np.ndarr
     While the tension (smoothed: :attr:`Dataset.force_smoothed_N`) exceeds ``hold_N`` the tendon pulls the
     carriage onto the nut's flank: it follows the stroke. Once the tension falls to ``hold_N`` the rail holds it
     where it is (where the tension fell to ``hold_N``: :func:`_sticks`, continuous in ``hold_N``), within the
-    gap: ``c_k = clip(c_(k-1), s_k, s_k + gap_mm)``. It lets go, back onto the flank (``c_k = s_k``), when the
-    tension falls below :data:`RELEASE_SHARE` of ``hold_N``, and stays there until the tension has risen past
-    :data:`HOLD_BAND` x ``hold_N`` (the next pull); it stays held while the tension stays below that. Per sample;
+    gap: ``c_k = clip(c_(k-1), s_k, s_k + gap_mm)``. It slips back onto the flank (``c_k = s_k``) where the
+    tension falls below :data:`RELEASE_SHARE` of ``hold_N``, and the rail holds it there again (the same clip from
+    that row on: the motor's further travel down opens the gap anew, and the next pull takes it up first), until the
+    tension has risen past :data:`HOLD_BAND` x ``hold_N`` (the next pull); it stays held while the tension stays
+    below that. Per sample;
     ``hold_N`` a number or one per row (a sample's own); ``gap_mm <= 0`` or ``hold_N <= 0``: the stroke itself.
 
     Exact and vectorised: inside a run of held rows the recursion is a running minimum of

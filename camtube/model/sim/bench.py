@@ -189,6 +189,8 @@ class BenchRecord:
         What the logger wrote (``nan`` in the angle where the tracker dropped out).
     angle_true_deg, tension_cell_true_N : (n,) float
         The joint's true bend and the true tension at the load cell (at the true times).
+    carriage_true_mm : (n,) float
+        Where the carriage truly stood (the drive's lost motion: the motor's stroke is ``data.stroke_mm``).
     spike_rows, dropout_rows, repeat_rows : (k,) int
         Rows of ``data`` carrying a spike, a missing angle, a repeated time stamp.
     noise_deg : float
@@ -208,6 +210,7 @@ class BenchRecord:
     noise_deg: float
     floor_deg: float
     params: dict = field(default_factory=dict)
+    carriage_true_mm: np.ndarray | None = None
 
 
 def motor_profile(p: Protocol, peak_mm: float, t_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -258,8 +261,9 @@ def _stamps(clock: Clock, duration_s: float, rng: np.random.Generator) -> tuple[
 
 
 def _run_sample(pattern: Pattern, b: SampleBench, t: np.ndarray, motor: np.ndarray,
-                rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """True bend (rad) of the joint and tension at the load cell (N) at times ``t`` (n,)."""
+                rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """True bend (rad) of the joint, tension at the load cell (N) and the carriage's position (mm) at times ``t``
+    (n,)."""
     geo = pattern_geometry(pattern)
     arm = geo.first.moment_arm_mm
     e_pa = BACKBONE_MODULUS_GPA * 1e3 * b.backbone.stiffness_scale
@@ -282,6 +286,7 @@ def _run_sample(pattern: Pattern, b: SampleBench, t: np.ndarray, motor: np.ndarr
     carriage_prev = 0.0
     out_theta = np.zeros(n)
     out_cell = np.zeros(n)
+    out_carriage = np.zeros(n)
     ewrap = math.exp(b.guide.mu * b.guide.wrap_rad)
     td = b.tendon
     for i in range(n):
@@ -339,7 +344,8 @@ def _run_sample(pattern: Pattern, b: SampleBench, t: np.ndarray, motor: np.ndarr
         v_prev = v
         out_theta[i] = float(theta_n.sum())
         out_cell[i] = cell
-    return out_theta, out_cell
+        out_carriage[i] = carriage
+    return out_theta, out_cell, out_carriage
 
 
 def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | SampleBench,
@@ -368,14 +374,15 @@ def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | 
     duration = record_length_s(protocol)
     geo = pattern_geometry(pattern)
     arm = geo.first.moment_arm_mm
-    parts: dict[str, list] = {k: [] for k in ("sample", "cycle", "time", "stroke", "force", "angle", "true", "cell")}
+    parts: dict[str, list] = {k: [] for k in ("sample", "cycle", "time", "stroke", "force", "angle", "true", "cell",
+                                                "carriage")}
     spikes, drops, reps = [], [], []
     offset = 0
     floors = []
     for s, b in enumerate(per):
         t_true, logged, rep = _stamps(clock, duration, rng)
         motor, cycle = motor_profile(protocol, peak, t_true)
-        theta, cell = _run_sample(pattern, b, t_true, motor, rng)
+        theta, cell, carriage = _run_sample(pattern, b, t_true, motor, rng)
         n = t_true.size
         tr, lc = b.tracker, b.load_cell
         # the tracker reports the bend it saw lag_ms ago
@@ -404,6 +411,7 @@ def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | 
         parts["angle"].append(angle)
         parts["true"].append(np.degrees(theta))
         parts["cell"].append(cell)
+        parts["carriage"].append(carriage)
         spikes.append(k_sp + offset)
         drops.append(k_dr + offset)
         reps.append(rep + offset)
@@ -413,7 +421,7 @@ def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | 
     params = {"arm_mm": arm, "samples": [repr(b) for b in per], "protocol": repr(protocol), "clock": repr(clock)}
     return BenchRecord(data, cat["true"], cat["cell"], np.concatenate(spikes), np.concatenate(drops),
                        np.concatenate(reps), float(math.sqrt(np.mean([b.tracker.noise_deg ** 2 for b in per]))),
-                       float(math.sqrt(np.mean(np.square(floors)))), params)
+                       float(math.sqrt(np.mean(np.square(floors)))), params, cat["carriage"])
 
 
 def with_tracker(b: SampleBench, **kw) -> SampleBench:
