@@ -508,7 +508,7 @@ class JointModel:
             values = values.values
         if any("@" in k for k in values):
             out = np.empty(len(data))
-            for smp, sl, sub in _sample_views(data):
+            for smp, sl, sub in sample_views(data):
                 out[sl] = self._predict(sub, values_for_sample(values, smp))
             return out
         return self._predict(data, values)
@@ -667,7 +667,7 @@ class _Checkpoints:
 # speed: per-sample views of a Dataset, cached on it (per-sample parameters run the model sample by sample)
 
 
-def _sample_views(data: Dataset) -> list:
+def sample_views(data: Dataset) -> list:
     """``(sample, slice, sub-dataset)`` of each sample, cached per Dataset (fits evaluate the same rows often)."""
     hit = data.cache.get("model.sample_views")
     if hit is None:

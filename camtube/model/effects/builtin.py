@@ -47,7 +47,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from camtube.design.geometry import backbone_angle_rad, centroid_mm
-from camtube.model.core.model import Context, Effect
+from camtube.model.core.model import Context, Effect, sample_views
 from camtube.model.core.noise import white_noise_sd
 from camtube.model.core.params import Param
 from camtube.model.data.dataset import Dataset, recently_used, rests_of
@@ -204,18 +204,14 @@ def carriage_lift_mm(data: Dataset, ratio: float, gap_mm: float = math.inf) -> n
     record, rows = data.rows_of_record()
     ratio, gap = float(ratio), float(gap_mm)
     kept = record.cache.get_or("builtin.carriage_lifts", dict)
-    alone = record.cache.get_or("builtin.sample_records", dict)
     out = np.zeros(rows.size)
     # per sample (speed: a fit with per-sample values evaluates one sample at a time, and the law runs per sample)
-    for smp, sl in record.sample_slices():
+    for smp, sl, sub in sample_views(record):
         inside = (rows >= sl.start) & (rows < sl.stop)
         if not inside.any():
             continue
 
-        def compute(sl=sl, smp=smp) -> np.ndarray:
-            sub = alone.get(smp)
-            if sub is None:
-                sub = alone[smp] = record.take(np.arange(sl.start, sl.stop))
+        def compute(sub=sub) -> np.ndarray:
             s = np.asarray(sub.stroke_mm, float)
             return _read_only(carriage_hold(sub, s, ratio * held_tension_N(sub), gap) - s)
 
