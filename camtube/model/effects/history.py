@@ -318,8 +318,9 @@ def carriage_hold(data: Dataset, stroke_mm: np.ndarray, hold_N: float | np.ndarr
     # motor's further travel down opens the gap anew (within the same run of rows)
     gone = np.maximum.accumulate((f < RELEASE_SHARE * hold) + 2 * run) - 2 * run
     low = band & (seen >= 1)
+    # the first row of a run past that share (a run starts anew at each sample's first row, so does its count)
     prev_gone = np.concatenate(([0], gone[:-1]))
-    slip = low & (gone >= 1) & ((prev_gone < 1) | starts_of_samples | (run != np.concatenate(([0], run[:-1]))))
+    slip = low & (gone >= 1) & ((prev_gone < 1) | (run != np.concatenate(([0], run[:-1]))))
     ds = np.diff(s, prepend=s[:1])
     up = ds >= 0.0
     prev_low = np.concatenate(([False], low[:-1])) & ~starts_of_samples
