@@ -114,6 +114,9 @@ from camtube.model.data.dataset import Cache, Dataset
 CORR_LIMIT = 0.99
 #: Held-out RMSEs within this fraction of each other: the data cannot tell the candidates apart.
 EQUAL_HELDOUT = 0.03
+#: A sample's per-sample copies of an effect whose off values raise that sample's RMSE by at most this share do
+#: nothing there: the sample does not show the effect (:func:`inert_in_sample`).
+INERT_SHARE = 1e-3
 #: Grid values per new parameter in the multi-start fits (also ``--starts`` of the printed command).
 GRID = 3
 #: Effects every real joint may show, which the diagnosis takes into its baseline (tried before every round)
@@ -605,6 +608,29 @@ def _resolution_problems(model: JointModel, names: Sequence[str], values: Mappin
     return out
 
 
+def inert_in_sample(eff: Effect, model: JointModel, data: Dataset, values: Mapping[str, float],
+                     predicted_deg: np.ndarray, sample: str) -> bool:
+    """True when ``eff``'s per-sample copies of ``sample`` do nothing there: with the copies named in ``eff.off``
+    set at their off values, that sample's RMSE rises by at most :data:`INERT_SHARE` over its RMSE at ``values``
+    (``predicted_deg`` ``(n,)``: the model at ``values`` on ``data``). The data do not depend on such copies, so
+    they cannot be resolved (a carriage that the rail of that sample holds for a few rows only, at a ratio far
+    below the other sample's): the sample does not show the effect. False when no copy of it has an off value."""
+    vals = dict(values)
+    moved = False
+    for p in eff.params:
+        nm = f"{eff.name}.{p.name}@{sample}"
+        if p.name in (eff.off or {}) and nm in vals:
+            vals[nm] = float(eff.off[p.name])
+            moved = True
+    sl = next((s for name, s in data.sample_slices() if name == sample), None)
+    if not moved or sl is None:
+        return False
+    meas = np.asarray(data.angle_deg[sl], float)
+    off = float(np.sqrt(np.mean((meas - model.predict(data, vals)[sl]) ** 2)))
+    fitted = float(np.sqrt(np.mean((meas - np.asarray(predicted_deg, float)[sl]) ** 2)))
+    return math.isfinite(off) and off <= (1.0 + INERT_SHARE) * fitted
+
+
 def _step(r: FitResult, per_sample: Sequence[str] = (), init: Mapping[str, float] | None = None) -> Step:
     return Step(tuple(e.name for e in r.model.effects), r.rmse, dict(r.rmse_per_sample), dict(r.params),
                 dict(r.stderr), dict(r.units), r.predicted, r.residuals, tuple(per_sample),
@@ -918,8 +944,9 @@ class Search:
 
     def _absent(self, eff: Effect, m: JointModel, f: FitResult) -> dict:
         """Per-sample copies of ``eff`` to hold off: in each sample where a copy of ``f`` (a per-sample fit) is
-        not resolved (on a bound, a time or length outside what the record resolves), every copy of that
-        sample, those named in ``eff.off`` at their off values and the others where they are; empty when there
+        not resolved (on a bound, a time or length outside what the record resolves) or where its copies do nothing
+        (:func:`inert_in_sample`), every copy of that sample, those named in ``eff.off`` at their off values and the
+        others where they are; empty when there
         is no such sample, when ``eff`` has no ``off`` values, or when it would be off in every sample."""
         if not eff.off:
             return {}
@@ -928,9 +955,10 @@ class Search:
         for smp in samples:
             mine = [f"{n}@{smp}" for n in eff.full_names() if f"{n}@{smp}" in f.fitted]
             # bounds and ranges only: one sample's unresolved copies make every standard error infinite
-            if mine and _resolution_problems(m, mine, f.params, {n: 1.0 for n in mine},
-                                             [n for n in f.at_bound if n in mine], self.data,
-                                             self.settings.modulus_range_gpa):
+            if mine and (_resolution_problems(m, mine, f.params, {n: 1.0 for n in mine},
+                                              [n for n in f.at_bound if n in mine], self.data,
+                                              self.settings.modulus_range_gpa)
+                         or inert_in_sample(eff, m, f.data, f.params, f.predicted, smp)):
                 bad.append(smp)
         if not bad or len(bad) == len(samples):
             return {}
