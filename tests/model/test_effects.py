@@ -171,30 +171,46 @@ def test_rest_angle_holds_the_joint_bent_once_loaded_and_not_before(tube1):
     np.testing.assert_allclose(both, got - 0.5)
 
 
-@pytest.mark.parametrize("tau_s", [1e-3, 0.03, 1.0, 50.0, 1e5])
-def test_first_order_lag_on_jittered_stamps_equals_the_recursion(tau_s):
-    """Every path of the non-uniform lag (prefix scan, blocks) equals the row-by-row recursion."""
-    from camtube.model.effects.history import _lag_nonuniform
-
-    rng = np.random.default_rng(7)
-    dt = 0.02 + rng.normal(0.0, 0.002, 4999)
-    dt[100] = 0.0  # a repeated stamp
-    u = np.sin(np.cumsum(np.r_[0.0, dt])) + rng.normal(0.0, 0.1, 5000)
+def _lag_by_rows(u, dt, tau_s):
+    """The lag row by row in Python: the reference of the compiled recursion."""
     ref = np.empty_like(u)
     ref[0] = prev = u[0]
     for k, step in enumerate(dt):
         a = math.exp(-max(step, 0.0) / tau_s)
         prev = a * prev + (1.0 - a) * u[k + 1]
         ref[k + 1] = prev
-    np.testing.assert_allclose(_lag_nonuniform(u, dt, tau_s), ref, rtol=1e-11, atol=1e-12)
-    # the kept plan (what depends on the steps and tau alone) gives the same numbers, to the bit, and is reused
+    return ref
+
+
+@pytest.mark.parametrize("tau_s", [1e-3, 0.03, 1.0, 50.0, 1e5])
+def test_first_order_lag_on_jittered_stamps_equals_the_recursion(tau_s):
+    """The lag on jittered stamps (a repeated stamp, a gap of many time constants) equals the row-by-row recursion,
+    per sample; the kept steps (what depends on the stamps and tau alone) give the same numbers, to the bit."""
+    rng = np.random.default_rng(7)
+    dt = 0.02 + rng.normal(0.0, 0.002, 4999)
+    dt[100] = 0.0  # a repeated stamp
+    dt[3000] = 40.0 * tau_s  # a long gap
+    u = np.sin(np.cumsum(np.r_[0.0, dt])) + rng.normal(0.0, 0.1, 5000)
     t = np.cumsum(np.r_[0.0, dt])
     data = _data(np.zeros(t.size), time=t)
     steps = np.diff(t)
     first = first_order_lag(data, u, tau_s)
-    np.testing.assert_array_equal(first, _lag_nonuniform(u, steps, tau_s))
-    np.testing.assert_array_equal(first_order_lag(data, 2.0 * u, tau_s), _lag_nonuniform(2.0 * u, steps, tau_s))
-    assert len(data.cache.get("history.lag_plans")) == 1
+    np.testing.assert_allclose(first, _lag_by_rows(u, steps, tau_s), rtol=1e-12, atol=1e-13)
+    np.testing.assert_array_equal(first_order_lag(data, u, tau_s), first)
+    np.testing.assert_allclose(first_order_lag(data, 2.0 * u, tau_s), _lag_by_rows(2.0 * u, steps, tau_s),
+                               rtol=1e-12, atol=1e-13)
+    assert len(data.cache.get("history.lag_steps")) == 1
+    # two samples: each starts at its own first value, nothing carries over
+    two = _data(np.zeros(2 * t.size), time=np.r_[t, t], samples=np.repeat(["a", "b"], t.size))
+    both = first_order_lag(two, np.r_[u, -u], tau_s)
+    np.testing.assert_array_equal(both[:t.size], first)
+    np.testing.assert_allclose(both[t.size:], -first, rtol=1e-12, atol=1e-13)
+    bad = u.copy()
+    bad[2500] = np.inf   # a non-finite input spreads from its row on, never before it
+    with np.errstate(invalid="ignore"):
+        got = first_order_lag(_data(np.zeros(t.size), time=t), bad, tau_s)
+    np.testing.assert_array_equal(got[:2500], first[:2500])
+    assert not np.isfinite(got[2500])
 
 
 def test_capstan_gives_the_mean_tension_of_a_tendon_wrapping_a_guide(tube1):
@@ -322,45 +338,3 @@ def test_every_builtin_says_where_it_sits_on_the_bench():
     assert set(BUILTINS) <= set(SIDES)
 
 
-def _lag_one_block_at_a_time(u, dt, tau_s):
-    """The blocks of the non-uniform lag summed one at a time (as before the table): the reference, to the bit."""
-    from camtube.model.effects.history import _LAG_BLOCK, _new_lag_plan
-
-    gain, scan, _ = _new_lag_plan(dt, tau_s)
-    assert not scan
-    cum = np.cumsum(np.maximum(dt, 0.0) / tau_s)
-    b = gain * u[1:]
-    out = np.empty_like(u)
-    out[0] = prev = float(u[0])
-    s, m = 0, cum.size
-    while s < m:
-        base = cum[s - 1] if s else 0.0
-        e = max(int(np.searchsorted(cum, base + _LAG_BLOCK, side="right")), s + 1)
-        log_a = -(cum[s:e] - base)
-        block = np.exp(log_a) * (prev + np.cumsum(np.exp(-log_a) * b[s:e]))
-        out[s + 1:e + 1] = block
-        prev = float(block[-1])
-        s = e
-    return out
-
-
-@pytest.mark.parametrize("tau_s", [0.2, 0.25, 0.3, 1.0, 50.0, 1e5])
-@pytest.mark.parametrize("seed", [1, 2, 3])
-def test_the_lag_blocks_table_gives_the_blockwise_numbers_to_the_bit(tau_s, seed):
-    """The blocks summed in one table (rows of a cumulative sum) equal the blocks summed one at a time, to the bit,
-    on jittered steps with repeats and a long gap; a non-finite input takes the blockwise path."""
-    from camtube.model.effects.history import _lag_nonuniform, _new_lag_plan
-
-    rng = np.random.default_rng(seed)
-    n = int(rng.integers(2000, 3000))
-    dt = np.abs(0.02 + rng.normal(0.0, 0.004, n - 1))
-    dt[rng.integers(0, n - 1, 5)] = 0.0
-    dt[n // 3] = 40.0 * tau_s       # a gap of many time constants: a block of one step
-    u = np.sin(np.cumsum(np.r_[0.0, dt])) * 10 ** rng.uniform(-3, 3) + rng.normal(0.0, 0.1, n)
-    gain, scan, levels = _new_lag_plan(dt, tau_s)
-    assert not scan and (levels[1] is not None) == (tau_s <= 0.3)   # the table for short blocks only
-    np.testing.assert_array_equal(_lag_nonuniform(u, dt, tau_s), _lag_one_block_at_a_time(u, dt, tau_s))
-    bad = u.copy()
-    bad[n // 2] = np.inf
-    with np.errstate(invalid="ignore"):
-        np.testing.assert_array_equal(_lag_nonuniform(bad, dt, tau_s), _lag_one_block_at_a_time(bad, dt, tau_s))
