@@ -180,3 +180,30 @@ def test_a_parameter_the_data_do_not_see_leaves_the_others_errors_finite(tube2):
     ref = fit(model_for_pattern(tube2, [_bias_effect()]), data, ("E_t", "test_bias.bias_deg"),
               pattern_values(tube2) | {"E_t": 15.0})
     assert r.stderr["E_t"] == pytest.approx(ref.stderr["E_t"], rel=1e-3)
+
+
+def test_the_starts_of_a_large_fit_on_the_cores_give_the_fit_of_one_after_another(tube2, monkeypatch):
+    """A fit on many rows runs its starts (a grid over a slack's width) in forked workers: the result is the one of
+    the starts run in turn here, to the bit (the same solver runs; the best picked in the starts' order)."""
+    from camtube.model.core import fit as fit_module
+    from camtube.model.core import parallel
+
+    data = synthesize(tube2, n_samples=2, n_cycles=40, slack_mm=0.12, seed=5)
+    model = model_for_pattern(tube2, ["slack"])
+    names = ("E_t", "slack.deadband_mm")
+    monkeypatch.setattr(fit_module, "PARALLEL_STARTS_MIN_WORK", 1)   # this fit counts as large
+    calls = []
+    real = parallel.map_forked
+
+    def spy(fn, n):
+        calls.append(n)
+        return real(fn, n)
+
+    monkeypatch.setattr(fit_module, "map_forked", spy)
+    both = fit(model, data, names, pattern_values(tube2) | {"E_t": 12.0}, grid=3, keep=2)
+    assert calls and calls[0] == both.starts_tried >= 2          # the starts went to the workers
+    monkeypatch.setattr(parallel, "cores", lambda: 1)
+    here = fit(model, data, names, pattern_values(tube2) | {"E_t": 12.0}, grid=3, keep=2)
+    assert both.params == here.params and both.start == here.start and both.nfev == here.nfev
+    np.testing.assert_array_equal(both.residuals, here.residuals)
+    np.testing.assert_array_equal(both.covariance, here.covariance)

@@ -46,6 +46,7 @@ import numpy as np
 
 from camtube.model.core.fdjac import GroupedJacobian, sample_groups
 from camtube.model.core.model import FitError, JointModel, unknown_parameter
+from camtube.model.core.parallel import map_forked
 from camtube.model.core.params import Parameters
 from camtube.model.core.threads import one_blas_thread
 from camtube.model.data.dataset import Dataset
@@ -142,6 +143,10 @@ def _unknown(name: str, known: Sequence[str]) -> FitError:
 
 #: Points of the one-parameter scan across a declared range, per grid value (``grid=3``: 60 points).
 SCAN_PER_GRID = 20
+#: A fit's starts run on the machine's cores (:func:`~camtube.model.core.parallel.map_forked`) when its rows times
+#: its fitted parameters reach this (a refit on every row of a 60,000-row record: 0.3-1 million; a fit of the
+#: diagnosis's 4,000 search rows, far below, where forking would cost more than it saves).
+PARALLEL_STARTS_MIN_WORK = 200_000
 
 
 def grid_starts(params: Parameters, names: Sequence[str], n: int = 3, cap: int = 27,
@@ -351,20 +356,29 @@ def fit(
         if not any(np.array_equal(x, u) for u in uniq):
             uniq.append(x)
 
-    with one_blas_thread():   # tall, thin linear algebra: threads bring nothing (camtube.model.core.threads)
+    def refine(i: int) -> tuple:
+        """The solver's fit from start ``i`` of ``uniq``: ``(cost, x, jac, success, message, nfev, start)``."""
+        xstart = uniq[i]
+        if not p:
+            return (float(np.dot(r0, r0)), xstart, np.zeros((n, 0)), True, "nothing to fit", 1, xstart)
+        scale = np.maximum(np.abs(xstart), 1e-3 * np.where(np.isfinite(span), span, 1.0))
+        scale = np.where(scale > 0, scale, 1.0)
+        fun, jac = _residual_and_jacobian(model, data, names, work, sel, guarded, lo, hi)
+        with one_blas_thread():   # tall, thin linear algebra: threads bring nothing (camtube.model.core.threads)
+            sol = least_squares(fun, xstart, jac=jac, bounds=(lo, hi), x_scale=scale, method="trf",
+                                max_nfev=max_nfev, xtol=tol, ftol=tol, gtol=tol)
+        return (2.0 * float(sol.cost), sol.x, np.atleast_2d(sol.jac), bool(sol.success), str(sol.message),
+                int(sol.nfev), xstart)
+
+    # speed: the starts of a fit on many rows (a refit on every row of a record) are independent solver runs, one
+    # per core; each gives what it gives in turn (the same numbers), and the best is picked in the starts' order
+    if p and len(uniq) > 1 and n * p >= PARALLEL_STARTS_MIN_WORK:
+        cands = map_forked(refine, len(uniq))
+    else:
+        cands = [refine(i) for i in range(len(uniq))]
+    with one_blas_thread():
         best = None
-        for xstart in uniq:
-            if p:
-                scale = np.maximum(np.abs(xstart), 1e-3 * np.where(np.isfinite(span), span, 1.0))
-                scale = np.where(scale > 0, scale, 1.0)
-                fun, jac = _residual_and_jacobian(model, data, names, work, sel, guarded, lo, hi)
-                sol = least_squares(fun, xstart, jac=jac, bounds=(lo, hi), x_scale=scale, method="trf",
-                                    max_nfev=max_nfev, xtol=tol, ftol=tol, gtol=tol)
-                cost = 2.0 * float(sol.cost)
-                cand = (cost, sol.x, np.atleast_2d(sol.jac), bool(sol.success), str(sol.message), int(sol.nfev),
-                        xstart)
-            else:
-                cand = (float(np.dot(r0, r0)), xstart, np.zeros((n, 0)), True, "nothing to fit", 1, xstart)
+        for cand in cands:
             if best is None or cand[0] < best[0] * (1.0 - 1e-12):
                 best = cand
         _, x, jac, success, message, nfev, x_start = best
