@@ -2,8 +2,9 @@
 
 Why compiled: a fit evaluates the model thousands of times, and a law whose state carries from row to row (a lag on
 jittered stamps, a carriage its rail holds) has no NumPy form but a parallel scan or a piecewise trick around a
-scalar loop (what :mod:`camtube.model.effects.history` had before: 40-55 % of a diagnosis's time on a 60,000-row bench
-file). The loop itself, compiled, is the law written once, checked against itself, and 10-25x faster.
+scalar loop (what :mod:`camtube.model.effects.history` had before: up to half of a lost-motion file's diagnosis, about a
+quarter of a typical bench file's). The loop itself, compiled, is the law written once, checked against itself, and faster: on a 30,000-row
+sample 64 us for the lag (243 before), 124 us for the carriage (2,245 before).
 
 ``lag_rows(u, a, gain)``: ``v_0 = u_0``, ``v_k = a_(k-1) v_(k-1) + gain_(k-1) u_k``.
 ``hold_rows(s, f, starts, stops, hold, gap, band, release)``: the held carriage of
