@@ -338,3 +338,30 @@ def test_every_builtin_says_where_it_sits_on_the_bench():
     assert set(BUILTINS) <= set(SIDES)
 
 
+
+
+class NoCacheFolder:
+    """A numba cache locator that finds no folder (a read-only install without a writable home)."""
+
+    @classmethod
+    def from_function(cls, py_func, source_path):
+        return None
+
+
+def test_the_compiled_laws_work_where_numba_can_write_no_cache():
+    """Where numba finds no folder to cache its machine code in, the laws compile in each process instead (numba
+    raises "no locator available" for a cached function there)."""
+    import os
+    import subprocess
+    import sys
+
+    code = ("import numpy as np\n"
+            "from camtube.model.effects import kernels\n"
+            "print(kernels.lag_rows(np.array([1.0, 3.0]), np.array([0.5]), np.array([0.5])).tolist())\n")
+    from tests.conftest import ROOT
+
+    env = {**os.environ, "NUMBA_CACHE_LOCATOR_CLASSES": "tests.model.test_effects.NoCacheFolder",
+           "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=str(ROOT))
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[1.0, 2.0]"

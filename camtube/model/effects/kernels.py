@@ -11,7 +11,8 @@ sample 64 us for the lag (243 before), 124 us for the carriage (2,245 before).
 :func:`camtube.model.effects.history.carriage_hold`.
 
 The functions compile on the first import of this module (or load from numba's cache beside it, or in the user's
-cache when the package folder cannot be written), so that worker processes forked later inherit them compiled.
+cache when the package folder cannot be written, or compile in each process when neither can be), so that worker
+processes forked later inherit them compiled.
 """
 from __future__ import annotations
 
@@ -21,7 +22,16 @@ from numba import njit
 __all__ = ["hold_rows", "lag_rows"]
 
 
-@njit(cache=True, nogil=True)
+def _compiled(fn):
+    """``fn`` compiled, its machine code cached on disk for the next process; where numba finds no folder it may
+    write the cache to (a read-only install, no writable home), compiled in each process instead."""
+    try:
+        return njit(cache=True, nogil=True)(fn)
+    except RuntimeError:   # numba: "cannot cache function ...: no locator available"
+        return njit(nogil=True)(fn)
+
+
+@_compiled
 def lag_rows(u: np.ndarray, a: np.ndarray, gain: np.ndarray) -> np.ndarray:  # pragma: no cover (compiled)
     """(n,) ``v_0 = u_0``, ``v_k = a_(k-1) v_(k-1) + gain_(k-1) u_k`` (``a``, ``gain`` (n - 1,): the decay and
     the gain ``1 - a`` of each step, the gain computed as ``-expm1(-dt / tau)`` by the caller)."""
@@ -37,7 +47,7 @@ def lag_rows(u: np.ndarray, a: np.ndarray, gain: np.ndarray) -> np.ndarray:  # p
     return v
 
 
-@njit(cache=True, nogil=True)
+@_compiled
 def hold_rows(s: np.ndarray, f: np.ndarray, starts: np.ndarray, stops: np.ndarray, hold: np.ndarray,
               gap: float, band: float, release: float) -> np.ndarray:  # pragma: no cover (compiled)
     """(n,) the carriage's position behind a nut with a gap ``gap`` (mm), held by its rail below ``hold`` (N, one
