@@ -158,8 +158,7 @@ def carriage_hold(data: Dataset, stroke_mm: np.ndarray, hold_N: float | np.ndarr
     While the tension (smoothed: :attr:`Dataset.force_smoothed_N`) exceeds ``hold_N`` the tendon pulls the
     carriage onto the nut's flank: it follows the stroke. Once the tension falls to ``hold_N`` the rail holds it
     where it is (where the tension fell to ``hold_N``, along the unloading from the two rows before: continuous in
-    ``hold_N``), within the
-    gap: ``c_k = clip(c_(k-1), s_k, s_k + gap_mm)``. It slips back onto the flank (``c_k = s_k``) where the
+    ``hold_N``), within the gap: ``c_k = clip(c_(k-1), s_k, s_k + gap_mm)``. It slips back onto the flank (``c_k = s_k``) where the
     tension falls below :data:`RELEASE_SHARE` of ``hold_N``, and the rail holds it there again (the same clip from
     that row on: the motor's further travel down opens the gap anew, and the next pull takes it up first), until the
     tension has risen past :data:`HOLD_BAND` x ``hold_N`` (the next pull); it stays held while the tension stays
@@ -170,13 +169,11 @@ def carriage_hold(data: Dataset, stroke_mm: np.ndarray, hold_N: float | np.ndarr
     form, pieces of running minima and maxima around a scalar loop, 18x slower on a 30,000-row sample).
     """
     s = np.asarray(stroke_mm, float)
-    out = s.copy()
     gap = float(gap_mm)
     hold = np.broadcast_to(np.asarray(hold_N, float), s.shape)
     if gap <= 0.0 or s.size == 0 or not np.any(hold > 0.0):
-        return out
+        return s.copy()
     gap = min(gap, float(np.ptp(s)) + 1.0)                 # a gap wider than the stroke never binds (and may be inf)
-
     f = np.ascontiguousarray(data.force_smoothed_N, dtype=float)
     slices = [sl for _, sl in data.sample_slices()]
     starts = np.array([sl.start for sl in slices], np.int64)

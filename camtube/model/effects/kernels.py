@@ -84,17 +84,16 @@ def hold_rows(s: np.ndarray, f: np.ndarray, starts: np.ndarray, stops: np.ndarra
                 continue
             if slip:
                 c = s[k]
-            elif not low_prev:       # held from here: where the force fell to the hold force
-                if first or f[k - 1] <= h:
-                    c = s[k]
-                elif k - 2 >= a and f[k - 2] > f[k - 1]:
-                    c = s[k - 1] + (s[k - 1] - s[k - 2]) * (f[k - 1] - h) / (f[k - 2] - f[k - 1])
-                else:
-                    c = s[k - 1] + (s[k] - s[k - 1]) * (f[k - 1] - h) / (f[k - 1] - f[k])
-                if not first:
-                    c = min(max(c, min(s[k], s[k - 1])), max(s[k], s[k - 1]))
-                c = min(max(c, s[k]), s[k] + gap)
             else:
+                if not low_prev:     # held from here: where the force fell to the hold force
+                    if first or f[k - 1] <= h:
+                        c = s[k]
+                    elif k - 2 >= a and f[k - 2] > f[k - 1]:
+                        c = s[k - 1] + (s[k - 1] - s[k - 2]) * (f[k - 1] - h) / (f[k - 2] - f[k - 1])
+                    else:
+                        c = s[k - 1] + (s[k] - s[k - 1]) * (f[k - 1] - h) / (f[k - 1] - f[k])
+                    if not first:
+                        c = min(max(c, min(s[k], s[k - 1])), max(s[k], s[k - 1]))
                 c = min(max(c, s[k]), s[k] + gap)
             out[k] = c
             low_prev = True
