@@ -165,6 +165,11 @@ HELDOUT12_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost mo
 #: and a toe (the other way round from the twelfth batch), the usual files around them.
 HELDOUT13_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "creep", "backbone",
                    "zero drift", "lag", ("lost motion", "creep"), ("toe", "lost motion"), "friction", "tracker drift"]
+#: The fourteenth fresh held-out batch (issue 19, after the floor became the noise's root mean square): lost motion
+#: twice, a three-arm backbone, and two pairs no batch had: friction at the guide beside a slack tendon, a relaxing
+#: backbone beside lost motion in the drive.
+HELDOUT14_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "creep", "backbone", "backbone3",
+                   "zero drift", "lag", ("friction", "slack"), ("backbone", "lost motion"), "friction", "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -191,7 +196,9 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            # drawn once the changes of the session after bench-heldout11 were settled (every batch above looked at)
            "bench-heldout12": (20270311, HELDOUT12_KINDS),
            # drawn once the changes of the session after bench-heldout12 were settled (every batch above looked at)
-           "bench-heldout13": (20270412, HELDOUT13_KINDS)}
+           "bench-heldout13": (20270412, HELDOUT13_KINDS),
+           # drawn once the changes of the session after bench-heldout13 were settled (every batch above looked at)
+           "bench-heldout14": (20270520, HELDOUT14_KINDS)}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
