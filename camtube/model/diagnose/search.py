@@ -411,7 +411,7 @@ def noise_floor(data: Dataset, residual_deg: np.ndarray) -> float:
     the smallest over the orders 2-4 of their MAD in short windows, averaged as squares (``("wmad", k)`` of
     :func:`_floor_estimates`). It estimates the root mean square of the noise, the RMSE a model without error
     leaves, also where the noise's size changes along the stroke (one MAD over the record reads the typical size:
-    5-15 % below it on bench records, where the force noise is absent at rest); each window's median keeps it
+    up to 8 % below it on bench records, where the force noise is absent at rest); each window's median keeps it
     robust to a spike or a kink, and the smallest order keeps the model's error out."""
     r = np.asarray(residual_deg, float)
     best = _floor_of([r[sl] for _, sl in data.sample_slices()])
