@@ -401,9 +401,19 @@ def _floor_estimates(parts: list) -> dict[tuple[str, int], float]:
     return out
 
 
-def _floor_of(parts: list, kind: str = "wmad") -> float:
-    est = [v for (k, _), v in _floor_estimates(parts).items() if k == kind]
-    return min(est) if est else math.inf
+def _smallest(est: dict, kind: str) -> float:
+    """The smallest over the orders of the estimates ``est`` (of :func:`_floor_estimates`) of ``kind``; inf for none."""
+    vals = [v for (k, _), v in est.items() if k == kind]
+    return min(vals) if vals else math.inf
+
+
+def noise_levels(data: Dataset, residual_deg: np.ndarray) -> tuple[float, float]:
+    """``(floor, typical size)`` (deg) of a residual ``(n,)``: :func:`noise_floor` and :func:`noise_typical` from one
+    pass over its differences per sample (the standard deviation of the residual where the record is too short)."""
+    r = np.asarray(residual_deg, float)
+    est = _floor_estimates([r[sl] for _, sl in data.sample_slices()])
+    out = [_smallest(est, kind) for kind in ("wmad", "mad")]
+    return tuple(v if math.isfinite(v) else float(np.std(r)) for v in out)
 
 
 def noise_floor(data: Dataset, residual_deg: np.ndarray) -> float:
@@ -413,9 +423,7 @@ def noise_floor(data: Dataset, residual_deg: np.ndarray) -> float:
     leaves, also where the noise's size changes along the stroke (one MAD over the record reads the typical size:
     up to 8 % below it on bench records, where the force noise is absent at rest); each window's median keeps it
     robust to a spike or a kink, and the smallest order keeps the model's error out."""
-    r = np.asarray(residual_deg, float)
-    best = _floor_of([r[sl] for _, sl in data.sample_slices()])
-    return best if math.isfinite(best) else float(np.std(r))
+    return noise_levels(data, residual_deg)[0]
 
 
 def noise_typical(data: Dataset, residual_deg: np.ndarray) -> float:
@@ -424,9 +432,7 @@ def noise_typical(data: Dataset, residual_deg: np.ndarray) -> float:
     to :func:`noise_floor` where the noise keeps its size, below it where the size changes along the stroke; the
     search's own tests (its stop, the error above the noise an effect must explain) compare with it, so the search
     looks for effects a little below the line of the labels (see :class:`Search`)."""
-    r = np.asarray(residual_deg, float)
-    best = _floor_of([r[sl] for _, sl in data.sample_slices()], "mad")
-    return best if math.isfinite(best) else float(np.std(r))
+    return noise_levels(data, residual_deg)[1]
 
 
 def noise_floor_parts(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarray) -> tuple[float, float]:
@@ -452,7 +458,7 @@ def noise_floor_parts(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarra
         idx = np.flatnonzero(blocks == b)
         # contiguous runs only (a block is contiguous within a sample)
         cut = np.flatnonzero(np.diff(idx) > 1) + 1
-        v = _floor_of([r[seg] for seg in np.split(idx, cut)])
+        v = _smallest(_floor_estimates([r[seg] for seg in np.split(idx, cut)]), "wmad")
         if math.isfinite(v):
             vals.append(v)
     if len(vals) < 3:
@@ -872,8 +878,7 @@ class Search:
         names = _names_for(self.given_model, s.fit_params)
         base_full = refit_all_rows(self.given_model, data, names, self.fixed, {}, s.grid)
         self.block_all, _ = cycle_blocks(data)
-        self.floor = noise_typical(data, base_full.residuals)
-        self.floor_rms = noise_floor(data, base_full.residuals)
+        self.floor_rms, self.floor = noise_levels(data, base_full.residuals)
         self.floor_parts = noise_floor_parts(data, base_full.residuals, self.block_all)
         self.floor_se = math.hypot(*self.floor_parts)
         self.clock["base"] = time.perf_counter()
@@ -1187,8 +1192,8 @@ class Search:
         problems += _resolution_problems(m, list(r.fitted), r.params, r.stderr, r.at_bound, data,
                                          s.modulus_range_gpa)
         # the floor seen through this model's residual (a model error inflates the estimate a little)
-        f_c = min(self.floor, noise_typical(data, r.residuals))
-        rms_c = min(self.floor_rms, noise_floor(data, r.residuals))
+        rms_r, typical_r = noise_levels(data, r.residuals)
+        f_c, rms_c = min(self.floor, typical_r), min(self.floor_rms, rms_r)
         parts_c = noise_floor_parts(data, r.residuals, self.block_all)
         se_c = math.hypot(*parts_c)
         if r.rmse < f_c - 2.0 * se_c:
