@@ -6,20 +6,21 @@ compiled, gave 243 us and 2,245 us on this machine; the compiled laws 64 us and 
 """
 from __future__ import annotations
 
-import time
-
 import numpy as np
+from benchutil import best_of
 
 from camtube.model.data.dataset import Dataset
 from camtube.model.effects.history import carriage_hold, first_order_lag
 
 
 def per_call_us(fn, calls: int = 300) -> float:
+    """Microseconds per call of ``fn()``: the best of three runs of ``calls`` calls, after one to warm up."""
+    def run() -> None:
+        for _ in range(calls):
+            fn()
+
     fn()
-    t0 = time.perf_counter()
-    for _ in range(calls):
-        fn()
-    return (time.perf_counter() - t0) / calls * 1e6
+    return best_of(run)[0] / calls * 1e6
 
 
 def main() -> None:
