@@ -465,3 +465,56 @@ def test_a_force_at_rest_that_steps_from_rest_to_rest_is_not_taken_for_a_driftin
     smooth = read_zero(Dataset(force_N=2.0 * stroke + drift + noise, **base))["S1"]
     assert smooth.drifts and smooth.smooth and smooth.zeroed
     assert smooth.jump_N < 0.1 * abs(smooth.change_N)
+
+
+def _moving_rows(rec, min_angle_deg: float, rng, k: int, length: int) -> list[np.ndarray]:
+    """``k`` runs of ``length`` rows, apart, inside one sample, where the joint is bent more than ``min_angle_deg``
+    and the motor moves."""
+    a = np.abs(rec.angle_true_deg)
+    moving = np.abs(np.gradient(rec.data.stroke_mm)) > 1e-6
+    ok = np.flatnonzero(np.convolve((a > min_angle_deg) & moving, np.ones(length + 6), "same") >= length + 6)
+    runs: list[np.ndarray] = []
+    for i in rng.permutation(ok):
+        r = np.arange(i - length // 2, i - length // 2 + length)
+        if all(abs(int(r[0]) - int(q[0])) > 60 for q in runs) and len(set(rec.data.sample[r - 3])) == 1:
+            runs.append(r)
+        if len(runs) == k:
+            break
+    return runs
+
+
+def test_bursts_of_interference_and_a_tracker_writing_zeros_are_set_aside_row_for_row(tube2):
+    # interference that lasts several samples, and a tracker that writes 0 while it has lost the sensor: runs of
+    # displaced rows whose neighbours either side agree. A single-row test misses every row of them (each row's
+    # neighbours inside the run are displaced too); the clean record's reversals, dwells and rests give none
+    rec = simulate_bench(tube2, SampleBench(tracker=QUIET), SHORT, Clock(rate_hz=50.0, n_repeats=0), seed=11)
+    clean = check_instruments(rec.data)
+    assert set(clean.aside) == {"repeated time stamp", "angle spike", "force spike"}
+    assert sum(len(v) for v in clean.aside.values()) == 0
+    rng = np.random.default_rng(5)
+    angle = rec.data.angle_deg.copy()
+    burst = _moving_rows(rec, 8.0, rng, 8, 4)
+    for j, r in enumerate(burst):
+        angle[r[: 2 + j % 3]] += (-1) ** j * rng.uniform(5.0, 9.0)   # runs of 2, 3 and 4 rows
+    zeros = _moving_rows(rec, 8.0, rng, 16, 12)[8:]
+    for r in zeros:
+        angle[r] = 0.0
+    want = {int(i) for j, r in enumerate(burst) for i in r[: 2 + j % 3]} | {int(i) for r in zeros for i in r}
+    ins = check_instruments(rec.data.with_angle(angle))
+    assert set(ins.aside["angle burst row"]) == want
+    assert len(ins.aside["angle spike"]) == 0 and "frozen angle row" not in ins.aside
+    assert any("angle burst rows" in line for line in ins.lines())
+
+
+def test_a_frozen_tracker_is_set_aside_while_the_stroke_moves_and_kept_at_rest(tube2):
+    # the tracker holds its last value: exact repeats of the angle across which the stroke moves; the first value
+    # is a real reading and stays. At rest the stroke does not move, so nothing there is taken for a freeze
+    rec = simulate_bench(tube2, SampleBench(tracker=QUIET), SHORT, Clock(rate_hz=50.0, n_repeats=0), seed=12)
+    angle = rec.data.angle_deg.copy()
+    runs = _moving_rows(rec, 4.0, np.random.default_rng(6), 5, 9)
+    for r in runs:
+        angle[r[1:]] = angle[r[0]]
+    rest = np.flatnonzero((rec.data.stroke_mm == 0.0) & (rec.data.sample == "S1"))[100:110]
+    angle[rest[1:]] = angle[rest[0]]
+    ins = check_instruments(rec.data.with_angle(angle))
+    assert set(ins.aside["frozen angle row"]) == {int(i) for r in runs for i in r[1:]}

@@ -8,6 +8,13 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
   either side (same sample) by more than :data:`SPIKE_Z` noise scales; the scale is the median absolute
   row-to-row change (x 1.4826 / sqrt 2, robust to the spikes themselves). Turning points and kinks of the
   motion stay within their neighbours' range, so only isolated jumps qualify.
+* **Bursts** (interference lasting several samples; a tracker that writes zeros while it has lost the sensor): a
+  run of 2 to :data:`BURST_S` seconds of rows (at most :data:`BURST_ROWS`) that all lie on one side of the range
+  of the two rows either side of the run, by more than :data:`SPIKE_Z` noise scales. A reversal of the motion
+  puts the run's first and last rows within a row's change of the rows beside them, so it does not qualify.
+* **A frozen tracker**: :data:`FROZEN_REPEATS` or more rows in a row repeating the angle before them exactly while
+  the stroke moves (more than :data:`FROZEN_STROKE` of the sample's stroke range across the run): the tracker
+  held its last value; the repeats are set aside, the first value kept.
 * **Repeated time stamps**: a row whose stamp equals the previous row's (the logger wrote one instant
   twice) is set aside. Rows whose stamp goes backwards, and rows with a missing value, are dropped when
   the file is read (:func:`camtube.model.data.read_measurements`), and counted there.
@@ -48,6 +55,14 @@ from camtube.model.data.dataset import Dataset, Rests, rests_of
 SPIKE_Z = 8.0
 #: Neighbours either side whose range a row is compared with.
 NEIGHBOURS = 2
+#: The longest burst (rows displaced together) set aside, in seconds of the sample's median interval ...
+BURST_S = 0.5
+#: ... and in rows.
+BURST_ROWS = 50
+#: Repeats of the angle before them, in a row, that make a frozen tracker ...
+FROZEN_REPEATS = 4
+#: ... while the stroke moves by this share of the sample's stroke range across them.
+FROZEN_STROKE = 0.01
 #: A lag is corrected only when it lowers the residual RMS of the lag regression by this fraction.
 MIN_FALL = 0.02
 #: A lag the regression resolves but barely improves with (below :data:`MIN_FALL`) is corrected when it lowers the
@@ -253,7 +268,8 @@ class Instruments:
     raw : Dataset
         The rows as read.
     aside : dict[str, (k,) int]
-        Rows of ``raw`` set aside, by reason (``"angle spike"``, ``"force spike"``, ``"repeated time stamp"``).
+        Rows of ``raw`` set aside, by reason (``"angle spike"``, ``"force spike"``, ``"repeated time stamp"``; and
+        where found ``"angle burst row"``, ``"force burst row"``, ``"frozen angle row"``).
     kept : (n_raw,) bool
         Rows of ``raw`` kept in ``data``.
     rates_hz : dict[str, float]
@@ -322,23 +338,94 @@ class Instruments:
         return out
 
 
+def _noise_scale(v: np.ndarray) -> float:
+    """The white-noise scale of ``v`` from its row-to-row changes: ``1.4826 MAD(diff v) / sqrt(2)`` (robust to
+    spikes and to the motion's steady changes)."""
+    return 1.4826 * float(np.median(np.abs(np.diff(v)))) / math.sqrt(2.0)
+
+
 def _spikes(x: np.ndarray, slices: list) -> np.ndarray:
     """Rows of ``x`` (n,) outside the range of their neighbours (:data:`NEIGHBOURS` rows either side, same
-    sample) by more than :data:`SPIKE_Z` noise scales; the scale is ``1.4826 MAD(diff x) / sqrt(2)`` (robust
-    to the spikes). A turning point or a kink of the motion stays within its neighbours' range (within a
-    row's change), so only isolated jumps qualify."""
+    sample) by more than :data:`SPIKE_Z` noise scales (:func:`_noise_scale`). A turning point or a kink of the
+    motion stays within its neighbours' range (within a row's change), so only isolated jumps qualify."""
     out = np.zeros(x.size, bool)
     h = NEIGHBOURS
     for _, sl in slices:
         v = x[sl]
         if v.size < 10 * h:
             continue
-        scale = 1.4826 * float(np.median(np.abs(np.diff(v)))) / math.sqrt(2.0)
+        scale = _noise_scale(v)
         if scale <= 0.0:
             continue
         pad = np.concatenate((np.full(h, v[0]), v, np.full(h, v[-1])))
         win = np.delete(np.lib.stride_tricks.sliding_window_view(pad, 2 * h + 1), h, axis=1)
         out[sl] = (v > win.max(axis=1) + SPIKE_Z * scale) | (v < win.min(axis=1) - SPIKE_Z * scale)
+    return out
+
+
+def _bursts(x: np.ndarray, t: np.ndarray, slices: list, single: np.ndarray) -> np.ndarray:
+    """Rows of ``x`` (n,) in runs of 2 or more rows that all lie outside the range of the run's neighbours
+    (:data:`NEIGHBOURS` rows either side, same sample) on the same side, by more than :data:`SPIKE_Z` noise scales;
+    runs up to :data:`BURST_S` seconds (at most :data:`BURST_ROWS` rows). ``single`` (n,) bool: the spikes of one
+    row, which are not neighbours (a burst beside a spike is still found)."""
+    out = np.zeros(x.size, bool)
+    h = NEIGHBOURS
+    for _, sl in slices:
+        v = x[sl]
+        n = v.size
+        if n < 10 * h:
+            continue
+        scale = _noise_scale(v)
+        dt = np.diff(t[sl])
+        dt = dt[dt > 0]
+        if scale <= 0.0 or not dt.size:
+            continue
+        longest = int(min(BURST_ROWS, max(2, math.floor(BURST_S / float(np.median(dt))))))
+        # a single spike beside a run stands for its neighbour: the value across it (its own neighbour's)
+        w = v.copy()
+        for i in np.flatnonzero(single[sl]):
+            w[i] = w[i - 1] if i > 0 else w[min(i + 1, n - 1)]
+        lo_run = w.copy()
+        hi_run = w.copy()
+        # the shortest runs first; a run found is replaced by the line across it, so that it does not stand beside
+        # the real rows between it and another artefact as their neighbour
+        for length in range(2, longest + 1):
+            m = n - length + 1
+            if m <= 0:
+                break
+            lo_run = np.minimum(lo_run[:m], w[length - 1:])
+            hi_run = np.maximum(hi_run[:m], w[length - 1:])
+            pad = np.concatenate((np.full(h, w[0]), w, np.full(h + 1, w[-1])))
+            i = np.arange(m)
+            nb = np.stack((pad[i], pad[i + 1], pad[i + h + length], pad[i + h + length + 1]))
+            hit = (lo_run > nb.max(axis=0) + SPIKE_Z * scale) | (hi_run < nb.min(axis=0) - SPIKE_Z * scale)
+            starts = np.flatnonzero(hit)
+            for start in starts:
+                out[sl.start + start:sl.start + start + length] = True
+                a, b = (w[start - 1] if start else w[start + length]), (w[start + length] if start + length < n
+                                                                       else w[start - 1])
+                w[start:start + length] = np.linspace(a, b, length + 2)[1:-1]
+            if starts.size:
+                win = np.lib.stride_tricks.sliding_window_view(w, length)
+                lo_run, hi_run = win.min(axis=1), win.max(axis=1)
+    return out
+
+
+def _frozen(angle: np.ndarray, stroke: np.ndarray, slices: list) -> np.ndarray:
+    """Rows repeating the angle before them exactly, in runs of :data:`FROZEN_REPEATS` or more, across which the
+    stroke moves by more than :data:`FROZEN_STROKE` of the sample's stroke range (a tracker holding its last
+    value); the run's first value is kept."""
+    out = np.zeros(angle.size, bool)
+    for _, sl in slices:
+        a, s = angle[sl], stroke[sl]
+        if a.size < 2:
+            continue
+        span = float(np.ptp(s))
+        rep = np.concatenate(([False], a[1:] == a[:-1]))
+        edges = np.diff(np.concatenate(([0], rep.astype(np.int8), [0])))
+        for b, e in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+            if e - b >= FROZEN_REPEATS and abs(float(s[e - 1]) - float(s[b - 1])) > FROZEN_STROKE * span:
+                out[sl.start + b:sl.start + e] = True
     return out
 
 
@@ -571,9 +658,15 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     aside["repeated time stamp"] = np.flatnonzero(rep)
     sa = _spikes(data.angle_deg, slices) & ~rep
     sf = _spikes(data.force_N, slices) & ~rep & ~sa
+    ba = _bursts(data.angle_deg, data.time_s, slices, sa) & ~rep & ~sa & ~sf
+    bf = _bursts(data.force_N, data.time_s, slices, sf) & ~rep & ~sa & ~sf & ~ba
+    fz = _frozen(data.angle_deg, data.stroke_mm, slices) & ~rep & ~sa & ~sf & ~ba & ~bf
     aside["angle spike"] = np.flatnonzero(sa)
     aside["force spike"] = np.flatnonzero(sf)
-    kept = ~(rep | sa | sf)
+    for why, rows in (("angle burst row", ba), ("force burst row", bf), ("frozen angle row", fz)):
+        if rows.any():   # (the findings name only the kinds found)
+            aside[why] = np.flatnonzero(rows)
+    kept = ~(rep | sa | sf | fz | ba | bf)
     clean = data.take(kept)
     rates, notes = _rates(clean)
     zeros = read_zero(clean)

@@ -505,7 +505,8 @@ def artefacts_png(d: Diagnosis, max_samples: int = 4) -> bytes | None:
     fig = _figure(13.0, 2.4 * len(sl) + 0.6)
     axes = np.atleast_1d(fig.subplots(len(sl), 1, squeeze=False)[:, 0])
     marks = {"angle spike": ("x", "tab:red"), "force spike": ("+", "tab:purple"),
-             "repeated time stamp": ("|", "tab:orange")}
+             "repeated time stamp": ("|", "tab:orange"), "angle burst row": ("x", "tab:brown"),
+             "force burst row": ("+", "tab:pink"), "frozen angle row": ("s", "tab:cyan")}
     for ax, (smp, s) in zip(axes, sl):
         t = raw.time_s[s]
         ax.plot(t, raw.angle_deg[s], "-", lw=0.4, color="0.55", label="angle as read", rasterized=True)
