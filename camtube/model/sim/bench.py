@@ -37,6 +37,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.optimize import brentq
+from scipy.signal import lfilter
 
 from camtube.design.geometry import pattern_geometry
 from camtube.design.pattern import Pattern
@@ -135,7 +136,13 @@ class Backbone:
 @dataclass(frozen=True)
 class Tracker:
     """EM tracker: lag, noise, spikes, dropouts, and a zero that drifts (``drift_deg_per_h``: the reading's offset
-    grows with the time since the record began, as a tracker's field and sensor warm up)."""
+    grows with the time since the record began, as a tracker's field and sensor warm up).
+
+    ``dropout``: what the tracker writes while it has lost the sensor: ``"nan"`` (a missing value), ``"zero"``
+    (0.0), ``"hold"`` (its last reading again). ``n_bursts``: interference lasting ``burst_rows`` rows, each
+    row of a burst displaced by the same ``spike_deg``-sized amount. ``filter_ms``: the time constant of a
+    first-order filter the tracker's noise passes (correlated from row to row; its standard deviation stays
+    ``noise_deg``); 0: white."""
 
     noise_deg: float = 0.15
     lag_ms: float = 0.0
@@ -144,6 +151,10 @@ class Tracker:
     spike_deg: tuple = (3.0, 9.0)
     n_dropouts: int = 4
     dropout_rows: tuple = (2, 15)
+    dropout: str = "nan"
+    n_bursts: int = 0
+    burst_rows: tuple = (2, 6)
+    filter_ms: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -192,7 +203,10 @@ class BenchRecord:
     carriage_true_mm : (n,) float
         Where the carriage truly stood (the drive's lost motion: the motor's stroke is ``data.stroke_mm``).
     spike_rows, dropout_rows, repeat_rows : (k,) int
-        Rows of ``data`` carrying a spike, a missing angle, a repeated time stamp.
+        Rows of ``data`` carrying a spike, a missing angle (or the zero or held value the tracker wrote in its
+        place, :attr:`Tracker.dropout`), a repeated time stamp.
+    burst_rows : (k,) int
+        Rows of ``data`` in a burst of interference.
     noise_deg : float
         The tracker's white-noise standard deviation (the angle's sensor noise; RMS over the samples).
     floor_deg : float
@@ -211,6 +225,7 @@ class BenchRecord:
     floor_deg: float
     params: dict = field(default_factory=dict)
     carriage_true_mm: np.ndarray | None = None
+    burst_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
 
 
 def motor_profile(p: Protocol, peak_mm: float, t_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -376,7 +391,7 @@ def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | 
     arm = geo.first.moment_arm_mm
     parts: dict[str, list] = {k: [] for k in ("sample", "cycle", "time", "stroke", "force", "angle", "true", "cell",
                                                 "carriage")}
-    spikes, drops, reps = [], [], []
+    spikes, drops, reps, bursts = [], [], [], []
     offset = 0
     floors = []
     for s, b in enumerate(per):
@@ -387,7 +402,12 @@ def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | 
         tr, lc = b.tracker, b.load_cell
         # the tracker reports the bend it saw lag_ms ago
         seen = np.interp(t_true - tr.lag_ms * 1e-3, t_true, theta)
-        angle = np.degrees(seen) + rng.normal(0.0, tr.noise_deg, n) + tr.drift_deg_per_h * t_true / 3600.0
+        noise = rng.normal(0.0, tr.noise_deg, n)
+        if tr.filter_ms > 0.0:   # a first-order filter at the logger's rate, its output's spread kept
+            rho = math.exp(-1e3 / (clock.rate_hz * tr.filter_ms))
+            gain = math.sqrt(1.0 - rho * rho)
+            noise = lfilter([gain], [1.0, -rho], noise, zi=[(1.0 - gain) * noise[0]])[0]   # stationary from row 0
+        angle = np.degrees(seen) + noise + tr.drift_deg_per_h * t_true / 3600.0
         k_sp = np.sort(rng.choice(np.arange(5, n - 5), tr.n_spikes, replace=False)) if tr.n_spikes else np.zeros(0, int)
         angle[k_sp] += rng.choice([-1.0, 1.0], k_sp.size) * rng.uniform(*tr.spike_deg, k_sp.size)
         k_dr = []
@@ -395,7 +415,22 @@ def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | 
             a0 = int(rng.integers(20, n - 40))
             k_dr.extend(range(a0, a0 + int(rng.integers(tr.dropout_rows[0], tr.dropout_rows[1] + 1))))
         k_dr = np.unique(np.array(k_dr, int))
-        angle[k_dr] = np.nan
+        k_bu = []
+        for _ in range(tr.n_bursts):   # (no draws without bursts: the records drawn before are unchanged)
+            a0 = int(rng.integers(20, n - 40))
+            rows = np.arange(a0, a0 + int(rng.integers(tr.burst_rows[0], tr.burst_rows[1] + 1)))
+            angle[rows] += float(rng.choice([-1.0, 1.0])) * float(rng.uniform(*tr.spike_deg))
+            k_bu.extend(rows.tolist())
+        k_bu = np.unique(np.array(k_bu, int))
+        if tr.dropout == "nan":
+            angle[k_dr] = np.nan
+        elif tr.dropout == "zero":
+            angle[k_dr] = 0.0
+        elif tr.dropout == "hold":
+            for a0, a1 in _runs(k_dr):
+                angle[a0:a1] = angle[a0 - 1]
+        else:
+            raise ValueError(f"Tracker.dropout {tr.dropout!r}: one of 'nan', 'zero', 'hold'")
         zero = lc.drift_N_per_h * t_true / 3600.0
         if lc.walk_N_per_sqrt_h > 0:
             zero = zero + np.cumsum(rng.normal(0.0, lc.walk_N_per_sqrt_h * math.sqrt(1.0 / clock.rate_hz / 3600.0), n))
@@ -413,6 +448,7 @@ def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | 
         parts["cell"].append(cell)
         parts["carriage"].append(carriage)
         spikes.append(k_sp + offset)
+        bursts.append(k_bu + offset)
         drops.append(k_dr + offset)
         reps.append(rep + offset)
         offset += n
@@ -421,7 +457,15 @@ def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | 
     params = {"arm_mm": arm, "samples": [repr(b) for b in per], "protocol": repr(protocol), "clock": repr(clock)}
     return BenchRecord(data, cat["true"], cat["cell"], np.concatenate(spikes), np.concatenate(drops),
                        np.concatenate(reps), float(math.sqrt(np.mean([b.tracker.noise_deg ** 2 for b in per]))),
-                       float(math.sqrt(np.mean(np.square(floors)))), params, cat["carriage"])
+                       float(math.sqrt(np.mean(np.square(floors)))), params, cat["carriage"], np.concatenate(bursts))
+
+
+def _runs(rows: np.ndarray) -> list[tuple[int, int]]:
+    """``[(first, stop)]`` of the runs of consecutive values in sorted ``rows``."""
+    if not rows.size:
+        return []
+    cut = np.flatnonzero(np.diff(rows) > 1) + 1
+    return [(int(r[0]), int(r[-1]) + 1) for r in np.split(rows, cut)]
 
 
 def with_tracker(b: SampleBench, **kw) -> SampleBench:
