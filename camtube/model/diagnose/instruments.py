@@ -14,7 +14,8 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
   puts the run's first and last rows within a row's change of the rows beside them, so it does not qualify.
 * **A frozen tracker**: :data:`FROZEN_REPEATS` or more rows in a row repeating the angle before them exactly while
   the stroke moves (more than :data:`FROZEN_STROKE` of the sample's stroke range across the run): the tracker
-  held its last value; the repeats are set aside, the first value kept.
+  held its last value; the repeats are set aside, the first value kept unless the angle jumped to it (a tracker
+  that writes 0 while it has lost the sensor).
 * **Repeated time stamps**: a row whose stamp equals the previous row's (the logger wrote one instant
   twice) is set aside. Rows whose stamp goes backwards, and rows with a missing value, are dropped when
   the file is read (:func:`camtube.model.data.read_measurements`), and counted there.
@@ -414,18 +415,21 @@ def _bursts(x: np.ndarray, t: np.ndarray, slices: list, single: np.ndarray) -> n
 def _frozen(angle: np.ndarray, stroke: np.ndarray, slices: list) -> np.ndarray:
     """Rows repeating the angle before them exactly, in runs of :data:`FROZEN_REPEATS` or more, across which the
     stroke moves by more than :data:`FROZEN_STROKE` of the sample's stroke range (a tracker holding its last
-    value); the run's first value is kept."""
+    value); the run's first value is kept, unless the angle jumped to it (more than :data:`SPIKE_Z` noise scales
+    from the row before: a tracker that writes a fixed value, such as 0, while it has lost the sensor)."""
     out = np.zeros(angle.size, bool)
     for _, sl in slices:
         a, s = angle[sl], stroke[sl]
-        if a.size < 2:
+        if a.size < 3:
             continue
         span = float(np.ptp(s))
+        scale = _noise_scale(a)
         rep = np.concatenate(([False], a[1:] == a[:-1]))
         edges = np.diff(np.concatenate(([0], rep.astype(np.int8), [0])))
         for b, e in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
             if e - b >= FROZEN_REPEATS and abs(float(s[e - 1]) - float(s[b - 1])) > FROZEN_STROKE * span:
-                out[sl.start + b:sl.start + e] = True
+                jumped = b >= 2 and abs(float(a[b - 1]) - float(a[b - 2])) > SPIKE_Z * scale
+                out[sl.start + b - int(jumped):sl.start + e] = True
     return out
 
 
