@@ -19,7 +19,7 @@ from camtube.model.core.registry import registry_with_files
 from camtube.model.data import Dataset
 from camtube.model.diagnose import diagnose
 from camtube.model.diagnose.search import (
-    REACH_RATIO, _floor_estimates, cycle_blocks, noise_floor, noise_floor_parts,
+    REACH_RATIO, _floor_estimates, cycle_blocks, noise_floor, noise_floor_parts, noise_lag,
 )
 from camtube.model.report.diagnosis import diagnosis_dict, diagnosis_text
 from tests.conftest import PATTERNS, ROOT
@@ -126,3 +126,45 @@ def test_windowed_mad_reads_sigma_on_white_noise(k):
     x = np.random.default_rng(100 + k).normal(0.0, 0.4, 400_000)
     est = _floor_estimates([x[:200_000], x[200_000:]])[("wmad", k)]
     assert abs(est / 0.4 - 1.0) < 0.005, est
+
+
+def _record(x: np.ndarray, rate_hz: float, cycles: int = 30) -> Dataset:
+    n = x.size
+    sample = np.array(["A"] * (n // 2) + ["B"] * (n // 2), dtype=object)
+    cycle = np.tile(np.repeat(np.arange(1, cycles + 1), n // (2 * cycles)), 2)
+    t = np.tile(np.arange(n // 2) / rate_hz, 2)
+    return Dataset(sample, cycle, t, np.zeros(n), np.zeros(n), x)
+
+
+@pytest.mark.parametrize("rate_hz, tau_ms", [(100.0, 15.0), (100.0, 45.0), (50.0, 40.0), (25.0, 30.0)])
+def test_floor_of_noise_correlated_from_row_to_row_is_its_standard_deviation(rate_hz, tau_ms):
+    """A tracker that filters its readings (first order, time constant tau): the noise of neighbouring rows is
+    correlated, and differences of neighbouring rows read 37-63 % low. Read from rows far enough apart, on a
+    slow motion's leftover error with a few spikes, the floor is the noise's standard deviation within 6 %."""
+    rng = np.random.default_rng(int(rate_hz + tau_ms))
+    n = 60000
+    rho = math.exp(-1e3 / (rate_hz * tau_ms))
+    w = rng.normal(0.0, 0.2 * math.sqrt(1.0 - rho * rho), n)
+    e = np.empty(n)
+    e[0] = rng.normal(0.0, 0.2)
+    for i in range(1, n):
+        e[i] = rho * e[i - 1] + w[i]
+    phase = 2.0 * math.pi * np.arange(n) / 600.0           # 600 rows a cycle, as on the bench
+    x = e + 0.5 * np.sin(phase) ** 3                       # a model's smooth leftover error
+    x[rng.choice(n, 12, replace=False)] += rng.choice([-1.0, 1.0], 12) * rng.uniform(3.0, 8.0, 12)
+    data = _record(x, rate_hz)
+    assert noise_lag(data, [x[sl] for _, sl in data.sample_slices()]) > 1
+    assert abs(noise_floor(data, x) / float(np.std(e)) - 1.0) < 0.06, (noise_floor(data, x), np.std(e))
+
+
+def test_white_noise_is_read_from_neighbouring_rows_even_beside_a_large_model_error():
+    """White noise beside a large smooth error (the paper model on a file it misfits by 16x) and spikes: the
+    floor is read from neighbouring rows, as before (the spacing moves only for noise that is correlated)."""
+    rng = np.random.default_rng(3)
+    n = 60000
+    e = rng.normal(0.0, 0.2, n)
+    x = e + 3.0 * np.sin(2.0 * math.pi * np.arange(n) / 600.0) ** 3
+    x[rng.choice(n, 12, replace=False)] += 6.0
+    data = _record(x, 100.0)
+    assert noise_lag(data, [x[sl] for _, sl in data.sample_slices()]) == 1
+    assert abs(noise_floor(data, x) / 0.2 - 1.0) < 0.03

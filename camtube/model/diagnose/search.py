@@ -272,6 +272,9 @@ class Diagnosis:
         The current model, then one step per partial effect (refitted on all rows), as ``waterfall`` would.
     noise_floor_parts_deg : (float, float)
         Statistical and systematic parts of ``noise_floor_se_deg`` (see :func:`noise_floor_parts`).
+    noise_lag_rows : int
+        The row spacing the floor is read at (:func:`noise_lag`; 1: white noise, else noise correlated between
+        neighbouring rows, read from rows this far apart), on the final model's residual.
     replaced : tuple[tuple[tuple[str, ...], str], ...]
         Effects chosen earlier and dropped for a later one that explains what they did: ``((old, ...), new)``.
     chosen_round : dict
@@ -328,6 +331,7 @@ class Diagnosis:
     explanation: str = ""
     instruments: object = None
     held: dict = field(default_factory=dict)
+    noise_lag_rows: int = 1
     cache: Cache = field(default_factory=Cache, init=False, compare=False, repr=False)
 
     @property
@@ -401,6 +405,47 @@ def _floor_estimates(parts: list) -> dict[tuple[str, int], float]:
     return out
 
 
+#: Noise correlated between neighbouring rows (a tracker or a load cell that filters its readings) reads low in
+#: differences of neighbouring rows. The differences are taken between rows ``L`` apart instead (every ``L``-th row,
+#: each phase a run of its own), ``L`` doubled while that raises the 2nd-difference estimate by more than this share
+#: (white noise reads the same at every ``L``; a model's smooth error rises only at much larger ``L``) ...
+NOISE_CORR_RISE = 0.05
+#: ... up to this span (s): the readings' own filters hold for tens of ms; the joint's motion takes seconds.
+NOISE_CORR_MAX_S = 0.2
+
+
+def _every(parts: list, lag: int) -> list:
+    """The runs ``parts`` taken every ``lag``-th row, each phase a run of its own."""
+    return parts if lag <= 1 else [seg[p::lag] for seg in parts for p in range(lag)]
+
+
+def _second_diff_sigma(parts: list) -> float:
+    ds = [np.diff(seg, 2) for seg in parts if seg.size > 6]
+    return _windowed_mad(ds, 2) / math.sqrt(6.0) if ds else math.nan
+
+
+def noise_lag(data: Dataset, parts: list) -> int:
+    """The row spacing ``L`` (1, 2, 4, ...) at which the noise of the residual ``parts`` (one run per sample) reads
+    white: doubled while the 2nd differences' windowed estimate (:func:`_windowed_mad`) at ``2 L`` exceeds that at
+    ``L`` by :data:`NOISE_CORR_RISE`, within :data:`NOISE_CORR_MAX_S`. 1 for white noise."""
+    dts = []
+    for _, sl in data.sample_slices():
+        dt = np.diff(np.asarray(data.time_s[sl], float))
+        dt = dt[dt > 0]
+        if dt.size:
+            dts.append(float(np.median(dt)))
+    if not dts:
+        return 1
+    longest = int(NOISE_CORR_MAX_S / float(np.median(dts)))
+    lag, sig = 1, _second_diff_sigma(parts)
+    while 2 * lag <= longest and math.isfinite(sig) and sig > 0.0:
+        wider = _second_diff_sigma(_every(parts, 2 * lag))
+        if not wider > (1.0 + NOISE_CORR_RISE) * sig:
+            break
+        lag, sig = 2 * lag, wider
+    return lag
+
+
 def _smallest(est: dict, kind: str) -> float:
     """The smallest over the orders of the estimates ``est`` (of :func:`_floor_estimates`) of ``kind``; inf for none."""
     vals = [v for (k, _), v in est.items() if k == kind]
@@ -411,7 +456,8 @@ def noise_levels(data: Dataset, residual_deg: np.ndarray) -> tuple[float, float]
     """``(floor, typical size)`` (deg) of a residual ``(n,)``: :func:`noise_floor` and :func:`noise_typical` from one
     pass over its differences per sample (the standard deviation of the residual where the record is too short)."""
     r = np.asarray(residual_deg, float)
-    est = _floor_estimates([r[sl] for _, sl in data.sample_slices()])
+    parts = [r[sl] for _, sl in data.sample_slices()]
+    est = _floor_estimates(_every(parts, noise_lag(data, parts)))
     out = [_smallest(est, kind) for kind in ("wmad", "mad")]
     return tuple(v if math.isfinite(v) else float(np.std(r)) for v in out)
 
@@ -451,14 +497,16 @@ def noise_floor_parts(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarra
     not known from the data, so their whole range is the systematic uncertainty.
     """
     r = np.asarray(residual_deg, float)
-    est = list(_floor_estimates([r[sl] for _, sl in data.sample_slices()]).values())
+    parts = [r[sl] for _, sl in data.sample_slices()]
+    lag = noise_lag(data, parts)
+    est = list(_floor_estimates(_every(parts, lag)).values())
     systematic = float(max(est) - min(est)) if len(est) > 1 else 0.0
     vals = []
     for b in np.unique(blocks):
         idx = np.flatnonzero(blocks == b)
         # contiguous runs only (a block is contiguous within a sample)
         cut = np.flatnonzero(np.diff(idx) > 1) + 1
-        v = _smallest(_floor_estimates([r[seg] for seg in np.split(idx, cut)]), "wmad")
+        v = _smallest(_floor_estimates(_every([r[seg] for seg in np.split(idx, cut)], lag)), "wmad")
         if math.isfinite(v):
             vals.append(v)
     if len(vals) < 3:
@@ -1659,7 +1707,9 @@ class Search:
                          self.given, tuple(self.baseline_added), self.baseline_gain, tuple(self.dropped), label,
                          held={k: v for k, v in self.held.items() if k.split(".")[0] in set(recommended)
                                or ("@" in k and recommended and k.split(".")[0] in set(self.baseline_added))
-                               or set(BASELINE_STAND_INS.get(k.split(".")[0], ())) & set(recommended)})
+                               or set(BASELINE_STAND_INS.get(k.split(".")[0], ())) & set(recommended)},
+                         noise_lag_rows=noise_lag(self.data, [steps[-1].residuals[sl]
+                                                              for _, sl in self.data.sample_slices()]))
 
 
 def _sample_notes(model: JointModel, r: FitResult, samples: Sequence[str], ps: Sequence[str]) -> list[str]:

@@ -9,6 +9,7 @@ report directory with an index is complete).
 
     {"schema", "noise_floor_deg", "noise_floor_se_deg",
      "noise_floor_se_parts_deg": {"statistical", "systematic"},
+     "noise_lag_rows",                          # 1: white noise; L: correlated, the floor read from rows L apart
      "base": {"effects", "rmse_deg", "heldout_rmse_deg", "per_sample", "params"},   # with the baseline
      "given": {"effects", "rmse_deg", "per_sample"},          # the model as given (before the baseline)
      "baseline": [{"effect", "meaning", "joined_chain", "rmse_before_deg", "rmse_deg", "params"}],  # rest_angle
@@ -185,6 +186,7 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
                     "params": {k: {"value": _num(v), "stderr": _num(final.stderr[k]) if k in final.stderr else None,
                                    "unit": final.units.get(k, "")} for k, v in final.params.items()}}
     out["noise_floor_se_deg"] = _num(d.noise_floor_se_deg)
+    out["noise_lag_rows"] = int(d.noise_lag_rows)
     if len(d.noise_floor_parts_deg) == 2:
         out["noise_floor_se_parts_deg"] = {"statistical": _num(d.noise_floor_parts_deg[0]),
                                            "systematic": _num(d.noise_floor_parts_deg[1])}
@@ -360,7 +362,9 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
     given = d.given or base
     cur = ", ".join(given.effects) or "none"
     parts = d.noise_floor_parts_deg
-    lines.append(f"noise floor (white noise in the residual): {floor:.3f} +- {d.noise_floor_se_deg:.3f} deg"
+    what = ("white noise in the residual" if d.noise_lag_rows <= 1 else
+            f"the noise in the residual, correlated from row to row: read from rows {d.noise_lag_rows} apart")
+    lines.append(f"noise floor ({what}): {floor:.3f} +- {d.noise_floor_se_deg:.3f} deg"
                  + (f" (statistical {parts[0]:.3f}, systematic {parts[1]:.3f})" if len(parts) == 2 else ""))
     lines.append(f"current model (effects: {cur}): RMSE {given.rmse_deg:.3f} deg = "
                  f"{_times(given.rmse_deg, floor)} the noise floor; held-out {d.base_heldout_rmse_deg:.3f} deg")
