@@ -2,7 +2,8 @@
 
 Each file: two samples, 25-100 Hz, about 60,000 rows, 50 cycles with dwells and rests, the first cycle
 dwelling longer, tracker spikes, dropouts (nan), stamp jitter and repeated stamps; one mechanism dominant,
-others present. The file is written as CSV and read back as a user's would be (rows with a missing value
+others present. In the batches of ``ROUGH`` the trackers vary as labs' do: dropouts written as nan, 0 or the
+last reading, bursts of interference over several rows, noise through a filter. The file is written as CSV and read back as a user's would be (rows with a missing value
 dropped and counted), the instruments are checked (spikes set aside, the angle's lag estimated and
 corrected), then ``diagnose`` runs on the rows kept.
 
@@ -102,9 +103,20 @@ def dominant(kind: str, base: SampleBench, rng: np.random.Generator, strength: f
     raise ValueError(kind)
 
 
-def draw_batch(seed: int, kinds: list) -> list:
-    """``[(name, tube, rate_hz, (SampleBench, SampleBench), (kind1, kind2), sim_seed)]`` drawn from ``seed``."""
+def rough_instruments(b: SampleBench, rng: np.random.Generator) -> SampleBench:
+    """``b`` with a tracker as varied as labs' are: its dropouts written as ``nan``, 0 or its last reading; 0-8
+    bursts of interference of 2-8 rows; in half the files its noise through a 10-50 ms first-order filter."""
+    filter_ms = float(rng.uniform(10.0, 50.0)) if rng.random() < 0.5 else 0.0
+    return replace(b, tracker=replace(b.tracker, dropout=str(rng.choice(["nan", "zero", "hold"])),
+                                      n_bursts=int(rng.integers(0, 9)), burst_rows=(2, 8), filter_ms=filter_ms))
+
+
+def draw_batch(seed: int, kinds: list, rough: bool = False) -> list:
+    """``[(name, tube, rate_hz, (SampleBench, SampleBench), (kind1, kind2), sim_seed)]`` drawn from ``seed``;
+    ``rough``: each tracker's artefacts drawn too (:func:`rough_instruments`, from ``seed + 1``: the mechanisms are
+    those of the plain batch)."""
     rng = np.random.default_rng(seed)
+    rng_ins = np.random.default_rng(seed + 1)
     out = []
     for i, kind in enumerate(kinds):
         k1, k2 = kind if isinstance(kind, tuple) else (kind, kind)
@@ -112,6 +124,8 @@ def draw_batch(seed: int, kinds: list) -> list:
         rate = float(rng.choice([25.0, 40.0, 50.0, 100.0]))
         b1 = dominant(k1, _mild(rng), rng)
         b2 = dominant(k2, _mild(rng), rng, strength=float(rng.uniform(0.7, 1.3)))
+        if rough:
+            b1, b2 = rough_instruments(b1, rng_ins), rough_instruments(b2, rng_ins)
         if k1 == "lag" == k2:  # one tracker for both samples
             b2 = replace(b2, tracker=replace(b2.tracker, lag_ms=b1.tracker.lag_ms))
         name = k1 if k1 == k2 else f"{k1} / {k2}"
@@ -170,6 +184,11 @@ HELDOUT13_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost mo
 #: backbone beside lost motion in the drive.
 HELDOUT14_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "creep", "backbone", "backbone3",
                    "zero drift", "lag", ("friction", "slack"), ("backbone", "lost motion"), "friction", "tracker drift"]
+#: The fifteenth fresh held-out batch (issue 19, after bursts, a frozen tracker and noise correlated from row to row):
+#: the usual files and two pairs, every tracker's artefacts drawn as well (dropouts written as nan, 0 or the last
+#: reading, bursts, a filter on its noise).
+HELDOUT15_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
+                   "lag", ("toe", "creep"), ("slack", "lost motion"), "friction", "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -198,7 +217,13 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            # drawn once the changes of the session after bench-heldout12 were settled (every batch above looked at)
            "bench-heldout13": (20270412, HELDOUT13_KINDS),
            # drawn once the changes of the session after bench-heldout13 were settled (every batch above looked at)
-           "bench-heldout14": (20270520, HELDOUT14_KINDS)}
+           "bench-heldout14": (20270520, HELDOUT14_KINDS),
+           # drawn once bursts, a frozen tracker and correlated noise were settled (every batch above looked at),
+           # each tracker's artefacts drawn too (ROUGH); run once
+           "bench-heldout15": (20270621, HELDOUT15_KINDS)}
+#: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
+#: filtered noise.
+ROUGH = {"bench-heldout15"}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
@@ -272,10 +297,15 @@ def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
     return out
 
 
-def run_batch(name: str) -> list:
+def batch_specs(name: str) -> list:
+    """The files of batch ``name`` (:func:`draw_batch`; the batches of :data:`ROUGH` with their trackers' artefacts)."""
     seed, kinds = BATCHES[name]
+    return draw_batch(seed, kinds, rough=name in ROUGH)
+
+
+def run_batch(name: str) -> list:
     with tempfile.TemporaryDirectory() as tmp:
-        res = [run_file(s, Path(tmp)) for s in draw_batch(seed, kinds)]
+        res = [run_file(s, Path(tmp)) for s in batch_specs(name)]
     n_ok = sum(r["ok"] for r in res)
     n_floor = sum(r["floor_ok"] for r in res)
     per_60k = [(r["s_instruments"] + r["s_diagnose"]) * 60_000 / r["rows"] for r in res]
@@ -286,8 +316,7 @@ def run_batch(name: str) -> list:
 
 def write_file(batch: str, kind: str, path: str) -> None:
     """Write the file of ``kind`` (its name in the batch's table) of ``batch`` as CSV, as a lab would have it."""
-    seed, kinds = BATCHES[batch]
-    spec = next(s for s in draw_batch(seed, kinds) if s[0] == kind)
+    spec = next(s for s in batch_specs(batch) if s[0] == kind)
     name, tube, rate, benches, _, sim_seed = spec
     pattern = load_pattern(ROOT / "patterns" / f"{tube}.yaml")
     rec = simulate_bench(pattern, benches, protocol_for(rate), Clock(rate_hz=rate), seed=sim_seed)
