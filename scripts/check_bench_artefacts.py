@@ -1,18 +1,41 @@
-"""Spikes and repeated stamps found by the instruments check against the bench simulator's truth, on both bench
-batches: ``python scripts/check_bench_artefacts.py``."""
+"""The instruments' check against the bench simulator's truth: spikes, bursts, dropouts written as values and
+repeated stamps found, per file: ``python scripts/check_bench_artefacts.py [BATCH ...]`` (default: the first two
+bench batches).
+
+Per file: the spikes found against the true ones (those not in a dropout), the rows of bursts found (as spikes or
+bursts), the dropouts the tracker wrote as 0 or its last reading that were set aside (those while the joint was
+bent and the motor moved: at rest a zero or a held value is no error), the repeated stamps, and any row set aside
+that carries no artefact ("false").
+"""
+import sys
+
+import numpy as np
 from benchutil import ROOT
-import numpy as np, bench_real as B
+
+import bench_real as B
 from camtube.design.loader import load_pattern
-from camtube.model.sim.bench import simulate_bench, Clock
 from camtube.model.diagnose.instruments import check_instruments
-for batch in ("bench", "bench-heldout"):
-    seed, kinds = B.BATCHES[batch]
-    for spec in B.draw_batch(seed, kinds):
-        name, tube, rate, benches, _, s = spec
-        rec = simulate_bench(load_pattern(ROOT / "patterns" / f"{tube}.yaml"), benches, B.protocol_for(rate), Clock(rate_hz=rate), seed=s)
+from camtube.model.sim.bench import Clock, simulate_bench
+
+for batch in sys.argv[1:] or ["bench", "bench-heldout"]:
+    for name, tube, rate, benches, _, s in B.batch_specs(batch):
+        rec = simulate_bench(load_pattern(ROOT / "patterns" / f"{tube}.yaml"), benches, B.protocol_for(rate),
+                             Clock(rate_hz=rate), seed=s)
         ok = np.isfinite(rec.data.angle_deg)
         ins = check_instruments(rec.data.take(ok))
         idx = np.flatnonzero(ok)
-        found = set(idx[ins.aside["angle spike"]]); true = set(rec.spike_rows) - set(rec.dropout_rows)
-        rep = set(idx[ins.aside["repeated time stamp"]])
-        print(batch, name, "spikes found", len(found), "true", len(true), "hits", len(found & true), "false", len(found - true), "repeats", len(rep & set(rec.repeat_rows)), "/", len(rec.repeat_rows), "force spikes", len(ins.aside["force spike"]))
+        aside = {k: set(idx[v]) for k, v in ins.aside.items()}
+        every = set().union(*aside.values())
+        drops = set(rec.dropout_rows.tolist())
+        spikes = set(rec.spike_rows.tolist()) - drops
+        bursts = set(rec.burst_rows.tolist()) - drops
+        stroke = rec.data.stroke_mm
+        bent = {i for i in drops & set(idx.tolist()) if abs(rec.angle_true_deg[i]) > 3.0
+                and 0 < i < len(stroke) - 1 and stroke[i + 1] != stroke[i - 1]}
+        artefact = spikes | bursts | drops | set(rec.repeat_rows.tolist())
+        shifted = aside.get("end of record after the lag shift", set())
+        print(f"{batch} {name}: spikes {len(aside['angle spike'] & spikes)} of {len(spikes)}; burst rows "
+              f"{len(every & bursts)} of {len(bursts)}; dropouts written as values, while bent and moving, "
+              f"{len(every & bent)} of {len(bent)}; repeats {len(aside['repeated time stamp'] & set(rec.repeat_rows))}"
+              f" of {len(rec.repeat_rows)}; force spikes {len(aside['force spike'])}; false "
+              f"{len(every - artefact - shifted)}", flush=True)
