@@ -406,11 +406,15 @@ def _floor_estimates(parts: list) -> dict[tuple[str, int], float]:
 
 
 #: Noise correlated between neighbouring rows (a tracker or a load cell that filters its readings) reads low in
-#: differences of neighbouring rows. The differences are taken between rows ``L`` apart instead (every ``L``-th row,
-#: each phase a run of its own), ``L`` doubled while that raises the 2nd-difference estimate by more than this share
-#: (white noise reads the same at every ``L``; a model's smooth error rises only at much larger ``L``) ...
-NOISE_CORR_RISE = 0.05
-#: ... up to this span (s): the readings' own filters hold for tens of ms; the joint's motion takes seconds.
+#: differences of neighbouring rows. It shows as a rise of the estimate from rows 1 to :data:`NOISE_CORR_PROBE` apart
+#: (every ``L``-th row, each phase a run of its own) by more than this share; white noise reads the same at every
+#: spacing, and a model's smooth error does not reach the highest order's differences at such short spacings ...
+NOISE_CORR_RISE = 0.08
+#: ... (the spacing of that test, in rows) ...
+NOISE_CORR_PROBE = 4
+#: ... and then the floor is read from rows as far apart as this span (s) allows (a power of 2 rows): the readings'
+#: filters hold for tens of ms (beside them the white part of the noise, the load cell's through the model, keeps the
+#: rise from one spacing to the next small), the joint's motion takes seconds.
 NOISE_CORR_MAX_S = 0.2
 
 
@@ -419,15 +423,11 @@ def _every(parts: list, lag: int) -> list:
     return parts if lag <= 1 else [seg[p::lag] for seg in parts for p in range(lag)]
 
 
-def _second_diff_sigma(parts: list) -> float:
-    ds = [np.diff(seg, 2) for seg in parts if seg.size > 6]
-    return _windowed_mad(ds, 2) / math.sqrt(6.0) if ds else math.nan
-
-
 def noise_lag(data: Dataset, parts: list) -> int:
-    """The row spacing ``L`` (1, 2, 4, ...) at which the noise of the residual ``parts`` (one run per sample) reads
-    white: doubled while the 2nd differences' windowed estimate (:func:`_windowed_mad`) at ``2 L`` exceeds that at
-    ``L`` by :data:`NOISE_CORR_RISE`, within :data:`NOISE_CORR_MAX_S`. 1 for white noise."""
+    """The row spacing ``L`` the floor of the residual ``parts`` (one run per sample) is read at: 1 for white noise;
+    for noise correlated from row to row (the estimate of :func:`_floor_estimates`, ``("wmad", k)``, smallest over
+    the orders, rises by :data:`NOISE_CORR_RISE` from 1 to :data:`NOISE_CORR_PROBE` rows apart) the largest power of
+    2 within :data:`NOISE_CORR_MAX_S`."""
     dts = []
     for _, sl in data.sample_slices():
         dt = np.diff(np.asarray(data.time_s[sl], float))
@@ -436,14 +436,16 @@ def noise_lag(data: Dataset, parts: list) -> int:
             dts.append(float(np.median(dt)))
     if not dts:
         return 1
-    longest = int(NOISE_CORR_MAX_S / float(np.median(dts)))
-    lag, sig = 1, _second_diff_sigma(parts)
-    while 2 * lag <= longest and math.isfinite(sig) and sig > 0.0:
-        wider = _second_diff_sigma(_every(parts, 2 * lag))
-        if not wider > (1.0 + NOISE_CORR_RISE) * sig:
-            break
-        lag, sig = 2 * lag, wider
-    return lag
+    widest = 1
+    while 2 * widest * float(np.median(dts)) <= NOISE_CORR_MAX_S:
+        widest *= 2
+    if widest < 2:
+        return 1
+    near = _smallest(_floor_estimates(parts), "wmad")
+    probe = _smallest(_floor_estimates(_every(parts, min(NOISE_CORR_PROBE, widest))), "wmad")
+    if not (math.isfinite(near) and near > 0.0 and probe > (1.0 + NOISE_CORR_RISE) * near):
+        return 1
+    return widest
 
 
 def _smallest(est: dict, kind: str) -> float:
