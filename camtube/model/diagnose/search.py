@@ -414,8 +414,12 @@ NOISE_CORR_RISE = 0.08
 NOISE_CORR_PROBE = 4
 #: ... and then the floor is read from rows as far apart as this span (s) allows (a power of 2 rows): the readings'
 #: filters hold for tens of ms (beside them the white part of the noise, the load cell's through the model, keeps the
-#: rise from one spacing to the next small), the joint's motion takes seconds.
+#: rise from one spacing to the next small), the joint's motion takes seconds ...
 NOISE_CORR_MAX_S = 0.2
+#: ... when there the 2nd-, 3rd- and 4th-difference estimates agree within this share, as they do for noise whose
+#: rows that far apart are independent. A model error that changes within a few rows (a lead screw's periodic error
+#: at a low rate) also rises with the spacing, but reads less in each higher order: it is not noise.
+NOISE_CORR_AGREE = 0.05
 
 
 def _every(parts: list, lag: int) -> list:
@@ -427,7 +431,7 @@ def noise_lag(data: Dataset, parts: list) -> int:
     """The row spacing ``L`` the floor of the residual ``parts`` (one run per sample) is read at: 1 for white noise;
     for noise correlated from row to row (the estimate of :func:`_floor_estimates`, ``("wmad", k)``, smallest over
     the orders, rises by :data:`NOISE_CORR_RISE` from 1 to :data:`NOISE_CORR_PROBE` rows apart) the largest power of
-    2 within :data:`NOISE_CORR_MAX_S`."""
+    2 within :data:`NOISE_CORR_MAX_S`, when the orders agree there (:data:`NOISE_CORR_AGREE`)."""
     dts = []
     for _, sl in data.sample_slices():
         dt = np.diff(np.asarray(data.time_s[sl], float))
@@ -444,6 +448,9 @@ def noise_lag(data: Dataset, parts: list) -> int:
     near = _smallest(_floor_estimates(parts), "wmad")
     probe = _smallest(_floor_estimates(_every(parts, min(NOISE_CORR_PROBE, widest))), "wmad")
     if not (math.isfinite(near) and near > 0.0 and probe > (1.0 + NOISE_CORR_RISE) * near):
+        return 1
+    far = [v for (kind, _), v in _floor_estimates(_every(parts, widest)).items() if kind == "wmad"]
+    if len(far) < 2 or not max(far) <= (1.0 + NOISE_CORR_AGREE) * min(far):
         return 1
     return widest
 
