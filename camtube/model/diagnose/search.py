@@ -427,11 +427,10 @@ def _every(parts: list, lag: int) -> list:
     return parts if lag <= 1 else [seg[p::lag] for seg in parts for p in range(lag)]
 
 
-def noise_lag(data: Dataset, parts: list) -> int:
-    """The row spacing ``L`` the floor of the residual ``parts`` (one run per sample) is read at: 1 for white noise;
-    for noise correlated from row to row (the estimate of :func:`_floor_estimates`, ``("wmad", k)``, smallest over
-    the orders, rises by :data:`NOISE_CORR_RISE` from 1 to :data:`NOISE_CORR_PROBE` rows apart) the largest power of
-    2 within :data:`NOISE_CORR_MAX_S`, when the orders agree there (:data:`NOISE_CORR_AGREE`)."""
+def _spaced_estimates(data: Dataset, parts: list) -> tuple[int, dict]:
+    """``(L, estimates)``: the row spacing :func:`noise_lag` gives and :func:`_floor_estimates` of the residual
+    ``parts`` (one run per sample) at that spacing (those computed to choose it, not again)."""
+    near_est = _floor_estimates(parts)
     dts = []
     for _, sl in data.sample_slices():
         dt = np.diff(np.asarray(data.time_s[sl], float))
@@ -439,20 +438,29 @@ def noise_lag(data: Dataset, parts: list) -> int:
         if dt.size:
             dts.append(float(np.median(dt)))
     if not dts:
-        return 1
+        return 1, near_est
     widest = 1
     while 2 * widest * float(np.median(dts)) <= NOISE_CORR_MAX_S:
         widest *= 2
     if widest < 2:
-        return 1
-    near = _smallest(_floor_estimates(parts), "wmad")
+        return 1, near_est
+    near = _smallest(near_est, "wmad")
     probe = _smallest(_floor_estimates(_every(parts, min(NOISE_CORR_PROBE, widest))), "wmad")
     if not (math.isfinite(near) and near > 0.0 and probe > (1.0 + NOISE_CORR_RISE) * near):
-        return 1
-    far = [v for (kind, _), v in _floor_estimates(_every(parts, widest)).items() if kind == "wmad"]
+        return 1, near_est
+    far_est = _floor_estimates(_every(parts, widest))
+    far = [v for (kind, _), v in far_est.items() if kind == "wmad"]
     if len(far) < 2 or not max(far) <= (1.0 + NOISE_CORR_AGREE) * min(far):
-        return 1
-    return widest
+        return 1, near_est
+    return widest, far_est
+
+
+def noise_lag(data: Dataset, parts: list) -> int:
+    """The row spacing ``L`` the floor of the residual ``parts`` (one run per sample) is read at: 1 for white noise;
+    for noise correlated from row to row (the estimate of :func:`_floor_estimates`, ``("wmad", k)``, smallest over
+    the orders, rises by :data:`NOISE_CORR_RISE` from 1 to :data:`NOISE_CORR_PROBE` rows apart) the largest power of
+    2 within :data:`NOISE_CORR_MAX_S`, when the orders agree there (:data:`NOISE_CORR_AGREE`)."""
+    return _spaced_estimates(data, parts)[0]
 
 
 def _smallest(est: dict, kind: str) -> float:
@@ -465,8 +473,7 @@ def noise_levels(data: Dataset, residual_deg: np.ndarray) -> tuple[float, float]
     """``(floor, typical size)`` (deg) of a residual ``(n,)``: :func:`noise_floor` and :func:`noise_typical` from one
     pass over its differences per sample (the standard deviation of the residual where the record is too short)."""
     r = np.asarray(residual_deg, float)
-    parts = [r[sl] for _, sl in data.sample_slices()]
-    est = _floor_estimates(_every(parts, noise_lag(data, parts)))
+    est = _spaced_estimates(data, [r[sl] for _, sl in data.sample_slices()])[1]
     out = [_smallest(est, kind) for kind in ("wmad", "mad")]
     return tuple(v if math.isfinite(v) else float(np.std(r)) for v in out)
 
@@ -506,9 +513,8 @@ def noise_floor_parts(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarra
     not known from the data, so their whole range is the systematic uncertainty.
     """
     r = np.asarray(residual_deg, float)
-    parts = [r[sl] for _, sl in data.sample_slices()]
-    lag = noise_lag(data, parts)
-    est = list(_floor_estimates(_every(parts, lag)).values())
+    lag, est_at = _spaced_estimates(data, [r[sl] for _, sl in data.sample_slices()])
+    est = list(est_at.values())
     systematic = float(max(est) - min(est)) if len(est) > 1 else 0.0
     vals = []
     for b in np.unique(blocks):
