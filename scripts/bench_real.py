@@ -189,6 +189,12 @@ HELDOUT14_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost mo
 #: reading, bursts, a filter on its noise).
 HELDOUT15_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
                    "lag", ("toe", "creep"), ("slack", "lost motion"), "friction", "tracker drift"]
+#: The sixteenth fresh held-out batch (issue 19, after a stand-in of the baseline's rest angle was credited with its
+#: gain): lost motion three times, beside a relaxing backbone and beside a creeping tendon, the usual files around them,
+#: every tracker's artefacts drawn too.
+HELDOUT16_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "lost motion", "creep",
+                   "backbone", "zero drift", "lag", ("lost motion", "backbone"), ("creep", "lost motion"), "friction",
+                   "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -220,10 +226,13 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            "bench-heldout14": (20270520, HELDOUT14_KINDS),
            # drawn once bursts, a frozen tracker and correlated noise were settled (every batch above looked at),
            # each tracker's artefacts drawn too (ROUGH); run once
-           "bench-heldout15": (20270621, HELDOUT15_KINDS)}
+           "bench-heldout15": (20270621, HELDOUT15_KINDS),
+           # drawn once the credit of a baseline's stand-in was settled (every batch above looked at), each
+           # tracker's artefacts drawn too (ROUGH); run once
+           "bench-heldout16": (20270722, HELDOUT16_KINDS)}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
-ROUGH = {"bench-heldout15"}
+ROUGH = {"bench-heldout15", "bench-heldout16"}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
