@@ -333,6 +333,9 @@ def test_a_carriage_the_baseline_rest_angle_stood_in_for_is_credited_with_it(tub
     assert d.final.rmse_deg <= 1.5 * rec.floor_deg
     if d.explanation == "partial":
         assert "can stand in for the baseline's rest_angle" in d.stop_reason
+    # the answer says where the rest angle's share went
+    from camtube.model.report.diagnosis import diagnosis_text
+    assert f"but {d.recommended[0]} can stand in for it" in diagnosis_text(d)
 
 def _drifting_zero(tube2, drift_N_per_h: float, offset_N: float = 0.0, seed: int = 7):
     """A 12-cycle bench file at 25 Hz whose sample S1's load cell zero drifts (S2's is steady)."""

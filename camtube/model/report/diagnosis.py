@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from camtube.model.diagnose.atlas import describe, residual_atlas
-from camtube.model.diagnose.search import REACH_RATIO, Candidate, Diagnosis
+from camtube.model.diagnose.search import BASELINE_STAND_INS, REACH_RATIO, Candidate, Diagnosis
 from camtube.model.unexplained import report as unexplained_report
 
 
@@ -290,6 +290,12 @@ def answer_lines(d: Diagnosis) -> list[str]:
         out.append(f"answer: add {', then '.join(d.recommended)}{label}")
         out.append(f"  current model: RMSE {steps[0].rmse_deg:.3f} deg ({_times(steps[0].rmse_deg, floor)} the noise "
                    f"floor {floor:.3f} deg)")
+        stands = [(b, e) for b in d.baseline for e in d.recommended if e in BASELINE_STAND_INS.get(b, ())]
+        if stands:
+            b, e = stands[0]
+            out.append(f"  (as given {d.given.rmse_deg:.3f} deg ({_times(d.given.rmse_deg, floor)} the floor): the "
+                       f"baseline's {b} takes it to {steps[0].rmse_deg:.3f}, but {e} can stand in for it, so that "
+                       "share is counted with the steps below)")
         for k, name in enumerate(d.recommended, 1):
             side = SIDES.get(name)
             out.append(f"  {k}. + {name}: {steps[k - 1].rmse_deg:.3f} -> {steps[k].rmse_deg:.3f} deg "
