@@ -232,6 +232,24 @@ class Dataset:
         out.setflags(write=False)
         return self.cache.set("dataset.stroke_speed", out)
 
+    def median_steps_s(self, positive: bool = False) -> tuple[float, ...]:
+        """Each sample's median time step (s), in the order of :meth:`sample_slices` (0.0 for a sample of fewer than
+        two rows, or with no positive step when ``positive``). ``positive``: over the steps above zero only (a
+        record whose repeated stamps are still in it). Computed once per Dataset: the sampling the laws, the noise
+        floor's row spacing and the instruments' windows all read."""
+        key = "dataset.median_steps_pos" if positive else "dataset.median_steps"
+        hit = self.cache.get(key)
+        if hit is None:
+            t = np.asarray(self.time_s, float)
+            steps = []
+            for _, sl in self.sample_slices():
+                dt = np.diff(t[sl])
+                if positive:
+                    dt = dt[dt > 0]
+                steps.append(float(np.median(dt)) if dt.size else 0.0)
+            hit = self.cache.set(key, tuple(steps))
+        return hit
+
     @property
     def force_smoothed_N(self) -> np.ndarray:
         """(n,) float: the measured force, a centred running mean over :data:`FORCE_SMOOTHING_S` per sample (the
@@ -245,9 +263,8 @@ class Dataset:
             return hit
         f = np.asarray(self.force_N, float)
         out = f.copy()
-        for _, sl in self.sample_slices():
-            x, dt = f[sl], np.diff(self.time_s[sl])
-            h = float(np.median(dt)) if dt.size else 0.0
+        for (_, sl), h in zip(self.sample_slices(), self.median_steps_s()):
+            x = f[sl]
             half = int(round(FORCE_SMOOTHING_S / h)) // 2 if h > 0 else 0
             if half == 0:
                 continue

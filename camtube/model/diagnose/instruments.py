@@ -488,9 +488,9 @@ def _lag_design(data: Dataset) -> list:
 
     out = []
     direction = data.direction
-    for _, sl in data.sample_slices():
+    for (_, sl), step in zip(data.sample_slices(), data.median_steps_s()):
         f = data.force_N[sl]
-        dt = float(np.median(np.diff(data.time_s[sl]))) if f.size > 1 else 1.0
+        dt = step if f.size > 1 else 1.0
         k = 2 * int(SMOOTH_S / max(dt, 1e-9) / 2) + 1
         if 1 < k < f.size:  # a centred running mean: less force noise in the regressors, no shift in time
             f = np.convolve(np.pad(f, k // 2, mode="edge"), np.ones(k) / k, "valid")

@@ -431,12 +431,7 @@ def _spaced_estimates(data: Dataset, parts: list) -> tuple[int, dict]:
     """``(L, estimates)``: the row spacing :func:`noise_lag` gives and :func:`_floor_estimates` of the residual
     ``parts`` (one run per sample) at that spacing (those computed to choose it, not again)."""
     near_est = _floor_estimates(parts)
-    dts = []
-    for _, sl in data.sample_slices():
-        dt = np.diff(np.asarray(data.time_s[sl], float))
-        dt = dt[dt > 0]
-        if dt.size:
-            dts.append(float(np.median(dt)))
+    dts = [h for h in data.median_steps_s(positive=True) if h > 0]
     if not dts:
         return 1, near_est
     widest = 1
@@ -690,7 +685,7 @@ def _resolution_scales(data: Dataset) -> tuple[float, float, float]:
     hit = data.cache.get("search.resolution_scales")
     if hit is None:
         t = np.asarray(data.time_s, float)
-        dts = [np.median(np.diff(t[sl])) for _, sl in data.sample_slices() if sl.stop - sl.start > 2]
+        dts = [h for (_, sl), h in zip(data.sample_slices(), data.median_steps_s()) if sl.stop - sl.start > 2]
         dt = float(np.median(dts)) if dts else 0.0
         record = max((float(np.ptp(t[sl])) for _, sl in data.sample_slices()), default=0.0)
         span = float(np.ptp(np.asarray(data.stroke_mm, float))) if len(data) else 0.0

@@ -517,14 +517,12 @@ def _force_windows(data: Dataset) -> list:
     the standard deviation of the noise left on the averaged force (white noise / sqrt(rows))."""
     hit = data.cache.get("builtin.force_windows")
     if hit is None:
-        t = np.asarray(data.time_s, float)
         f = np.asarray(data.force_N, float)
         window_s = TOE_FORCE_WINDOW * _period(data)
         hit = []
-        for _, sl in data.sample_slices():
+        for (_, sl), dt in zip(data.sample_slices(), data.median_steps_s()):
             rows = 1
             if sl.stop - sl.start >= 3:
-                dt = float(np.median(np.diff(t[sl])))
                 rows = int(round(window_s / dt)) if dt > 0 else 1
                 rows = max(rows - (1 - rows % 2), 1)  # odd: centred
             hit.append((sl, rows, white_noise_sd(f[sl]) / math.sqrt(rows)))

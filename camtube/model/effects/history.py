@@ -88,9 +88,8 @@ def _sampling(data: Dataset) -> list:
     if hit is None:
         t = np.asarray(data.time_s, float)
         hit = []
-        for _, sl in data.sample_slices():
+        for (_, sl), h in zip(data.sample_slices(), data.median_steps_s()):
             dt = np.diff(t[sl])
-            h = float(np.median(dt)) if dt.size else 0.0
             uniform = bool(dt.size and h > 0 and np.all(np.abs(dt - h) <= 1e-6 * h + 1e-12))
             hit.append((sl, h, uniform, dt))
         data.cache.set("history.sampling", hit)
