@@ -265,3 +265,24 @@ def test_recently_used_keeps_the_most_recent_and_computes_each_once():
     assert [get(1), get(2), get(1), get(3)] == [10, 20, 10, 30]   # 2, the least recently used, is dropped
     assert list(store) == [1, 3] and calls == [1, 2, 3]
     assert get(2) == 20 and calls == [1, 2, 3, 2]
+
+
+def test_each_samples_median_step_with_and_without_repeated_stamps():
+    """Two samples: A at 0.1 s with two repeated stamps (three zero steps of seven), B at 0.04 s; a one-row sample C.
+    All steps: A's median is 0.1 (four of seven steps), the positive ones the same; with most steps repeated the two
+    differ. Computed once per Dataset."""
+    from camtube.model.data.dataset import Dataset
+
+    t_a = np.array([0.0, 0.1, 0.1, 0.2, 0.3, 0.3, 0.4, 0.4])
+    t_b = np.arange(5) * 0.04
+    t = np.concatenate((t_a, t_b, [7.0]))
+    n = t.size
+    d = Dataset(np.array(["A"] * 8 + ["B"] * 5 + ["C"], dtype=object), np.ones(n, int), t, np.zeros(n), np.zeros(n),
+                np.zeros(n))
+    assert d.median_steps_s() == pytest.approx((0.1, 0.04, 0.0))
+    assert d.median_steps_s(positive=True) == pytest.approx((0.1, 0.04, 0.0))
+    assert d.median_steps_s() is d.median_steps_s()
+    mostly_repeated = Dataset(np.array(["A"] * 6, dtype=object), np.ones(6, int),
+                              np.array([0.0, 0.0, 0.0, 0.1, 0.1, 0.1]), np.zeros(6), np.zeros(6), np.zeros(6))
+    assert mostly_repeated.median_steps_s() == (0.0,)
+    assert mostly_repeated.median_steps_s(positive=True) == pytest.approx((0.1,))
