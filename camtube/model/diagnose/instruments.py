@@ -69,9 +69,13 @@ MIN_FALL = 0.02
 #: A lag the regression resolves but barely improves with (below :data:`MIN_FALL`) is corrected when it lowers the
 #: current model's RMSE by this fraction (:func:`confirm_lag`) ...
 MODEL_LAG_FALL = 0.05
-#: ... and that model is within this many times the angle's white noise without it (a model that misfits more
-#: than that would take a shift of the angle for any missing effect with a history).
+#: ... and that model is within this many times the angle's white noise and the misfit the estimated lag itself
+#: leaves (:func:`lag_misfit_deg`), taken together, without it (a model that misfits more than that would take a
+#: shift of the angle for any missing effect with a history).
 MODEL_LAG_MAX_RATIO = 3.0
+#: Window (s) of the filter that reads the angle's rate for :func:`lag_misfit_deg`: several rows at 25-100 Hz, short
+#: against a ramp.
+LAG_RATE_WINDOW_S = 0.25
 #: A sampling interval this far off the sample's median is a rate change.
 RATE_CHANGE = 0.2
 
@@ -741,6 +745,23 @@ def with_aside(ins: Instruments, predicted_deg: np.ndarray, floor_deg: float) ->
     return rmse, allowed, counted
 
 
+def lag_misfit_deg(data: Dataset, lag_ms: float) -> float:
+    """The misfit (deg, RMS) a lag of ``lag_ms`` leaves in a model that has none: the angle's RMS rate times the lag,
+    the largest over the samples. The rate is the measured angle's first derivative through a quadratic
+    Savitzky-Golay filter over :data:`LAG_RATE_WINDOW_S` (at least 5 rows), so the tracker's noise does not count."""
+    from scipy.signal import savgol_filter
+
+    out = 0.0
+    for (_, sl), h in zip(data.sample_slices(), data.median_steps_s(positive=True)):
+        a = np.asarray(data.angle_deg[sl], float)
+        if h <= 0.0 or a.size < 5:
+            continue
+        w = min(max(5, 2 * int(LAG_RATE_WINDOW_S / h / 2) + 1), a.size - (1 - a.size % 2))
+        rate = savgol_filter(a, w, 2, deriv=1, delta=h)
+        out = max(out, float(np.sqrt(np.mean(rate * rate))) * abs(lag_ms) / 1e3)
+    return out
+
+
 def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Instruments:
     """The instruments' check with a lag the regression resolved but did not correct tested against the current
     model.
@@ -748,7 +769,8 @@ def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Ins
     At a low logging rate a lag of one or two rows lowers the lag regression's residual by less than
     :data:`MIN_FALL` (its force terms absorb part of a delay at constant speed), so it is left uncorrected. When
     the estimate is resolved (beyond three standard errors and a quarter of the sampling interval) and the current
-    model fits within :data:`MODEL_LAG_MAX_RATIO` x the angle's white noise, the model is fitted to the angle read
+    model fits within :data:`MODEL_LAG_MAX_RATIO` x the angle's white noise and the misfit the estimated lag itself
+    leaves (:func:`lag_misfit_deg`), taken together, the model is fitted to the angle read
     the estimate's whole rows later (and one row either side); the best of those is corrected when it lowers the
     RMSE by :data:`MODEL_LAG_FALL`. Otherwise ``ins`` is returned as it is.
     """
@@ -764,7 +786,8 @@ def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Ins
     try:
         r0 = fit(model, ins.data, list(fit_names), fixed)
         noise = min(white_noise_sd(r0.residuals[sl]) for _, sl in ins.data.sample_slices())
-        if not (noise > 0.0 and r0.rmse <= MODEL_LAG_MAX_RATIO * noise):
+        own = lag_misfit_deg(ins.data, lg.lag_ms)
+        if not (noise > 0.0 and r0.rmse <= MODEL_LAG_MAX_RATIO * math.hypot(noise, own)):
             return ins
         k0 = int(round(lg.lag_ms / dt_ms))
         sign = 1 if lg.lag_ms > 0 else -1
