@@ -136,6 +136,7 @@ BASELINE = ("rest_angle",)
 #: the relaxation explains the bent rest the constant rest angle goes to zero, on its bound; a carriage held by its
 #: rail holds the tendon taut and the joint bent while the motor rests at zero).
 BASELINE_STAND_INS = {"rest_angle": ("relaxation", "relaxation2", "carriage_hold", "carriage_gap")}
+
 #: A chain of effects is recommended only when its all-rows RMSE is within this multiple of the noise floor.
 REACH_RATIO = 1.15
 #: A chain above :data:`REACH_RATIO` x the floor is still recommended (labelled a partial explanation) when it
@@ -1506,11 +1507,10 @@ class Search:
             rmse = [w.rmse_deg for w in d_s.waterfall]
             explained = {e: len(sub) * (a * a - b * b) for e, a, b in zip(d_s.recommended, rmse, rmse[1:])}
             # a recommended stand-in of a baseline effect that joined is credited with the baseline's gain too (a
-            # carriage its rail holds bends the joint at rest as a rest angle does: see Search._share_base)
-            stand_in = next((e for e in d_s.recommended
-                             if any(e in BASELINE_STAND_INS.get(b, ()) for b in d_s.baseline)), None)
-            if stand_in is not None:
-                explained[stand_in] += len(sub) * max(d_s.given.rmse_deg ** 2 - rmse[0] ** 2, 0.0)
+            # carriage its rail holds bends the joint at rest as a rest angle does: see baseline_stand_ins)
+            stands = baseline_stand_ins(d_s.baseline, d_s.recommended)
+            if stands:
+                explained[stands[0][1]] += len(sub) * max(d_s.given.rmse_deg ** 2 - rmse[0] ** 2, 0.0)
             base = [b for b in d_s.baseline
                     if not all(n in d_s.held for n in self.registry[b].full_names())]
             return (tuple(d_s.partial), list(d_s.recommended), base,
@@ -1680,22 +1680,6 @@ class Search:
                              f"{fin_ps[smp]:.3f} deg (the shared parameters suit the other samples)")
         return ps_names, notes
 
-    def _stand_ins_of_baseline(self, recommended: Sequence[str]) -> list[tuple[str, str]]:
-        """``(baseline effect, recommended stand-in)`` pairs: a baseline effect that joined, and a recommended effect
-        that can take its place (:data:`BASELINE_STAND_INS`)."""
-        return [(b, e) for b in self.baseline_added for e in recommended if e in BASELINE_STAND_INS.get(b, ())]
-
-    def _share_base(self, recommended: Sequence[str], base_rmse_deg: float) -> float:
-        """The RMSE the explained share is measured from: the waterfall's first step (the model with its baseline),
-        or the model as given when a recommended effect is a stand-in of a baseline effect that joined. There the
-        baseline's gain is the stand-in's own physics as much as the joint's: a carriage its rail holds keeps the
-        joint bent at rest as a rest angle does (a lost-motion file: the rest angle takes 1.63 -> 0.41 deg and leaves
-        the carriage 0.41 -> 0.40), so the baseline's share is counted with the chain's."""
-        return self.given.rmse_deg if self._stand_ins_of_baseline(recommended) else base_rmse_deg
-
-    def _share_why(self, recommended: Sequence[str]) -> str:
-        return "; ".join(f"{e} can stand in for the baseline's {b}" for b, e in self._stand_ins_of_baseline(recommended))
-
     def result(self) -> Diagnosis:
         """The :class:`Diagnosis` of the state (per-sample values tried first)."""
         ch, s = self.chain, self.settings
@@ -1718,14 +1702,17 @@ class Search:
         # complete, partial (recommended), or partial effects that are not recommended (see explanation_label)
         partial: tuple = ()
         partial_steps: tuple = ()
-        base = self._share_base(recommended, steps[0].rmse_deg)
+        # the share is counted from the model as given where a recommended effect stands in for the baseline
+        stands = baseline_stand_ins(self.baseline_added, recommended)
+        base = self.given.rmse_deg if stands else steps[0].rmse_deg
         label = explanation_label(base, steps[-1].rmse_deg, floor) if recommended else ""
         if label == "partial":
+            why = "; ".join(f"{e} can stand in for the baseline's {b}" for b, e in stands)
             stop += (f"; with {', '.join(recommended)} the RMSE is {steps[-1].rmse_deg / floor:.2f} x the noise "
                      f"floor (above {REACH_RATIO:g} x: a partial explanation), but they explain "
                      f"{100 * explained_share(base, steps[-1].rmse_deg, floor):.1f} % of the misfit "
-                     f"above the floor{' (from the model as given: ' + self._share_why(recommended) + ')' if base != steps[0].rmse_deg else ''}, "
-                     "so they are recommended")
+                     f"above the floor{f' (from the model as given: {why})' if stands else ''}, so they are "
+                     "recommended")
         elif recommended and not steps[-1].rmse_deg <= REACH_RATIO * floor:
             partial, partial_steps = tuple(recommended), tuple(steps)
             stop += (f"; with {', '.join(recommended)} the RMSE stays at {steps[-1].rmse_deg / floor:.2f} x the "
@@ -1814,6 +1801,13 @@ def _order_candidates(tried: list, families: Mapping[str, str], floor: float, cu
     return tuple(out)
 
 
+def baseline_stand_ins(baseline: Sequence[str], recommended: Sequence[str]) -> list[tuple[str, str]]:
+    """``(baseline effect, stand-in)`` pairs, in the order recommended: a recommended effect that can take the place
+    of a baseline effect that joined (:data:`BASELINE_STAND_INS`). There the baseline's gain is the stand-in's own
+    physics as much as the joint's: a carriage its rail holds keeps the joint bent at rest as a rest angle does (a
+    lost-motion file: the rest angle takes 1.63 -> 0.41 deg and leaves the carriage 0.41 -> 0.40), so it is counted
+    with the chain's (the explained share of the label; the order of the samples' union)."""
+    return [(b, e) for e in recommended for b in baseline if e in BASELINE_STAND_INS.get(b, ())]
 
 
 def explained_share(base_rmse_deg: float, final_rmse_deg: float, floor_deg: float) -> float:

@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from camtube.model.diagnose.atlas import describe, residual_atlas
-from camtube.model.diagnose.search import BASELINE_STAND_INS, REACH_RATIO, Candidate, Diagnosis
+from camtube.model.diagnose.search import REACH_RATIO, Candidate, Diagnosis, baseline_stand_ins
 from camtube.model.unexplained import report as unexplained_report
 
 
@@ -290,7 +290,7 @@ def answer_lines(d: Diagnosis) -> list[str]:
         out.append(f"answer: add {', then '.join(d.recommended)}{label}")
         out.append(f"  current model: RMSE {steps[0].rmse_deg:.3f} deg ({_times(steps[0].rmse_deg, floor)} the noise "
                    f"floor {floor:.3f} deg)")
-        stands = [(b, e) for b in d.baseline for e in d.recommended if e in BASELINE_STAND_INS.get(b, ())]
+        stands = baseline_stand_ins(d.baseline, d.recommended)
         if stands:
             b, e = stands[0]
             out.append(f"  (as given {d.given.rmse_deg:.3f} deg ({_times(d.given.rmse_deg, floor)} the floor): the "
