@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from typing import Sequence
 
 import numpy as np
 
@@ -368,24 +369,23 @@ def _spikes(x: np.ndarray, slices: list) -> np.ndarray:
     return out
 
 
-def _bursts(x: np.ndarray, t: np.ndarray, slices: list, single: np.ndarray) -> np.ndarray:
+def _bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, single: np.ndarray) -> np.ndarray:
     """Rows of ``x`` (n,) in runs of 2 or more rows that all lie outside the range of the run's neighbours
     (:data:`NEIGHBOURS` rows either side, same sample) on the same side, by more than :data:`SPIKE_Z` noise scales;
-    runs up to :data:`BURST_S` seconds (at most :data:`BURST_ROWS` rows). ``single`` (n,) bool: the spikes of one
+    runs up to :data:`BURST_S` seconds (at most :data:`BURST_ROWS` rows). ``steps_s``: each sample's median positive
+    time step (:meth:`Dataset.median_steps_s`, in the order of ``slices``). ``single`` (n,) bool: the spikes of one
     row, which are not neighbours (a burst beside a spike is still found)."""
     out = np.zeros(x.size, bool)
     h = NEIGHBOURS
-    for _, sl in slices:
+    for (_, sl), step in zip(slices, steps_s):
         v = x[sl]
         n = v.size
         if n < 10 * h:
             continue
         scale = _noise_scale(v)
-        dt = np.diff(t[sl])
-        dt = dt[dt > 0]
-        if scale <= 0.0 or not dt.size:
+        if scale <= 0.0 or not step > 0.0:
             continue
-        longest = int(min(BURST_ROWS, max(2, math.floor(BURST_S / float(np.median(dt))))))
+        longest = int(min(BURST_ROWS, max(2, math.floor(BURST_S / step))))
         # a single spike beside a run stands for its neighbour: the value across it (its own neighbour's)
         w = v.copy()
         for i in np.flatnonzero(single[sl]):
@@ -666,8 +666,9 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     aside["repeated time stamp"] = np.flatnonzero(rep)
     sa = _spikes(data.angle_deg, slices) & ~rep
     sf = _spikes(data.force_N, slices) & ~rep & ~sa
-    ba = _bursts(data.angle_deg, data.time_s, slices, sa) & ~rep & ~sa & ~sf
-    bf = _bursts(data.force_N, data.time_s, slices, sf) & ~rep & ~sa & ~sf & ~ba
+    steps = data.median_steps_s(positive=True)
+    ba = _bursts(data.angle_deg, steps, slices, sa) & ~rep & ~sa & ~sf
+    bf = _bursts(data.force_N, steps, slices, sf) & ~rep & ~sa & ~sf & ~ba
     fz = _frozen(data.angle_deg, data.stroke_mm, slices) & ~rep & ~sa & ~sf & ~ba & ~bf
     aside["angle spike"] = np.flatnonzero(sa)
     aside["force spike"] = np.flatnonzero(sf)
