@@ -4,8 +4,9 @@ bench batches).
 
 Per file: the spikes found against the true ones (those not in a dropout), the rows of bursts found (as spikes or
 bursts), the dropouts the tracker wrote as 0 or its last reading that were set aside (those while the joint was
-bent and the motor moved: at rest a zero or a held value is no error), the repeated stamps, and any row set aside
-that carries no artefact ("false").
+bent and the motor moved, and those written as 0 while it stood bent in a dwell: at rest a zero or a held value is
+no error, nor is a held value in a dwell), the repeated stamps, and any row set aside that carries no artefact
+("false").
 """
 import sys
 
@@ -32,10 +33,12 @@ for batch in sys.argv[1:] or ["bench", "bench-heldout"]:
         stroke = rec.data.stroke_mm
         bent = {i for i in drops & set(idx.tolist()) if abs(rec.angle_true_deg[i]) > 3.0
                 and 0 < i < len(stroke) - 1 and stroke[i + 1] != stroke[i - 1]}
+        dwell = {i for i in drops & set(idx.tolist()) if abs(rec.angle_true_deg[i]) > 3.0 and i not in bent
+                 and rec.data.angle_deg[i] == 0.0}
         artefact = spikes | bursts | drops | set(rec.repeat_rows.tolist())
         shifted = aside.get("end of record after the lag shift", set())
         print(f"{batch} {name}: spikes {len(aside['angle spike'] & spikes)} of {len(spikes)}; burst rows "
               f"{len(every & bursts)} of {len(bursts)}; dropouts written as values, while bent and moving, "
-              f"{len(every & bent)} of {len(bent)}; repeats {len(aside['repeated time stamp'] & set(rec.repeat_rows))}"
+              f"{len(every & bent)} of {len(bent)}, written as 0 in a dwell {len(every & dwell)} of {len(dwell)}; repeats {len(aside['repeated time stamp'] & set(rec.repeat_rows))}"
               f" of {len(rec.repeat_rows)}; force spikes {len(aside['force spike'])}; false "
               f"{len(every - artefact - shifted)}", flush=True)

@@ -560,6 +560,32 @@ def test_a_frozen_tracker_is_set_aside_while_the_stroke_moves_and_kept_at_rest(t
     assert set(ins.aside["frozen angle row"]) == {int(i) for r in runs for i in r[1:]}
 
 
+def test_a_tracker_writing_zeros_through_a_dwell_is_set_aside_longer_than_a_burst(tube2):
+    # at 25 Hz a burst is at most 12 rows (0.5 s); a tracker that loses the sensor for 16 rows while the joint
+    # stands bent at the top of a stroke writes 0 where the stroke rests, so neither the burst nor the freeze while
+    # the stroke moves saw it (bench-heldout16's lag file: 13 rows of 0 at 32 deg doubled the RMSE). A value held
+    # in a dwell (no jump to it) and a quantised reading repeating at rest stay
+    rec = simulate_bench(tube2, SampleBench(tracker=QUIET), SHORT, Clock(rate_hz=25.0, n_repeats=0), seed=13)
+    d = rec.data
+    still = np.concatenate(([False], np.diff(d.stroke_mm) == 0.0))
+    top = still & (np.abs(rec.angle_true_deg) > 8.0) & (d.sample == "S1")
+    runs = np.flatnonzero(np.convolve(top, np.ones(20), "valid") == 20)
+    assert runs.size
+    zero = np.arange(runs[0] + 2, runs[0] + 18)                       # 16 rows of 0 inside one dwell
+    held_at = runs[runs > zero[-1] + 40]
+    held = np.arange(held_at[0] + 2, held_at[0] + 12)                 # 10 rows holding the dwell's last reading
+    rest = np.flatnonzero((d.stroke_mm == 0.0) & (d.sample == "S1"))[100:110]
+    angle = d.angle_deg.copy()
+    angle[zero] = 0.0
+    angle[held] = angle[held[0] - 1]
+    angle[rest] = np.round(angle[rest[0]], 1)
+    ins = check_instruments(d.with_angle(angle))
+    aside = {int(i) for v in ins.aside.values() for i in v}
+    assert set(zero) <= aside
+    assert not (set(held) | set(rest)) & aside
+    assert set(ins.aside["frozen angle row"]) == set(zero)
+
+
 @pytest.mark.parametrize("dropout", ["zero", "hold"])
 def test_the_simulators_bursts_and_dropouts_written_as_values_are_set_aside_and_nothing_else(tube2, dropout):
     # the bench simulator's tracker with bursts of interference and dropouts written as 0 or as its last reading
