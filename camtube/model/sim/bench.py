@@ -65,11 +65,14 @@ class Drive:
 
 @dataclass(frozen=True)
 class LoadCell:
-    """Load cell on the carriage: ``zero(t) = drift_N_per_h t / 3600 + random walk``; noise ``noise_N``."""
+    """Load cell on the carriage: ``zero(t) = drift_N_per_h t / 3600 + random walk``; noise ``noise_N``;
+    ``range_N``: the largest reading its amplifier gives (the reading is clipped there: a cell too small for the
+    tension); ``inf``: none reached."""
 
     noise_N: float = 0.005
     drift_N_per_h: float = 0.0
     walk_N_per_sqrt_h: float = 0.0
+    range_N: float = math.inf
 
 
 @dataclass(frozen=True)
@@ -418,7 +421,7 @@ def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | 
         k_bu = []
         for _ in range(tr.n_bursts):   # (no draws without bursts: the records drawn before are unchanged)
             a0 = int(rng.integers(20, n - 40))
-            rows = np.arange(a0, a0 + int(rng.integers(tr.burst_rows[0], tr.burst_rows[1] + 1)))
+            rows = np.arange(a0, min(a0 + int(rng.integers(tr.burst_rows[0], tr.burst_rows[1] + 1)), n))
             angle[rows] += float(rng.choice([-1.0, 1.0])) * float(rng.uniform(*tr.spike_deg))
             k_bu.extend(rows.tolist())
         k_bu = np.unique(np.array(k_bu, int))
@@ -434,7 +437,7 @@ def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | 
         zero = lc.drift_N_per_h * t_true / 3600.0
         if lc.walk_N_per_sqrt_h > 0:
             zero = zero + np.cumsum(rng.normal(0.0, lc.walk_N_per_sqrt_h * math.sqrt(1.0 / clock.rate_hz / 3600.0), n))
-        force = cell + zero + rng.normal(0.0, lc.noise_N, n)
+        force = np.minimum(cell + zero + rng.normal(0.0, lc.noise_N, n), lc.range_N)
         comp = pattern.tendon.length_mm / (pattern.tendon.modulus_gpa * 1e3 * b.tendon.modulus_scale
                                             * math.pi * pattern.tendon.radius_mm ** 2)
         floors.append(math.hypot(tr.noise_deg, math.degrees(comp / arm) * lc.noise_N))
