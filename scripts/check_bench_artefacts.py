@@ -36,7 +36,7 @@ for batch in sys.argv[1:] or ["bench", "bench-heldout"]:
         dwell = {i for i in drops & set(idx.tolist()) if abs(rec.angle_true_deg[i]) > 3.0 and i not in bent
                  and rec.data.angle_deg[i] == 0.0}
         artefact = spikes | bursts | drops | set(rec.repeat_rows.tolist())
-        shifted = aside.get("end of record after the lag shift", set())
+        shifted = aside.get("end of record after the lag shift", set()) | aside.get("row before a gap after the lag shift", set())
         print(f"{batch} {name}: spikes {len(aside['angle spike'] & spikes)} of {len(spikes)}; burst rows "
               f"{len(every & bursts)} of {len(bursts)}; dropouts written as values, while bent and moving, "
               f"{len(every & bent)} of {len(bent)}, written as 0 in a dwell {len(every & dwell)} of {len(dwell)}; repeats {len(aside['repeated time stamp'] & set(rec.repeat_rows))}"

@@ -12,12 +12,20 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
   run of 2 to :data:`BURST_S` seconds of rows (at most :data:`BURST_ROWS`) that all lie on one side of the range
   of the two rows either side of the run, by more than :data:`SPIKE_Z` noise scales. A reversal of the motion
   puts the run's first and last rows within a row's change of the rows beside them, so it does not qualify.
+  Interference lasting longer, up to :data:`LONG_BURST_S`, displaces the angle through a ramp, where the range
+  test does not see it: a jump (a row-to-row change off the changes either side of it, by more than
+  :data:`SPIKE_Z` noise scales) and the next jump, back by the same amount, set aside the rows between.
 * **A frozen tracker**: :data:`FROZEN_REPEATS` or more rows in a row repeating the angle before them exactly while
   the stroke moves (more than :data:`FROZEN_STROKE` of the sample's stroke range across the run): the tracker
   held its last value; the repeats are set aside, the first value kept unless the angle jumped to it (a tracker
   that writes 0 while it has lost the sensor). A run the angle jumped to *and* jumped away from is set aside
   whole while the stroke rests too: a tracker writing 0 through a dwell at the top, where the joint stands bent
   (longer than a burst: 13 rows of 0 at 32 deg in one file of ``bench-heldout16`` doubled its RMSE).
+* **A load cell at the end of its range**: the force repeating its sample's largest reading exactly, in a run of
+  :data:`FROZEN_REPEATS` or more rows across which the stroke moves (by more than :data:`FROZEN_STROKE` of its
+  range): the cell (or its amplifier) saturated, and the force it read is no longer the tension. Every row at that
+  reading is set aside and the level is stated. A force quantised by the logger repeats its top value only where
+  the stroke rests (a dwell), so it does not qualify.
 * **Repeated time stamps**: a row whose stamp equals the previous row's (the logger wrote one instant
   twice) is set aside. Rows whose stamp goes backwards, and rows with a missing value, are dropped when
   the file is read (:func:`camtube.model.data.read_measurements`), and counted there.
@@ -36,7 +44,10 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
   a delay). The step also absorbs what a delay does at constant speed, so the lag is resolved by the parts
   of the record where the speed changes (ramps that start and stop smoothly, reversals, dwells); on a
   constant-speed triangle it is usually not resolved and not corrected. The lag minimising the residual
-  is refined by a parabola through the best three shifts. Its standard error is the spread of the same
+  is refined by a parabola through the best three shifts. A shift is of time, not of rows: a row whose trial
+  shifts reach across rows set aside (a load cell at its limit sets aside a chunk of every cycle) is left out, the
+  same rows for every shift; once corrected, a row whose angle a lag later was set aside is set aside too. Its
+  standard error is the spread of the same
   estimate over blocks of
   cycles (``sd / sqrt(blocks)``). It is a property of the instruments: it is corrected (the angle read
   ``lag`` later) when it exceeds three standard errors and a quarter of the sampling interval, is a minimum inside
@@ -63,6 +74,13 @@ NEIGHBOURS = 2
 BURST_S = 0.5
 #: ... and in rows.
 BURST_ROWS = 50
+#: The longest interference set aside as displaced together (s) when it is longer than a burst (:data:`BURST_S`):
+#: a jump and a jump back by the same amount, within this time ...
+LONG_BURST_S = 3.0
+#: ... the jump back equal to the jump within this share of it ...
+STEP_MATCH = 0.25
+#: ... each jump read against the medians of this many row-to-row changes either side.
+STEP_SIDE = 3
 #: Repeats of the angle before them, in a row, that make a frozen tracker ...
 FROZEN_REPEATS = 4
 #: ... while the stroke moves by this share of the sample's stroke range across them.
@@ -277,7 +295,8 @@ class Instruments:
         The rows as read.
     aside : dict[str, (k,) int]
         Rows of ``raw`` set aside, by reason (``"angle spike"``, ``"force spike"``, ``"repeated time stamp"``; and
-        where found ``"angle burst row"``, ``"force burst row"``, ``"frozen angle row"``).
+        where found ``"angle burst row"``, ``"force burst row"``, ``"frozen angle row"``, ``"load cell limit
+        row"``).
     kept : (n_raw,) bool
         Rows of ``raw`` kept in ``data``.
     rates_hz : dict[str, float]
@@ -288,6 +307,11 @@ class Instruments:
     dropped : str
         The reader's line on rows dropped (missing values, backward stamps), or ``""``.
     n_dropped : int
+    zeros : dict
+        Each sample's load-cell zero read at the rests (:func:`read_zero`).
+    rezero : bool
+    limits : dict[str, (float, int)]
+        Each sample whose load cell read the end of its range: ``(reading N, rows)`` (:func:`_saturated`).
     """
 
     data: Dataset
@@ -301,6 +325,7 @@ class Instruments:
     n_dropped: int = 0
     zeros: dict = field(default_factory=dict)
     rezero: bool = True
+    limits: dict = field(default_factory=dict)
 
     @property
     def rezeroed(self) -> bool:
@@ -322,6 +347,11 @@ class Instruments:
             out.append(f"set aside before fitting: {self.n_aside} of {n_raw} rows ({', '.join(parts)})")
         else:
             out.append(f"set aside before fitting: none of {n_raw} rows (no spikes, no repeated time stamps)")
+        if self.limits:
+            out.append("load cell at the end of its range: " + ", ".join(
+                f"{smp} reads {v:.4g} N in {k} rows while the stroke goes on" for smp, (v, k) in self.limits.items())
+                + ": those rows are set aside (the force there is not the tension); a cell of larger range, or a "
+                  "smaller stroke, measures them")
         out.append("sampling: " + ", ".join(f"{s} {r:.4g} Hz" for s, r in self.rates_hz.items()))
         out.extend(self.rate_changes)
         out.extend(zero_lines(self.zeros, self.rezero))
@@ -418,6 +448,61 @@ def _bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, single: np.nd
     return out
 
 
+def _steps(w: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]:
+    """Rows where ``w`` (m,) jumps: ``(rows, size)``, row ``k`` the first after a change ``w[k] - w[k - 1]`` that is
+    off the changes before it *and* those after it (the medians of :data:`STEP_SIDE` either side) by more than
+    :data:`SPIKE_Z` noise scales, on the same side of both. A kink of the motion (a ramp that starts or stops) keeps
+    its change beside those of one side, so it is not a jump."""
+    d = np.diff(w)
+    h = STEP_SIDE
+    if d.size < 2 * h + 1:
+        return np.zeros(0, int), np.zeros(0)
+    win = np.lib.stride_tricks.sliding_window_view(d, h)
+    before = np.full(d.size, np.nan)
+    after = np.full(d.size, np.nan)
+    before[h:] = np.median(win[:-1], axis=1)
+    after[:-h] = np.median(win[1:], axis=1)
+    a, b = d - before, d - after
+    hit = (np.abs(a) > SPIKE_Z * scale) & (np.abs(b) > SPIKE_Z * scale) & (np.sign(a) == np.sign(b))
+    k = np.flatnonzero(hit)
+    return k + 1, 0.5 * (a[k] + b[k])
+
+
+def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: np.ndarray) -> np.ndarray:
+    """Rows of ``x`` (n,) displaced together for longer than a burst, up to :data:`LONG_BURST_S`: a jump
+    (:func:`_steps`) and, within that time, the next jump, back by the same amount (within
+    :data:`STEP_MATCH` of it). ``known`` (n,) bool: rows already set aside, read across (the line between their
+    neighbours). Interference that lasts a second displaces the angle through a ramp, so the range test of
+    :func:`_bursts` does not see it; the jumps into it and out of it stand out at any speed of the motion."""
+    out = np.zeros(x.size, bool)
+    for (_, sl), step in zip(slices, steps_s):
+        v = x[sl]
+        n = v.size
+        if n < 10 * NEIGHBOURS or not step > 0.0:
+            continue
+        scale = _noise_scale(v)
+        if scale <= 0.0:
+            continue
+        good = ~known[sl]
+        if good.sum() < 10 * NEIGHBOURS:
+            continue
+        idx = np.flatnonzero(good)
+        w = np.interp(np.arange(n), idx, v[idx])
+        rows, size = _steps(w, scale)
+        longest = int(LONG_BURST_S / step)
+        i = 0
+        while i < rows.size - 1:
+            j = i + 1
+            if (rows[j] - rows[i] <= longest and np.sign(size[j]) == -np.sign(size[i])
+                    and abs(size[i] + size[j]) <= STEP_MATCH * abs(size[i])):
+                out[sl.start + rows[i]:sl.start + rows[j]] = True
+                i += 2
+            else:
+                i += 1
+        # (a single jump is not set aside: one near the record's end was the joint's own, in two files of 187)
+    return out & ~known
+
+
 def _frozen(angle: np.ndarray, stroke: np.ndarray, slices: list) -> np.ndarray:
     """Rows repeating the angle before them exactly, in runs of :data:`FROZEN_REPEATS` or more, across which the
     stroke moves by more than :data:`FROZEN_STROKE` of the sample's stroke range (a tracker holding its last
@@ -443,6 +528,28 @@ def _frozen(angle: np.ndarray, stroke: np.ndarray, slices: list) -> np.ndarray:
             if abs(float(s[e - 1]) - float(s[b - 1])) > FROZEN_STROKE * span or (jumped and left):
                 out[sl.start + b - int(jumped):sl.start + e] = True
     return out
+
+
+def _saturated(force: np.ndarray, stroke: np.ndarray, slices: list) -> tuple[np.ndarray, dict]:
+    """Rows of a load cell at the end of its range: ``(mask (n,), {sample: (reading N, rows)})``. In each sample,
+    every row at the sample's largest force reading, when that reading repeats exactly in a run of
+    :data:`FROZEN_REPEATS` or more rows across which the stroke moves by more than :data:`FROZEN_STROKE` of its
+    range within the run (the tension rose on, and fell back, while the cell read its limit)."""
+    out = np.zeros(force.size, bool)
+    levels = {}
+    for smp, sl in slices:
+        f, s = force[sl], stroke[sl]
+        if f.size < 3 or not np.isfinite(f).all():
+            continue
+        top = float(f.max())
+        at = f == top
+        edges = np.diff(np.concatenate(([0], at.astype(np.int8), [0])))
+        span = float(np.ptp(s))
+        if any(e - b >= FROZEN_REPEATS and float(np.ptp(s[b:e])) > FROZEN_STROKE * span
+               for b, e in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1))):
+            out[sl] = at
+            levels[str(smp)] = (top, int(at.sum()))
+    return out, levels
 
 
 def _rates(data: Dataset) -> tuple[dict, tuple]:
@@ -592,6 +699,13 @@ def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_
     max_shift = max(3, int(round(max_lag_ms * 1e-3 / dt)))
     step = max(1, n // max_rows)
     rows = np.arange(0, n, step)
+    # rows whose every trial shift is that many rows of time later: none across rows set aside (a spike, a burst, a
+    # load cell at its limit), the same rows for every shift (a sum of squares over fewer rows is smaller)
+    t = data.time_s
+    for (_, sl), h in zip(data.sample_slices(), data.median_steps_s(positive=True)):
+        r = rows[(rows - max_shift >= sl.start) & (rows + max_shift < sl.stop)]
+        gap = np.abs(t[r + max_shift] - t[r - max_shift] - 2 * max_shift * h) >= 0.5 * h
+        rows = np.setdiff1d(rows, r[gap], assume_unique=True)
     design = _lag_design(data)
     est, interior, fall = _lag_scan(data, design, rows, -max_shift, max_shift)
     near = int(round(est))
@@ -609,6 +723,13 @@ def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_
     if not interior:  # no minimum inside the range tried: not a delay the data resolve
         se = float("inf")
     return Lag(est * dt * 1e3, se * dt * 1e3, fall=fall)
+
+
+def _shift_rows(data: Dataset, sl: slice, lag_ms: float) -> int:
+    """The whole rows of sample ``sl`` nearest ``lag_ms`` (its median sampling interval)."""
+    t = data.time_s[sl]
+    dt = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+    return int(round(lag_ms * 1e-3 / dt)) if dt > 0 else 0
 
 
 def shift_angle(data: Dataset, lag_ms: float) -> tuple[Dataset, np.ndarray, float]:
@@ -632,14 +753,16 @@ def shift_angle(data: Dataset, lag_ms: float) -> tuple[Dataset, np.ndarray, floa
     for _, sl in data.sample_slices():
         t = data.time_s[sl]
         dt = float(np.median(np.diff(t))) if t.size > 1 else 0.0
-        k = int(round(lag_ms * 1e-3 / dt)) if dt > 0 else 0
+        k = _shift_rows(data, sl, lag_ms)
         applied.append(k * dt * 1e3)
         if k == 0:
             continue
         idx = np.arange(sl.start, sl.stop)
         src = np.clip(idx + k, sl.start, sl.stop - 1)
         ang[idx] = data.angle_deg[src]
-        keep[idx] = (idx + k >= sl.start) & (idx + k < sl.stop)
+        # the angle k rows later must be k rows of time later: not past the record, nor across rows set aside
+        keep[idx] = ((idx + k >= sl.start) & (idx + k < sl.stop)
+                     & (np.abs(data.time_s[src] - t - k * dt) < 0.5 * dt))
     return data.with_angle(ang).take(keep), keep, float(np.mean(applied))
 
 
@@ -673,17 +796,24 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
         rep[sl.start + 1:sl.stop] = np.diff(t) <= 0.0
     aside["repeated time stamp"] = np.flatnonzero(rep)
     sa = _spikes(data.angle_deg, slices) & ~rep
-    sf = _spikes(data.force_N, slices) & ~rep & ~sa
+    sat, limits = _saturated(data.force_N, data.stroke_mm, slices)
+    sat &= ~rep
+    sf = _spikes(data.force_N, slices) & ~rep & ~sa & ~sat
     steps = data.median_steps_s(positive=True)
     ba = _bursts(data.angle_deg, steps, slices, sa) & ~rep & ~sa & ~sf
     bf = _bursts(data.force_N, steps, slices, sf) & ~rep & ~sa & ~sf & ~ba
-    fz = _frozen(data.angle_deg, data.stroke_mm, slices) & ~rep & ~sa & ~sf & ~ba & ~bf
+    fz = _frozen(data.angle_deg, data.stroke_mm, slices) & ~rep & ~sa & ~sf & ~ba & ~bf & ~sat
+    # (read across the angle's own artefacts only: where the force was set aside the angle is still read)
+    ba |= _long_bursts(data.angle_deg, steps, slices, rep | sa | ba | fz) & ~(sf | bf | sat)
+    ba &= ~sat
+    bf &= ~sat
     aside["angle spike"] = np.flatnonzero(sa)
     aside["force spike"] = np.flatnonzero(sf)
-    for why, rows in (("angle burst row", ba), ("force burst row", bf), ("frozen angle row", fz)):
+    for why, rows in (("angle burst row", ba), ("force burst row", bf), ("frozen angle row", fz),
+                      ("load cell limit row", sat)):
         if rows.any():   # (the findings name only the kinds found)
             aside[why] = np.flatnonzero(rows)
-    kept = ~(rep | sa | sf | fz | ba | bf)
+    kept = ~(rep | sa | sf | fz | ba | bf | sat)
     clean = data.take(kept)
     rates, notes = _rates(clean)
     zeros = read_zero(clean)
@@ -703,8 +833,17 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     idx = np.flatnonzero(kept)
     kept[idx[~k2]] = False
     if (~k2).any():
-        aside["end of record after the lag shift"] = idx[~k2]
-    return Instruments(shifted, data, aside, kept, rates, notes, lag, dropped, n_dropped, zeros, rezero)
+        # a row whose angle a lag later is past the record's end, or across rows set aside (no reading there)
+        ends = np.zeros(idx.size, bool)
+        for _, sl in clean.sample_slices():
+            k = _shift_rows(clean, sl, lag.applied_ms)
+            rows = np.arange(sl.start, sl.stop)
+            ends[sl] = (rows + k < sl.start) | (rows + k >= sl.stop)
+        if (~k2 & ends).any():
+            aside["end of record after the lag shift"] = idx[~k2 & ends]
+        if (~k2 & ~ends).any():
+            aside["row before a gap after the lag shift"] = idx[~k2 & ~ends]
+    return Instruments(shifted, data, aside, kept, rates, notes, lag, dropped, n_dropped, zeros, rezero, limits)
 
 
 @np.errstate(over="ignore", invalid="ignore")  # an absurd value (angle 1e300) overflows: inf, and no warning
@@ -816,4 +955,4 @@ def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Ins
                             rezero=ins.rezero)
     return Instruments(new.data, new.raw, new.aside, new.kept, new.rates_hz, new.rate_changes,
                        Lag(lg.lag_ms, lg.se_ms, False, new.lag.applied_ms, lg.fall, (r0.rmse, best[0])),
-                       new.dropped, new.n_dropped, new.zeros, new.rezero)
+                       new.dropped, new.n_dropped, new.zeros, new.rezero, new.limits)

@@ -177,7 +177,8 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
             "load_cell_zero": {smp: {"rests": z.n_rests, "start_N": _num(z.start_N), "end_N": _num(z.end_N),
                                      "change_N": _num(z.change_N), "change_se_N": _num(z.se_N),
                                      "scatter_N": _num(z.scatter_N), "rezeroed": bool(z.applied)}
-                               for smp, z in ins.zeros.items()}}
+                               for smp, z in ins.zeros.items()},
+            "load_cell_limit_N": {smp: {"reading_N": _num(v), "rows": int(k)} for smp, (v, k) in ins.limits.items()}}
     out["replaced"] = [{"effects": list(old), "by": new} for old, new in d.replaced]
     out["dropped"] = list(d.dropped)
     out["waterfall"] = [{"effects": list(s.effects), "rmse_deg": _num(s.rmse_deg),
@@ -516,7 +517,8 @@ def artefacts_png(d: Diagnosis, max_samples: int = 4) -> bytes | None:
     axes = np.atleast_1d(fig.subplots(len(sl), 1, squeeze=False)[:, 0])
     marks = {"angle spike": ("x", "tab:red"), "force spike": ("+", "tab:purple"),
              "repeated time stamp": ("|", "tab:orange"), "angle burst row": ("x", "tab:brown"),
-             "force burst row": ("+", "tab:pink"), "frozen angle row": ("s", "tab:cyan")}
+             "force burst row": ("+", "tab:pink"), "frozen angle row": ("s", "tab:cyan"),
+             "load cell limit row": (".", "tab:olive")}
     for ax, (smp, s) in zip(axes, sl):
         t = raw.time_s[s]
         ax.plot(t, raw.angle_deg[s], "-", lw=0.4, color="0.55", label="angle as read", rasterized=True)
