@@ -111,10 +111,26 @@ def rough_instruments(b: SampleBench, rng: np.random.Generator) -> SampleBench:
                                       n_bursts=int(rng.integers(0, 9)), burst_rows=(2, 8), filter_ms=filter_ms))
 
 
-def draw_batch(seed: int, kinds: list, rough: bool = False) -> list:
+#: The peak tension (N) the bench's tubes reach at the largest stroke (the 99.9th percentile of the force in the
+#: controls of bench-heldout15 and bench-heldout16): the scale of a load cell's range in :func:`rougher_instruments`.
+PEAK_TENSION_N = {"tube1": 3.05, "tube2": 3.85}
+
+
+def rougher_instruments(b: SampleBench, rng: np.random.Generator, tube: str, rate_hz: float) -> SampleBench:
+    """:func:`rough_instruments`, with interference lasting 2 rows to 2 s, and in a third of the samples a load
+    cell whose range ends at 75-95 % of the peak tension (it reads its limit while the tension goes on)."""
+    b = rough_instruments(b, rng)
+    b = replace(b, tracker=replace(b.tracker, burst_rows=(2, max(8, int(2.0 * rate_hz)))))
+    if rng.random() < 1.0 / 3.0:
+        b = replace(b, load_cell=replace(b.load_cell, range_N=float(rng.uniform(0.75, 0.95)) * PEAK_TENSION_N[tube]))
+    return b
+
+
+def draw_batch(seed: int, kinds: list, rough: bool = False, rougher: bool = False) -> list:
     """``[(name, tube, rate_hz, (SampleBench, SampleBench), (kind1, kind2), sim_seed)]`` drawn from ``seed``;
     ``rough``: each tracker's artefacts drawn too (:func:`rough_instruments`, from ``seed + 1``: the mechanisms are
-    those of the plain batch)."""
+    those of the plain batch); ``rougher``: those and longer interference, a load cell's range
+    (:func:`rougher_instruments`)."""
     rng = np.random.default_rng(seed)
     rng_ins = np.random.default_rng(seed + 1)
     out = []
@@ -124,7 +140,9 @@ def draw_batch(seed: int, kinds: list, rough: bool = False) -> list:
         rate = float(rng.choice([25.0, 40.0, 50.0, 100.0]))
         b1 = dominant(k1, _mild(rng), rng)
         b2 = dominant(k2, _mild(rng), rng, strength=float(rng.uniform(0.7, 1.3)))
-        if rough:
+        if rougher:
+            b1, b2 = rougher_instruments(b1, rng_ins, tube, rate), rougher_instruments(b2, rng_ins, tube, rate)
+        elif rough:
             b1, b2 = rough_instruments(b1, rng_ins), rough_instruments(b2, rng_ins)
         if k1 == "lag" == k2:  # one tracker for both samples
             b2 = replace(b2, tracker=replace(b2.tracker, lag_ms=b1.tracker.lag_ms))
@@ -195,6 +213,11 @@ HELDOUT15_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 HELDOUT16_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "lost motion", "creep",
                    "backbone", "zero drift", "lag", ("lost motion", "backbone"), ("creep", "lost motion"), "friction",
                    "tracker drift"]
+#: The seventeenth fresh held-out batch (issue 19, after a tracker's zeros through a dwell, interference lasting
+#: seconds and a load cell at the end of its range were set aside): the usual files and two pairs, with the
+#: instruments of :func:`rougher_instruments`.
+HELDOUT17_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "creep", "backbone",
+                   "zero drift", "lag", ("toe", "slack"), ("backbone", "creep"), "friction", "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -229,10 +252,16 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            "bench-heldout15": (20270621, HELDOUT15_KINDS),
            # drawn once the credit of a baseline's stand-in was settled (every batch above looked at), each
            # tracker's artefacts drawn too (ROUGH); run once
-           "bench-heldout16": (20270722, HELDOUT16_KINDS)}
+           "bench-heldout16": (20270722, HELDOUT16_KINDS),
+           # drawn once the instruments' checks of the session after bench-heldout16 were settled (every batch above
+           # looked at), with the instruments of rougher_instruments (ROUGHER); run once
+           "bench-heldout17": (20270823, HELDOUT17_KINDS)}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
+#: Batches with those, interference lasting seconds and load cells that reach their range
+#: (:func:`rougher_instruments`).
+ROUGHER = {"bench-heldout17"}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
@@ -309,7 +338,7 @@ def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
 def batch_specs(name: str) -> list:
     """The files of batch ``name`` (:func:`draw_batch`; the batches of :data:`ROUGH` with their trackers' artefacts)."""
     seed, kinds = BATCHES[name]
-    return draw_batch(seed, kinds, rough=name in ROUGH)
+    return draw_batch(seed, kinds, rough=name in ROUGH, rougher=name in ROUGHER)
 
 
 def run_batch(name: str) -> list:
