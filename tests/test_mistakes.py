@@ -257,3 +257,14 @@ def test_a_pattern_name_that_is_not_a_plain_file_name(tmp_path, name):
     r = camtube("toolpath", str(p), "-o", str(tmp_path / "o"), "-q")
     assert_refused(r, f"{p}:1", "name:", "fix:")
     assert listing(tmp_path) == ["p.yaml"]
+
+
+def test_a_whole_number_of_thousands_of_digits(tmp_path):
+    """More digits than Python converts from text (4300) was a ValueError traceback from the YAML reader."""
+    big = "9" * 5000
+    p = tmp_path / "p.yaml"
+    p.write_text(pattern_text(count=big))
+    assert_refused(camtube("design", str(p)), f"{p}:3", "a whole number of 5000 digits", "fix:")
+    r = camtube("toolpath", TUBE1, "--set", f"notch.count={big}", "-o", str(tmp_path / "o"))
+    assert_refused(r, "notch.count", "out of range", "5000 digits")
+    assert listing(tmp_path) == ["p.yaml"]

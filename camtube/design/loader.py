@@ -21,7 +21,7 @@ from camtube.design.generate import notch_row
 from camtube.design.pattern import Pattern, Process, RepeatRule, Rules, Tendon, Tube, hole, notch, sort_cuts
 from camtube.design.schema import SCHEMA, Field
 from camtube.errors import Issue, PatternError
-from camtube.yamltext import closest, line_map, parse_yaml, read_yaml_file
+from camtube.yamltext import NumberTooLongError, closest, line_map, parse_yaml, read_yaml_file
 
 #: The shipped presets (package data): tube patterns and the process files they name.
 PRESETS_DIR = Path(__file__).resolve().parent / "presets"
@@ -63,6 +63,10 @@ def parse_override(item: str) -> tuple[str, Any]:
     key, _, value = item.partition("=")
     try:
         parsed = parse_yaml(value)
+    except NumberTooLongError as exc:
+        raise PatternError([Issue(key.strip(), "out of range in --set", f"a number of {exc.digits} digits",
+                                  "the range `camtube schema` lists for the key",
+                                  "bring it inside the allowed range")]) from None
     except yaml.YAMLError:
         parsed = value
     return key.strip(), parsed
