@@ -259,6 +259,28 @@ def test_a_pattern_name_that_is_not_a_plain_file_name(tmp_path, name):
     assert listing(tmp_path) == ["p.yaml"]
 
 
+@pytest.mark.parametrize("override", ["holes.1={x: 3, size: 0.3}", "process.repeat_rule.3={max_depth: 3, repeats: 9}"])
+def test_a_set_of_a_whole_list_entry_past_the_end_names_the_index(override):
+    """``--set holes.1=...`` (adding a second hole) was an IndexError traceback."""
+    assert_refused(camtube("design", TUBE1, "--set", override), "past the end of the list", "fix:")
+
+
+@pytest.mark.parametrize("entry", ["0.75", "[1, 2]"])
+def test_a_set_into_a_list_entry_that_is_not_a_mapping_names_the_entry(tmp_path, entry):
+    """``holes: [0.75]`` with ``--set holes.0.x=1`` was a TypeError traceback."""
+    p = tmp_path / "p.yaml"
+    p.write_text(pattern_text() + f"holes:\n  - {entry}\n")
+    assert_refused(camtube("design", str(p), "--set", "holes.0.x=1"), f"{p}:6", "holes[0]: expected a mapping")
+
+
+@pytest.mark.parametrize("index", ["\u00b2", "9" * 5000], ids=["superscript-two", "5000-digits"])
+def test_a_set_index_that_is_not_a_small_ascii_number(index):
+    """``'²'.isdigit()`` is true and ``int('9' * 5000)`` is refused by Python: both were tracebacks."""
+    r = camtube("design", TUBE1, "--set", f"holes.{index}.x=1")
+    assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+    assert "fix:" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
 def test_a_whole_number_of_thousands_of_digits(tmp_path):
     """More digits than Python converts from text (4300) was a ValueError traceback from the YAML reader."""
     big = "9" * 5000

@@ -72,11 +72,21 @@ def parse_override(item: str) -> tuple[str, Any]:
     return key.strip(), parsed
 
 
+def _is_index(part: str) -> bool:
+    """True for a list index in a dotted --set key (``holes.0.x``): ASCII digits only (``'²'.isdigit()`` is true)."""
+    return part.isascii() and part.isdigit()
+
+
+def _past_end(key: str, idx: str, node: list) -> Issue:
+    return Issue(key, f"index {idx} is past the end of the list", None, f"0..{len(node) - 1}",
+                 "add the entry in the YAML first")
+
+
 def _schema_node(parts: list[str]):
     node: Any = SCHEMA
     for p in parts:
         if isinstance(node, Field) and node.kind == "rows":
-            if p.isdigit():
+            if _is_index(p):
                 node = dict(node.row)
                 continue
             return None
@@ -108,26 +118,30 @@ def apply_overrides(raw: dict, overrides: Iterable[str], file: str | None = None
             continue
         node = raw
         for depth, p in enumerate(parts[:-1]):
-            nxt = parts[depth + 1]
-            if p.isdigit() and isinstance(node, list):
-                idx = int(p)
-                if idx >= len(node):
-                    issues.append(Issue(key, f"index {idx} is past the end of the list", None,
-                                        f"0..{len(node) - 1}", "add the entry in the YAML first"))
+            if isinstance(node, list) and _is_index(p):
+                if len(p) > 9 or int(p) >= len(node):
+                    issues.append(_past_end(key, p, node))
                     node = None
                     break
-                node = node[idx]
-                continue
-            if not isinstance(node.get(p), (dict, list)):
-                node[p] = [] if nxt.isdigit() else {}
-            node = node[p]
+                node = node[int(p)]
+            elif isinstance(node, dict):
+                if not isinstance(node.get(p), (dict, list)):
+                    node[p] = [] if _is_index(parts[depth + 1]) else {}
+                node = node[p]
+            else:  # an entry the YAML gives as a scalar (holes: [0.75]): the check of the YAML names it
+                node = None
+                break
         if node is None:
             continue
         last = parts[-1]
-        if last.isdigit() and isinstance(node, list):
+        if isinstance(node, list) and _is_index(last):
+            if len(last) > 9 or int(last) >= len(node):
+                issues.append(_past_end(key, last, node))
+                continue
             node[int(last)] = value
-        else:
+        elif isinstance(node, dict):
             node[last] = value
+        # else: not a mapping in the YAML (holes: [[1, 2]]); the check of the YAML names the entry
     if issues:
         raise PatternError(issues)
     return raw
