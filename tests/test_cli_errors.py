@@ -141,3 +141,12 @@ def test_calibration_without_stroke_says_the_fix():
     """Before: '...forward model: fix: add --stroke MM' (a colon, not '; fix:')."""
     r = camtube("design", TUBE1, "--calibration", "cal.json", "-q")
     assert_refused(r, "--calibration", "; fix: add --stroke MM")
+
+
+def test_a_folder_named_like_an_output_file_is_kept_and_refused(tmp_path):
+    """A folder ``out/tube1.ngc/`` was replaced by the new G-code, the files in it deleted, exit 0."""
+    (tmp_path / "out" / "tube1.ngc").mkdir(parents=True)
+    (tmp_path / "out" / "tube1.ngc" / "mine.txt").write_text("mine")
+    r = camtube("toolpath", TUBE1, "-o", str(tmp_path / "out"), "-q")
+    assert_refused(r, str(tmp_path / "out" / "tube1.ngc"), "a folder of that name")
+    assert listing(tmp_path) == ["out", "out/tube1.ngc", "out/tube1.ngc/mine.txt"]
