@@ -290,3 +290,15 @@ def test_a_whole_number_of_thousands_of_digits(tmp_path):
     r = camtube("toolpath", TUBE1, "--set", f"notch.count={big}", "-o", str(tmp_path / "o"))
     assert_refused(r, "notch.count", "out of range", "5000 digits")
     assert listing(tmp_path) == ["p.yaml"]
+
+
+@pytest.mark.parametrize("path,words", [(".", ("is a directory", "--json out.json")),
+                                        ("/", ("is a directory", "--json /out.json")),
+                                        ("..", ("is a directory",))])
+def test_a_json_output_that_is_a_folder_with_no_file_name(tmp_path, path, words):
+    """``--json .`` was a ValueError traceback from pathlib (a path with an empty name has no suffix to set)."""
+    data = tmp_path / "d.csv"
+    data.write_text("sample,cycle,time_s,stroke_mm,force_N,angle_deg\n1,1,0,0,0,0\n")
+    r = camtube("model", "fit", str(data), "--pattern", "tube2", "--json", path, cwd=tmp_path)
+    assert_refused(r, f"--json {path}", *words)
+    assert listing(tmp_path) == ["d.csv"]
