@@ -292,6 +292,24 @@ def test_a_whole_number_of_thousands_of_digits(tmp_path):
     assert listing(tmp_path) == ["p.yaml"]
 
 
+@pytest.mark.parametrize("argv", [
+    ["toolpath", TUBE1, "-o", "{tmp}/o", "--machine", ""],
+    ["design", TUBE1, "--stroke", "1", "--calibration", ""],
+    ["model", "fit", "{data}", "--pattern", "tube2", "--json", ""],
+    ["model", "fit", "{data}", "--pattern", "tube2", "--plot", ""],
+    ["model", "diagnose", "{data}", "--pattern", "tube2", "--report", " "],
+    ["model", "effect", "new", "drive", "--follows", "stroke", "-o", ""],
+], ids=["machine", "calibration", "fit-json", "fit-plot", "diagnose-report", "effect-output"])
+def test_an_empty_option_value_is_refused_not_taken_for_no_option(tmp_path, argv):
+    """``--machine "$MACHINE"`` with the variable unset: the option was dropped (the default machine, exit 0),
+    ``--json ''`` a ValueError traceback, ``--report ''`` no report and exit 0."""
+    data = tmp_path / "d.csv"
+    data.write_text("sample,cycle,time_s,stroke_mm,force_N,angle_deg\n1,1,0,0,0,0\n")
+    r = camtube(*[a.replace("{tmp}", str(tmp_path)).replace("{data}", str(data)) for a in argv], cwd=tmp_path)
+    assert_refused(r, "the path is empty")
+    assert listing(tmp_path) == ["d.csv"]
+
+
 @pytest.mark.parametrize("path,words", [(".", ("is a directory", "--json out.json")),
                                         ("/", ("is a directory", "--json /out.json")),
                                         ("..", ("is a directory",))])

@@ -13,6 +13,14 @@ from camtube.io import PublishedInterrupt
 LAYER_ROLES = ("notch", "hole", "slit", "ignore")
 
 
+def path_value(value: str) -> str:
+    """argparse ``type`` of an option naming a file or folder: an empty value (``--json ''``, an unset
+    shell variable) is refused, not taken as "option not given"."""
+    if not value.strip():
+        raise argparse.ArgumentTypeError(f"the path is empty ({value!r}): give a file or folder name")
+    return value
+
+
 def add_pattern_argument(parser: argparse.ArgumentParser) -> None:
     """Add ``PATTERN``, repeatable ``--set KEY=VALUE``, ``-q`` and the drawing options to a sub-command."""
     parser.add_argument("pattern", metavar="PATTERN",
@@ -122,7 +130,7 @@ def run_outputs(args: argparse.Namespace, what: str) -> int:
     check_output_dir(args.output)
     loaded = load_from_args(args)
     dialects = None if getattr(args, "dialect", "all") == "all" else (DIALECTS[args.dialect],)
-    if getattr(args, "machine", None):
+    if getattr(args, "machine", None) is not None:
         from camtube.export.dialects import dialect_from_profile
         from camtube.machine import load_profile
 

@@ -5,7 +5,7 @@ import argparse
 import math
 from pathlib import Path
 
-from camtube.commands.common import add_pattern_argument, load_from_args
+from camtube.commands.common import add_pattern_argument, load_from_args, path_value
 from camtube.errors import CamtubeError
 
 
@@ -17,7 +17,7 @@ def register(sub) -> None:
     p.add_argument("--stroke", type=float, metavar="MM",
                    help="also print the notch-by-notch forward model at this tendon stroke (mm): per-notch angles "
                         "and strain, tendon force, tip position and direction, one tendon pulled at a time")
-    p.add_argument("--calibration", metavar="FIT.json",
+    p.add_argument("--calibration", type=path_value, metavar="FIT.json",
                    help="with --stroke: use the parameters of a 'camtube model fit/diagnose --json' file")
     p.add_argument("--hinge", choices=("fe_row", "beam", "fe_fit"), default="fe_row",
                    help="with --stroke: notch stiffness: E I over h plus a root length that shrinks with the webs "

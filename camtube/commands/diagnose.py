@@ -10,6 +10,8 @@ import dataclasses
 import shlex
 from pathlib import Path
 
+from camtube.commands.common import path_value
+
 
 def register(model_sub) -> None:
     from camtube.model import EFFECT_NAMES
@@ -65,8 +67,8 @@ def register(model_sub) -> None:
     d.add_argument("--no-rezero", dest="rezero", action="store_false",
                    help="keep the force as read where the load cell's zero drifts (default: re-zero it at every rest, "
                         "motor at zero and tendon slack, when the rests show a smooth drift from a zeroed cell)")
-    d.add_argument("--json", metavar="OUT.json", help="write the diagnosis as JSON")
-    d.add_argument("--report", metavar="DIR", help="write an HTML report with PNG plots into DIR")
+    d.add_argument("--json", type=path_value, metavar="OUT.json", help="write the diagnosis as JSON")
+    d.add_argument("--report", type=path_value, metavar="DIR", help="write an HTML report with PNG plots into DIR")
     d.set_defaults(func=cmd_diagnose)
 
 

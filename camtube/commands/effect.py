@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 
+from camtube.commands.common import path_value
 from camtube.model.unexplained.analysis import VARIABLES
 
 
@@ -29,7 +30,7 @@ def register_effect_commands(subparsers) -> None:
     n.add_argument("--stage", choices=("force", "stroke", "elongation", "kinematics", "angle"),
                    help="stage to act on (default: the one the diagnosis suggests)")
     n.add_argument("--follows", choices=VARIABLES, help="variable the effect follows (default: the diagnosis's lead)")
-    n.add_argument("-o", "--output", metavar="OUT.py", help="file to write (default NAME.py)")
+    n.add_argument("-o", "--output", type=path_value, metavar="OUT.py", help="file to write (default NAME.py)")
     n.add_argument("--overwrite", action="store_true", help="replace an existing file")
     n.set_defaults(func=cmd_effect_new)
 

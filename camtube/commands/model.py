@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import importlib
 
+from camtube.commands.common import path_value
 from camtube.model import EFFECT_NAMES
 
 
@@ -68,8 +69,8 @@ def register(sub) -> None:
     f.add_argument("--rezero", action="store_true",
                    help="with --set-aside: re-zero the force at every rest where the load cell's zero drifts, as "
                         "model diagnose does")
-    f.add_argument("--json", metavar="OUT.json", help="write the summary as JSON")
-    f.add_argument("--plot", metavar="OUT.png", help="write angle and residual vs stroke (PNG)")
+    f.add_argument("--json", type=path_value, metavar="OUT.json", help="write the summary as JSON")
+    f.add_argument("--plot", type=path_value, metavar="OUT.png", help="write angle and residual vs stroke (PNG)")
     f.set_defaults(func=cmd_fit)
 
     s = model_sub.add_parser(
@@ -77,7 +78,7 @@ def register(sub) -> None:
         description="Triangular stroke 0 -> rules.max_stroke -> 0 at a lead-screw speed, force from the "
                     "joint bending stiffness (E_pi 2.5 GPa), Gaussian EM-tracker and load-cell noise.")
     _add_pattern_option(s)
-    s.add_argument("-o", "--output", required=True, metavar="DATA.csv", help="output CSV file")
+    s.add_argument("-o", "--output", required=True, type=path_value, metavar="DATA.csv", help="output CSV file")
     s.add_argument("--samples", type=int, default=2, help="number of samples (default 2)")
     s.add_argument("--cycles", type=int, default=50, help="cycles per sample (default 50)")
     s.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
@@ -111,8 +112,10 @@ def register(sub) -> None:
     i.add_argument("--sample", default=None, metavar="NAME", help="sample name (default: the tracker file's stem)")
     i.add_argument("--max-lag", type=float, default=None, metavar="S",
                    help="largest clock offset between instruments to consider, s (default: any)")
-    i.add_argument("-o", "--output", required=True, metavar="DATA.csv", help="the measurement CSV to write")
-    i.add_argument("--report", metavar="DIR", help="write index.html and figures (alignment, angle, dropouts) here")
+    i.add_argument("-o", "--output", required=True, type=path_value, metavar="DATA.csv",
+                   help="the measurement CSV to write")
+    i.add_argument("--report", type=path_value, metavar="DIR",
+                   help="write index.html and figures (alignment, angle, dropouts) here")
     i.set_defaults(func=cmd_ingest)
 
     from camtube.commands import diagnose, effect

@@ -6,6 +6,7 @@ import sys
 import time
 from pathlib import Path
 
+from camtube.commands.common import path_value
 from camtube.errors import CamtubeError
 
 
@@ -22,7 +23,7 @@ def register(sub) -> None:
                     "Lengths mm, angles deg, forces N.")
     p.add_argument("goal", metavar="GOAL.yaml", help="goal file (see examples/goals/ and docs/design.md)")
     p.add_argument("-o", "--output", required=True, metavar="PATTERN.yaml", help="pattern YAML to write")
-    p.add_argument("--calibration", metavar="FIT.json",
+    p.add_argument("--calibration", type=path_value, metavar="FIT.json",
                    help="parameters of an earlier tube's 'camtube model fit --json' or 'model diagnose --json' "
                         "(E_t, L0, slack, toe, kerf, friction, ...) to design with")
     p.set_defaults(func=cmd_synthesize)
