@@ -150,3 +150,14 @@ def test_a_folder_named_like_an_output_file_is_kept_and_refused(tmp_path):
     r = camtube("toolpath", TUBE1, "-o", str(tmp_path / "out"), "-q")
     assert_refused(r, str(tmp_path / "out" / "tube1.ngc"), "a folder of that name")
     assert listing(tmp_path) == ["out", "out/tube1.ngc", "out/tube1.ngc/mine.txt"]
+
+
+@pytest.mark.parametrize("opt,value,fix", [("--outer-radius", "0.8", "use --set tube.outer_radius=0.8"),
+                                           ("--length", "20", "use --set tube.length=20"),
+                                           ("--units", "inch", "remove --units"),
+                                           ("--layer", "CUTS=notch", "remove --layer")])
+def test_a_drawing_option_with_a_yaml_pattern_is_refused_not_ignored(tmp_path, opt, value, fix):
+    """``--outer-radius 0.8`` with a YAML pattern was silently ignored (r_o stayed 0.75, exit 0)."""
+    r = camtube("toolpath", TUBE1, "-q", "-o", str(tmp_path / "o"), opt, value)
+    assert_refused(r, opt, "reads a DXF drawing", "fix: " + fix)
+    assert listing(tmp_path) == []

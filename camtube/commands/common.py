@@ -65,7 +65,7 @@ def drawing_options(args: argparse.Namespace):
 def load_from_args(args: argparse.Namespace) -> Loaded:
     """Load the pattern or drawing named by ``args``; print the import summary and design warnings to stderr."""
     from camtube.design.loader import preset_names, resolve_preset
-    from camtube.design.source import load_source
+    from camtube.design.source import is_drawing, load_source
 
     path = str(resolve_preset(args.pattern))
     if not os.path.exists(path):
@@ -73,7 +73,10 @@ def load_from_args(args: argparse.Namespace) -> Loaded:
                            f"drawing, or a preset name ({', '.join(preset_names())})")
     if os.path.isdir(path):
         raise CamtubeError(f"{path}: is a directory; fix: give the path of a pattern YAML or a DXF drawing")
-    loaded = load_source(path, args.overrides, drawing_options(args))
+    options = drawing_options(args)
+    if not is_drawing(path):
+        _refuse_drawing_options(args, path)
+    loaded = load_source(path, args.overrides, options)
     if not getattr(args, "quiet", False):
         summary = getattr(loaded, "summary", "")
         if summary:
@@ -81,6 +84,21 @@ def load_from_args(args: argparse.Namespace) -> Loaded:
         for w in loaded.warnings:
             print(f"warning: {w}", file=sys.stderr)
     return loaded
+
+
+def _refuse_drawing_options(args: argparse.Namespace, path: str) -> None:
+    """A drawing option given with a YAML pattern would be ignored: refuse it, saying what to write instead."""
+    for opt, key in (("outer_radius", "tube.outer_radius"), ("length", "tube.length")):
+        v = getattr(args, opt, None)
+        if v is not None:
+            raise CamtubeError(f"--{opt.replace('_', '-')} {v:g}: reads a DXF drawing, but {path} is a pattern YAML, "
+                               f"whose {key} it would not change; fix: use --set {key}={v:g}")
+    if getattr(args, "units", None) is not None:
+        raise CamtubeError(f"--units {args.units}: reads a DXF drawing, but {path} is a pattern YAML (always mm); "
+                           "fix: remove --units")
+    if getattr(args, "layers", None):
+        raise CamtubeError(f"--layer {args.layers[0]}: reads a DXF drawing, but {path} is a pattern YAML (no layers); "
+                           "fix: remove --layer")
 
 
 def add_cad_options(p: argparse.ArgumentParser) -> None:
