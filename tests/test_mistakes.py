@@ -320,3 +320,13 @@ def test_a_json_output_that_is_a_folder_with_no_file_name(tmp_path, path, words)
     r = camtube("model", "fit", str(data), "--pattern", "tube2", "--json", path, cwd=tmp_path)
     assert_refused(r, f"--json {path}", *words)
     assert listing(tmp_path) == ["d.csv"]
+
+
+@pytest.mark.parametrize("argv,name", [(["design", ""], "PATTERN"), (["model", "fit", "", "--pattern", "tube2"], "DATA.csv"),
+                                       (["model", "synth", "--pattern", "", "-o", "d.csv"], "--pattern"),
+                                       (["synthesize", "", "-o", "p.yaml"], "GOAL.yaml")])
+def test_an_empty_input_path_is_named_not_called_the_working_directory(tmp_path, argv, name):
+    """``camtube design ''`` said '.: is a directory' (the empty path read as the working directory)."""
+    r = camtube(*argv, cwd=tmp_path)
+    assert_refused(r, f"argument {name}: the path is empty")
+    assert ".: is a directory" not in r.stderr and listing(tmp_path) == []

@@ -23,7 +23,7 @@ def path_value(value: str) -> str:
 
 def add_pattern_argument(parser: argparse.ArgumentParser) -> None:
     """Add ``PATTERN``, repeatable ``--set KEY=VALUE``, ``-q`` and the drawing options to a sub-command."""
-    parser.add_argument("pattern", metavar="PATTERN",
+    parser.add_argument("pattern", type=path_value, metavar="PATTERN",
                         help="pattern YAML file, a preset name (tube1, tube2, tube3, tube1-bidirectional) "
                              "or a DXF drawing of the unrolled tube")
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",

@@ -24,9 +24,10 @@ def register(model_sub) -> None:
                     "recommend only effects whose gain beats the noise, whose parameters are identified and "
                     "resolvable, and whose refit on all rows lowers the RMSE; test per-sample values; print the "
                     "model fit command that reproduces the result. Angles deg, strokes mm, forces N.")
-    d.add_argument("data", metavar="DATA.csv",
+    d.add_argument("data", type=path_value, metavar="DATA.csv",
                    help="columns sample, cycle, time_s, stroke_mm, force_N, angle_deg")
-    d.add_argument("--pattern", required=True, metavar="PATTERN", help="pattern YAML of the joint (see patterns/)")
+    d.add_argument("--pattern", required=True, type=path_value, metavar="PATTERN",
+                   help="pattern YAML of the joint (see patterns/)")
     d.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a pattern scalar, e.g. --set tendon.length=80")
     d.add_argument("-q", "--quiet", action="store_true", help="do not print design warnings")

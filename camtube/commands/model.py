@@ -32,7 +32,7 @@ def register(sub) -> None:
         description="Compare the paper's model L_t = (ybar + r_i - r_t) theta + F L0 / (E_t pi r_t^2) with "
                     "measured stroke, force and angle. By default, like the paper: each sample's last "
                     "loading cycle, slack deadband removed, E_t fitted, L0 and E_t start from the pattern.")
-    f.add_argument("data", metavar="DATA.csv",
+    f.add_argument("data", type=path_value, metavar="DATA.csv",
                    help="columns sample, cycle, time_s, stroke_mm, force_N, angle_deg (extra columns kept)")
     _add_pattern_option(f)
     f.add_argument("--cycles", default="last", metavar="SPEC",
@@ -125,7 +125,8 @@ def register(sub) -> None:
 
 
 def _add_pattern_option(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--pattern", required=True, metavar="PATTERN", help="pattern YAML of the joint (see patterns/)")
+    p.add_argument("--pattern", required=True, type=path_value, metavar="PATTERN",
+                   help="pattern YAML of the joint (see patterns/)")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a pattern scalar, e.g. --set tendon.length=80")
     p.add_argument("-q", "--quiet", action="store_true", help="do not print design warnings")

@@ -21,7 +21,7 @@ def register(sub) -> None:
                     "closely the centre line is followed. "
                     "An infeasible goal: one line naming the limit and the nearest feasible target, exit 2. "
                     "Lengths mm, angles deg, forces N.")
-    p.add_argument("goal", metavar="GOAL.yaml", help="goal file (see examples/goals/ and docs/design.md)")
+    p.add_argument("goal", type=path_value, metavar="GOAL.yaml", help="goal file (see examples/goals/ and docs/design.md)")
     p.add_argument("-o", "--output", required=True, metavar="PATTERN.yaml", help="pattern YAML to write")
     p.add_argument("--calibration", type=path_value, metavar="FIT.json",
                    help="parameters of an earlier tube's 'camtube model fit --json' or 'model diagnose --json' "
