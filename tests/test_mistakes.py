@@ -9,7 +9,7 @@ import signal
 import pytest
 
 from camtube.commands import main
-from tests.conftest import PATTERNS
+from tests.conftest import PATTERNS, ROOT
 from tests.test_cli_errors import TUBE1, assert_refused, camtube, listing
 
 
@@ -330,3 +330,22 @@ def test_an_empty_input_path_is_named_not_called_the_working_directory(tmp_path,
     r = camtube(*argv, cwd=tmp_path)
     assert_refused(r, f"argument {name}: the path is empty")
     assert ".: is a directory" not in r.stderr and listing(tmp_path) == []
+
+
+BENCH = ROOT / "examples" / "bench"
+
+
+def ingest_argv(tmp_path, *extra) -> list[str]:
+    return ["model", "ingest", "--tracker", str(BENCH / "aurora-export.csv"), "--daq", str(BENCH / "daq.csv"),
+            "--motor", str(BENCH / "motor.csv"), "-o", str(tmp_path / "data.csv"), *extra]
+
+
+@pytest.mark.parametrize("extra,words", [("notes: 1\n", ("notes: unknown section",)),
+                                         ("angle: 3\n", ("angle: expected a mapping of keys, got 3",))])
+def test_a_bench_map_section_that_is_not_a_mapping(tmp_path, extra, words):
+    """An extra top-level key of the bench map (``notes: 1``) was a TypeError traceback."""
+    bench = tmp_path / "bench.yaml"
+    bench.write_text((BENCH / "bench.yaml").read_text() + extra)
+    r = camtube(*ingest_argv(tmp_path, "--bench", str(bench)))
+    assert_refused(r, str(bench), *words)
+    assert listing(tmp_path) == ["bench.yaml"]
