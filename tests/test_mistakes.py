@@ -349,3 +349,18 @@ def test_a_bench_map_section_that_is_not_a_mapping(tmp_path, extra, words):
     r = camtube(*ingest_argv(tmp_path, "--bench", str(bench)))
     assert_refused(r, str(bench), *words)
     assert listing(tmp_path) == ["bench.yaml"]
+
+
+@pytest.mark.parametrize("role,content,words", [("daq", "", ("the file is empty", "fix: give the daq log")),
+                                                ("motor", "t_us,enc_counts\n", ("no data lines after the header",)),
+                                                ("tracker", None, ("no frames after the header",))])
+def test_an_empty_bench_log_says_the_fix(tmp_path, role, content, words):
+    """An empty DAQ or motor log, or a header-only tracker export, was refused without a fix."""
+    if content is None:
+        content = (BENCH / "aurora-export.csv").read_text().splitlines()[0] + "\n"
+    log = tmp_path / f"{role}.csv"
+    log.write_text(content)
+    argv = ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"))
+    argv[argv.index(f"--{role}") + 1] = str(log)
+    assert_refused(camtube(*argv), str(log), *words)
+    assert listing(tmp_path) == [f"{role}.csv"]

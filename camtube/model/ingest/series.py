@@ -310,8 +310,10 @@ def parse_series(text: str, source: str, time: str, time_unit: str, value: str, 
         (file, line and column), a time that does not increase.
     """
     table = read_table(text, source, comments=True)
+    log = role if role == "log" else f"{role} log"
     if table is None:
-        raise DataError(f"{source}: the file is empty")
+        raise DataError(f"{source}: the file is empty; fix: give the {log} as exported (a header line naming the "
+                        "columns, then one line per sample time)")
     header, hline, rows, lines = table.header, table.header_line, table.rows, table.lines
     if len(header) == 1 and (";" in header[0] or "\t" in header[0]):
         raise DataError(f"{source}:{hline}: the columns are not separated by commas; fix: save the log as "
@@ -327,7 +329,8 @@ def parse_series(text: str, source: str, time: str, time_unit: str, value: str, 
             raise DataError(f"{source}:{hline}: no column {col!r} for the {what} (found: {', '.join(header)}); fix: {fix}")
         idx[what] = header.index(col)
     if not rows:
-        raise DataError(f"{source}:{hline}: no data lines after the header")
+        raise DataError(f"{source}:{hline}: no data lines after the header; fix: give the whole {log} (was the "
+                        "recording stopped before it started, or the export cut short?)")
     ln = np.asarray(lines, dtype=np.int64)
     out = {}
     for what, j in idx.items():
