@@ -364,3 +364,21 @@ def test_an_empty_bench_log_says_the_fix(tmp_path, role, content, words):
     argv[argv.index(f"--{role}") + 1] = str(log)
     assert_refused(camtube(*argv), str(log), *words)
     assert listing(tmp_path) == [f"{role}.csv"]
+
+
+def test_an_output_that_is_an_input_file_is_refused_and_the_input_kept(tmp_path):
+    """``synthesize goal.yaml -o goal.yaml``, ``dxf d.dxf -o d.dxf`` and ``model ingest --daq daq.csv -o daq.csv``
+    replaced the input with the output (the goal, the drawing, the raw log lost), exit 0."""
+    goal, drawing, daq = tmp_path / "g.yaml", tmp_path / "d.dxf", tmp_path / "daq.csv"
+    goal.write_text((ROOT / "examples" / "goals" / "01-tube1-uniform-60.yaml").read_text())
+    drawing.write_bytes((ROOT / "examples" / "dxf" / "four_lines.dxf").read_bytes())
+    daq.write_text((BENCH / "daq.csv").read_text())
+    before = {p: p.read_bytes() for p in (goal, drawing, daq)}
+    assert_refused(camtube("synthesize", str(goal), "-o", str(goal)), f"is the input GOAL.yaml {goal}")
+    assert_refused(camtube("dxf", str(drawing), "-o", str(drawing)), f"is the input PATTERN {drawing}")
+    argv = ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"))
+    argv[argv.index("--daq") + 1] = argv[argv.index("-o") + 1] = str(daq)
+    assert_refused(camtube(*argv), f"is the input --daq {daq}")
+    assert {p: p.read_bytes() for p in (goal, drawing, daq)} == before
+    assert listing(tmp_path) == ["d.dxf", "daq.csv", "g.yaml"]
+

@@ -127,6 +127,24 @@ def cad_options(args: argparse.Namespace):
                       kerf_mm=args.kerf)
 
 
+def refuse_output_over_input(output: str, option: str, inputs) -> None:
+    """Refuse an output file that is one of the command's input files (``synthesize goal.yaml -o goal.yaml``,
+    ``model ingest ... --daq daq.csv -o daq.csv``): writing it would destroy the input.
+
+    ``inputs`` holds ``(option, path or None)`` pairs; the same file under another name (a link) counts too.
+    """
+    for opt, path in inputs:
+        if not path or not os.path.exists(output) or not os.path.exists(path):
+            continue
+        try:
+            same = os.path.samefile(output, path)
+        except OSError:
+            continue
+        if same:
+            raise CamtubeError(f"{option} {output}: is the input {opt} {path}, which writing would replace; "
+                               "fix: name another output file")
+
+
 def check_output_dir(path: str, option: str = "-o") -> None:
     """Refuse, before any work, an output directory that names a file or cannot be written."""
     from camtube.io import check_writable_dir

@@ -5,7 +5,7 @@ import argparse
 import math
 from pathlib import Path
 
-from camtube.commands.common import add_pattern_argument, load_from_args, path_value
+from camtube.commands.common import add_pattern_argument, load_from_args, path_value, refuse_output_over_input
 from camtube.errors import CamtubeError
 
 
@@ -143,6 +143,7 @@ def cmd_dxf(args: argparse.Namespace) -> int:
 
     if Path(args.output).suffix.lower() != ".dxf":
         raise CamtubeError(f"{args.output}: dxf writes a DXF drawing; fix: name the output OUT.dxf")
+    refuse_output_over_input(args.output, "-o", [("PATTERN", args.pattern)])
     loaded = load_from_args(args)
     text = design_dxf(loaded.pattern)
     path = write_atomic(args.output, text)

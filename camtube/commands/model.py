@@ -246,7 +246,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
 def cmd_ingest(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from camtube.commands.common import check_output_dir
+    from camtube.commands.common import check_output_dir, refuse_output_over_input
     from camtube.io import check_writable_dir, write_atomic, write_set
     from camtube.model.data.csvfile import format_csv
     from camtube.model.ingest.merge import ingest_files
@@ -258,6 +258,8 @@ def cmd_ingest(args: argparse.Namespace) -> int:
 
         raise DataError(f"-o {args.output}: is a directory; fix: name the measurement CSV to write")
     check_writable_dir(Path(args.output).absolute().parent)
+    refuse_output_over_input(args.output, "-o", [("--tracker", args.tracker), ("--angle-log", args.angle_log),
+                                                 ("--daq", args.daq), ("--motor", args.motor), ("--bench", args.bench)])
     if args.report:
         check_output_dir(args.report, "--report")
     bench = load_bench_map(args.bench, args.map_overrides)

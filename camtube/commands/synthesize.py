@@ -6,7 +6,7 @@ import sys
 import time
 from pathlib import Path
 
-from camtube.commands.common import path_value
+from camtube.commands.common import path_value, refuse_output_over_input
 from camtube.errors import CamtubeError
 
 
@@ -42,6 +42,7 @@ def cmd_synthesize(args: argparse.Namespace) -> int:
         raise CamtubeError(f"{args.output}: synthesize writes a pattern YAML; fix: name the output PATTERN.yaml")
     if out.is_dir():
         raise CamtubeError(f"{args.output}: is a directory; fix: name the pattern file, e.g. {out / 'pattern.yaml'}")
+    refuse_output_over_input(args.output, "-o", [("GOAL.yaml", args.goal), ("--calibration", args.calibration)])
     goal = load_goal(args.goal)
     calib = Mechanics.from_fit_json(args.calibration) if args.calibration else None
     t0 = time.perf_counter()
