@@ -382,3 +382,10 @@ def test_an_output_that_is_an_input_file_is_refused_and_the_input_kept(tmp_path)
     assert {p: p.read_bytes() for p in (goal, drawing, daq)} == before
     assert listing(tmp_path) == ["d.dxf", "daq.csv", "g.yaml"]
 
+
+def test_an_ingest_report_folder_named_like_the_csv_is_refused_before_the_csv_is_written(tmp_path):
+    """``-o o.csv --report o.csv`` wrote o.csv, then failed on the report: half the outputs left behind."""
+    out = str(tmp_path / "data.csv")
+    r = camtube(*ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"), "--report", out))
+    assert_refused(r, f"--report {out}: is also the -o file")
+    assert listing(tmp_path) == []

@@ -11,6 +11,7 @@ import argparse
 import importlib
 
 from camtube.commands.common import path_value
+from camtube.errors import CamtubeError
 from camtube.model import EFFECT_NAMES
 
 
@@ -262,6 +263,9 @@ def cmd_ingest(args: argparse.Namespace) -> int:
                                                  ("--daq", args.daq), ("--motor", args.motor), ("--bench", args.bench)])
     if args.report:
         check_output_dir(args.report, "--report")
+        if Path(args.report).resolve() == Path(args.output).resolve():
+            raise CamtubeError(f"--report {args.report}: is also the -o file; fix: give the report a folder of its "
+                               f"own, e.g. --report {Path(args.output).with_suffix('')}-report")
     bench = load_bench_map(args.bench, args.map_overrides)
     first = args.tracker or args.angle_log
     ing = ingest_files(first, args.daq, args.motor, bench, args.sample, max_lag_s=args.max_lag,
