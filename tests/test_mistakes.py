@@ -389,3 +389,14 @@ def test_an_ingest_report_folder_named_like_the_csv_is_refused_before_the_csv_is
     r = camtube(*ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"), "--report", out))
     assert_refused(r, f"--report {out}: is also the -o file")
     assert listing(tmp_path) == []
+
+
+@pytest.mark.parametrize("sample,words", [("#1", ("--sample '#1' starts with '#'",)), ("", ("--sample '' is empty",)),
+                                          ("a\nb", ("holds a line break",))])
+def test_an_ingest_sample_name_that_would_break_the_csv(tmp_path, sample, words):
+    """``--sample '#1'`` wrote a CSV whose every row reads as a comment (model fit: 'no data rows'), exit 0;
+    ``--sample ''`` was taken for no name."""
+    r = camtube(*ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"), "--sample", sample))
+    assert_refused(r, *words)
+    assert listing(tmp_path) == []
+
