@@ -400,3 +400,9 @@ def test_an_ingest_sample_name_that_would_break_the_csv(tmp_path, sample, words)
     assert_refused(r, *words)
     assert listing(tmp_path) == []
 
+
+def test_a_measurement_file_whose_rows_all_start_with_a_hash_says_why(tmp_path):
+    data = tmp_path / "d.csv"
+    data.write_text("sample,cycle,time_s,stroke_mm,force_N,angle_deg\n#1,1,0,0,0,0\n#1,1,1,1,1,1\n")
+    r = camtube("model", "fit", str(data), "--pattern", "tube2")
+    assert_refused(r, f"{data}:1", "start with '#' and are read as comments")

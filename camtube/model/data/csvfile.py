@@ -131,10 +131,12 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
     header_line = 0
     rows: list[list[str]] = []
     lines: list[int] = []
+    comments = 0  # '#' lines after the header
     try:
         for rec in reader:
             ln = reader.line_num
             if not rec or not any(c.strip() for c in rec) or rec[0].lstrip().startswith("#"):
+                comments += header is not None and bool(rec) and rec[0].lstrip().startswith("#")
                 continue
             if header is None:
                 header = [c.strip() for c in rec]
@@ -175,6 +177,10 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
         raise _err(source, header_line,
                    f"missing column(s) {', '.join(missing)} (found: {', '.join(header)})",
                    "; ".join(hints) if hints else f"the header must contain {', '.join(COLUMNS)}")
+    if not rows and comments:
+        raise _err(source, header_line, f"no data rows after the header: all {comments} lines below it start with "
+                   "'#' and are read as comments (a sample named '#...'?)",
+                   "rename the sample so that it does not start with '#', e.g. S1")
     if not rows:
         raise _err(source, header_line, "no data rows after the header",
                    "add the measurements, one row per sample time, below the header")
