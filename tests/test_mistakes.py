@@ -406,3 +406,13 @@ def test_a_measurement_file_whose_rows_all_start_with_a_hash_says_why(tmp_path):
     data.write_text("sample,cycle,time_s,stroke_mm,force_N,angle_deg\n#1,1,0,0,0,0\n#1,1,1,1,1,1\n")
     r = camtube("model", "fit", str(data), "--pattern", "tube2")
     assert_refused(r, f"{data}:1", "start with '#' and are read as comments")
+
+
+def test_nul_bytes_in_a_measurement_file_are_refused_not_read_as_a_sample_name(tmp_path):
+    """NULs in the sample cell (a logger's unfinished write) made a new sample '1\\x00\\x00...' and the fit ran, exit 0."""
+    data = tmp_path / "d.csv"
+    assert camtube("model", "synth", "--pattern", "tube2", "-o", str(data), "--cycles", "3").returncode == 0
+    lines = data.read_bytes().split(b"\n")
+    lines[12] = lines[12][:1] + b"\x00" * 8 + lines[12][1:]
+    data.write_bytes(b"\n".join(lines))
+    assert_refused(camtube("model", "fit", str(data), "--pattern", "tube2"), f"{data}:13", "NUL bytes")

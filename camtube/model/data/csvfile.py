@@ -301,6 +301,10 @@ def _read_text(path: Path) -> str:
     except UnicodeDecodeError as exc:
         raise DataError(f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start}); fix: give the "
                         "measurement CSV (save it as UTF-8 text)") from None
+    if "\x00" in text:  # a logger's unfinished write (NUL padding) or a binary file: the cells would be garbage
+        line = text[:text.index("\x00")].count("\n") + 1
+        raise DataError(f"{path}:{line}: not a text file: it holds NUL bytes; fix: give the measurement CSV as "
+                        "exported (cut the damaged lines if the logger stopped mid-write)")
     return text
 
 
