@@ -416,3 +416,15 @@ def test_nul_bytes_in_a_measurement_file_are_refused_not_read_as_a_sample_name(t
     lines[12] = lines[12][:1] + b"\x00" * 8 + lines[12][1:]
     data.write_bytes(b"\n".join(lines))
     assert_refused(camtube("model", "fit", str(data), "--pattern", "tube2"), f"{data}:13", "NUL bytes")
+
+
+@pytest.mark.parametrize("cmd", [["model", "synth", "-o", "{tmp}/d.csv"], ["model", "fit", "{data}"],
+                                 ["model", "diagnose", "{data}"]], ids=["synth", "fit", "diagnose"])
+def test_a_model_command_on_a_pattern_without_notches(tmp_path, cmd):
+    """``--set notch.count=0`` (or a pattern of holes only) was a ValueError traceback from the joint geometry."""
+    data = tmp_path / "data.csv"
+    data.write_text("sample,cycle,time_s,stroke_mm,force_N,angle_deg\n1,1,0,0,0,0\n1,1,1,1,1,1\n")
+    argv = [a.replace("{tmp}", str(tmp_path)).replace("{data}", str(data)) for a in cmd]
+    r = camtube(*argv, "--pattern", "tube2", "--set", "notch.count=0")
+    assert_refused(r, "tube2: notch.count: the pattern has no notches")
+    assert listing(tmp_path) == ["data.csv"]

@@ -86,6 +86,15 @@ def load_from_args(args: argparse.Namespace) -> Loaded:
     return loaded
 
 
+def load_joint_pattern(args: argparse.Namespace):
+    """The pattern of a ``model`` command (``--pattern``): it must have notches, the joint the model describes."""
+    pattern = load_from_args(args).pattern
+    if not pattern.notches:
+        raise CamtubeError(f"{args.pattern}: notch.count: the pattern has no notches, so there is no joint to model; "
+                           "fix: give the pattern of the measured joint (notch.count >= 1, or cuts:)")
+    return pattern
+
+
 def _refuse_drawing_options(args: argparse.Namespace, path: str) -> None:
     """A drawing option given with a YAML pattern would be ignored: refuse it, saying what to write instead."""
     for opt, key in (("outer_radius", "tube.outer_radius"), ("length", "tube.length")):

@@ -117,7 +117,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 
 
 def _diagnose(args: argparse.Namespace) -> int:
-    from camtube.commands.common import load_from_args
+    from camtube.commands.common import load_joint_pattern
     from camtube.errors import DataError
     from camtube.io import write_atomic
     from camtube.model.core.build import build_registry, check_suffix, fitted_and_held, parse_in_range, split_names
@@ -142,7 +142,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     if not 0 < lo < hi < float("inf"):
         raise DataError(f"--modulus-range {args.modulus_range!r}: need finite 0 < LO < HI (GPa); fix: e.g. "
                         "--modulus-range 1,300")
-    pattern = load_from_args(args).pattern
+    pattern = load_joint_pattern(args)
     reg, _ = build_registry(args.effect_file)
     model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects, "--effects")])
     # every parameter the model or a candidate has (its range), checked before the data are read

@@ -134,7 +134,7 @@ def _add_pattern_option(p: argparse.ArgumentParser) -> None:
 
 
 def cmd_fit(args: argparse.Namespace) -> int:
-    from camtube.commands.common import load_from_args
+    from camtube.commands.common import load_joint_pattern
     from camtube.io import write_atomic
     from camtube.model.core.build import (
         build_registry, fitted_and_held, history_warning, parse_in_range, split_names,
@@ -155,7 +155,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     if t is not None and not (0 < t < 360):
         raise DataError(f"--deadband-threshold {t}: the smallest angle rise that counts as motion must be > 0 and "
                         "< 360 deg; fix: e.g. --deadband-threshold 0.5, or leave it out for max(0.5, 4 x noise)")
-    pattern = load_from_args(args).pattern
+    pattern = load_joint_pattern(args)
     reg, _ = build_registry(args.effect_file)
     model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects, "--effects")])
     if args.set_aside:
@@ -229,11 +229,11 @@ def cmd_fit(args: argparse.Namespace) -> int:
 
 
 def cmd_synth(args: argparse.Namespace) -> int:
-    from camtube.commands.common import load_from_args
+    from camtube.commands.common import load_joint_pattern
     from camtube.model.sim.synth import noise_floor_deg, synthesize, write
 
     check_suffix(args.output, (".csv",), "-o/--output")
-    pattern = load_from_args(args).pattern
+    pattern = load_joint_pattern(args)
     data = synthesize(pattern, args.samples, args.cycles, args.noise_angle, args.noise_force, args.seed,
                       modulus_gpa=args.modulus, speed_mm_s=args.speed, rate_hz=args.rate,
                       slack_mm=args.slack)
