@@ -428,3 +428,21 @@ def test_a_model_command_on_a_pattern_without_notches(tmp_path, cmd):
     r = camtube(*argv, "--pattern", "tube2", "--set", "notch.count=0")
     assert_refused(r, "tube2: notch.count: the pattern has no notches")
     assert listing(tmp_path) == ["data.csv"]
+
+
+@pytest.mark.parametrize("cmd,outputs", [
+    (["model", "fit", "{data}", "--json", "{tmp}/fit.json", "--plot", "/proc/camtube-x/fit.png"], "--plot"),
+    (["model", "diagnose", "{data}", "--max-rows", "300", "--json", "{tmp}/d.json", "--report", "/proc/camtube-x/rep"],
+     "--report"),
+    (["model", "diagnose", "{data}", "--max-rows", "300", "--json", "{tmp}/d.json", "--report", "{tmp}/d.json"],
+     "--report"),
+], ids=["fit-plot-unwritable", "diagnose-report-unwritable", "diagnose-report-is-the-json"])
+def test_model_outputs_are_written_both_or_neither(tmp_path, cmd, outputs):
+    """The --json was written, then the --plot or --report failed (after the whole fit or diagnosis): one output of
+    two left behind. Now where both go is checked before the work."""
+    data = tmp_path / "data.csv"
+    assert camtube("model", "synth", "--pattern", "tube2", "-o", str(data), "--cycles", "4").returncode == 0
+    argv = [a.replace("{tmp}", str(tmp_path)).replace("{data}", str(data)) for a in cmd]
+    r = camtube(*argv, "--pattern", "tube2", "-q")
+    assert r.returncode == 2 and "Traceback" not in r.stderr and "fix:" in r.stderr, r.stderr
+    assert listing(tmp_path) == ["data.csv"]

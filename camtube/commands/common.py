@@ -154,6 +154,15 @@ def refuse_output_over_input(output: str, option: str, inputs) -> None:
                                "fix: name another output file")
 
 
+def check_output_file(path: str, option: str) -> None:
+    """Refuse, before any work, an output file that names a directory or lies where nothing can be written."""
+    from camtube.io import check_writable_dir
+
+    if os.path.isdir(path):
+        raise CamtubeError(f"{option} {path}: is a directory; fix: name a file")
+    check_writable_dir(os.path.dirname(os.path.abspath(path)))
+
+
 def check_output_dir(path: str, option: str = "-o") -> None:
     """Refuse, before any work, an output directory that names a file or cannot be written."""
     from camtube.io import check_writable_dir

@@ -117,20 +117,30 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 
 
 def _diagnose(args: argparse.Namespace) -> int:
-    from camtube.commands.common import load_joint_pattern
+    from camtube.commands.common import check_output_dir, check_output_file, load_joint_pattern
     from camtube.errors import DataError
-    from camtube.io import write_atomic
+    from camtube.io import write_atomic, write_set
     from camtube.model.core.build import build_registry, check_suffix, fitted_and_held, parse_in_range, split_names
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import check_fittable, read_measurements, select_cycles
     from camtube.model.data.csvfile import check_force_identifies
     from camtube.model.diagnose import diagnose
     from camtube.model.diagnose.instruments import check_instruments, confirm_lag
-    from camtube.model.report.diagnosis import diagnosis_json, diagnosis_text, write_report
+    from camtube.model.report.diagnosis import diagnosis_json, diagnosis_text, report_files
 
     check_suffix(args.json, (".json",), "--json")
     if args.report is not None and Path(args.report).exists() and not Path(args.report).is_dir():
-        raise DataError(f"--report {args.report}: is a file; the report is a directory (index.html and PNGs)")
+        raise DataError(f"--report {args.report}: is a file; the report is a directory (index.html and PNGs); "
+                        "fix: name a directory (new or existing)")
+    # --json and --report are written both or neither: where they go is checked before the work
+    if args.json is not None:
+        check_output_file(args.json, "--json")
+    if args.report is not None:
+        check_output_dir(args.report, "--report")
+        if args.json is not None and Path(args.report).resolve() in (Path(args.json).resolve(),
+                                                                     *Path(args.json).resolve().parents):
+            raise DataError(f"--json {args.json}: is or lies in the --report folder {args.report}; fix: write the "
+                            "JSON beside the report folder, not inside it")
     for opt, v, eg in (("--max-rows", args.max_rows, "4000 (0 = all rows)"), ("--max-effects", args.max_effects, "4")):
         if v < 0:
             raise DataError(f"{opt} {v}: must be >= 0; fix: e.g. {opt} {eg}")
@@ -170,8 +180,10 @@ def _diagnose(args: argparse.Namespace) -> int:
     title = f"{pattern.name}: {args.data} ({len(rows)} rows, cycles {args.cycles}, both directions, deadband kept)"
     print(diagnosis_text(d, prefix, title))
     meta = {"pattern": pattern.name, "data": str(args.data), "cycles": args.cycles}
+    files = report_files(d, prefix, title) if args.report else None  # made before anything is written
     if args.json:
         print(f"wrote {write_atomic(args.json, diagnosis_json(d, prefix, meta))}")
-    if args.report:
-        print(f"wrote {write_report(d, args.report, prefix, title)}")
+    if files is not None:
+        write_set(args.report, files)
+        print(f"wrote {Path(args.report) / 'index.html'}")
     return 0

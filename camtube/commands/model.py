@@ -134,7 +134,7 @@ def _add_pattern_option(p: argparse.ArgumentParser) -> None:
 
 
 def cmd_fit(args: argparse.Namespace) -> int:
-    from camtube.commands.common import load_joint_pattern
+    from camtube.commands.common import check_output_file, load_joint_pattern
     from camtube.io import write_atomic
     from camtube.model.core.build import (
         build_registry, fitted_and_held, history_warning, parse_in_range, split_names,
@@ -148,6 +148,9 @@ def cmd_fit(args: argparse.Namespace) -> int:
 
     check_suffix(args.json, (".json",), "--json")
     check_suffix(args.plot, (".png",), "--plot")
+    for opt, path in (("--json", args.json), ("--plot", args.plot)):  # both written, or neither: checked first
+        if path is not None:
+            check_output_file(path, opt)
     if not 0 <= args.starts <= 50:
         raise DataError(f"--starts {args.starts}: allowed 0..50 grid points per parameter; fix: e.g. --starts 3 "
                         "(0: one start)")
@@ -215,15 +218,17 @@ def cmd_fit(args: argparse.Namespace) -> int:
                        "--branch both --no-deadband)")
     meta = {"pattern": pattern.name, "data": str(args.data),
             "selection": {"cycles": args.cycles, "branch": args.branch, "deadband": bool(args.deadband)}}
-    if args.json:
-        print(f"wrote {write_atomic(args.json, fit_json(result, meta))}")
-    if args.plot:
+    png = None
+    if args.plot:  # made before anything is written, so that a failure leaves no --json without its --plot
         from camtube.model.report.plot import fit_png
 
         full = raw
         if args.deadband:
             full = remove_deadband(raw, args.deadband_threshold)
         png = fit_png(result, full, title=f"{pattern.name}: model vs measurement ({sel})")
+    if args.json:
+        print(f"wrote {write_atomic(args.json, fit_json(result, meta))}")
+    if png is not None:
         print(f"wrote {write_atomic(args.plot, png)}")
     return 0
 
