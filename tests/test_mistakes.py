@@ -446,3 +446,15 @@ def test_model_outputs_are_written_both_or_neither(tmp_path, cmd, outputs):
     r = camtube(*argv, "--pattern", "tube2", "-q")
     assert r.returncode == 2 and "Traceback" not in r.stderr and "fix:" in r.stderr, r.stderr
     assert listing(tmp_path) == ["data.csv"]
+
+
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+def test_a_json_output_that_is_the_measurement_file(tmp_path, cmd):
+    """Measurements saved as d.json and ``--json d.json``: the fit's summary replaced the data, exit 0."""
+    data = tmp_path / "d.json"
+    assert camtube("model", "synth", "--pattern", "tube2", "-o", str(tmp_path / "d.csv"), "--cycles", "3").returncode == 0
+    (tmp_path / "d.csv").rename(data)
+    before = data.read_bytes()
+    r = camtube("model", cmd, str(data), "--pattern", "tube2", "-q", "--json", str(data))
+    assert_refused(r, f"--json {data}: is the input DATA.csv")
+    assert data.read_bytes() == before

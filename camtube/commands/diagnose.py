@@ -117,7 +117,9 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 
 
 def _diagnose(args: argparse.Namespace) -> int:
-    from camtube.commands.common import check_output_dir, check_output_file, load_joint_pattern
+    from camtube.commands.common import (
+        check_output_dir, check_output_file, load_joint_pattern, refuse_output_over_input,
+    )
     from camtube.errors import DataError
     from camtube.io import write_atomic, write_set
     from camtube.model.core.build import build_registry, check_suffix, fitted_and_held, parse_in_range, split_names
@@ -135,6 +137,8 @@ def _diagnose(args: argparse.Namespace) -> int:
     # --json and --report are written both or neither: where they go is checked before the work
     if args.json is not None:
         check_output_file(args.json, "--json")
+        refuse_output_over_input(args.json, "--json", [("DATA.csv", args.data), ("--pattern", args.pattern)]
+                                 + [("--effect-file", f) for f in args.effect_file])
     if args.report is not None:
         check_output_dir(args.report, "--report")
         if args.json is not None and Path(args.report).resolve() in (Path(args.json).resolve(),

@@ -134,7 +134,7 @@ def _add_pattern_option(p: argparse.ArgumentParser) -> None:
 
 
 def cmd_fit(args: argparse.Namespace) -> int:
-    from camtube.commands.common import check_output_file, load_joint_pattern
+    from camtube.commands.common import check_output_file, load_joint_pattern, refuse_output_over_input
     from camtube.io import write_atomic
     from camtube.model.core.build import (
         build_registry, fitted_and_held, history_warning, parse_in_range, split_names,
@@ -148,9 +148,11 @@ def cmd_fit(args: argparse.Namespace) -> int:
 
     check_suffix(args.json, (".json",), "--json")
     check_suffix(args.plot, (".png",), "--plot")
+    inputs = [("DATA.csv", args.data), ("--pattern", args.pattern)] + [("--effect-file", f) for f in args.effect_file]
     for opt, path in (("--json", args.json), ("--plot", args.plot)):  # both written, or neither: checked first
         if path is not None:
             check_output_file(path, opt)
+            refuse_output_over_input(path, opt, inputs)
     if not 0 <= args.starts <= 50:
         raise DataError(f"--starts {args.starts}: allowed 0..50 grid points per parameter; fix: e.g. --starts 3 "
                         "(0: one start)")
