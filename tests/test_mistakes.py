@@ -458,3 +458,12 @@ def test_a_json_output_that_is_the_measurement_file(tmp_path, cmd):
     r = camtube("model", cmd, str(data), "--pattern", "tube2", "-q", "--json", str(data))
     assert_refused(r, f"--json {data}: is the input DATA.csv")
     assert data.read_bytes() == before
+
+
+@pytest.mark.parametrize("spec", ["9" * 5000, "last" + "9" * 5000], ids=["5000-digits", "last-5000-digits"])
+def test_a_cycle_selection_of_thousands_of_digits(tmp_path, spec):
+    """``--cycles 999...9`` (5000 digits) was a ValueError traceback from int()."""
+    data = tmp_path / "d.csv"
+    data.write_text("sample,cycle,time_s,stroke_mm,force_N,angle_deg\n1,1,0,0,0,0\n1,1,1,1,1,1\n")
+    r = camtube("model", "fit", str(data), "--pattern", "tube2", "--cycles", spec)
+    assert_refused(r, "cycle selection", "cannot read")

@@ -43,7 +43,9 @@ class CycleSpec:
         return m
 
 
-_ITEM = re.compile(r"^(?:(?P<all>all)|last\s*(?P<last>\d+)?|(?P<lo>\d+)?\s*(?P<dash>-)?\s*(?P<hi>\d+)?)$")
+#: Cycle numbers of up to 18 digits (a count of cycles; Python refuses to convert thousands of digits).
+_ITEM = re.compile(r"^(?:(?P<all>all)|last\s*(?P<last>\d{1,18})?"
+                   r"|(?P<lo>\d{1,18})?\s*(?P<dash>-)?\s*(?P<hi>\d{1,18})?)$")
 
 
 def parse_cycles(spec: str | None) -> CycleSpec:
