@@ -467,3 +467,11 @@ def test_a_cycle_selection_of_thousands_of_digits(tmp_path, spec):
     data.write_text("sample,cycle,time_s,stroke_mm,force_N,angle_deg\n1,1,0,0,0,0\n1,1,1,1,1,1\n")
     r = camtube("model", "fit", str(data), "--pattern", "tube2", "--cycles", spec)
     assert_refused(r, "cycle selection", "cannot read")
+
+
+def test_every_row_in_the_deadband_says_the_fix(tmp_path):
+    """An angle lag of 10^9 ms (--set-aside --lag-ms 1e9) left no row past the slack: 'try --no-deadband', no fix."""
+    data = tmp_path / "d.csv"
+    assert camtube("model", "synth", "--pattern", "tube2", "-o", str(data), "--cycles", "3").returncode == 0
+    r = camtube("model", "fit", str(data), "--pattern", "tube2", "-q", "--set-aside", "--lag-ms", "1e9")
+    assert_refused(r, "slack deadband", "fix: keep those rows with --no-deadband")
