@@ -475,3 +475,10 @@ def test_every_row_in_the_deadband_says_the_fix(tmp_path):
     assert camtube("model", "synth", "--pattern", "tube2", "-o", str(data), "--cycles", "3").returncode == 0
     r = camtube("model", "fit", str(data), "--pattern", "tube2", "-q", "--set-aside", "--lag-ms", "1e9")
     assert_refused(r, "slack deadband", "fix: keep those rows with --no-deadband")
+
+
+@pytest.mark.parametrize("opt,value", [("--rate", "1e-6"), ("--speed", "1e9")])
+def test_a_synthetic_sampling_too_coarse_says_the_fix(tmp_path, opt, value):
+    r = camtube("model", "synth", "--pattern", "tube2", "-o", str(tmp_path / "d.csv"), opt, value)
+    assert_refused(r, "rows per cycle", "fix: raise --rate or lower --speed")
+    assert listing(tmp_path) == []
