@@ -482,3 +482,12 @@ def test_a_synthetic_sampling_too_coarse_says_the_fix(tmp_path, opt, value):
     r = camtube("model", "synth", "--pattern", "tube2", "-o", str(tmp_path / "d.csv"), opt, value)
     assert_refused(r, "rows per cycle", "fix: raise --rate or lower --speed")
     assert listing(tmp_path) == []
+
+
+def test_a_drawing_named_with_a_folder_by_set_is_refused_before_planning(tmp_path):
+    """A DXF with ``--set name=runs/a`` planned the whole job, then failed in the writer with a ValueError
+    traceback; the YAML path refused the same name at once."""
+    drawing = ROOT / "examples" / "dxf" / "outline_layer0.dxf"
+    r = camtube("toolpath", str(drawing), "--set", "name=runs/a", "-q", "-o", str(tmp_path / "o"))
+    assert_refused(r, f"{drawing}", "name:", "must be a plain file name")
+    assert listing(tmp_path) == []

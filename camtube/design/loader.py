@@ -306,6 +306,7 @@ def build_settings(raw: dict, file: str | None = None) -> tuple[Tube, Process, T
     tendon = _section(r, raw, "tendon")
     proc = _section(r, raw, "process")
     rl = _section(r, raw, "rules")
+    check_name(r, raw.get("name"))
     if r.issues:
         raise PatternError(r.issues)
     return (Tube(tube["outer_radius"], tube["inner_radius"], tube["length"], tube["material"]), _process(proc),
