@@ -491,3 +491,26 @@ def test_a_drawing_named_with_a_folder_by_set_is_refused_before_planning(tmp_pat
     r = camtube("toolpath", str(drawing), "--set", "name=runs/a", "-q", "-o", str(tmp_path / "o"))
     assert_refused(r, f"{drawing}", "name:", "must be a plain file name")
     assert listing(tmp_path) == []
+
+
+def test_a_block_that_places_itself_is_refused_not_a_recursion_traceback(tmp_path):
+    """A block whose definition holds an INSERT of itself (a script's or a broken file's) was a RecursionError."""
+    import math
+
+    import ezdxf
+
+    doc = ezdxf.new("R2013", setup=False)
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    c = 2 * math.pi
+    msp.add_lwpolyline([(0, 0), (10, 0), (10, c), (0, c)], close=True)
+    msp.add_lwpolyline([(2, 2), (2.5, 2), (2.5, 4), (2, 4)], close=True, dxfattribs={"layer": "NOTCHES"})
+    blk = doc.blocks.new("SELF")
+    blk.add_line((0, 0), (0.1, 0.1))
+    blk.add_blockref("SELF", (0, 0))
+    msp.add_blockref("SELF", (6, 2))
+    drawing = tmp_path / "d.dxf"
+    doc.saveas(drawing)
+    r = camtube("toolpath", str(drawing), "-q", "-o", str(tmp_path / "o"))
+    assert_refused(r, str(drawing), "places block 'SELF' inside itself", "fix:")
+    assert listing(tmp_path) == ["d.dxf"]
