@@ -514,3 +514,14 @@ def test_a_block_that_places_itself_is_refused_not_a_recursion_traceback(tmp_pat
     r = camtube("toolpath", str(drawing), "-q", "-o", str(tmp_path / "o"))
     assert_refused(r, str(drawing), "places block 'SELF' inside itself", "fix:")
     assert listing(tmp_path) == ["d.dxf"]
+
+
+def test_a_drawing_finds_a_shipped_process_and_names_a_missing_one(tmp_path):
+    """With a DXF, ``--set process=femto-polyimide.yaml`` (the shipped process a YAML pattern finds anywhere) and
+    ``--set process=nothere.yaml`` were both 'file: cannot read pattern: No such file or directory'."""
+    drawing = tmp_path / "d.dxf"
+    drawing.write_bytes((ROOT / "examples" / "dxf" / "outline_layer0.dxf").read_bytes())
+    r = camtube("design", str(drawing), "--set", "process=femto-polyimide.yaml", "-q", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    r = camtube("design", str(drawing), "--set", "process=nothere.yaml", cwd=tmp_path)
+    assert_refused(r, f"{drawing}: process: names a process file that is not there", "femto-polyimide")
