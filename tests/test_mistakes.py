@@ -525,3 +525,15 @@ def test_a_drawing_finds_a_shipped_process_and_names_a_missing_one(tmp_path):
     assert r.returncode == 0, r.stderr
     r = camtube("design", str(drawing), "--set", "process=nothere.yaml", cwd=tmp_path)
     assert_refused(r, f"{drawing}: process: names a process file that is not there", "femto-polyimide")
+
+
+@pytest.mark.parametrize("params,words", [('{"E_t": -5}', ("parameter E_t = -5 GPa", "physical range")),
+                                          ('{"E_t": 20, "slack.deadband_mm": -0.1}', ("slack.deadband_mm = -0.1",)),
+                                          ('{"E_t": 20, "kerf.kerf_mm": 5}', ("kerf.kerf_mm = 5 mm",))])
+def test_a_calibration_with_an_unphysical_value_names_it(tmp_path, params, words):
+    """A calibration with E_t = -5 was used as given: 'the joint cannot take up the stroke (no finite force found)',
+    no fix; a kerf of 5 mm was blamed on --overcut, which was not given."""
+    cal = tmp_path / "c.json"
+    cal.write_text('{"params": %s}' % params)
+    r = camtube("design", TUBE1, "-q", "--stroke", "1", "--calibration", str(cal))
+    assert_refused(r, str(cal), *words)

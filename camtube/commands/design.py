@@ -117,6 +117,9 @@ def cmd_design(args: argparse.Namespace) -> int:
         mech = calib or Mechanics()
         overcut = args.overcut if args.overcut is not None else expected_overcut_mm(loaded.pattern.process, calib)
         if not 0.0 <= overcut < 0.5:
+            if args.overcut is None:  # from the calibration's kerf.kerf_mm
+                raise CamtubeError(f"{args.calibration}: kerf.kerf_mm = {overcut:g} mm, the overcut it gives, must be "
+                                   ">= 0 and < 0.5 mm; fix: pass --overcut MM, or a calibration with a physical kerf")
             raise CamtubeError(f"--overcut {overcut:g}: must be >= 0 and < 0.5 mm; fix: give the laser's overcut in mm")
         mech = replace(mech, kerf_mm=overcut, hinge=args.hinge)
     print(design_report(loaded.pattern))
