@@ -537,3 +537,13 @@ def test_a_calibration_with_an_unphysical_value_names_it(tmp_path, params, words
     cal.write_text('{"params": %s}' % params)
     r = camtube("design", TUBE1, "-q", "--stroke", "1", "--calibration", str(cal))
     assert_refused(r, str(cal), *words)
+
+
+def test_a_goal_with_an_empty_list_of_shares(tmp_path):
+    """``goal.distribution: []`` was a ValueError traceback from numpy ('zero-size array to reduction')."""
+    goal = tmp_path / "g.yaml"
+    goal.write_text((ROOT / "examples" / "goals" / "01-tube1-uniform-60.yaml").read_text()
+                    .replace("distribution: uniform", "distribution: []"))
+    r = camtube("synthesize", str(goal), "-o", str(tmp_path / "p.yaml"))
+    assert_refused(r, f"{goal}:7", "goal.distribution: an empty list of shares")
+    assert listing(tmp_path) == ["g.yaml"]
