@@ -161,3 +161,14 @@ def test_a_drawing_option_with_a_yaml_pattern_is_refused_not_ignored(tmp_path, o
     r = camtube("toolpath", TUBE1, "-q", "-o", str(tmp_path / "o"), opt, value)
     assert_refused(r, opt, "reads a DXF drawing", "fix: " + fix)
     assert listing(tmp_path) == []
+
+
+def test_a_job_beyond_the_machine_profiles_rotary_travel_is_refused(tmp_path):
+    """``rotary_range_deg: [0, 10]`` was read and never checked: the G-code turned A to 288 deg, exit 0."""
+    prof = tmp_path / "stage.yaml"
+    prof.write_text((ROOT / "machines" / "linuxcnc-rotary.yaml").read_text()
+                    .replace("rotary_range_deg: [-360, 720]", "rotary_range_deg: [0, 10]"))
+    r = camtube("toolpath", TUBE1, "-q", "--machine", str(prof), "-o", str(tmp_path / "o"))
+    assert_refused(r, str(prof), "outside the stage's travel rotary_range_deg = [0, 10] deg")
+    assert listing(tmp_path) == ["stage.yaml"]
+
