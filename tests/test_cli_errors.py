@@ -172,3 +172,11 @@ def test_a_job_beyond_the_machine_profiles_rotary_travel_is_refused(tmp_path):
     assert_refused(r, str(prof), "outside the stage's travel rotary_range_deg = [0, 10] deg")
     assert listing(tmp_path) == ["stage.yaml"]
 
+
+def test_too_few_decimals_in_a_machine_profile_are_named(tmp_path):
+    """``decimals: 4`` on the GRBL profile: '264 unsafe move(s)' and five lines of moves, no fix."""
+    prof = tmp_path / "bed.yaml"
+    prof.write_text((ROOT / "machines" / "grbl-flat.yaml").read_text().replace("decimals: 6", "decimals: 4"))
+    r = camtube("toolpath", TUBE1, "-q", "--machine", str(prof), "-o", str(tmp_path / "o"))
+    assert_refused(r, str(prof), "decimals = 4", "fix: set decimals: 6")
+    assert listing(tmp_path) == ["bed.yaml"]

@@ -210,7 +210,8 @@ def _check_machine_moves(job, dialect: Dialect, mv: Moves, mm: MachineMoves) -> 
     Raises
     ------
     SafetyError
-        A move leaves its cut (:func:`check_moves`). The rotary axis leaves the profile's
+        A move leaves its cut (:func:`check_moves`); when only the printed moves do, the profile's
+        ``decimals`` are named (the rounding moved the beam). The rotary axis leaves the profile's
         ``rotary_range_deg``.
     """
     from camtube.errors import SafetyError
@@ -229,7 +230,19 @@ def _check_machine_moves(job, dialect: Dialect, mv: Moves, mm: MachineMoves) -> 
                               f"the stage's travel rotary_range_deg = [{lo:g}, {hi:g}] deg (camtube keeps A within "
                               "-180..540 deg); nothing was written; fix: set rotary_range_deg to the stage's real "
                               "travel, or use a machine whose rotary axis turns that far")
-    check_moves(job, mm.unrolled())
+    try:
+        check_moves(job, mm.unrolled())
+    except SafetyError as exc:
+        if prof is None:
+            raise
+        try:
+            check_moves(job, mv)  # the moves before rounding: if they pass, the printed digits moved the beam
+        except SafetyError:
+            raise exc from None
+        first = str(exc).splitlines()[0]
+        raise SafetyError(f"{first}: {where}: coordinates printed with decimals = {prof.decimals} move the beam "
+                          f"outside the cuts (by up to {0.5 * 10.0 ** -prof.decimals:g} mm or deg); fix: set "
+                          "decimals: 6 in the machine profile") from None
 
 
 def _chunks(job, moves) -> Iterable[Moves]:
