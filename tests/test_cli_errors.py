@@ -180,3 +180,13 @@ def test_too_few_decimals_in_a_machine_profile_are_named(tmp_path):
     r = camtube("toolpath", TUBE1, "-q", "--machine", str(prof), "-o", str(tmp_path / "o"))
     assert_refused(r, str(prof), "decimals = 4", "fix: set decimals: 6")
     assert listing(tmp_path) == ["bed.yaml"]
+
+
+def test_two_laser_signals_on_one_analog_output_are_refused(tmp_path):
+    """``frequency_output: 0`` beside ``power_output: 0``: both written as M68 E0, each overwriting the other, exit 0."""
+    prof = tmp_path / "stage.yaml"
+    prof.write_text((ROOT / "machines" / "linuxcnc-rotary.yaml").read_text()
+                    .replace("frequency_output: 1 ", "frequency_output: 0 "))
+    r = camtube("toolpath", TUBE1, "-q", "--machine", str(prof), "-o", str(tmp_path / "o"))
+    assert_refused(r, f"{prof}:", "laser.frequency_output: is the same analog output as laser.power_output")
+    assert listing(tmp_path) == ["stage.yaml"]
