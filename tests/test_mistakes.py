@@ -547,3 +547,13 @@ def test_a_goal_with_an_empty_list_of_shares(tmp_path):
     r = camtube("synthesize", str(goal), "-o", str(tmp_path / "p.yaml"))
     assert_refused(r, f"{goal}:7", "goal.distribution: an empty list of shares")
     assert listing(tmp_path) == ["g.yaml"]
+
+
+@pytest.mark.parametrize("section", ["5", '{"leading": "stroke", "range": 5}', '{"leading": "stroke", "periodic": [5]}'])
+def test_a_diagnosis_json_whose_unexplained_section_was_edited(tmp_path, section):
+    """``model effect new NAME --from d.json`` with ``"unexplained": 5`` was a TypeError traceback."""
+    diag = tmp_path / "d.json"
+    diag.write_text('{"unexplained": %s}' % section)
+    r = camtube("model", "effect", "new", "mine", "--from", str(diag), cwd=tmp_path)
+    assert_refused(r, f"{diag}: the 'unexplained' section", "fix: write it again")
+    assert listing(tmp_path) == ["d.json"]
