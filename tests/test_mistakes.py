@@ -557,3 +557,10 @@ def test_a_diagnosis_json_whose_unexplained_section_was_edited(tmp_path, section
     r = camtube("model", "effect", "new", "mine", "--from", str(diag), cwd=tmp_path)
     assert_refused(r, f"{diag}: the 'unexplained' section", "fix: write it again")
     assert listing(tmp_path) == ["d.json"]
+
+
+def test_a_starter_effect_file_not_named_py_is_refused(tmp_path):
+    """``effect new mine --follows stroke -o mine.txt`` wrote a file --effect-file then could not import."""
+    r = camtube("model", "effect", "new", "mine", "--follows", "stroke", "-o", "mine.txt", cwd=tmp_path)
+    assert_refused(r, "-o mine.txt", "must end in .py", "fix: e.g. -o mine.py")
+    assert listing(tmp_path) == []

@@ -50,6 +50,10 @@ def cmd_effect_new(args: argparse.Namespace) -> int:
         raise DataError("model effect new: nothing to start from; fix: give --from DIAG.json, or --follows VARIABLE "
                         "(and optionally --stage)")
     out = Path(args.output or f"{args.name}.py")
+    if out.suffix != ".py" and not out.is_dir():  # --effect-file imports it: Python needs the .py suffix
+        example = out.with_suffix(".py").name if out.name not in ("", ".", "..") else "effect.py"
+        raise DataError(f"-o {out}: --effect-file loads the effect as a Python module, which must end in .py; "
+                        f"fix: e.g. -o {example}")
     if out.exists() and not args.overwrite:
         raise DataError(f"{out}: exists; fix: add --overwrite to replace it, or -o OTHER.py")
     print(f"wrote {write_atomic(out, text)}")
