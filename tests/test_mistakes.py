@@ -564,3 +564,18 @@ def test_a_starter_effect_file_not_named_py_is_refused(tmp_path):
     r = camtube("model", "effect", "new", "mine", "--follows", "stroke", "-o", "mine.txt", cwd=tmp_path)
     assert_refused(r, "-o mine.txt", "must end in .py", "fix: e.g. -o mine.py")
     assert listing(tmp_path) == []
+
+
+@pytest.mark.parametrize("params,words", [
+    ("Param('a', 'mm', 0, 1, 0.5, 'x'), Param('a', 'mm', 0, 2, 0.5, 'y')", ("two parameters are named 'a'",)),
+    ("Param('a', 'mm', float('nan'), 1, 0.5, 'x'),", ("has a NaN bound",)),
+], ids=["duplicate-name", "nan-bound"])
+def test_an_effect_file_with_clashing_or_nan_parameters(tmp_path, params, words):
+    """Two Params of one name (one value fitted for both) and a NaN bound were accepted, the fit ran, exit 0."""
+    data = tmp_path / "d.csv"
+    assert camtube("model", "synth", "--pattern", "tube2", "-o", str(data), "--cycles", "3").returncode == 0
+    eff = tmp_path / "mine.py"
+    eff.write_text("from camtube.model.api import Effect, Param\n"
+                   f"E = Effect(name='mine', stage='stroke', params=({params}), apply=lambda c, s, p: s)\n")
+    r = camtube("model", "fit", str(data), "--pattern", "tube2", "-q", "--effect-file", str(eff), "--effects", "mine")
+    assert_refused(r, f"{eff}:2", *words)
