@@ -448,6 +448,11 @@ def test_model_outputs_are_written_both_or_neither(tmp_path, cmd, outputs):
     assert listing(tmp_path) == ["data.csv"]
 
 
+def test_an_unwritable_json_output_names_the_option_and_the_file(tmp_path):
+    r = camtube("model", "fit", str(tmp_path / "d.csv"), "--pattern", "tube2", "--json", "/proc/camtube-x/f.json")
+    assert_refused(r, "--json /proc/camtube-x/f.json: cannot write")
+
+
 @pytest.mark.parametrize("cmd", ["fit", "diagnose"])
 def test_a_json_output_that_is_the_measurement_file(tmp_path, cmd):
     """Measurements saved as d.json and ``--json d.json``: the fit's summary replaced the data, exit 0."""

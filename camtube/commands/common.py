@@ -158,9 +158,14 @@ def check_output_file(path: str, option: str) -> None:
     """Refuse, before any work, an output file that names a directory or lies where nothing can be written."""
     from camtube.io import check_writable_dir
 
+    from camtube.io import OutputError
+
     if os.path.isdir(path):
         raise CamtubeError(f"{option} {path}: is a directory; fix: name a file")
-    check_writable_dir(os.path.dirname(os.path.abspath(path)))
+    try:
+        check_writable_dir(os.path.dirname(os.path.abspath(path)))
+    except OutputError as exc:  # name the file the user gave, not its folder
+        raise OutputError(f"{option} {path}", exc.reason, "give a file in a folder you can write to") from None
 
 
 def check_output_dir(path: str, option: str = "-o") -> None:
