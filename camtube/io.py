@@ -326,6 +326,10 @@ def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload]) -> list[P
     for name in files:
         if Path(name).name != name or name in ("", ".", ".."):
             raise ValueError(f"write_set: {name!r} is not a plain file name")
+        if (out / name).is_dir() and not (out / name).is_symlink():
+            # the swap would replace the folder and everything in it with the new file
+            raise OutputError(out / name, "a folder of that name is in the way of the output file",
+                              "move or rename the folder, or choose another output directory")
     parent = out.absolute().parent
     stage = None
     published = False

@@ -38,7 +38,24 @@ class StrictLoader(yaml.SafeLoader):
                 seen[key] = key_node.start_mark.line
         return super().construct_mapping(node, deep=deep)
 
+    def construct_yaml_int(self, node):
+        try:
+            return super().construct_yaml_int(node)
+        except ValueError:  # more digits than Python converts (sys.get_int_max_str_digits, 4300)
+            digits = sum(c.isdigit() for c in str(node.value))
+            raise NumberTooLongError(None, None, f"a whole number of {digits} digits is too long to read",
+                                     node.start_mark, digits=digits) from None
 
+
+class NumberTooLongError(yaml.constructor.ConstructorError):
+    """An integer with more digits than Python converts from text (thousands)."""
+
+    def __init__(self, *args, digits: int = 0):
+        super().__init__(*args)
+        self.digits = digits
+
+
+StrictLoader.add_constructor("tag:yaml.org,2002:int", StrictLoader.construct_yaml_int)
 StrictLoader.yaml_implicit_resolvers = {k: list(v) for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()}
 StrictLoader.add_implicit_resolver(
     "tag:yaml.org,2002:float",
@@ -100,7 +117,8 @@ def read_yaml_file(path: str | os.PathLike, what: str, fix: str | Callable[[], s
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
         fix_ = ("keep one of the two (a later key would silently replace the earlier one)" if "given twice" in problem
                 else "remove the runaway brackets or indentation (the file's keys nest a few levels)"
-                if isinstance(exc, TooDeepError) else "fix the syntax at the line shown")
+                if isinstance(exc, TooDeepError) else "write a number in the key's allowed range (camtube schema)"
+                if isinstance(exc, NumberTooLongError) else "fix the syntax at the line shown")
         raise PatternError([Issue("yaml", f"not valid YAML: {problem}", None, "YAML mapping", fix_, file,
                                   mark.line + 1 if mark else None)]) from None
     return raw, text

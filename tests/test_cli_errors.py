@@ -141,3 +141,52 @@ def test_calibration_without_stroke_says_the_fix():
     """Before: '...forward model: fix: add --stroke MM' (a colon, not '; fix:')."""
     r = camtube("design", TUBE1, "--calibration", "cal.json", "-q")
     assert_refused(r, "--calibration", "; fix: add --stroke MM")
+
+
+def test_a_folder_named_like_an_output_file_is_kept_and_refused(tmp_path):
+    """A folder ``out/tube1.ngc/`` was replaced by the new G-code, the files in it deleted, exit 0."""
+    (tmp_path / "out" / "tube1.ngc").mkdir(parents=True)
+    (tmp_path / "out" / "tube1.ngc" / "mine.txt").write_text("mine")
+    r = camtube("toolpath", TUBE1, "-o", str(tmp_path / "out"), "-q")
+    assert_refused(r, str(tmp_path / "out" / "tube1.ngc"), "a folder of that name")
+    assert listing(tmp_path) == ["out", "out/tube1.ngc", "out/tube1.ngc/mine.txt"]
+
+
+@pytest.mark.parametrize("opt,value,fix", [("--outer-radius", "0.8", "use --set tube.outer_radius=0.8"),
+                                           ("--length", "20", "use --set tube.length=20"),
+                                           ("--units", "inch", "remove --units"),
+                                           ("--layer", "CUTS=notch", "remove --layer")])
+def test_a_drawing_option_with_a_yaml_pattern_is_refused_not_ignored(tmp_path, opt, value, fix):
+    """``--outer-radius 0.8`` with a YAML pattern was silently ignored (r_o stayed 0.75, exit 0)."""
+    r = camtube("toolpath", TUBE1, "-q", "-o", str(tmp_path / "o"), opt, value)
+    assert_refused(r, opt, "reads a DXF drawing", "fix: " + fix)
+    assert listing(tmp_path) == []
+
+
+def test_a_job_beyond_the_machine_profiles_rotary_travel_is_refused(tmp_path):
+    """``rotary_range_deg: [0, 10]`` was read and never checked: the G-code turned A to 288 deg, exit 0."""
+    prof = tmp_path / "stage.yaml"
+    prof.write_text((ROOT / "machines" / "linuxcnc-rotary.yaml").read_text()
+                    .replace("rotary_range_deg: [-360, 720]", "rotary_range_deg: [0, 10]"))
+    r = camtube("toolpath", TUBE1, "-q", "--machine", str(prof), "-o", str(tmp_path / "o"))
+    assert_refused(r, str(prof), "outside the stage's travel rotary_range_deg = [0, 10] deg")
+    assert listing(tmp_path) == ["stage.yaml"]
+
+
+def test_too_few_decimals_in_a_machine_profile_are_named(tmp_path):
+    """``decimals: 4`` on the GRBL profile: '264 unsafe move(s)' and five lines of moves, no fix."""
+    prof = tmp_path / "bed.yaml"
+    prof.write_text((ROOT / "machines" / "grbl-flat.yaml").read_text().replace("decimals: 6", "decimals: 4"))
+    r = camtube("toolpath", TUBE1, "-q", "--machine", str(prof), "-o", str(tmp_path / "o"))
+    assert_refused(r, str(prof), "decimals = 4", "fix: set decimals: 6")
+    assert listing(tmp_path) == ["bed.yaml"]
+
+
+def test_two_laser_signals_on_one_analog_output_are_refused(tmp_path):
+    """``frequency_output: 0`` beside ``power_output: 0``: both written as M68 E0, each overwriting the other, exit 0."""
+    prof = tmp_path / "stage.yaml"
+    prof.write_text((ROOT / "machines" / "linuxcnc-rotary.yaml").read_text()
+                    .replace("frequency_output: 1 ", "frequency_output: 0 "))
+    r = camtube("toolpath", TUBE1, "-q", "--machine", str(prof), "-o", str(tmp_path / "o"))
+    assert_refused(r, f"{prof}:", "laser.frequency_output: is the same analog output as laser.power_output")
+    assert listing(tmp_path) == ["stage.yaml"]

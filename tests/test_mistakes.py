@@ -9,7 +9,7 @@ import signal
 import pytest
 
 from camtube.commands import main
-from tests.conftest import PATTERNS
+from tests.conftest import PATTERNS, ROOT
 from tests.test_cli_errors import TUBE1, assert_refused, camtube, listing
 
 
@@ -257,3 +257,330 @@ def test_a_pattern_name_that_is_not_a_plain_file_name(tmp_path, name):
     r = camtube("toolpath", str(p), "-o", str(tmp_path / "o"), "-q")
     assert_refused(r, f"{p}:1", "name:", "fix:")
     assert listing(tmp_path) == ["p.yaml"]
+
+
+@pytest.mark.parametrize("override", ["holes.1={x: 3, size: 0.3}", "process.repeat_rule.3={max_depth: 3, repeats: 9}"])
+def test_a_set_of_a_whole_list_entry_past_the_end_names_the_index(override):
+    """``--set holes.1=...`` (adding a second hole) was an IndexError traceback."""
+    assert_refused(camtube("design", TUBE1, "--set", override), "past the end of the list", "fix:")
+
+
+@pytest.mark.parametrize("entry", ["0.75", "[1, 2]"])
+def test_a_set_into_a_list_entry_that_is_not_a_mapping_names_the_entry(tmp_path, entry):
+    """``holes: [0.75]`` with ``--set holes.0.x=1`` was a TypeError traceback."""
+    p = tmp_path / "p.yaml"
+    p.write_text(pattern_text() + f"holes:\n  - {entry}\n")
+    assert_refused(camtube("design", str(p), "--set", "holes.0.x=1"), f"{p}:6", "holes[0]: expected a mapping")
+
+
+@pytest.mark.parametrize("index", ["\u00b2", "9" * 5000], ids=["superscript-two", "5000-digits"])
+def test_a_set_index_that_is_not_a_small_ascii_number(index):
+    """``'²'.isdigit()`` is true and ``int('9' * 5000)`` is refused by Python: both were tracebacks."""
+    r = camtube("design", TUBE1, "--set", f"holes.{index}.x=1")
+    assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+    assert "fix:" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_a_whole_number_of_thousands_of_digits(tmp_path):
+    """More digits than Python converts from text (4300) was a ValueError traceback from the YAML reader."""
+    big = "9" * 5000
+    p = tmp_path / "p.yaml"
+    p.write_text(pattern_text(count=big))
+    assert_refused(camtube("design", str(p)), f"{p}:3", "a whole number of 5000 digits", "fix:")
+    r = camtube("toolpath", TUBE1, "--set", f"notch.count={big}", "-o", str(tmp_path / "o"))
+    assert_refused(r, "notch.count", "out of range", "5000 digits")
+    assert listing(tmp_path) == ["p.yaml"]
+
+
+@pytest.mark.parametrize("argv", [
+    ["toolpath", TUBE1, "-o", "{tmp}/o", "--machine", ""],
+    ["design", TUBE1, "--stroke", "1", "--calibration", ""],
+    ["model", "fit", "{data}", "--pattern", "tube2", "--json", ""],
+    ["model", "fit", "{data}", "--pattern", "tube2", "--plot", ""],
+    ["model", "diagnose", "{data}", "--pattern", "tube2", "--report", " "],
+    ["model", "effect", "new", "drive", "--follows", "stroke", "-o", ""],
+], ids=["machine", "calibration", "fit-json", "fit-plot", "diagnose-report", "effect-output"])
+def test_an_empty_option_value_is_refused_not_taken_for_no_option(tmp_path, argv):
+    """``--machine "$MACHINE"`` with the variable unset: the option was dropped (the default machine, exit 0),
+    ``--json ''`` a ValueError traceback, ``--report ''`` no report and exit 0."""
+    data = tmp_path / "d.csv"
+    data.write_text("sample,cycle,time_s,stroke_mm,force_N,angle_deg\n1,1,0,0,0,0\n")
+    r = camtube(*[a.replace("{tmp}", str(tmp_path)).replace("{data}", str(data)) for a in argv], cwd=tmp_path)
+    assert_refused(r, "the path is empty")
+    assert listing(tmp_path) == ["d.csv"]
+
+
+@pytest.mark.parametrize("path,words", [(".", ("is a directory", "--json out.json")),
+                                        ("/", ("is a directory", "--json /out.json")),
+                                        ("..", ("is a directory",))])
+def test_a_json_output_that_is_a_folder_with_no_file_name(tmp_path, path, words):
+    """``--json .`` was a ValueError traceback from pathlib (a path with an empty name has no suffix to set)."""
+    data = tmp_path / "d.csv"
+    data.write_text("sample,cycle,time_s,stroke_mm,force_N,angle_deg\n1,1,0,0,0,0\n")
+    r = camtube("model", "fit", str(data), "--pattern", "tube2", "--json", path, cwd=tmp_path)
+    assert_refused(r, f"--json {path}", *words)
+    assert listing(tmp_path) == ["d.csv"]
+
+
+@pytest.mark.parametrize("argv,name", [(["design", ""], "PATTERN"), (["model", "fit", "", "--pattern", "tube2"], "DATA.csv"),
+                                       (["model", "synth", "--pattern", "", "-o", "d.csv"], "--pattern"),
+                                       (["synthesize", "", "-o", "p.yaml"], "GOAL.yaml")])
+def test_an_empty_input_path_is_named_not_called_the_working_directory(tmp_path, argv, name):
+    """``camtube design ''`` said '.: is a directory' (the empty path read as the working directory)."""
+    r = camtube(*argv, cwd=tmp_path)
+    assert_refused(r, f"argument {name}: the path is empty")
+    assert ".: is a directory" not in r.stderr and listing(tmp_path) == []
+
+
+BENCH = ROOT / "examples" / "bench"
+
+
+def ingest_argv(tmp_path, *extra) -> list[str]:
+    return ["model", "ingest", "--tracker", str(BENCH / "aurora-export.csv"), "--daq", str(BENCH / "daq.csv"),
+            "--motor", str(BENCH / "motor.csv"), "-o", str(tmp_path / "data.csv"), *extra]
+
+
+@pytest.mark.parametrize("extra,words", [("notes: 1\n", ("notes: unknown section",)),
+                                         ("angle: 3\n", ("angle: expected a mapping of keys, got 3",))])
+def test_a_bench_map_section_that_is_not_a_mapping(tmp_path, extra, words):
+    """An extra top-level key of the bench map (``notes: 1``) was a TypeError traceback."""
+    bench = tmp_path / "bench.yaml"
+    bench.write_text((BENCH / "bench.yaml").read_text() + extra)
+    r = camtube(*ingest_argv(tmp_path, "--bench", str(bench)))
+    assert_refused(r, str(bench), *words)
+    assert listing(tmp_path) == ["bench.yaml"]
+
+
+@pytest.mark.parametrize("role,content,words", [("daq", "", ("the file is empty", "fix: give the daq log")),
+                                                ("motor", "t_us,enc_counts\n", ("no data lines after the header",)),
+                                                ("tracker", None, ("no frames after the header",))])
+def test_an_empty_bench_log_says_the_fix(tmp_path, role, content, words):
+    """An empty DAQ or motor log, or a header-only tracker export, was refused without a fix."""
+    if content is None:
+        content = (BENCH / "aurora-export.csv").read_text().splitlines()[0] + "\n"
+    log = tmp_path / f"{role}.csv"
+    log.write_text(content)
+    argv = ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"))
+    argv[argv.index(f"--{role}") + 1] = str(log)
+    assert_refused(camtube(*argv), str(log), *words)
+    assert listing(tmp_path) == [f"{role}.csv"]
+
+
+def test_an_output_that_is_an_input_file_is_refused_and_the_input_kept(tmp_path):
+    """``synthesize goal.yaml -o goal.yaml``, ``dxf d.dxf -o d.dxf`` and ``model ingest --daq daq.csv -o daq.csv``
+    replaced the input with the output (the goal, the drawing, the raw log lost), exit 0."""
+    goal, drawing, daq = tmp_path / "g.yaml", tmp_path / "d.dxf", tmp_path / "daq.csv"
+    goal.write_text((ROOT / "examples" / "goals" / "01-tube1-uniform-60.yaml").read_text())
+    drawing.write_bytes((ROOT / "examples" / "dxf" / "four_lines.dxf").read_bytes())
+    daq.write_text((BENCH / "daq.csv").read_text())
+    before = {p: p.read_bytes() for p in (goal, drawing, daq)}
+    assert_refused(camtube("synthesize", str(goal), "-o", str(goal)), f"is the input GOAL.yaml {goal}")
+    assert_refused(camtube("dxf", str(drawing), "-o", str(drawing)), f"is the input PATTERN {drawing}")
+    argv = ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"))
+    argv[argv.index("--daq") + 1] = argv[argv.index("-o") + 1] = str(daq)
+    assert_refused(camtube(*argv), f"is the input --daq {daq}")
+    assert {p: p.read_bytes() for p in (goal, drawing, daq)} == before
+    assert listing(tmp_path) == ["d.dxf", "daq.csv", "g.yaml"]
+
+
+def test_an_ingest_report_folder_named_like_the_csv_is_refused_before_the_csv_is_written(tmp_path):
+    """``-o o.csv --report o.csv`` wrote o.csv, then failed on the report: half the outputs left behind."""
+    out = str(tmp_path / "data.csv")
+    r = camtube(*ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"), "--report", out))
+    assert_refused(r, f"--report {out}: is also the -o file")
+    assert listing(tmp_path) == []
+
+
+@pytest.mark.parametrize("sample,words", [("#1", ("--sample '#1' starts with '#'",)), ("", ("--sample '' is empty",)),
+                                          ("a\nb", ("holds a line break",))])
+def test_an_ingest_sample_name_that_would_break_the_csv(tmp_path, sample, words):
+    """``--sample '#1'`` wrote a CSV whose every row reads as a comment (model fit: 'no data rows'), exit 0;
+    ``--sample ''`` was taken for no name."""
+    r = camtube(*ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"), "--sample", sample))
+    assert_refused(r, *words)
+    assert listing(tmp_path) == []
+
+
+def test_a_measurement_file_whose_rows_all_start_with_a_hash_says_why(tmp_path):
+    data = tmp_path / "d.csv"
+    data.write_text("sample,cycle,time_s,stroke_mm,force_N,angle_deg\n#1,1,0,0,0,0\n#1,1,1,1,1,1\n")
+    r = camtube("model", "fit", str(data), "--pattern", "tube2")
+    assert_refused(r, f"{data}:1", "start with '#' and are read as comments")
+
+
+def test_nul_bytes_in_a_measurement_file_are_refused_not_read_as_a_sample_name(tmp_path):
+    """NULs in the sample cell (a logger's unfinished write) made a new sample '1\\x00\\x00...' and the fit ran, exit 0."""
+    data = tmp_path / "d.csv"
+    assert camtube("model", "synth", "--pattern", "tube2", "-o", str(data), "--cycles", "3").returncode == 0
+    lines = data.read_bytes().split(b"\n")
+    lines[12] = lines[12][:1] + b"\x00" * 8 + lines[12][1:]
+    data.write_bytes(b"\n".join(lines))
+    assert_refused(camtube("model", "fit", str(data), "--pattern", "tube2"), f"{data}:13", "NUL bytes")
+
+
+@pytest.mark.parametrize("cmd", [["model", "synth", "-o", "{tmp}/d.csv"], ["model", "fit", "{data}"],
+                                 ["model", "diagnose", "{data}"]], ids=["synth", "fit", "diagnose"])
+def test_a_model_command_on_a_pattern_without_notches(tmp_path, cmd):
+    """``--set notch.count=0`` (or a pattern of holes only) was a ValueError traceback from the joint geometry."""
+    data = tmp_path / "data.csv"
+    data.write_text("sample,cycle,time_s,stroke_mm,force_N,angle_deg\n1,1,0,0,0,0\n1,1,1,1,1,1\n")
+    argv = [a.replace("{tmp}", str(tmp_path)).replace("{data}", str(data)) for a in cmd]
+    r = camtube(*argv, "--pattern", "tube2", "--set", "notch.count=0")
+    assert_refused(r, "tube2: notch.count: the pattern has no notches")
+    assert listing(tmp_path) == ["data.csv"]
+
+
+@pytest.mark.parametrize("cmd,outputs", [
+    (["model", "fit", "{data}", "--json", "{tmp}/fit.json", "--plot", "/proc/camtube-x/fit.png"], "--plot"),
+    (["model", "diagnose", "{data}", "--max-rows", "300", "--json", "{tmp}/d.json", "--report", "/proc/camtube-x/rep"],
+     "--report"),
+    (["model", "diagnose", "{data}", "--max-rows", "300", "--json", "{tmp}/d.json", "--report", "{tmp}/d.json"],
+     "--report"),
+], ids=["fit-plot-unwritable", "diagnose-report-unwritable", "diagnose-report-is-the-json"])
+def test_model_outputs_are_written_both_or_neither(tmp_path, cmd, outputs):
+    """The --json was written, then the --plot or --report failed (after the whole fit or diagnosis): one output of
+    two left behind. Now where both go is checked before the work."""
+    data = tmp_path / "data.csv"
+    assert camtube("model", "synth", "--pattern", "tube2", "-o", str(data), "--cycles", "4").returncode == 0
+    argv = [a.replace("{tmp}", str(tmp_path)).replace("{data}", str(data)) for a in cmd]
+    r = camtube(*argv, "--pattern", "tube2", "-q")
+    assert r.returncode == 2 and "Traceback" not in r.stderr and "fix:" in r.stderr, r.stderr
+    assert listing(tmp_path) == ["data.csv"]
+
+
+def test_an_unwritable_json_output_names_the_option_and_the_file(tmp_path):
+    r = camtube("model", "fit", str(tmp_path / "d.csv"), "--pattern", "tube2", "--json", "/proc/camtube-x/f.json")
+    assert_refused(r, "--json /proc/camtube-x/f.json: cannot write")
+
+
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+def test_a_json_output_that_is_the_measurement_file(tmp_path, cmd):
+    """Measurements saved as d.json and ``--json d.json``: the fit's summary replaced the data, exit 0."""
+    data = tmp_path / "d.json"
+    assert camtube("model", "synth", "--pattern", "tube2", "-o", str(tmp_path / "d.csv"), "--cycles", "3").returncode == 0
+    (tmp_path / "d.csv").rename(data)
+    before = data.read_bytes()
+    r = camtube("model", cmd, str(data), "--pattern", "tube2", "-q", "--json", str(data))
+    assert_refused(r, f"--json {data}: is the input DATA.csv")
+    assert data.read_bytes() == before
+
+
+@pytest.mark.parametrize("spec", ["9" * 5000, "last" + "9" * 5000], ids=["5000-digits", "last-5000-digits"])
+def test_a_cycle_selection_of_thousands_of_digits(tmp_path, spec):
+    """``--cycles 999...9`` (5000 digits) was a ValueError traceback from int()."""
+    data = tmp_path / "d.csv"
+    data.write_text("sample,cycle,time_s,stroke_mm,force_N,angle_deg\n1,1,0,0,0,0\n1,1,1,1,1,1\n")
+    r = camtube("model", "fit", str(data), "--pattern", "tube2", "--cycles", spec)
+    assert_refused(r, "cycle selection", "cannot read")
+
+
+def test_every_row_in_the_deadband_says_the_fix(tmp_path):
+    """An angle lag of 10^9 ms (--set-aside --lag-ms 1e9) left no row past the slack: 'try --no-deadband', no fix."""
+    data = tmp_path / "d.csv"
+    assert camtube("model", "synth", "--pattern", "tube2", "-o", str(data), "--cycles", "3").returncode == 0
+    r = camtube("model", "fit", str(data), "--pattern", "tube2", "-q", "--set-aside", "--lag-ms", "1e9")
+    assert_refused(r, "slack deadband", "fix: keep those rows with --no-deadband")
+
+
+@pytest.mark.parametrize("opt,value", [("--rate", "1e-6"), ("--speed", "1e9")])
+def test_a_synthetic_sampling_too_coarse_says_the_fix(tmp_path, opt, value):
+    r = camtube("model", "synth", "--pattern", "tube2", "-o", str(tmp_path / "d.csv"), opt, value)
+    assert_refused(r, "rows per cycle", "fix: raise --rate or lower --speed")
+    assert listing(tmp_path) == []
+
+
+def test_a_drawing_named_with_a_folder_by_set_is_refused_before_planning(tmp_path):
+    """A DXF with ``--set name=runs/a`` planned the whole job, then failed in the writer with a ValueError
+    traceback; the YAML path refused the same name at once."""
+    drawing = ROOT / "examples" / "dxf" / "outline_layer0.dxf"
+    r = camtube("toolpath", str(drawing), "--set", "name=runs/a", "-q", "-o", str(tmp_path / "o"))
+    assert_refused(r, f"{drawing}", "name:", "must be a plain file name")
+    assert listing(tmp_path) == []
+
+
+def test_a_block_that_places_itself_is_refused_not_a_recursion_traceback(tmp_path):
+    """A block whose definition holds an INSERT of itself (a script's or a broken file's) was a RecursionError."""
+    import math
+
+    import ezdxf
+
+    doc = ezdxf.new("R2013", setup=False)
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    c = 2 * math.pi
+    msp.add_lwpolyline([(0, 0), (10, 0), (10, c), (0, c)], close=True)
+    msp.add_lwpolyline([(2, 2), (2.5, 2), (2.5, 4), (2, 4)], close=True, dxfattribs={"layer": "NOTCHES"})
+    blk = doc.blocks.new("SELF")
+    blk.add_line((0, 0), (0.1, 0.1))
+    blk.add_blockref("SELF", (0, 0))
+    msp.add_blockref("SELF", (6, 2))
+    drawing = tmp_path / "d.dxf"
+    doc.saveas(drawing)
+    r = camtube("toolpath", str(drawing), "-q", "-o", str(tmp_path / "o"))
+    assert_refused(r, str(drawing), "places block 'SELF' inside itself", "fix:")
+    assert listing(tmp_path) == ["d.dxf"]
+
+
+def test_a_drawing_finds_a_shipped_process_and_names_a_missing_one(tmp_path):
+    """With a DXF, ``--set process=femto-polyimide.yaml`` (the shipped process a YAML pattern finds anywhere) and
+    ``--set process=nothere.yaml`` were both 'file: cannot read pattern: No such file or directory'."""
+    drawing = tmp_path / "d.dxf"
+    drawing.write_bytes((ROOT / "examples" / "dxf" / "outline_layer0.dxf").read_bytes())
+    r = camtube("design", str(drawing), "--set", "process=femto-polyimide.yaml", "-q", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    r = camtube("design", str(drawing), "--set", "process=nothere.yaml", cwd=tmp_path)
+    assert_refused(r, f"{drawing}: process: names a process file that is not there", "femto-polyimide")
+
+
+@pytest.mark.parametrize("params,words", [('{"E_t": -5}', ("parameter E_t = -5 GPa", "physical range")),
+                                          ('{"E_t": 20, "slack.deadband_mm": -0.1}', ("slack.deadband_mm = -0.1",)),
+                                          ('{"E_t": 20, "kerf.kerf_mm": 5}', ("kerf.kerf_mm = 5 mm",))])
+def test_a_calibration_with_an_unphysical_value_names_it(tmp_path, params, words):
+    """A calibration with E_t = -5 was used as given: 'the joint cannot take up the stroke (no finite force found)',
+    no fix; a kerf of 5 mm was blamed on --overcut, which was not given."""
+    cal = tmp_path / "c.json"
+    cal.write_text('{"params": %s}' % params)
+    r = camtube("design", TUBE1, "-q", "--stroke", "1", "--calibration", str(cal))
+    assert_refused(r, str(cal), *words)
+
+
+def test_a_goal_with_an_empty_list_of_shares(tmp_path):
+    """``goal.distribution: []`` was a ValueError traceback from numpy ('zero-size array to reduction')."""
+    goal = tmp_path / "g.yaml"
+    goal.write_text((ROOT / "examples" / "goals" / "01-tube1-uniform-60.yaml").read_text()
+                    .replace("distribution: uniform", "distribution: []"))
+    r = camtube("synthesize", str(goal), "-o", str(tmp_path / "p.yaml"))
+    assert_refused(r, f"{goal}:7", "goal.distribution: an empty list of shares")
+    assert listing(tmp_path) == ["g.yaml"]
+
+
+@pytest.mark.parametrize("section", ["5", '{"leading": "stroke", "range": 5}', '{"leading": "stroke", "periodic": [5]}'])
+def test_a_diagnosis_json_whose_unexplained_section_was_edited(tmp_path, section):
+    """``model effect new NAME --from d.json`` with ``"unexplained": 5`` was a TypeError traceback."""
+    diag = tmp_path / "d.json"
+    diag.write_text('{"unexplained": %s}' % section)
+    r = camtube("model", "effect", "new", "mine", "--from", str(diag), cwd=tmp_path)
+    assert_refused(r, f"{diag}: the 'unexplained' section", "fix: write it again")
+    assert listing(tmp_path) == ["d.json"]
+
+
+def test_a_starter_effect_file_not_named_py_is_refused(tmp_path):
+    """``effect new mine --follows stroke -o mine.txt`` wrote a file --effect-file then could not import."""
+    r = camtube("model", "effect", "new", "mine", "--follows", "stroke", "-o", "mine.txt", cwd=tmp_path)
+    assert_refused(r, "-o mine.txt", "must end in .py", "fix: e.g. -o mine.py")
+    assert listing(tmp_path) == []
+
+
+@pytest.mark.parametrize("params,words", [
+    ("Param('a', 'mm', 0, 1, 0.5, 'x'), Param('a', 'mm', 0, 2, 0.5, 'y')", ("two parameters are named 'a'",)),
+    ("Param('a', 'mm', float('nan'), 1, 0.5, 'x'),", ("has a NaN bound",)),
+], ids=["duplicate-name", "nan-bound"])
+def test_an_effect_file_with_clashing_or_nan_parameters(tmp_path, params, words):
+    """Two Params of one name (one value fitted for both) and a NaN bound were accepted, the fit ran, exit 0."""
+    data = tmp_path / "d.csv"
+    assert camtube("model", "synth", "--pattern", "tube2", "-o", str(data), "--cycles", "3").returncode == 0
+    eff = tmp_path / "mine.py"
+    eff.write_text("from camtube.model.api import Effect, Param\n"
+                   f"E = Effect(name='mine', stage='stroke', params=({params}), apply=lambda c, s, p: s)\n")
+    r = camtube("model", "fit", str(data), "--pattern", "tube2", "-q", "--effect-file", str(eff), "--effects", "mine")
+    assert_refused(r, f"{eff}:2", *words)

@@ -13,9 +13,17 @@ from camtube.io import PublishedInterrupt
 LAYER_ROLES = ("notch", "hole", "slit", "ignore")
 
 
+def path_value(value: str) -> str:
+    """argparse ``type`` of an option naming a file or folder: an empty value (``--json ''``, an unset
+    shell variable) is refused, not taken as "option not given"."""
+    if not value.strip():
+        raise argparse.ArgumentTypeError(f"the path is empty ({value!r}): give a file or folder name")
+    return value
+
+
 def add_pattern_argument(parser: argparse.ArgumentParser) -> None:
     """Add ``PATTERN``, repeatable ``--set KEY=VALUE``, ``-q`` and the drawing options to a sub-command."""
-    parser.add_argument("pattern", metavar="PATTERN",
+    parser.add_argument("pattern", type=path_value, metavar="PATTERN",
                         help="pattern YAML file, a preset name (tube1, tube2, tube3, tube1-bidirectional) "
                              "or a DXF drawing of the unrolled tube")
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
@@ -57,7 +65,7 @@ def drawing_options(args: argparse.Namespace):
 def load_from_args(args: argparse.Namespace) -> Loaded:
     """Load the pattern or drawing named by ``args``; print the import summary and design warnings to stderr."""
     from camtube.design.loader import preset_names, resolve_preset
-    from camtube.design.source import load_source
+    from camtube.design.source import is_drawing, load_source
 
     path = str(resolve_preset(args.pattern))
     if not os.path.exists(path):
@@ -65,7 +73,10 @@ def load_from_args(args: argparse.Namespace) -> Loaded:
                            f"drawing, or a preset name ({', '.join(preset_names())})")
     if os.path.isdir(path):
         raise CamtubeError(f"{path}: is a directory; fix: give the path of a pattern YAML or a DXF drawing")
-    loaded = load_source(path, args.overrides, drawing_options(args))
+    options = drawing_options(args)
+    if not is_drawing(path):
+        _refuse_drawing_options(args, path)
+    loaded = load_source(path, args.overrides, options)
     if not getattr(args, "quiet", False):
         summary = getattr(loaded, "summary", "")
         if summary:
@@ -73,6 +84,30 @@ def load_from_args(args: argparse.Namespace) -> Loaded:
         for w in loaded.warnings:
             print(f"warning: {w}", file=sys.stderr)
     return loaded
+
+
+def load_joint_pattern(args: argparse.Namespace):
+    """The pattern of a ``model`` command (``--pattern``): it must have notches, the joint the model describes."""
+    pattern = load_from_args(args).pattern
+    if not pattern.notches:
+        raise CamtubeError(f"{args.pattern}: notch.count: the pattern has no notches, so there is no joint to model; "
+                           "fix: give the pattern of the measured joint (notch.count >= 1, or cuts:)")
+    return pattern
+
+
+def _refuse_drawing_options(args: argparse.Namespace, path: str) -> None:
+    """A drawing option given with a YAML pattern would be ignored: refuse it, saying what to write instead."""
+    for opt, key in (("outer_radius", "tube.outer_radius"), ("length", "tube.length")):
+        v = getattr(args, opt, None)
+        if v is not None:
+            raise CamtubeError(f"--{opt.replace('_', '-')} {v:g}: reads a DXF drawing, but {path} is a pattern YAML, "
+                               f"whose {key} it would not change; fix: use --set {key}={v:g}")
+    if getattr(args, "units", None) is not None:
+        raise CamtubeError(f"--units {args.units}: reads a DXF drawing, but {path} is a pattern YAML (always mm); "
+                           "fix: remove --units")
+    if getattr(args, "layers", None):
+        raise CamtubeError(f"--layer {args.layers[0]}: reads a DXF drawing, but {path} is a pattern YAML (no layers); "
+                           "fix: remove --layer")
 
 
 def add_cad_options(p: argparse.ArgumentParser) -> None:
@@ -101,6 +136,38 @@ def cad_options(args: argparse.Namespace):
                       kerf_mm=args.kerf)
 
 
+def refuse_output_over_input(output: str, option: str, inputs) -> None:
+    """Refuse an output file that is one of the command's input files (``synthesize goal.yaml -o goal.yaml``,
+    ``model ingest ... --daq daq.csv -o daq.csv``): writing it would destroy the input.
+
+    ``inputs`` holds ``(option, path or None)`` pairs; the same file under another name (a link) counts too.
+    """
+    for opt, path in inputs:
+        if not path or not os.path.exists(output) or not os.path.exists(path):
+            continue
+        try:
+            same = os.path.samefile(output, path)
+        except OSError:
+            continue
+        if same:
+            raise CamtubeError(f"{option} {output}: is the input {opt} {path}, which writing would replace; "
+                               "fix: name another output file")
+
+
+def check_output_file(path: str, option: str) -> None:
+    """Refuse, before any work, an output file that names a directory or lies where nothing can be written."""
+    from camtube.io import check_writable_dir
+
+    from camtube.io import OutputError
+
+    if os.path.isdir(path):
+        raise CamtubeError(f"{option} {path}: is a directory; fix: name a file")
+    try:
+        check_writable_dir(os.path.dirname(os.path.abspath(path)))
+    except OutputError as exc:  # name the file the user gave, not its folder
+        raise OutputError(f"{option} {path}", exc.reason, "give a file in a folder you can write to") from None
+
+
 def check_output_dir(path: str, option: str = "-o") -> None:
     """Refuse, before any work, an output directory that names a file or cannot be written."""
     from camtube.io import check_writable_dir
@@ -122,7 +189,7 @@ def run_outputs(args: argparse.Namespace, what: str) -> int:
     check_output_dir(args.output)
     loaded = load_from_args(args)
     dialects = None if getattr(args, "dialect", "all") == "all" else (DIALECTS[args.dialect],)
-    if getattr(args, "machine", None):
+    if getattr(args, "machine", None) is not None:
         from camtube.export.dialects import dialect_from_profile
         from camtube.machine import load_profile
 

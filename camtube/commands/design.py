@@ -5,7 +5,7 @@ import argparse
 import math
 from pathlib import Path
 
-from camtube.commands.common import add_pattern_argument, load_from_args
+from camtube.commands.common import add_pattern_argument, load_from_args, path_value, refuse_output_over_input
 from camtube.errors import CamtubeError
 
 
@@ -17,7 +17,7 @@ def register(sub) -> None:
     p.add_argument("--stroke", type=float, metavar="MM",
                    help="also print the notch-by-notch forward model at this tendon stroke (mm): per-notch angles "
                         "and strain, tendon force, tip position and direction, one tendon pulled at a time")
-    p.add_argument("--calibration", metavar="FIT.json",
+    p.add_argument("--calibration", type=path_value, metavar="FIT.json",
                    help="with --stroke: use the parameters of a 'camtube model fit/diagnose --json' file")
     p.add_argument("--hinge", choices=("fe_row", "beam", "fe_fit"), default="fe_row",
                    help="with --stroke: notch stiffness: E I over h plus a root length that shrinks with the webs "
@@ -117,6 +117,9 @@ def cmd_design(args: argparse.Namespace) -> int:
         mech = calib or Mechanics()
         overcut = args.overcut if args.overcut is not None else expected_overcut_mm(loaded.pattern.process, calib)
         if not 0.0 <= overcut < 0.5:
+            if args.overcut is None:  # from the calibration's kerf.kerf_mm
+                raise CamtubeError(f"{args.calibration}: kerf.kerf_mm = {overcut:g} mm, the overcut it gives, must be "
+                                   ">= 0 and < 0.5 mm; fix: pass --overcut MM, or a calibration with a physical kerf")
             raise CamtubeError(f"--overcut {overcut:g}: must be >= 0 and < 0.5 mm; fix: give the laser's overcut in mm")
         mech = replace(mech, kerf_mm=overcut, hinge=args.hinge)
     print(design_report(loaded.pattern))
@@ -143,6 +146,7 @@ def cmd_dxf(args: argparse.Namespace) -> int:
 
     if Path(args.output).suffix.lower() != ".dxf":
         raise CamtubeError(f"{args.output}: dxf writes a DXF drawing; fix: name the output OUT.dxf")
+    refuse_output_over_input(args.output, "-o", [("PATTERN", args.pattern)])
     loaded = load_from_args(args)
     text = design_dxf(loaded.pattern)
     path = write_atomic(args.output, text)

@@ -10,6 +10,8 @@ import dataclasses
 import shlex
 from pathlib import Path
 
+from camtube.commands.common import path_value
+
 
 def register(model_sub) -> None:
     from camtube.model import EFFECT_NAMES
@@ -22,9 +24,10 @@ def register(model_sub) -> None:
                     "recommend only effects whose gain beats the noise, whose parameters are identified and "
                     "resolvable, and whose refit on all rows lowers the RMSE; test per-sample values; print the "
                     "model fit command that reproduces the result. Angles deg, strokes mm, forces N.")
-    d.add_argument("data", metavar="DATA.csv",
+    d.add_argument("data", type=path_value, metavar="DATA.csv",
                    help="columns sample, cycle, time_s, stroke_mm, force_N, angle_deg")
-    d.add_argument("--pattern", required=True, metavar="PATTERN", help="pattern YAML of the joint (see patterns/)")
+    d.add_argument("--pattern", required=True, type=path_value, metavar="PATTERN",
+                   help="pattern YAML of the joint (see patterns/)")
     d.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a pattern scalar, e.g. --set tendon.length=80")
     d.add_argument("-q", "--quiet", action="store_true", help="do not print design warnings")
@@ -65,8 +68,8 @@ def register(model_sub) -> None:
     d.add_argument("--no-rezero", dest="rezero", action="store_false",
                    help="keep the force as read where the load cell's zero drifts (default: re-zero it at every rest, "
                         "motor at zero and tendon slack, when the rests show a smooth drift from a zeroed cell)")
-    d.add_argument("--json", metavar="OUT.json", help="write the diagnosis as JSON")
-    d.add_argument("--report", metavar="DIR", help="write an HTML report with PNG plots into DIR")
+    d.add_argument("--json", type=path_value, metavar="OUT.json", help="write the diagnosis as JSON")
+    d.add_argument("--report", type=path_value, metavar="DIR", help="write an HTML report with PNG plots into DIR")
     d.set_defaults(func=cmd_diagnose)
 
 
@@ -114,20 +117,34 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 
 
 def _diagnose(args: argparse.Namespace) -> int:
-    from camtube.commands.common import load_from_args
+    from camtube.commands.common import (
+        check_output_dir, check_output_file, load_joint_pattern, refuse_output_over_input,
+    )
     from camtube.errors import DataError
-    from camtube.io import write_atomic
+    from camtube.io import write_atomic, write_set
     from camtube.model.core.build import build_registry, check_suffix, fitted_and_held, parse_in_range, split_names
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import check_fittable, read_measurements, select_cycles
     from camtube.model.data.csvfile import check_force_identifies
     from camtube.model.diagnose import diagnose
     from camtube.model.diagnose.instruments import check_instruments, confirm_lag
-    from camtube.model.report.diagnosis import diagnosis_json, diagnosis_text, write_report
+    from camtube.model.report.diagnosis import diagnosis_json, diagnosis_text, report_files
 
     check_suffix(args.json, (".json",), "--json")
     if args.report is not None and Path(args.report).exists() and not Path(args.report).is_dir():
-        raise DataError(f"--report {args.report}: is a file; the report is a directory (index.html and PNGs)")
+        raise DataError(f"--report {args.report}: is a file; the report is a directory (index.html and PNGs); "
+                        "fix: name a directory (new or existing)")
+    # --json and --report are written both or neither: where they go is checked before the work
+    if args.json is not None:
+        check_output_file(args.json, "--json")
+        refuse_output_over_input(args.json, "--json", [("DATA.csv", args.data), ("--pattern", args.pattern)]
+                                 + [("--effect-file", f) for f in args.effect_file])
+    if args.report is not None:
+        check_output_dir(args.report, "--report")
+        if args.json is not None and Path(args.report).resolve() in (Path(args.json).resolve(),
+                                                                     *Path(args.json).resolve().parents):
+            raise DataError(f"--json {args.json}: is or lies in the --report folder {args.report}; fix: write the "
+                            "JSON beside the report folder, not inside it")
     for opt, v, eg in (("--max-rows", args.max_rows, "4000 (0 = all rows)"), ("--max-effects", args.max_effects, "4")):
         if v < 0:
             raise DataError(f"{opt} {v}: must be >= 0; fix: e.g. {opt} {eg}")
@@ -139,7 +156,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     if not 0 < lo < hi < float("inf"):
         raise DataError(f"--modulus-range {args.modulus_range!r}: need finite 0 < LO < HI (GPa); fix: e.g. "
                         "--modulus-range 1,300")
-    pattern = load_from_args(args).pattern
+    pattern = load_joint_pattern(args)
     reg, _ = build_registry(args.effect_file)
     model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects, "--effects")])
     # every parameter the model or a candidate has (its range), checked before the data are read
@@ -167,8 +184,10 @@ def _diagnose(args: argparse.Namespace) -> int:
     title = f"{pattern.name}: {args.data} ({len(rows)} rows, cycles {args.cycles}, both directions, deadband kept)"
     print(diagnosis_text(d, prefix, title))
     meta = {"pattern": pattern.name, "data": str(args.data), "cycles": args.cycles}
+    files = report_files(d, prefix, title) if args.report else None  # made before anything is written
     if args.json:
         print(f"wrote {write_atomic(args.json, diagnosis_json(d, prefix, meta))}")
-    if args.report:
-        print(f"wrote {write_report(d, args.report, prefix, title)}")
+    if files is not None:
+        write_set(args.report, files)
+        print(f"wrote {Path(args.report) / 'index.html'}")
     return 0

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 
+from camtube.commands.common import path_value
 from camtube.model.unexplained.analysis import VARIABLES
 
 
@@ -29,7 +30,7 @@ def register_effect_commands(subparsers) -> None:
     n.add_argument("--stage", choices=("force", "stroke", "elongation", "kinematics", "angle"),
                    help="stage to act on (default: the one the diagnosis suggests)")
     n.add_argument("--follows", choices=VARIABLES, help="variable the effect follows (default: the diagnosis's lead)")
-    n.add_argument("-o", "--output", metavar="OUT.py", help="file to write (default NAME.py)")
+    n.add_argument("-o", "--output", type=path_value, metavar="OUT.py", help="file to write (default NAME.py)")
     n.add_argument("--overwrite", action="store_true", help="replace an existing file")
     n.set_defaults(func=cmd_effect_new)
 
@@ -49,6 +50,10 @@ def cmd_effect_new(args: argparse.Namespace) -> int:
         raise DataError("model effect new: nothing to start from; fix: give --from DIAG.json, or --follows VARIABLE "
                         "(and optionally --stage)")
     out = Path(args.output or f"{args.name}.py")
+    if out.suffix != ".py" and not out.is_dir():  # --effect-file imports it: Python needs the .py suffix
+        example = out.with_suffix(".py").name if out.name not in ("", ".", "..") else "effect.py"
+        raise DataError(f"-o {out}: --effect-file loads the effect as a Python module, which must end in .py; "
+                        f"fix: e.g. -o {example}")
     if out.exists() and not args.overwrite:
         raise DataError(f"{out}: exists; fix: add --overwrite to replace it, or -o OTHER.py")
     print(f"wrote {write_atomic(out, text)}")

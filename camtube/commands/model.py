@@ -10,6 +10,8 @@ from __future__ import annotations
 import argparse
 import importlib
 
+from camtube.commands.common import path_value
+from camtube.errors import CamtubeError
 from camtube.model import EFFECT_NAMES
 
 
@@ -31,7 +33,7 @@ def register(sub) -> None:
         description="Compare the paper's model L_t = (ybar + r_i - r_t) theta + F L0 / (E_t pi r_t^2) with "
                     "measured stroke, force and angle. By default, like the paper: each sample's last "
                     "loading cycle, slack deadband removed, E_t fitted, L0 and E_t start from the pattern.")
-    f.add_argument("data", metavar="DATA.csv",
+    f.add_argument("data", type=path_value, metavar="DATA.csv",
                    help="columns sample, cycle, time_s, stroke_mm, force_N, angle_deg (extra columns kept)")
     _add_pattern_option(f)
     f.add_argument("--cycles", default="last", metavar="SPEC",
@@ -68,8 +70,8 @@ def register(sub) -> None:
     f.add_argument("--rezero", action="store_true",
                    help="with --set-aside: re-zero the force at every rest where the load cell's zero drifts, as "
                         "model diagnose does")
-    f.add_argument("--json", metavar="OUT.json", help="write the summary as JSON")
-    f.add_argument("--plot", metavar="OUT.png", help="write angle and residual vs stroke (PNG)")
+    f.add_argument("--json", type=path_value, metavar="OUT.json", help="write the summary as JSON")
+    f.add_argument("--plot", type=path_value, metavar="OUT.png", help="write angle and residual vs stroke (PNG)")
     f.set_defaults(func=cmd_fit)
 
     s = model_sub.add_parser(
@@ -77,7 +79,7 @@ def register(sub) -> None:
         description="Triangular stroke 0 -> rules.max_stroke -> 0 at a lead-screw speed, force from the "
                     "joint bending stiffness (E_pi 2.5 GPa), Gaussian EM-tracker and load-cell noise.")
     _add_pattern_option(s)
-    s.add_argument("-o", "--output", required=True, metavar="DATA.csv", help="output CSV file")
+    s.add_argument("-o", "--output", required=True, type=path_value, metavar="DATA.csv", help="output CSV file")
     s.add_argument("--samples", type=int, default=2, help="number of samples (default 2)")
     s.add_argument("--cycles", type=int, default=50, help="cycles per sample (default 50)")
     s.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
@@ -111,8 +113,10 @@ def register(sub) -> None:
     i.add_argument("--sample", default=None, metavar="NAME", help="sample name (default: the tracker file's stem)")
     i.add_argument("--max-lag", type=float, default=None, metavar="S",
                    help="largest clock offset between instruments to consider, s (default: any)")
-    i.add_argument("-o", "--output", required=True, metavar="DATA.csv", help="the measurement CSV to write")
-    i.add_argument("--report", metavar="DIR", help="write index.html and figures (alignment, angle, dropouts) here")
+    i.add_argument("-o", "--output", required=True, type=path_value, metavar="DATA.csv",
+                   help="the measurement CSV to write")
+    i.add_argument("--report", type=path_value, metavar="DIR",
+                   help="write index.html and figures (alignment, angle, dropouts) here")
     i.set_defaults(func=cmd_ingest)
 
     from camtube.commands import diagnose, effect
@@ -122,14 +126,15 @@ def register(sub) -> None:
 
 
 def _add_pattern_option(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--pattern", required=True, metavar="PATTERN", help="pattern YAML of the joint (see patterns/)")
+    p.add_argument("--pattern", required=True, type=path_value, metavar="PATTERN",
+                   help="pattern YAML of the joint (see patterns/)")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a pattern scalar, e.g. --set tendon.length=80")
     p.add_argument("-q", "--quiet", action="store_true", help="do not print design warnings")
 
 
 def cmd_fit(args: argparse.Namespace) -> int:
-    from camtube.commands.common import load_from_args
+    from camtube.commands.common import check_output_file, load_joint_pattern, refuse_output_over_input
     from camtube.io import write_atomic
     from camtube.model.core.build import (
         build_registry, fitted_and_held, history_warning, parse_in_range, split_names,
@@ -143,6 +148,11 @@ def cmd_fit(args: argparse.Namespace) -> int:
 
     check_suffix(args.json, (".json",), "--json")
     check_suffix(args.plot, (".png",), "--plot")
+    inputs = [("DATA.csv", args.data), ("--pattern", args.pattern)] + [("--effect-file", f) for f in args.effect_file]
+    for opt, path in (("--json", args.json), ("--plot", args.plot)):  # both written, or neither: checked first
+        if path is not None:
+            check_output_file(path, opt)
+            refuse_output_over_input(path, opt, inputs)
     if not 0 <= args.starts <= 50:
         raise DataError(f"--starts {args.starts}: allowed 0..50 grid points per parameter; fix: e.g. --starts 3 "
                         "(0: one start)")
@@ -150,7 +160,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     if t is not None and not (0 < t < 360):
         raise DataError(f"--deadband-threshold {t}: the smallest angle rise that counts as motion must be > 0 and "
                         "< 360 deg; fix: e.g. --deadband-threshold 0.5, or leave it out for max(0.5, 4 x noise)")
-    pattern = load_from_args(args).pattern
+    pattern = load_joint_pattern(args)
     reg, _ = build_registry(args.effect_file)
     model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects, "--effects")])
     if args.set_aside:
@@ -210,25 +220,27 @@ def cmd_fit(args: argparse.Namespace) -> int:
                        "--branch both --no-deadband)")
     meta = {"pattern": pattern.name, "data": str(args.data),
             "selection": {"cycles": args.cycles, "branch": args.branch, "deadband": bool(args.deadband)}}
-    if args.json:
-        print(f"wrote {write_atomic(args.json, fit_json(result, meta))}")
-    if args.plot:
+    png = None
+    if args.plot:  # made before anything is written, so that a failure leaves no --json without its --plot
         from camtube.model.report.plot import fit_png
 
         full = raw
         if args.deadband:
             full = remove_deadband(raw, args.deadband_threshold)
         png = fit_png(result, full, title=f"{pattern.name}: model vs measurement ({sel})")
+    if args.json:
+        print(f"wrote {write_atomic(args.json, fit_json(result, meta))}")
+    if png is not None:
         print(f"wrote {write_atomic(args.plot, png)}")
     return 0
 
 
 def cmd_synth(args: argparse.Namespace) -> int:
-    from camtube.commands.common import load_from_args
+    from camtube.commands.common import load_joint_pattern
     from camtube.model.sim.synth import noise_floor_deg, synthesize, write
 
     check_suffix(args.output, (".csv",), "-o/--output")
-    pattern = load_from_args(args).pattern
+    pattern = load_joint_pattern(args)
     data = synthesize(pattern, args.samples, args.cycles, args.noise_angle, args.noise_force, args.seed,
                       modulus_gpa=args.modulus, speed_mm_s=args.speed, rate_hz=args.rate,
                       slack_mm=args.slack)
@@ -242,7 +254,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
 def cmd_ingest(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from camtube.commands.common import check_output_dir
+    from camtube.commands.common import check_output_dir, refuse_output_over_input
     from camtube.io import check_writable_dir, write_atomic, write_set
     from camtube.model.data.csvfile import format_csv
     from camtube.model.ingest.merge import ingest_files
@@ -254,8 +266,13 @@ def cmd_ingest(args: argparse.Namespace) -> int:
 
         raise DataError(f"-o {args.output}: is a directory; fix: name the measurement CSV to write")
     check_writable_dir(Path(args.output).absolute().parent)
+    refuse_output_over_input(args.output, "-o", [("--tracker", args.tracker), ("--angle-log", args.angle_log),
+                                                 ("--daq", args.daq), ("--motor", args.motor), ("--bench", args.bench)])
     if args.report:
         check_output_dir(args.report, "--report")
+        if Path(args.report).resolve() == Path(args.output).resolve():
+            raise CamtubeError(f"--report {args.report}: is also the -o file; fix: give the report a folder of its "
+                               f"own, e.g. --report {Path(args.output).with_suffix('')}-report")
     bench = load_bench_map(args.bench, args.map_overrides)
     first = args.tracker or args.angle_log
     ing = ingest_files(first, args.daq, args.motor, bench, args.sample, max_lag_s=args.max_lag,

@@ -6,6 +6,8 @@ import json
 import sys
 from pathlib import Path
 
+from camtube.commands.common import path_value
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -20,7 +22,7 @@ def register(sub) -> None:
     p.add_argument("program", metavar="JOB.ngc", help="G-code written by camtube toolpath (LinuxCNC dialect)")
     p.add_argument("--job", metavar="JOB.job.json",
                    help="the job file written with it (default: JOB.job.json next to the program)")
-    p.add_argument("--machine", metavar="NAME|FILE", default=None,
+    p.add_argument("--machine", type=path_value, metavar="NAME|FILE", default=None,
                    help="machine profile (default linuxcnc-rotary; `camtube machines` lists them)")
     p.add_argument("--json", action="store_true", help="print the figures as JSON instead of a table")
     p.add_argument("--keep", metavar="DIR", help="keep the LinuxCNC configuration, log and recording in DIR")

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from camtube.commands.common import add_cad_options, add_pattern_argument, run_outputs
+from camtube.commands.common import add_cad_options, add_pattern_argument, path_value, run_outputs
 
 def register(sub) -> None:
     from camtube.export.dialects import DIALECTS
@@ -23,7 +23,7 @@ def register(sub) -> None:
         p.add_argument("--dialect", choices=("all",) + tuple(DIALECTS), default="all",
                        help="G-code dialect(s) to write (default all: linuxcnc .ngc rotary X/A/Z, "
                             "grbl .nc flat X/Y/Z)")
-        p.add_argument("--machine", metavar="NAME|FILE",
+        p.add_argument("--machine", type=path_value, metavar="NAME|FILE",
                        help="machine profile to write the G-code for (see `camtube machines`; a YAML file of "
                             "your own): axes, limits, blending, laser I/O, corner strategy. Replaces --dialect; "
                             "the estimate and the job file follow its limits")

@@ -6,6 +6,7 @@ import sys
 import time
 from pathlib import Path
 
+from camtube.commands.common import path_value, refuse_output_over_input
 from camtube.errors import CamtubeError
 
 
@@ -20,9 +21,9 @@ def register(sub) -> None:
                     "closely the centre line is followed. "
                     "An infeasible goal: one line naming the limit and the nearest feasible target, exit 2. "
                     "Lengths mm, angles deg, forces N.")
-    p.add_argument("goal", metavar="GOAL.yaml", help="goal file (see examples/goals/ and docs/design.md)")
+    p.add_argument("goal", type=path_value, metavar="GOAL.yaml", help="goal file (see examples/goals/ and docs/design.md)")
     p.add_argument("-o", "--output", required=True, metavar="PATTERN.yaml", help="pattern YAML to write")
-    p.add_argument("--calibration", metavar="FIT.json",
+    p.add_argument("--calibration", type=path_value, metavar="FIT.json",
                    help="parameters of an earlier tube's 'camtube model fit --json' or 'model diagnose --json' "
                         "(E_t, L0, slack, toe, kerf, friction, ...) to design with")
     p.set_defaults(func=cmd_synthesize)
@@ -41,6 +42,7 @@ def cmd_synthesize(args: argparse.Namespace) -> int:
         raise CamtubeError(f"{args.output}: synthesize writes a pattern YAML; fix: name the output PATTERN.yaml")
     if out.is_dir():
         raise CamtubeError(f"{args.output}: is a directory; fix: name the pattern file, e.g. {out / 'pattern.yaml'}")
+    refuse_output_over_input(args.output, "-o", [("GOAL.yaml", args.goal), ("--calibration", args.calibration)])
     goal = load_goal(args.goal)
     calib = Mechanics.from_fit_json(args.calibration) if args.calibration else None
     t0 = time.perf_counter()

@@ -258,8 +258,11 @@ def _settings_raw(overrides: list[str], file: str, folder: Path) -> dict:
         raise PatternError(bad)
     raw: dict = {}
     if process_file is not None:
-        candidates = [Path(process_file), folder / process_file]
-        found = next((p for p in candidates if p.is_file()), candidates[0])
+        from camtube.design.loader import _process_file
+
+        # as given (from the working directory), else beside the drawing or shipped, as a YAML pattern's process:
+        found = Path(process_file) if Path(process_file).is_file() else _process_file(process_file, folder / "_",
+                                                                                          file, None)
         praw, _, _ = read_yaml(found)
         raw["process"] = dict(praw.get("process", praw))
     return apply_overrides(raw, plain, file)
@@ -337,7 +340,13 @@ def _layer_roles(pairs, layer_names: dict[str, str], file: str) -> dict[str, str
 
 
 # ---------------------------------------------------------------- walking the entities
-def _walk(rd: _Reading, entity, via: str, insert_layer: str) -> None:
+#: Most copies one INSERT (a MINSERT array) may place: more than a pattern may have notches (100000).
+MAX_INSERT_COPIES = 100_000
+#: Deepest nesting of blocks in blocks followed (CAD programs nest a few levels).
+MAX_BLOCK_DEPTH = 64
+
+
+def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, ...] = ()) -> None:
     t = entity.dxftype()
     layer = entity.dxf.get("layer", "0")
     if via and layer == "0":
@@ -357,6 +366,21 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str) -> None:
                 rd.refuse(ent.describe(), f"places {what} {name!r}: its content is not in this file",
                           "bind the XREF into the drawing (XREF > Bind) and save again", entities=[ent])
             return
+        if name in blocks or len(blocks) >= MAX_BLOCK_DEPTH:
+            ent = _Entity("INSERT", entity.dxf.handle or "-", layer, via)
+            rd.entities.append(ent)
+            why = (f"places block {name!r} inside itself ({' > '.join(blocks + (name,))})" if name in blocks
+                   else f"nests blocks more than {MAX_BLOCK_DEPTH} deep ({' > '.join(blocks[:3])} > ...)")
+            rd.refuse(ent.describe(), why, "redefine the block without placing itself in it, or explode it in CAD",
+                      entities=[ent])
+            return
+        if entity.mcount > MAX_INSERT_COPIES:
+            ent = _Entity("INSERT", entity.dxf.handle or "-", layer, via)
+            rd.entities.append(ent)
+            rd.refuse(ent.describe(), f"places block {name!r} {entity.mcount} times (an array of "
+                      f"{entity.dxf.get('row_count', 1)} x {entity.dxf.get('column_count', 1)})",
+                      "check the array's row and column counts", f"at most {MAX_INSERT_COPIES} copies", entities=[ent])
+            return
         copies = list(entity.multi_insert()) if entity.mcount > 1 else [entity]
         for k, ins in enumerate(copies):
             tag = f"in block {name} of {here}" + (f" (copy {k + 1} of {len(copies)})" if len(copies) > 1 else "")
@@ -364,7 +388,7 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str) -> None:
                 tag += f", {via}"
             skipped: list = []
             for sub in ins.virtual_entities(skipped_entity_callback=lambda e, why: skipped.append((e, why))):
-                _walk(rd, sub, tag, layer)
+                _walk(rd, sub, tag, layer, blocks + (name,))
             for sub, why in skipped:
                 ent = _Entity(sub.dxftype(), "-", layer if sub.dxf.get("layer", "0") == "0" else sub.dxf.layer, tag)
                 rd.entities.append(ent)

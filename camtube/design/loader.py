@@ -21,7 +21,7 @@ from camtube.design.generate import notch_row
 from camtube.design.pattern import Pattern, Process, RepeatRule, Rules, Tendon, Tube, hole, notch, sort_cuts
 from camtube.design.schema import SCHEMA, Field
 from camtube.errors import Issue, PatternError
-from camtube.yamltext import closest, line_map, parse_yaml, read_yaml_file
+from camtube.yamltext import NumberTooLongError, closest, line_map, parse_yaml, read_yaml_file
 
 #: The shipped presets (package data): tube patterns and the process files they name.
 PRESETS_DIR = Path(__file__).resolve().parent / "presets"
@@ -63,16 +63,30 @@ def parse_override(item: str) -> tuple[str, Any]:
     key, _, value = item.partition("=")
     try:
         parsed = parse_yaml(value)
+    except NumberTooLongError as exc:
+        raise PatternError([Issue(key.strip(), "out of range in --set", f"a number of {exc.digits} digits",
+                                  "the range `camtube schema` lists for the key",
+                                  "bring it inside the allowed range")]) from None
     except yaml.YAMLError:
         parsed = value
     return key.strip(), parsed
+
+
+def _is_index(part: str) -> bool:
+    """True for a list index in a dotted --set key (``holes.0.x``): ASCII digits only (``'²'.isdigit()`` is true)."""
+    return part.isascii() and part.isdigit()
+
+
+def _past_end(key: str, idx: str, node: list) -> Issue:
+    return Issue(key, f"index {idx} is past the end of the list", None, f"0..{len(node) - 1}",
+                 "add the entry in the YAML first")
 
 
 def _schema_node(parts: list[str]):
     node: Any = SCHEMA
     for p in parts:
         if isinstance(node, Field) and node.kind == "rows":
-            if p.isdigit():
+            if _is_index(p):
                 node = dict(node.row)
                 continue
             return None
@@ -104,26 +118,30 @@ def apply_overrides(raw: dict, overrides: Iterable[str], file: str | None = None
             continue
         node = raw
         for depth, p in enumerate(parts[:-1]):
-            nxt = parts[depth + 1]
-            if p.isdigit() and isinstance(node, list):
-                idx = int(p)
-                if idx >= len(node):
-                    issues.append(Issue(key, f"index {idx} is past the end of the list", None,
-                                        f"0..{len(node) - 1}", "add the entry in the YAML first"))
+            if isinstance(node, list) and _is_index(p):
+                if len(p) > 9 or int(p) >= len(node):
+                    issues.append(_past_end(key, p, node))
                     node = None
                     break
-                node = node[idx]
-                continue
-            if not isinstance(node.get(p), (dict, list)):
-                node[p] = [] if nxt.isdigit() else {}
-            node = node[p]
+                node = node[int(p)]
+            elif isinstance(node, dict):
+                if not isinstance(node.get(p), (dict, list)):
+                    node[p] = [] if _is_index(parts[depth + 1]) else {}
+                node = node[p]
+            else:  # an entry the YAML gives as a scalar (holes: [0.75]): the check of the YAML names it
+                node = None
+                break
         if node is None:
             continue
         last = parts[-1]
-        if last.isdigit() and isinstance(node, list):
+        if isinstance(node, list) and _is_index(last):
+            if len(last) > 9 or int(last) >= len(node):
+                issues.append(_past_end(key, last, node))
+                continue
             node[int(last)] = value
-        else:
+        elif isinstance(node, dict):
             node[last] = value
+        # else: not a mapping in the YAML (holes: [[1, 2]]); the check of the YAML names the entry
     if issues:
         raise PatternError(issues)
     return raw
@@ -288,6 +306,7 @@ def build_settings(raw: dict, file: str | None = None) -> tuple[Tube, Process, T
     tendon = _section(r, raw, "tendon")
     proc = _section(r, raw, "process")
     rl = _section(r, raw, "rules")
+    check_name(r, raw.get("name"))
     if r.issues:
         raise PatternError(r.issues)
     return (Tube(tube["outer_radius"], tube["inner_radius"], tube["length"], tube["material"]), _process(proc),

@@ -27,6 +27,8 @@ from __future__ import annotations
 
 from typing import Iterable, Iterator, Sequence
 
+import numpy as np
+
 from camtube import __version__
 from camtube.export.dialects import LINUXCNC, Dialect
 from camtube.fmt import format_duration_s
@@ -202,6 +204,47 @@ class _Emitter:
         return "\n".join(out) + "\n"
 
 
+def _check_machine_moves(job, dialect: Dialect, mv: Moves, mm: MachineMoves) -> None:
+    """The safety check of the moves as printed, plus the machine profile's own limits.
+
+    Raises
+    ------
+    SafetyError
+        A move leaves its cut (:func:`check_moves`); when only the printed moves do, the profile's
+        ``decimals`` are named (the rounding moved the beam). The rotary axis leaves the profile's
+        ``rotary_range_deg``.
+    """
+    from camtube.errors import SafetyError
+
+    prof = dialect.profile
+    where = f"machine {prof.name}" + (f" ({prof.source})" if prof is not None and prof.source else "") \
+        if prof is not None else f"dialect {dialect.name}"
+    if prof is not None and prof.rotary and prof.rotary_range_deg is not None and len(mm.ay):
+        lo, hi = prof.rotary_range_deg
+        eps = 0.5 * 10.0 ** -prof.decimals
+        a = np.concatenate(([mm.start[1]], mm.ay))
+        out = np.flatnonzero((a < lo - eps) | (a > hi + eps))
+        if out.size:
+            i = int(out[0])
+            raise SafetyError(f"{job.name}: {where}: the job turns the rotary axis to A = {a[i]:.3f} deg, outside "
+                              f"the stage's travel rotary_range_deg = [{lo:g}, {hi:g}] deg (camtube keeps A within "
+                              "-180..540 deg); nothing was written; fix: set rotary_range_deg to the stage's real "
+                              "travel, or use a machine whose rotary axis turns that far")
+    try:
+        check_moves(job, mm.unrolled())
+    except SafetyError as exc:
+        if prof is None:
+            raise
+        try:
+            check_moves(job, mv)  # the moves before rounding: if they pass, the printed digits moved the beam
+        except SafetyError:
+            raise exc from None
+        first = str(exc).splitlines()[0]
+        raise SafetyError(f"{first}: {where}: coordinates printed with decimals = {prof.decimals} move the beam "
+                          f"outside the cuts (by up to {0.5 * 10.0 ** -prof.decimals:g} mm or deg); fix: set "
+                          "decimals: 6 in the machine profile") from None
+
+
 def _chunks(job, moves) -> Iterable[Moves]:
     if moves is None:
         return iter_moves(job)
@@ -243,7 +286,7 @@ def iter_gcode(job, dialect: Dialect = LINUXCNC, *, progress: Progress = NO_PROG
     with progress.task(f"G-code {dialect.name}", total=len(job.passes)) as task:
         for mv in _chunks(job, moves):
             mm = machine_moves(job, dialect, mv)
-            check_moves(job, mm.unrolled())
+            _check_machine_moves(job, dialect, mv, mm)
             with no_gc():
                 text = em.chunk(mm)
             rows = mv.pass_rows()

@@ -220,9 +220,16 @@ class Mechanics:
         used = {"E_t": "tendon_modulus_gpa", "L0": "tendon_length_mm", "arm_scale": "arm_scale",
                 "slack.deadband_mm": "slack_mm", "toe.toe_mm": "toe_mm", "kerf.kerf_mm": "kerf_mm",
                 "series.compliance_mm_per_N": "series_compliance_mm_per_N", "friction.mu": "sheath_loss"}
+        # the physical range of each used value: a fitted value outside it is not a calibration of a joint
+        positive = {"E_t": "GPa", "L0": "mm", "arm_scale": ""}
         values: dict[str, float] = dict(base)
         ignored = []
         for name, v in params.items():
+            if name in used and (v <= 0.0 if name in positive else v < 0.0 and name != "friction.mu"):
+                unit = positive.get(name, "")
+                raise CamtubeError(f"{p}: parameter {name} = {v:g}{' ' + unit if unit else ''}: outside its physical "
+                                   f"range ({'> 0' if name in positive else '>= 0'}); fix: pass the JSON of a fit "
+                                   "whose parameters are physical (hold a parameter with --fix NAME=VALUE)")
             if name in used:
                 values[used[name]] = v
             else:

@@ -368,6 +368,17 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
     elif "dose_output" in laser or "radius_output" in laser:
         ck.add("laser.dose_output", "only distance gating uses dose_output and radius_output", None,
                "laser.gating: distance", "add laser.gating: distance, or remove them")
+    seen: dict = {}  # M68 E<n>: one analog output carries one signal (a second would overwrite the first)
+    for k in ("power_output", "frequency_output", "dose_output", "radius_output"):
+        v = outs.get(k)
+        if v is None:
+            continue
+        if v in seen:
+            ck.add(f"laser.{k}", f"is the same analog output as laser.{seen[v]} (M68 E{v} would carry both "
+                   "values, each overwriting the other)", v, "a different analog output for each signal",
+                   f"give laser.{k} an output of its own")
+        else:
+            seen[v] = k
     warn_factor = ck.number(m.get("warn_time_factor", 3.0), "warn_time_factor", 1.0, strict=False)
     from camtube.plan.planner import DEFAULT_ORDERING, ORDERINGS
 

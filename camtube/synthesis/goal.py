@@ -248,7 +248,10 @@ def build_goal(raw: dict, file: str | None = None, lines: dict[str, int] | None 
         m = closest(dist, DISTRIBUTIONS)
         r.issue("goal.distribution", "not an allowed choice", dist, "uniform, tip_first, base_first or a list of "
                 "positive shares", f"did you mean '{m}'?" if m else "use uniform")
-    if isinstance(dist, tuple):
+    if isinstance(dist, tuple) and not dist:
+        r.issue("goal.distribution", "an empty list of shares", [], "uniform, tip_first, base_first or a list of "
+                "positive shares, one per notch from the tip", "leave it out for uniform, or give the shares")
+    elif isinstance(dist, tuple):
         if len(bends) > 1:
             r.issue("goal.distribution", "a list of shares needs a single bend", None, "one entry in goal.bends",
                     "use uniform or tip_first for several directions")

@@ -169,9 +169,11 @@ def check_suffix(path: str | None, suffixes: tuple[str, ...], option: str) -> No
     if path is None:
         return
     p = Path(path)
+    if p.is_dir():  # also '.', '/' and '..', whose file name is empty
+        raise DataError(f"{option} {path}: is a directory; fix: name a file, e.g. {option.split('/')[-1]} "
+                        f"{p / ('out' + suffixes[0])}")
     if p.suffix.lower() not in suffixes:
+        stem = p.stem if p.stem not in ("", ".", "..") else "out"
         raise DataError(f"{option} {path}: writes {suffixes[0][1:].upper()}, so the file must end in "
                         f"{' or '.join(suffixes)} (got {p.suffix or 'no suffix'!r}); "
-                        f"fix: e.g. {option.split('/')[-1]} {p.with_suffix(suffixes[0]).name}")
-    if p.is_dir():
-        raise DataError(f"{option} {path}: is a directory; fix: name a file")
+                        f"fix: e.g. {option.split('/')[-1]} {stem}{suffixes[0]}")

@@ -233,7 +233,15 @@ class Effect:
         elif len(self.stages) > 1:
             raise ValueError(f"effect {self.name!r} acts on {len(self.stages)} stages: give apply as "
                              "{stage: function}")
+        seen = set()
         for q in self.params:
+            if q.name in seen:  # the fit would hold one value under the name for both
+                raise ValueError(f"effect {self.name!r}: two parameters are named {q.name!r}; fix: give each Param "
+                                 "a name of its own")
+            seen.add(q.name)
+            if q.lo != q.lo or q.hi != q.hi:  # NaN: every comparison with it is false, no bound would hold
+                raise ValueError(f"effect {self.name!r}: parameter {q.name!r} has a NaN bound (lo {q.lo:g}, hi "
+                                 f"{q.hi:g}); fix: give numbers (Param(name, unit, lo, hi, init))")
             if q.lo > q.hi:
                 raise ValueError(f"effect {self.name!r}: parameter {q.name!r} has lo {q.lo:g} > hi {q.hi:g}; "
                                  "fix: swap them (Param(name, unit, lo, hi, init))")

@@ -131,10 +131,12 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
     header_line = 0
     rows: list[list[str]] = []
     lines: list[int] = []
+    comments = 0  # '#' lines after the header
     try:
         for rec in reader:
             ln = reader.line_num
             if not rec or not any(c.strip() for c in rec) or rec[0].lstrip().startswith("#"):
+                comments += header is not None and bool(rec) and rec[0].lstrip().startswith("#")
                 continue
             if header is None:
                 header = [c.strip() for c in rec]
@@ -175,6 +177,10 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
         raise _err(source, header_line,
                    f"missing column(s) {', '.join(missing)} (found: {', '.join(header)})",
                    "; ".join(hints) if hints else f"the header must contain {', '.join(COLUMNS)}")
+    if not rows and comments:
+        raise _err(source, header_line, f"no data rows after the header: all {comments} lines below it start with "
+                   "'#' and are read as comments (a sample named '#...'?)",
+                   "rename the sample so that it does not start with '#', e.g. S1")
     if not rows:
         raise _err(source, header_line, "no data rows after the header",
                    "add the measurements, one row per sample time, below the header")
@@ -295,6 +301,10 @@ def _read_text(path: Path) -> str:
     except UnicodeDecodeError as exc:
         raise DataError(f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start}); fix: give the "
                         "measurement CSV (save it as UTF-8 text)") from None
+    if "\x00" in text:  # a logger's unfinished write (NUL padding) or a binary file: the cells would be garbage
+        line = text[:text.index("\x00")].count("\n") + 1
+        raise DataError(f"{path}:{line}: not a text file: it holds NUL bytes; fix: give the measurement CSV as "
+                        "exported (cut the damaged lines if the logger stopped mid-write)")
     return text
 
 

@@ -43,7 +43,9 @@ class CycleSpec:
         return m
 
 
-_ITEM = re.compile(r"^(?:(?P<all>all)|last\s*(?P<last>\d+)?|(?P<lo>\d+)?\s*(?P<dash>-)?\s*(?P<hi>\d+)?)$")
+#: Cycle numbers of up to 18 digits (a count of cycles; Python refuses to convert thousands of digits).
+_ITEM = re.compile(r"^(?:(?P<all>all)|last\s*(?P<last>\d{1,18})?"
+                   r"|(?P<lo>\d{1,18})?\s*(?P<dash>-)?\s*(?P<hi>\d{1,18})?)$")
 
 
 def parse_cycles(spec: str | None) -> CycleSpec:
@@ -246,7 +248,8 @@ def _deadband(data: Dataset, threshold_deg: float | None) -> tuple[Dataset, np.n
     shifted = np.asarray(data.stroke_mm, float) - per_row
     keep = shifted >= 0.0
     if not keep.any():
-        raise DataError("every row lies inside the slack deadband; try --no-deadband")
+        raise DataError("every row lies inside the slack deadband (the stroke never passes the slack found in its "
+                        "cycle); fix: keep those rows with --no-deadband, or check the stroke column (and --lag-ms)")
     out = Dataset(data.sample, data.cycle, data.time_s, shifted, data.force_N, data.angle_deg,
                   {**data.extra, "slack_mm": per_row})
     return out, keep

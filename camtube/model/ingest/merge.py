@@ -258,6 +258,12 @@ def ingest_files(tracker_path, daq_path, motor_path, bench: BenchMap, sample: st
     from camtube.model.ingest.ndi import load_ndi
     from camtube.model.ingest.series import load_series
 
+    name = sample if sample is not None else Path(tracker_path).stem
+    origin = "--sample" if sample is not None else f"the sample name from the file name {Path(tracker_path).name}:"
+    if not name.strip() or name.lstrip().startswith("#") or any(c in name for c in "\r\n\x00"):
+        why = ("is empty" if not name.strip() else "starts with '#', which makes every row of the CSV a comment"
+               if name.lstrip().startswith("#") else "holds a line break or NUL, which splits the CSV's rows")
+        raise DataError(f"{origin} {name!r} {why}; fix: give a plain name, e.g. --sample S1")
     tm = bench.tracker
     if angle_log:
         a = bench.angle
@@ -268,4 +274,4 @@ def ingest_files(tracker_path, daq_path, motor_path, bench: BenchMap, sample: st
     daq = load_series(daq_path, d.time, d.time_unit, d.force, d.trigger, role="daq")
     m = bench.motor
     motor = load_series(motor_path, m.time, m.time_unit, m.stroke, m.trigger, role="motor")
-    return ingest(log, daq, motor, bench, sample or Path(tracker_path).stem, max_lag_s=max_lag_s)
+    return ingest(log, daq, motor, bench, name, max_lag_s=max_lag_s)

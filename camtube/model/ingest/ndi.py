@@ -200,7 +200,8 @@ def parse_ndi(text: str, source: str = "<ndi>", *, unit: str = "mm", rate_hz: fl
         raise _err(source, hline, "no tool column group (a header cell starting with 'Port')",
                    "this reader expects NDI Track's CSV export: Tools,Port ...,Frame,State,Q0,Qx,Qy,Qz,Tx,Ty,Tz,Error")
     if not rows:
-        raise _err(source, hline, "no frames after the header")
+        raise _err(source, hline, "no frames after the header",
+                   "export the recording with its frames from NDI Track (was the export cut short?)")
     groups = []
     for g, s in enumerate(starts):
         end = starts[g + 1] if g + 1 < len(starts) else len(header)

@@ -204,9 +204,18 @@ def bench_map_from_dict(doc: dict, source: str = "<bench map>", overrides: list[
     DataError
         An unknown section or key (with a "did you mean"), a value of the wrong type or out of range.
     """
-    doc = {k: dict(v or {}) for k, v in (doc or {}).items()} if isinstance(doc, dict) else None
-    if doc is None:
+    if doc is not None and not isinstance(doc, dict):
         raise DataError(f"{source}: the bench map must be a mapping of tracker/daq/motor; fix: see docs/bench.md")
+    doc = dict(doc or {})
+    for sec, body in doc.items():
+        if not hasattr(BenchMap(), str(sec)):
+            hint = difflib.get_close_matches(str(sec), ["tracker", "daq", "motor", "angle"], n=1)
+            raise _map_err(source, sec, "unknown section", f"did you mean {hint[0]!r}?" if hint
+                           else "use tracker, daq, motor and angle")
+        if body is not None and not isinstance(body, dict):
+            raise _map_err(source, sec, f"expected a mapping of keys, got {body!r}",
+                           f"write '{sec}: {{key: value, ...}}' (see docs/bench.md)")
+        doc[sec] = dict(body or {})
     for item in overrides:
         if "=" not in item:
             raise DataError(f"--map {item!r}: expected KEY=VALUE; fix: e.g. --map daq.N_per_V=2.2")
@@ -301,8 +310,10 @@ def parse_series(text: str, source: str, time: str, time_unit: str, value: str, 
         (file, line and column), a time that does not increase.
     """
     table = read_table(text, source, comments=True)
+    log = role if role == "log" else f"{role} log"
     if table is None:
-        raise DataError(f"{source}: the file is empty")
+        raise DataError(f"{source}: the file is empty; fix: give the {log} as exported (a header line naming the "
+                        "columns, then one line per sample time)")
     header, hline, rows, lines = table.header, table.header_line, table.rows, table.lines
     if len(header) == 1 and (";" in header[0] or "\t" in header[0]):
         raise DataError(f"{source}:{hline}: the columns are not separated by commas; fix: save the log as "
@@ -318,7 +329,8 @@ def parse_series(text: str, source: str, time: str, time_unit: str, value: str, 
             raise DataError(f"{source}:{hline}: no column {col!r} for the {what} (found: {', '.join(header)}); fix: {fix}")
         idx[what] = header.index(col)
     if not rows:
-        raise DataError(f"{source}:{hline}: no data lines after the header")
+        raise DataError(f"{source}:{hline}: no data lines after the header; fix: give the whole {log} (was the "
+                        "recording stopped before it started, or the export cut short?)")
     ln = np.asarray(lines, dtype=np.int64)
     out = {}
     for what, j in idx.items():

@@ -102,7 +102,8 @@ def check_arguments(n_samples: int, n_cycles: int, noise_angle_deg: float, noise
     if m < 12:
         raise DataError(f"sampling rate (--rate) = {rate_hz!r}: only {m} rows per cycle "
                         f"({2 * max_stroke_mm / speed_mm_s:g} s); allowed: at least 12 rows per cycle, "
-                        f"i.e. --rate >= {12 * speed_mm_s / (2 * max_stroke_mm):.3g} Hz at --speed {speed_mm_s:g}")
+                        f"i.e. --rate >= {12 * speed_mm_s / (2 * max_stroke_mm):.3g} Hz at --speed {speed_mm_s:g}; "
+                        "fix: raise --rate or lower --speed")
     if rows > MAX_ROWS:
         raise DataError(f"{n_samples} sample(s) x {n_cycles} cycles x {m} rows per cycle = {rows:,} rows: "
                         f"allowed at most {MAX_ROWS:,}; fix: lower --rate, --cycles or --samples, or raise --speed")

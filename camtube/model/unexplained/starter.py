@@ -236,4 +236,13 @@ def starter_from_json(name: str, path: str | Path, *, stage: str | None = None,
     if u is None and follows is None:
         raise DataError(f"{path}: the diagnosis left nothing unexplained (unexplained: null); fix: give --follows to "
                         f"start an effect anyway")
-    return starter_source(name, u, stage=stage, follows=follows)
+    redo = ("fix: write it again with camtube model diagnose ... --json, or give --stage and --follows instead of "
+            "--from")
+    if u is not None and not isinstance(u, dict):
+        raise DataError(f"{path}: the 'unexplained' section is {type(u).__name__} {u!r:.40}, not the mapping camtube "
+                        f"model diagnose writes; {redo}")
+    try:
+        return starter_source(name, u, stage=stage, follows=follows)
+    except (TypeError, ValueError, KeyError, AttributeError, IndexError) as exc:  # an edited section's values
+        raise DataError(f"{path}: the 'unexplained' section does not read as camtube model diagnose writes it "
+                        f"({type(exc).__name__}: {exc}); {redo}") from None
