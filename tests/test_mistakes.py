@@ -474,12 +474,15 @@ def test_a_cycle_selection_of_thousands_of_digits(tmp_path, spec):
     assert_refused(r, "cycle selection", "cannot read")
 
 
-def test_every_row_in_the_deadband_says_the_fix(tmp_path):
-    """An angle lag of 10^9 ms (--set-aside --lag-ms 1e9) left no row past the slack: 'try --no-deadband', no fix."""
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+def test_an_angle_lag_of_clocks_not_aligned_is_refused(tmp_path, cmd):
+    """An angle lag of 10^9 ms (--set-aside --lag-ms 1e9) left no row past the slack: fit said 'try --no-deadband'
+    with no fix, diagnose 'no data rows to fit'. A lag beyond 2 s is clocks not aligned: refused as such."""
     data = tmp_path / "d.csv"
     assert camtube("model", "synth", "--pattern", "tube2", "-o", str(data), "--cycles", "3").returncode == 0
-    r = camtube("model", "fit", str(data), "--pattern", "tube2", "-q", "--set-aside", "--lag-ms", "1e9")
-    assert_refused(r, "slack deadband", "fix: keep those rows with --no-deadband")
+    extra = ["--set-aside"] if cmd == "fit" else []
+    r = camtube("model", cmd, str(data), "--pattern", "tube2", "-q", *extra, "--lag-ms", "1e9")
+    assert_refused(r, "--lag-ms 1e+09", "clocks that were not aligned", "fix: give the tracker's delay")
 
 
 @pytest.mark.parametrize("opt,value", [("--rate", "1e-6"), ("--speed", "1e9")])

@@ -85,6 +85,8 @@ STEP_SIDE = 3
 FROZEN_REPEATS = 4
 #: ... while the stroke moves by this share of the sample's stroke range across them.
 FROZEN_STROKE = 0.01
+#: The largest ``--lag-ms`` taken (ms): a tracker's delay is tens of milliseconds; more is clocks not aligned.
+MAX_GIVEN_LAG_MS = 2000.0
 #: A lag is corrected only when it lowers the residual RMS of the lag regression by this fraction.
 MIN_FALL = 0.02
 #: A lag the regression resolves but barely improves with (below :data:`MIN_FALL`) is corrected when it lowers the
@@ -788,6 +790,11 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     if lag_ms is not None and not math.isfinite(lag_ms):
         raise DataError(f"--lag-ms {lag_ms}: the angle channel's lag must be a finite number of ms; fix: give e.g. "
                         "--lag-ms 20, or 0 for none")
+    if lag_ms is not None and abs(lag_ms) > MAX_GIVEN_LAG_MS:
+        raise DataError(f"--lag-ms {lag_ms:g}: a lag of more than {MAX_GIVEN_LAG_MS:g} ms between the tracker and the "
+                        "load cell is not an instrument's delay but clocks that were not aligned; fix: give the "
+                        "tracker's delay in ms (e.g. --lag-ms 20, 0 for none), and align the logs' clocks first "
+                        "(camtube model ingest)")
     slices = data.sample_slices()
     aside: dict[str, np.ndarray] = {}
     rep = np.zeros(len(data), bool)
