@@ -544,6 +544,8 @@ def _saturated(force: np.ndarray, stroke: np.ndarray, slices: list) -> tuple[np.
         if f.size < 3 or not np.isfinite(f).all():
             continue
         top = float(f.max())
+        if not top > float(np.median(f)):   # a force that never rises (all 0) has no limit to reach
+            continue
         at = f == top
         edges = np.diff(np.concatenate(([0], at.astype(np.int8), [0])))
         span = float(np.ptp(s))
