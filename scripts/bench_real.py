@@ -366,8 +366,19 @@ def write_file(batch: str, kind: str, path: str) -> None:
 if __name__ == "__main__":
     import sys
 
-    if sys.argv[1:2] == ["--write"]:  # --write BATCH KIND OUT.csv
-        write_file(*sys.argv[2:5])
+    args = sys.argv[1:]
+    if args[:1] in (["-h"], ["--help"]):
+        print(__doc__ + "\nUsage: python scripts/bench_real.py [BATCH ...] | --write BATCH KIND OUT.csv\nBatches: "
+              + ", ".join(BATCHES))
+    elif args[:1] == ["--write"]:  # --write BATCH KIND OUT.csv
+        if len(args) != 4:
+            print("usage: python scripts/bench_real.py --write BATCH KIND OUT.csv", file=sys.stderr)
+            sys.exit(2)
+        write_file(*args[1:4])
     else:
-        for b in sys.argv[1:] or ["bench"]:
+        unknown = [b for b in args if b not in BATCHES]
+        if unknown:
+            print(f"unknown batch {unknown[0]!r}; fix: give one of {', '.join(BATCHES)}", file=sys.stderr)
+            sys.exit(2)
+        for b in args or ["bench"]:
             run_batch(b)
