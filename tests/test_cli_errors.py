@@ -190,3 +190,13 @@ def test_two_laser_signals_on_one_analog_output_are_refused(tmp_path):
     r = camtube("toolpath", TUBE1, "-q", "--machine", str(prof), "-o", str(tmp_path / "o"))
     assert_refused(r, f"{prof}:", "laser.frequency_output: is the same analog output as laser.power_output")
     assert listing(tmp_path) == ["stage.yaml"]
+
+
+@pytest.mark.parametrize("argv", [[], ["model"], ["model", "effect"]])
+def test_a_command_without_its_subcommand_is_a_usage_mistake(argv):
+    """``camtube``, ``camtube model`` and ``camtube model effect`` alone printed the help and exited 1 (the code of a
+    result that failed a check); a command left out is a usage mistake: the help, one line with the fix, exit 2."""
+    r = camtube(*argv)
+    assert r.returncode == 2, r.stdout + r.stderr
+    assert r.stdout.startswith("usage:")
+    assert len(r.stderr.strip().splitlines()) == 1 and "fix: give one of the" in r.stderr

@@ -55,9 +55,10 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
-        if not getattr(args, "func", None):
+        if not getattr(args, "func", None):   # no command: a usage mistake, as argparse's own (exit 2)
             parser.print_help()
-            return 1
+            print("camtube: error: no command given; fix: give one of the commands above", file=sys.stderr)
+            return 2
         return _run(args)
     except PublishedInterrupt as exc:
         where = os.path.dirname(exc.paths[0]) if exc.paths else "the output folder"

@@ -13,6 +13,13 @@ from camtube.io import PublishedInterrupt
 LAYER_ROLES = ("notch", "hole", "slit", "ignore")
 
 
+def no_subcommand(parser, name: str) -> int:
+    """``name`` given without its subcommand: its help, one line saying so, exit 2 (a usage mistake)."""
+    parser.print_help()
+    print(f"{name}: error: no subcommand given; fix: give one of the subcommands above", file=sys.stderr)
+    return 2
+
+
 def path_value(value: str) -> str:
     """argparse ``type`` of an option naming a file or folder: an empty value (``--json ''``, an unset
     shell variable) is refused, not taken as "option not given"."""

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import argparse
 
-from camtube.commands.common import path_value
+from camtube.commands.common import no_subcommand, path_value
 from camtube.model.unexplained.analysis import VARIABLES
 
 
@@ -16,7 +16,7 @@ def register_effect_commands(subparsers) -> None:
     """Add ``effect`` (with ``new``) to the ``model`` group's sub-parsers."""
     e = subparsers.add_parser("effect", help="write your own effect: a starter file from a diagnosis",
                               description="Tools for user effects (the effect API: docs/diagnose.md).")
-    e.set_defaults(func=lambda args: (e.print_help(), 1)[1])
+    e.set_defaults(func=lambda args: no_subcommand(e, "camtube model effect"))
     esub = e.add_subparsers(dest="effect_command", metavar="SUBCOMMAND")
     n = esub.add_parser(
         "new", help="write a starter effect file from a diagnosis's 'unexplained' section",

@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 import importlib
 
-from camtube.commands.common import path_value
+from camtube.commands.common import no_subcommand, path_value
 from camtube.errors import CamtubeError
 from camtube.model import EFFECT_NAMES
 
@@ -25,7 +25,7 @@ def check_suffix(path, suffixes, option):
 def register(sub) -> None:
     p = sub.add_parser("model", help="fit the joint model to measurements, make synthetic data",
                        description="Joint mechanics: tendon stroke (mm) and force (N) -> joint angle (deg).")
-    p.set_defaults(func=lambda args: (p.print_help(), 1)[1])
+    p.set_defaults(func=lambda args: no_subcommand(p, "camtube model"))
     model_sub = p.add_subparsers(dest="model_command", metavar="SUBCOMMAND")
 
     f = model_sub.add_parser(
