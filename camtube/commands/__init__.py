@@ -95,7 +95,11 @@ def _run(args: argparse.Namespace) -> int:
     try:
         return int(args.func(args) or 0)
     except CamtubeError as exc:
-        print(f"camtube {args.command}: error: {exc}", file=sys.stderr)
+        msg = str(exc)
+        data = getattr(args, "data", None)
+        if type(exc).__name__ == "FitError" and isinstance(data, str) and os.path.basename(data) not in msg:
+            msg = f"{data}: {msg}"   # a fit that cannot be made is about the measurement file: name it
+        print(f"camtube {args.command}: error: {msg}", file=sys.stderr)
         return 2
     except MemoryError:
         print(f"camtube {args.command}: error: out of memory; fix: make the job smaller (fewer notches or "

@@ -217,7 +217,7 @@ def test_too_few_rows_for_the_parameters_says_what_to_do(data_csv, tmp_path, cap
     f = tmp_path / "few.csv"
     f.write_text("".join(open(data_csv).readlines()[:4]))
     _fails_cleanly(["model", "fit", str(f), "--pattern", TUBE2, "-q", "--fit", "E_t,L0,arm_scale", "--no-deadband",
-                    "--cycles", "all", "--branch", "both"], capsys, "3 data rows cannot fit 3 parameters", "fix:")
+                    "--cycles", "all", "--branch", "both"], capsys, f"{f}: 3 data rows cannot fit 3 parameters", "fix:")
 
 
 @pytest.mark.parametrize("argv", [["fit", "--set-aside"], ["diagnose", "--candidates", "slack"]])
