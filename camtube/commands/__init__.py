@@ -56,9 +56,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         args = parser.parse_args(argv)
         if not getattr(args, "func", None):   # no command: a usage mistake, as argparse's own (exit 2)
-            parser.print_help()
-            print("camtube: error: no command given; fix: give one of the commands above", file=sys.stderr)
-            return 2
+            from camtube.commands.common import no_subcommand
+
+            return no_subcommand(parser, "camtube", "command")
         return _run(args)
     except PublishedInterrupt as exc:
         where = os.path.dirname(exc.paths[0]) if exc.paths else "the output folder"
@@ -97,7 +97,9 @@ def _run(args: argparse.Namespace) -> int:
     except CamtubeError as exc:
         msg = str(exc)
         data = getattr(args, "data", None)
-        if type(exc).__name__ == "FitError" and isinstance(data, str) and os.path.basename(data) not in msg:
+        model = sys.modules.get("camtube.model.core.model")   # (loaded whenever a FitError was raised)
+        if (model is not None and isinstance(exc, model.FitError) and isinstance(data, str)
+                and os.path.basename(data) not in msg):
             msg = f"{data}: {msg}"   # a fit that cannot be made is about the measurement file: name it
         print(f"camtube {args.command}: error: {msg}", file=sys.stderr)
         return 2

@@ -13,10 +13,11 @@ from camtube.io import PublishedInterrupt
 LAYER_ROLES = ("notch", "hole", "slit", "ignore")
 
 
-def no_subcommand(parser, name: str) -> int:
-    """``name`` given without its subcommand: its help, one line saying so, exit 2 (a usage mistake)."""
+def no_subcommand(parser, name: str, kind: str = "subcommand") -> int:
+    """``name`` given without its ``kind`` (``camtube``: a command): its help, one line saying so, exit 2 (a usage
+    mistake)."""
     parser.print_help()
-    print(f"{name}: error: no subcommand given; fix: give one of the subcommands above", file=sys.stderr)
+    print(f"{name}: error: no {kind} given; fix: give one of the {kind}s above", file=sys.stderr)
     return 2
 
 
@@ -163,9 +164,7 @@ def refuse_output_over_input(output: str, option: str, inputs) -> None:
 
 def check_output_file(path: str, option: str) -> None:
     """Refuse, before any work, an output file that names a directory or lies where nothing can be written."""
-    from camtube.io import check_writable_dir
-
-    from camtube.io import OutputError
+    from camtube.io import OutputError, check_writable_dir
 
     if os.path.isdir(path):
         raise CamtubeError(f"{option} {path}: is a directory; fix: name a file")

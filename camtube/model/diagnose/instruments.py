@@ -505,6 +505,12 @@ def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: n
     return out & ~known
 
 
+def _true_runs(mask: np.ndarray) -> zip:
+    """``(start, stop)`` of each run of True in ``mask`` (1-D bool), stop exclusive."""
+    edges = np.diff(np.concatenate(([0], mask.astype(np.int8), [0])))
+    return zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1))
+
+
 def _frozen(angle: np.ndarray, stroke: np.ndarray, slices: list) -> np.ndarray:
     """Rows repeating the angle before them exactly, in runs of :data:`FROZEN_REPEATS` or more, across which the
     stroke moves by more than :data:`FROZEN_STROKE` of the sample's stroke range (a tracker holding its last
@@ -521,8 +527,7 @@ def _frozen(angle: np.ndarray, stroke: np.ndarray, slices: list) -> np.ndarray:
         span = float(np.ptp(s))
         scale = _noise_scale(a)
         rep = np.concatenate(([False], a[1:] == a[:-1]))
-        edges = np.diff(np.concatenate(([0], rep.astype(np.int8), [0])))
-        for b, e in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+        for b, e in _true_runs(rep):
             if e - b < FROZEN_REPEATS:
                 continue
             jumped = b >= 2 and abs(float(a[b - 1]) - float(a[b - 2])) > SPIKE_Z * scale
@@ -547,10 +552,8 @@ def _saturated(force: np.ndarray, stroke: np.ndarray, slices: list) -> tuple[np.
         if not top > float(np.median(f)):   # a force that never rises (all 0) has no limit to reach
             continue
         at = f == top
-        edges = np.diff(np.concatenate(([0], at.astype(np.int8), [0])))
         span = float(np.ptp(s))
-        if any(e - b >= FROZEN_REPEATS and float(np.ptp(s[b:e])) > FROZEN_STROKE * span
-               for b, e in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1))):
+        if any(e - b >= FROZEN_REPEATS and float(np.ptp(s[b:e])) > FROZEN_STROKE * span for b, e in _true_runs(at)):
             out[sl] = at
             levels[str(smp)] = (top, int(at.sum()))
     return out, levels
@@ -729,17 +732,10 @@ def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_
     return Lag(est * dt * 1e3, se * dt * 1e3, fall=fall)
 
 
-def _shift_rows(data: Dataset, sl: slice, lag_ms: float) -> int:
-    """The whole rows of sample ``sl`` nearest ``lag_ms`` (its median sampling interval)."""
-    t = data.time_s[sl]
-    dt = float(np.median(np.diff(t))) if t.size > 1 else 0.0
-    return int(round(lag_ms * 1e-3 / dt)) if dt > 0 else 0
-
-
-def shift_angle(data: Dataset, lag_ms: float) -> tuple[Dataset, np.ndarray, float]:
+def shift_angle(data: Dataset, lag_ms: float) -> tuple[Dataset, np.ndarray, float, np.ndarray]:
     """``data`` with the angle read ``lag_ms`` later, by whole rows of each sample (interpolating between rows
-    would average the tracker's noise and hide it from the noise floor); the rows at the end whose later angle
-    is past the record are dropped.
+    would average the tracker's noise and hide it from the noise floor); a row whose later angle is past the
+    record, or not that many rows of time later (across rows set aside), is dropped.
 
     Returns
     -------
@@ -748,27 +744,29 @@ def shift_angle(data: Dataset, lag_ms: float) -> tuple[Dataset, np.ndarray, floa
         Rows of the input kept.
     applied_ms : float
         The shift applied: whole rows times the median sampling interval (within half a row of ``lag_ms``).
+    past_end : (n,) bool
+        Rows dropped because their later angle is past the record (the others dropped: across a gap).
     """
     if lag_ms == 0.0:
-        return data, np.ones(len(data), bool), 0.0
+        return data, np.ones(len(data), bool), 0.0, np.zeros(len(data), bool)
     ang = data.angle_deg.copy()
     keep = np.ones(len(data), bool)
+    past_end = np.zeros(len(data), bool)
     applied = []
     for _, sl in data.sample_slices():
         t = data.time_s[sl]
         dt = float(np.median(np.diff(t))) if t.size > 1 else 0.0
-        k = _shift_rows(data, sl, lag_ms)
+        k = int(round(lag_ms * 1e-3 / dt)) if dt > 0 else 0
         applied.append(k * dt * 1e3)
         if k == 0:
             continue
         idx = np.arange(sl.start, sl.stop)
         src = np.clip(idx + k, sl.start, sl.stop - 1)
         ang[idx] = data.angle_deg[src]
+        past_end[idx] = (idx + k < sl.start) | (idx + k >= sl.stop)
         # the angle k rows later must be k rows of time later: not past the record, nor across rows set aside
-        keep[idx] = ((idx + k >= sl.start) & (idx + k < sl.stop)
-                     & (np.abs(data.time_s[src] - t - k * dt) < 0.5 * dt))
-    return data.with_angle(ang).take(keep), keep, float(np.mean(applied))
-
+        keep[idx] = ~past_end[idx] & (np.abs(data.time_s[src] - t - k * dt) < 0.5 * dt)
+    return data.with_angle(ang).take(keep), keep, float(np.mean(applied)), past_end
 
 def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str = "", n_dropped: int = 0,
                       rezero: bool = True) -> Instruments:
@@ -836,22 +834,16 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
         dt_ms = 1e3 / max(np.median(list(rates.values())) if rates else 1.0, 1e-9)
         if abs(lag.lag_ms) > 3.0 * lag.se_ms and abs(lag.lag_ms) > 0.25 * dt_ms and lag.fall >= MIN_FALL:
             lag = Lag(lag.lag_ms, lag.se_ms, applied_ms=lag.lag_ms, fall=lag.fall)
-    shifted, k2, applied = shift_angle(clean, lag.applied_ms)
+    shifted, k2, applied, ends = shift_angle(clean, lag.applied_ms)
     if lag.applied_ms:
         lag = Lag(lag.lag_ms, lag.se_ms, lag.given, applied, lag.fall)
     idx = np.flatnonzero(kept)
     kept[idx[~k2]] = False
-    if (~k2).any():
-        # a row whose angle a lag later is past the record's end, or across rows set aside (no reading there)
-        ends = np.zeros(idx.size, bool)
-        for _, sl in clean.sample_slices():
-            k = _shift_rows(clean, sl, lag.applied_ms)
-            rows = np.arange(sl.start, sl.stop)
-            ends[sl] = (rows + k < sl.start) | (rows + k >= sl.stop)
-        if (~k2 & ends).any():
-            aside["end of record after the lag shift"] = idx[~k2 & ends]
-        if (~k2 & ~ends).any():
-            aside["row before a gap after the lag shift"] = idx[~k2 & ~ends]
+    # a row whose angle a lag later is past the record's end, or across rows set aside (no reading there)
+    if ends.any():
+        aside["end of record after the lag shift"] = idx[ends]
+    if (~k2 & ~ends).any():
+        aside["row before a gap after the lag shift"] = idx[~k2 & ~ends]
     return Instruments(shifted, data, aside, kept, rates, notes, lag, dropped, n_dropped, zeros, rezero, limits)
 
 
