@@ -14,6 +14,7 @@ from typing import Callable, Iterable
 import yaml
 
 from camtube.errors import Issue, PatternError
+from camtube.io import read_input_bytes
 
 
 class StrictLoader(yaml.SafeLoader):
@@ -95,7 +96,7 @@ def read_yaml_file(path: str | os.PathLike, what: str, fix: str | Callable[[], s
     """
     file = str(path)
     try:
-        data = Path(path).read_bytes()
+        data = read_input_bytes(path)
     except OSError as exc:
         raise PatternError([Issue("file", f"cannot read {what}: {exc.strerror}", file, "a readable YAML file",
                                   fix() if callable(fix) else fix)]) from None

@@ -587,3 +587,35 @@ def test_an_effect_file_with_clashing_or_nan_parameters(tmp_path, params, words)
                    f"E = Effect(name='mine', stage='stroke', params=({params}), apply=lambda c, s, p: s)\n")
     r = camtube("model", "fit", str(data), "--pattern", "tube2", "-q", "--effect-file", str(eff), "--effects", "mine")
     assert_refused(r, f"{eff}:2", *words)
+
+
+@pytest.mark.parametrize("argv", [
+    ["design", "{dev}"], ["build", "{dev}", "-o", "{tmp}/o"], ["design", "{tmp}/drawing.dxf"],
+    ["build", TUBE1, "--machine", "{dev}", "-o", "{tmp}/o"], ["synthesize", "{dev}", "-o", "{tmp}/p.yaml"],
+    ["model", "diagnose", "{dev}", "--pattern", "tube1"], ["model", "fit", "{tmp}/data.csv", "--pattern", "tube1"],
+    ["model", "ingest", "--tracker", "{dev}", "--daq", "{dev}", "--motor", "{dev}", "-o", "{tmp}/m.csv"],
+])
+def test_a_device_given_as_an_input_is_refused_not_read_forever(tmp_path, argv):
+    # /dev/zero never ends: a reader that reads it to the end runs until memory runs out (found by the bad-input sweep)
+    for name in ("drawing.dxf", "data.csv"):
+        (tmp_path / name).symlink_to("/dev/zero")
+    args = [a.format(dev="/dev/zero", tmp=tmp_path) for a in argv]
+    assert_refused(camtube(*args, timeout=60), "a device, not a file")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["data.csv", "drawing.dxf"]
+
+
+def test_a_pipe_is_still_read_as_a_file(tmp_path):
+    # what the device check must not refuse: a measurement file given through a pipe (<(gunzip -c data.csv.gz))
+    from camtube.io import read_input_text
+
+    fifo = tmp_path / "pipe.csv"
+    os.mkfifo(fifo)
+    pid = os.fork()
+    if pid == 0:   # the writer
+        with open(fifo, "w") as fh:
+            fh.write("sample,cycle,time_s,stroke_mm,force_N,angle_deg\r\n")
+        os._exit(0)
+    try:
+        assert read_input_text(fifo) == "sample,cycle,time_s,stroke_mm,force_N,angle_deg\n"
+    finally:
+        os.waitpid(pid, 0)

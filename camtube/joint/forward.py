@@ -37,6 +37,7 @@ from camtube.design.geometry import (
 )
 from camtube.design.pattern import Pattern
 from camtube.errors import CamtubeError
+from camtube.io import read_input_text
 
 #: Tube modulus (GPa) when the material has no entry in MATERIAL_MODULUS_GPA.
 FALLBACK_MODULUS_GPA = 2.5
@@ -206,7 +207,7 @@ class Mechanics:
         """
         p = Path(path)
         try:
-            doc = json.loads(p.read_text(encoding="utf-8"))
+            doc = json.loads(read_input_text(p))
         except OSError as exc:
             raise CamtubeError(f"{p}: cannot read the calibration: {exc.strerror}; fix: check the path") from None
         except (json.JSONDecodeError, UnicodeDecodeError) as exc:

@@ -47,6 +47,7 @@ from pathlib import Path
 import numpy as np
 
 from camtube.errors import DataError
+from camtube.io import read_input_text
 
 SPEED_BAND = 0.05
 
@@ -120,9 +121,10 @@ class JobGeometry:
         from camtube.export.jobfile import read_job
 
         try:
-            d = json.loads(Path(path).read_text(encoding="utf-8"))
+            d = json.loads(read_input_text(path))
         except OSError as exc:
-            raise DataError(f"{path}: cannot read the job file: {exc.strerror}") from None
+            raise DataError(f"{path}: cannot read the job file: {exc.strerror}; fix: give the NAME.job.json written "
+                            "next to the G-code") from None
         except ValueError as exc:
             raise DataError(f"{path}: not a camtube job file ({exc}); give the NAME.job.json written next to "
                             "the G-code") from None

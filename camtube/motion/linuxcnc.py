@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from camtube.errors import CamtubeError
+from camtube.io import read_input_bytes
 
 #: LinuxCNC's own Python (the ``linuxcnc`` module is built for it).
 SYSTEM_PYTHON = "/usr/bin/python3"
@@ -265,7 +266,7 @@ def check_program(path: str | os.PathLike, profile) -> str:
     """
     path = Path(path)
     try:
-        raw = path.read_bytes()
+        raw = read_input_bytes(path)
     except OSError as exc:
         raise MotionRunError(f"{path}: cannot read the program: {exc.strerror}") from None
     fix = "give the .ngc that `camtube toolpath` wrote for a LinuxCNC machine"

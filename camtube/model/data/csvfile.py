@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from camtube.errors import DataError
+from camtube.io import read_input_text
 from camtube.model.data.dataset import Dataset
 
 #: Required CSV columns, in the order :func:`format_csv` writes them.
@@ -287,7 +288,7 @@ def read_measurements(path: str | Path, strict: bool = False) -> Measurements:
 
 def _read_text(path: Path) -> str:
     try:
-        text = path.read_text(encoding="utf-8-sig")
+        text = read_input_text(path, "utf-8-sig")
     except FileNotFoundError:
         raise DataError(f"{path}: no such measurement file; fix: check the path of the CSV file") from None
     except IsADirectoryError:

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from camtube.errors import DataError
+from camtube.io import read_input_text
 from camtube.model.ingest.table import read_table
 
 #: NDI's marker for a value that could not be measured; anything below ``-3e28`` is treated as missing.
@@ -290,7 +291,7 @@ def read_text(path: str | Path, what: str) -> str:
     """The text of ``path``; an unreadable file raises :class:`DataError` naming it."""
     path = Path(path)
     try:
-        return path.read_text(encoding="utf-8-sig")
+        return read_input_text(path, "utf-8-sig")
     except FileNotFoundError:
         raise DataError(f"{path}: no such {what}; fix: give the path of an existing {what}") from None
     except IsADirectoryError:
@@ -299,4 +300,5 @@ def read_text(path: str | Path, what: str) -> str:
         raise DataError(f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start}); "
                         "fix: export the log as CSV text") from None
     except OSError as exc:
-        raise DataError(f"{path}: cannot read the {what} ({exc.strerror or exc})") from None
+        raise DataError(f"{path}: cannot read the {what} ({exc.strerror or exc}); fix: give the {what} as a "
+                        "readable file") from None
