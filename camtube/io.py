@@ -15,10 +15,6 @@ outputs too large to hold); this layer puts them on disk.
 
 Every failure to write is raised as :class:`OutputError`, which names the path,
 the reason and the fix.
-
-Inputs a user names are read through :func:`read_input_bytes` and :func:`read_input_text`: a device
-(``/dev/zero``, ``/dev/urandom``, a terminal) is refused as an :class:`OSError` the readers already turn into
-their one line, instead of being read until memory runs out.
 """
 from __future__ import annotations
 
@@ -28,7 +24,6 @@ import errno
 import os
 import shutil
 import signal
-import stat
 import tempfile
 import threading
 from contextlib import contextmanager
@@ -50,32 +45,6 @@ _FIXES = {
     errno.ENOSPC: "free some disk space or write elsewhere",
     errno.ENAMETOOLONG: "use a shorter path",
 }
-
-
-#: What a device given as an input file is told (the ``strerror`` of the :class:`OSError` raised).
-DEVICE_INPUT = "it is a device, not a file: reading it would not end"
-
-
-def _refuse_device(path: str | os.PathLike) -> None:
-    """Raise :class:`OSError` (``ENODEV``, naming ``path``) when ``path`` is a character or block device; a pipe
-    (``<(gunzip -c data.csv.gz)``) is read as a file is."""
-    mode = os.stat(path).st_mode
-    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
-        raise OSError(errno.ENODEV, DEVICE_INPUT, os.fspath(path))
-
-
-def read_input_bytes(path: str | os.PathLike) -> bytes:
-    """The bytes of the input file ``path``; a device is refused (:data:`DEVICE_INPUT`)."""
-    _refuse_device(path)
-    with open(path, "rb") as fh:
-        return fh.read()
-
-
-def read_input_text(path: str | os.PathLike, encoding: str = "utf-8") -> str:
-    """The text of the input file ``path`` (universal newlines, as :meth:`Path.read_text`); a device is refused."""
-    _refuse_device(path)
-    with open(path, encoding=encoding) as fh:
-        return fh.read()
 
 
 class PublishedInterrupt(KeyboardInterrupt):

@@ -14,7 +14,7 @@ from typing import Callable, Iterable
 import yaml
 
 from camtube.errors import Issue, PatternError
-from camtube.io import read_input_bytes
+from camtube.inputfile import read_input_bytes
 
 
 class StrictLoader(yaml.SafeLoader):

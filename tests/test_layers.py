@@ -18,8 +18,9 @@ PACKAGE = ROOT / "camtube"
 #: Floor of every top-level part of camtube, lowest first. A module may import from its own
 #: part and from parts on lower floors; parts on one floor do not import each other.
 FLOORS: dict[str, int] = {
-    # the ground: errors, tolerances and number formats; then the YAML, file and progress helpers
-    "errors": 0, "tol": 0, "fmt": 0, "__init__": 0,
+    # the ground: errors, tolerances, number formats and reading an input file; then the YAML, file and progress
+    # helpers
+    "errors": 0, "tol": 0, "fmt": 0, "inputfile": 0, "__init__": 0,
     "yamltext": 1, "io": 1, "progress": 1,
     "design": 2,
     "joint": 3, "plan": 3,

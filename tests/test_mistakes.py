@@ -606,7 +606,7 @@ def test_a_device_given_as_an_input_is_refused_not_read_forever(tmp_path, argv):
 
 def test_a_pipe_is_still_read_as_a_file(tmp_path):
     # what the device check must not refuse: a measurement file given through a pipe (<(gunzip -c data.csv.gz))
-    from camtube.io import read_input_text
+    from camtube.inputfile import read_input_text
 
     fifo = tmp_path / "pipe.csv"
     os.mkfifo(fifo)

@@ -34,7 +34,7 @@ from typing import Iterable
 from camtube.design.loader import Loaded, apply_overrides, build_settings, parse_override, read_yaml
 from camtube.design.pattern import Cut, Pattern, drawn, sort_cuts
 from camtube.errors import Issue, PatternError
-from camtube.io import _refuse_device
+from camtube.inputfile import refuse_device
 from camtube.tol import TOL
 
 ROLES = ("notch", "hole", "slit", "ignore")
@@ -284,7 +284,7 @@ def _read_document(path, file: str):
     import ezdxf
 
     try:
-        _refuse_device(path)
+        refuse_device(path)
         return ezdxf.readfile(str(path))
     except OSError as exc:
         if Path(path).is_file():

@@ -21,7 +21,7 @@ import numpy as np
 
 from camtube import __version__
 from camtube.errors import DataError
-from camtube.io import read_input_text
+from camtube.inputfile import read_input_text
 from camtube.plan.safety import check_job
 from camtube.progress import NO_PROGRESS, Progress
 

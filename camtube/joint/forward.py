@@ -37,7 +37,7 @@ from camtube.design.geometry import (
 )
 from camtube.design.pattern import Pattern
 from camtube.errors import CamtubeError
-from camtube.io import read_input_text
+from camtube.inputfile import read_input_text
 
 #: Tube modulus (GPa) when the material has no entry in MATERIAL_MODULUS_GPA.
 FALLBACK_MODULUS_GPA = 2.5

@@ -47,7 +47,7 @@ from pathlib import Path
 import numpy as np
 
 from camtube.errors import DataError
-from camtube.io import read_input_text
+from camtube.inputfile import read_input_text
 
 SPEED_BAND = 0.05
 

@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from camtube.errors import CamtubeError
-from camtube.io import read_input_bytes
+from camtube.inputfile import read_input_bytes
 
 #: LinuxCNC's own Python (the ``linuxcnc`` module is built for it).
 SYSTEM_PYTHON = "/usr/bin/python3"

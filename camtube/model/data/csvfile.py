@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from camtube.errors import DataError
-from camtube.io import read_input_text
+from camtube.inputfile import read_input_text
 from camtube.model.data.dataset import Dataset
 
 #: Required CSV columns, in the order :func:`format_csv` writes them.

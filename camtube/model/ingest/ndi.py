@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from camtube.errors import DataError
-from camtube.io import read_input_text
+from camtube.inputfile import read_input_text
 from camtube.model.ingest.table import read_table
 
 #: NDI's marker for a value that could not be measured; anything below ``-3e28`` is treated as missing.

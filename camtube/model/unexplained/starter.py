@@ -23,7 +23,7 @@ import re
 from pathlib import Path
 
 from camtube.errors import DataError
-from camtube.io import read_input_text
+from camtube.inputfile import read_input_text
 from camtube.model.unexplained.analysis import HINTS, LABELS, VARIABLES
 
 STAGES = ("force", "stroke", "elongation", "kinematics", "angle")

@@ -1,0 +1,37 @@
+"""Reading the files a user names: a device is refused, a file or a pipe is read.
+
+:func:`read_input_bytes` and :func:`read_input_text` read an input (a pattern, a measurement file, a log, a job
+file); a device (``/dev/zero``, ``/dev/urandom``, a terminal) raises an :class:`OSError` the readers already turn
+into their one line, instead of being read until memory runs out. A pipe (``<(gunzip -c data.csv.gz)``) ends, so it
+is read as a file is. (Files are written by :mod:`camtube.io`.)
+"""
+from __future__ import annotations
+
+import errno
+import os
+import stat
+
+#: What a device given as an input file is told (the ``strerror`` of the :class:`OSError` raised).
+DEVICE_INPUT = "it is a device, not a file: reading it would not end"
+
+
+def refuse_device(path: str | os.PathLike) -> None:
+    """Raise :class:`OSError` (``ENODEV``, naming ``path``) when ``path`` is a character or block device; a pipe
+    (``<(gunzip -c data.csv.gz)``) is read as a file is."""
+    mode = os.stat(path).st_mode
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        raise OSError(errno.ENODEV, DEVICE_INPUT, os.fspath(path))
+
+
+def read_input_bytes(path: str | os.PathLike) -> bytes:
+    """The bytes of the input file ``path``; a device is refused (:data:`DEVICE_INPUT`)."""
+    refuse_device(path)
+    with open(path, "rb") as fh:
+        return fh.read()
+
+
+def read_input_text(path: str | os.PathLike, encoding: str = "utf-8") -> str:
+    """The text of the input file ``path`` (universal newlines, as :meth:`Path.read_text`); a device is refused."""
+    refuse_device(path)
+    with open(path, encoding=encoding) as fh:
+        return fh.read()
