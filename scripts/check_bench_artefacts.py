@@ -6,9 +6,9 @@ Per file: the spikes found against the true ones (those not in a dropout), the r
 bursts), the dropouts the tracker wrote as 0 or its last reading that were set aside (those while the joint was
 bent and the motor moved, and those written as 0 while it stood bent in a dwell: at rest a zero or a held value is
 no error, nor is a held value in a dwell), the repeated stamps, and any row set aside that carries no artefact
-("false").
+("false"; the rows a load cell read the end of its range in count as artefacts).
 """
-import sys
+import argparse
 
 import numpy as np
 from benchutil import ROOT
@@ -18,7 +18,10 @@ from camtube.design.loader import load_pattern
 from camtube.model.diagnose.instruments import check_instruments
 from camtube.model.sim.bench import Clock, simulate_bench
 
-for batch in sys.argv[1:] or ["bench", "bench-heldout"]:
+ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+ap.add_argument("batches", nargs="*", metavar="BATCH", choices=[[], *B.BATCHES],
+                help=f"bench batches ({', '.join(B.BATCHES)}); default: bench bench-heldout")
+for batch in ap.parse_args().batches or ["bench", "bench-heldout"]:
     for name, tube, rate, benches, _, s in B.batch_specs(batch):
         rec = simulate_bench(load_pattern(ROOT / "patterns" / f"{tube}.yaml"), benches, B.protocol_for(rate),
                              Clock(rate_hz=rate), seed=s)
@@ -35,7 +38,12 @@ for batch in sys.argv[1:] or ["bench", "bench-heldout"]:
                 and 0 < i < len(stroke) - 1 and stroke[i + 1] != stroke[i - 1]}
         dwell = {i for i in drops & set(idx.tolist()) if abs(rec.angle_true_deg[i]) > 3.0 and i not in bent
                  and rec.data.angle_deg[i] == 0.0}
-        artefact = spikes | bursts | drops | set(rec.repeat_rows.tolist())
+        # a load cell at the end of its range: the rows it read its limit in (range_N; inf: none)
+        smp = rec.data.sample
+        limit = np.zeros(len(smp), bool)
+        for b, name_s in zip(benches, np.unique(smp)):
+            limit |= (smp == name_s) & (rec.data.force_N >= b.load_cell.range_N)
+        artefact = spikes | bursts | drops | set(rec.repeat_rows.tolist()) | set(np.flatnonzero(limit).tolist())
         shifted = aside.get("end of record after the lag shift", set()) | aside.get("row before a gap after the lag shift", set())
         print(f"{batch} {name}: spikes {len(aside['angle spike'] & spikes)} of {len(spikes)}; burst rows "
               f"{len(every & bursts)} of {len(bursts)}; dropouts written as values, while bent and moving, "

@@ -607,6 +607,26 @@ def test_interference_lasting_a_second_is_set_aside_through_the_ramps(tube2):
     assert d.final.rmse_deg < 1.1 * rec.floor_deg
 
 
+@pytest.mark.parametrize("form", ["overlapping", "nested", "inside a short burst"])
+def test_two_bursts_of_interference_one_over_the_other_are_set_aside_together(tube2, form):
+    # the jumps of two bursts that overlap add: 8 deg, 4 more, 8 back, 4 back (a 100 Hz control of bench-heldout17
+    # kept 217 rows 4-8 deg off, at 1.63x the floor); one inside the other: 8, 4, 4 back, 8 back
+    rec = simulate_bench(tube2, SampleBench(tracker=QUIET), SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=5)
+    d = rec.data
+    n = len(d)
+    a = d.angle_deg.copy()
+    first, second = {"overlapping": ((1000, 1150), (1060, 1260)), "nested": ((1000, 1250), (1060, 1150)),
+                     "inside a short burst": ((1000, 1200), (1080, 1100))}[form]
+    a[slice(*first)] += 8.0
+    a[slice(*second)] += 4.0
+    ins = check_instruments(Dataset(d.sample, d.cycle, d.time_s, d.stroke_mm, d.force_N, a))
+    aside = {int(i) for v in ins.aside.values() for i in v}
+    displaced = set(range(min(first[0], second[0]), max(first[1], second[1])))
+    assert displaced <= aside
+    assert len(aside - displaced) <= 2, sorted(aside - displaced)   # (a row beside a jump, at most)
+    assert n - len(aside) > 0.9 * n
+
+
 def test_a_load_cell_at_the_end_of_its_range_is_set_aside_and_said(tube2):
     # the cell saturates at 80 % of the peak tension: the force reads a flat limit while the stroke goes on, and
     # the paper's physics read 26x the floor with friction and viscoelastic "partial". The rows at the limit are
