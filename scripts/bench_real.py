@@ -218,6 +218,12 @@ HELDOUT16_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost mo
 #: instruments of :func:`rougher_instruments`.
 HELDOUT17_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "creep", "backbone",
                    "zero drift", "lag", ("toe", "slack"), ("backbone", "creep"), "friction", "tracker drift"]
+#: The eighteenth fresh held-out batch (issue 19, after two bursts one over the other were set aside, and a device
+#: refused as an input): the usual files, a three-arm backbone, and two pairs no batch had: friction at the guide
+#: beside lost motion in the drive, a slack tendon beside a relaxing backbone; the instruments of
+#: :func:`rougher_instruments`.
+HELDOUT18_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "creep", "backbone", "backbone3",
+                   "zero drift", "lag", ("friction", "lost motion"), ("slack", "backbone"), "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -255,13 +261,16 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            "bench-heldout16": (20270722, HELDOUT16_KINDS),
            # drawn once the instruments' checks of the session after bench-heldout16 were settled (every batch above
            # looked at), with the instruments of rougher_instruments (ROUGHER); run once
-           "bench-heldout17": (20270823, HELDOUT17_KINDS)}
+           "bench-heldout17": (20270823, HELDOUT17_KINDS),
+           # drawn once the overlapping bursts of the session after bench-heldout17 were settled (every batch above
+           # looked at), with the instruments of rougher_instruments (ROUGHER); run once
+           "bench-heldout18": (20270924, HELDOUT18_KINDS)}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
 #: Batches with those, interference lasting seconds and load cells that reach their range
 #: (:func:`rougher_instruments`).
-ROUGHER = {"bench-heldout17"}
+ROUGHER = {"bench-heldout17", "bench-heldout18"}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
