@@ -81,6 +81,8 @@ LONG_BURST_S = 3.0
 STEP_MATCH = 0.25
 #: ... each jump read against the medians of this many row-to-row changes either side.
 STEP_SIDE = 3
+#: ... and besides that share, by this many noise scales (each size is read from one row's change: two noisy rows)
+STEP_NOISE = 4.0
 #: Repeats of the angle before them, in a row, that make a frozen tracker ...
 FROZEN_REPEATS = 4
 #: ... while the stroke moves by this share of the sample's stroke range across them.
@@ -491,15 +493,17 @@ def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: n
         idx = np.flatnonzero(good)
         w = np.interp(np.arange(n), idx, v[idx])
         rows, size = _steps(w, scale)
-        for r0, r1 in _paired_jumps(rows, size, int(LONG_BURST_S / step)):
+        for r0, r1 in _paired_jumps(rows, size, int(LONG_BURST_S / step), STEP_NOISE * scale):
             out[sl.start + r0:sl.start + r1] = True
         # (a single jump is not set aside: one near the record's end was the joint's own, in two files of 187)
     return out & ~known
 
 
-def _paired_jumps(rows: np.ndarray, size: np.ndarray, longest: int) -> list:
+def _paired_jumps(rows: np.ndarray, size: np.ndarray, longest: int, noise: float = 0.0) -> list:
     """``(first row, stop row)`` of each displacement the jumps ``(rows, size)`` (:func:`_steps`) enclose: a jump
-    and a jump back of the same size (within :data:`STEP_MATCH`) at most ``longest`` rows later. Taken in turn:
+    and a jump back of the same size (within :data:`STEP_MATCH` of it, plus ``noise``: each size is read from one
+    row's change, so two noisy rows; a 4.5 deg burst at 100 Hz read +4.1 in and -5.2 out) at most ``longest`` rows
+    later. Taken in turn:
 
     1. each jump and the next one (one burst);
     2. then, among the jumps not yet paired, again each and the next one: two bursts, one inside the other (the
@@ -511,7 +515,7 @@ def _paired_jumps(rows: np.ndarray, size: np.ndarray, longest: int) -> list:
     """
     def match(i: int, j: int) -> bool:
         return (rows[j] - rows[i] <= longest and np.sign(size[j]) == -np.sign(size[i])
-                and abs(size[i] + size[j]) <= STEP_MATCH * abs(size[i]))
+                and abs(size[i] + size[j]) <= STEP_MATCH * abs(size[i]) + noise)
 
     out = []
     free = list(range(rows.size))
