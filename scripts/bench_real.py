@@ -224,6 +224,11 @@ HELDOUT17_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost mo
 #: :func:`rougher_instruments`.
 HELDOUT18_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "creep", "backbone", "backbone3",
                    "zero drift", "lag", ("friction", "lost motion"), ("slack", "backbone"), "tracker drift"]
+#: The nineteenth fresh held-out batch (issue 19, after the jumps of a burst were paired within the noise, bench-heldout18
+#: looked at): the usual files, a toe beside a creeping tendon, lost motion beside friction at the guide (the other way
+#: round from bench-heldout18), with the instruments of :func:`rougher_instruments`.
+HELDOUT19_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "creep", "backbone", "zero drift",
+                   "lag", ("toe", "creep"), ("lost motion", "friction"), "friction", "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -264,13 +269,15 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            "bench-heldout17": (20270823, HELDOUT17_KINDS),
            # drawn once the overlapping bursts of the session after bench-heldout17 were settled (every batch above
            # looked at), with the instruments of rougher_instruments (ROUGHER); run once
-           "bench-heldout18": (20270924, HELDOUT18_KINDS)}
+           "bench-heldout18": (20270924, HELDOUT18_KINDS),
+           # drawn once the jumps' pairing within the noise was settled (every batch above looked at), ROUGHER; run once
+           "bench-heldout19": (20271026, HELDOUT19_KINDS)}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
 #: Batches with those, interference lasting seconds and load cells that reach their range
 #: (:func:`rougher_instruments`).
-ROUGHER = {"bench-heldout17", "bench-heldout18"}
+ROUGHER = {"bench-heldout17", "bench-heldout18", "bench-heldout19"}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
