@@ -647,6 +647,26 @@ def test_a_burst_a_few_times_the_noise_is_paired_though_its_two_jumps_read_diffe
     assert len(aside - displaced) <= 24    # (a row beside a jump, at most)
 
 
+def test_real_rows_between_a_long_burst_and_a_jump_of_the_joint_are_kept(tube2):
+    # a 2 s burst of -3.6 deg ended 5 rows before the carriage slipped (the joint fell 1.2 deg at once, 10 noise
+    # scales; here 8 and 3 deg under the short record's larger scale): the 5 real rows between stood above both their
+    # neighbours, the burst's on one side and the fallen joint's on the other,
+    # and were set aside as a short burst (bench-heldout18's second lost-motion file). Read across the long burst,
+    # they are the joint's
+    tr = Tracker(noise_deg=0.1, n_spikes=0, n_dropouts=0)
+    rec = simulate_bench(tube2, SampleBench(tracker=tr), SHORT, Clock(rate_hz=40.0, n_repeats=0), seed=12)
+    d = rec.data
+    rest = np.flatnonzero((d.stroke_mm == 0.0) & (np.arange(len(d)) > 200))
+    r1 = int(rest[len(rest) // 2])              # the burst ends at a rest, the joint still (no ramp)
+    a = d.angle_deg.copy()
+    a[r1 - 80:r1] -= 8.0
+    a[r1 + 5:] -= 3.0                            # the joint's own jump (it stays: no jump back)
+    ins = check_instruments(Dataset(d.sample, d.cycle, d.time_s, d.stroke_mm, d.force_N, a))
+    aside = {int(i) for v in ins.aside.values() for i in v}
+    assert set(range(r1 - 80, r1)) <= aside
+    assert not set(range(r1, r1 + 5)) & aside, sorted(set(range(r1, r1 + 5)) & aside)
+
+
 def test_a_load_cell_at_the_end_of_its_range_is_set_aside_and_said(tube2):
     # the cell saturates at 80 % of the peak tension: the force reads a flat limit while the stroke goes on, and
     # the paper's physics read 26x the floor with friction and viscoelastic "partial". The rows at the limit are

@@ -405,12 +405,15 @@ def _spikes(x: np.ndarray, slices: list) -> np.ndarray:
     return out
 
 
-def _bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, single: np.ndarray) -> np.ndarray:
+def _bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, single: np.ndarray,
+            across: np.ndarray | None = None) -> np.ndarray:
     """Rows of ``x`` (n,) in runs of 2 or more rows that all lie outside the range of the run's neighbours
     (:data:`NEIGHBOURS` rows either side, same sample) on the same side, by more than :data:`SPIKE_Z` noise scales;
     runs up to :data:`BURST_S` seconds (at most :data:`BURST_ROWS` rows). ``steps_s``: each sample's median positive
     time step (:meth:`Dataset.median_steps_s`, in the order of ``slices``). ``single`` (n,) bool: the spikes of one
-    row, which are not neighbours (a burst beside a spike is still found)."""
+    row, which are not neighbours (a burst beside a spike is still found). ``across`` (n,) bool, optional: rows
+    displaced for longer (:func:`_long_bursts`), read as the line between the rows either side of each run of them,
+    so that they are not the neighbours of the real rows beside them."""
     out = np.zeros(x.size, bool)
     h = NEIGHBOURS
     for (_, sl), step in zip(slices, steps_s):
@@ -424,6 +427,9 @@ def _bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, single: np.nd
         longest = int(min(BURST_ROWS, max(2, math.floor(BURST_S / step))))
         # a single spike beside a run stands for its neighbour: the value across it (its own neighbour's)
         w = v.copy()
+        if across is not None and across[sl].any() and (~across[sl]).sum() >= 2:
+            real = np.flatnonzero(~across[sl])
+            w = np.interp(np.arange(n), real, v[real])
         for i in np.flatnonzero(single[sl]):
             w[i] = w[i - 1] if i > 0 else w[min(i + 1, n - 1)]
         lo_run = w.copy()
@@ -846,7 +852,11 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     bf = _bursts(data.force_N, steps, slices, sf) & ~rep & ~sa & ~sf & ~ba
     fz = _frozen(data.angle_deg, data.stroke_mm, slices) & ~rep & ~sa & ~sf & ~ba & ~bf & ~sat
     # (read across the angle's own artefacts only: where the force was set aside the angle is still read)
-    ba |= _long_bursts(data.angle_deg, steps, slices, rep | sa | fz) & ~(sf | bf | sat)
+    lb = _long_bursts(data.angle_deg, steps, slices, rep | sa | fz) & ~(sf | bf | sat)
+    if lb.any():
+        # the short bursts read again across the long ones: rows displaced for a second beside a run of real rows
+        # made it look displaced (5 rows after a 2 s burst, where the carriage slipped, in one file of 244)
+        ba = (_bursts(data.angle_deg, steps, slices, sa, across=lb) & ~rep & ~sa & ~sf & ~lb) | lb
     ba &= ~sat
     bf &= ~sat
     aside["angle spike"] = np.flatnonzero(sa)
