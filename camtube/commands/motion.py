@@ -54,10 +54,8 @@ def cmd_motion(args: argparse.Namespace) -> int:
     profile = load_profile(args.machine)
     program = Path(args.program)
     if not program.is_file():
-        raise CamtubeError(f"{program}: no such G-code file; fix: give the .ngc that `camtube toolpath` wrote"
-                           if not program.exists() else
-                           f"{program}: not a G-code file (a directory or a device); fix: give the .ngc that "
-                           "`camtube toolpath` wrote")
+        why = "not a G-code file (a directory or a device)" if program.exists() else "no such G-code file"
+        raise CamtubeError(f"{program}: {why}; fix: give the .ngc that `camtube toolpath` wrote")
     text = check_program(program, profile)  # one line and exit 2 for a file LinuxCNC cannot run, before it starts
     geom = JobGeometry.from_job_file(_job_path(program, args.job))
     est = estimate_program(text, profile)

@@ -358,9 +358,15 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
         here = f"INSERT #{entity.dxf.handle}" if entity.dxf.handle else "INSERT"
         name = entity.dxf.name
         block = entity.block()
-        if block is None or block.block.is_xref:
+
+        def unplaced() -> _Entity:
+            """This INSERT as an entity of the reading (one whose block is not placed)."""
             ent = _Entity("INSERT", entity.dxf.handle or "-", layer, via)
             rd.entities.append(ent)
+            return ent
+
+        if block is None or block.block.is_xref:
+            ent = unplaced()
             if rd.role(layer) == "ignore":
                 ent.status = "aside:ignored layer"
             else:
@@ -369,16 +375,14 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
                           "bind the XREF into the drawing (XREF > Bind) and save again", entities=[ent])
             return
         if name in blocks or len(blocks) >= MAX_BLOCK_DEPTH:
-            ent = _Entity("INSERT", entity.dxf.handle or "-", layer, via)
-            rd.entities.append(ent)
+            ent = unplaced()
             why = (f"places block {name!r} inside itself ({' > '.join(blocks + (name,))})" if name in blocks
                    else f"nests blocks more than {MAX_BLOCK_DEPTH} deep ({' > '.join(blocks[:3])} > ...)")
             rd.refuse(ent.describe(), why, "redefine the block without placing itself in it, or explode it in CAD",
                       entities=[ent])
             return
         if entity.mcount > MAX_INSERT_COPIES:
-            ent = _Entity("INSERT", entity.dxf.handle or "-", layer, via)
-            rd.entities.append(ent)
+            ent = unplaced()
             rd.refuse(ent.describe(), f"places block {name!r} {entity.mcount} times (an array of "
                       f"{entity.dxf.get('row_count', 1)} x {entity.dxf.get('column_count', 1)})",
                       "check the array's row and column counts", f"at most {MAX_INSERT_COPIES} copies", entities=[ent])

@@ -217,8 +217,8 @@ def _check_machine_moves(job, dialect: Dialect, mv: Moves, mm: MachineMoves) -> 
     from camtube.errors import SafetyError
 
     prof = dialect.profile
-    where = f"machine {prof.name}" + (f" ({prof.source})" if prof is not None and prof.source else "") \
-        if prof is not None else f"dialect {dialect.name}"
+    where = (f"machine {prof.name}" + (f" ({prof.source})" if prof.source else "") if prof is not None
+             else f"dialect {dialect.name}")
     if prof is not None and prof.rotary and prof.rotary_range_deg is not None and len(mm.ay):
         lo, hi = prof.rotary_range_deg
         eps = 0.5 * 10.0 ** -prof.decimals
