@@ -19,9 +19,13 @@ from camtube.model.diagnose.instruments import check_instruments
 from camtube.model.sim.bench import Clock, simulate_bench
 
 ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-ap.add_argument("batches", nargs="*", metavar="BATCH", choices=[[], *B.BATCHES],
+ap.add_argument("batches", nargs="*", metavar="BATCH",
                 help=f"bench batches ({', '.join(B.BATCHES)}); default: bench bench-heldout")
-for batch in ap.parse_args().batches or ["bench", "bench-heldout"]:
+batches = ap.parse_args().batches
+unknown = [b for b in batches if b not in B.BATCHES]
+if unknown:
+    ap.error(f"unknown batch {unknown[0]!r}; fix: give one of {', '.join(B.BATCHES)}")
+for batch in batches or ["bench", "bench-heldout"]:
     for name, tube, rate, benches, _, s in B.batch_specs(batch):
         rec = simulate_bench(load_pattern(ROOT / "patterns" / f"{tube}.yaml"), benches, B.protocol_for(rate),
                              Clock(rate_hz=rate), seed=s)
