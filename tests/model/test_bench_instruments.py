@@ -709,6 +709,31 @@ def test_a_lag_is_read_by_time_across_the_rows_a_load_cell_at_its_limit_set_asid
     assert before.size and all({i + 1, i + 2} & other for i in before)
 
 
+@pytest.mark.parametrize("rate_hz", [25.0, 100.0])
+def test_the_drives_speed_is_read_across_the_rows_a_load_cell_at_its_limit_set_aside(tube2, rate_hz):
+    # friction at the guide, and a cell whose range ends below the peak tension: the top of every stroke is set
+    # aside (a third of the rows). Read from the rows kept, the speed across that gap put the end of the pull, the
+    # dwell and the start of the release in one step, and the guide's law fitted 6-11x the floor; read on every
+    # row whose stamp is sound, it fits at the floor and finds the guide's mu * wrap
+    from camtube.model.core.build import build_registry
+    from camtube.model.data.dataset import SPEED_COLUMN
+
+    b = SampleBench(guide=Guide(mu=0.2), tracker=QUIET, load_cell=LoadCell(range_N=3.2))
+    rec = simulate_bench(tube2, b, SHORT, Clock(rate_hz=rate_hz, n_repeats=3), seed=21)
+    ins = check_instruments(rec.data)
+    assert len(ins.aside["load cell limit row"]) > 0.25 * len(rec.data)
+    reg, _ = build_registry([])
+    capstan = model_for_pattern(tube2, [reg.get_effect("capstan")])
+    r = fit(capstan, ins.data, ["E_t", "capstan.mu_wrap", "capstan.slip_mm_s", "capstan.hold"],
+            pattern_values(tube2), grid=2)
+    assert r.rmse < 1.1 * rec.floor_deg
+    assert r.params["capstan.mu_wrap"] == pytest.approx(0.2 * math.pi / 2, rel=0.05)
+    sound = np.ones(len(rec.data), bool)
+    sound[ins.aside["repeated time stamp"]] = False
+    speed = rec.data.take(sound).stroke_speed_mm_s
+    assert np.array_equal(ins.data.extra[SPEED_COLUMN], speed[np.cumsum(sound)[ins.kept] - 1])
+
+
 @pytest.mark.parametrize("dropout", ["zero", "hold"])
 def test_the_simulators_bursts_and_dropouts_written_as_values_are_set_aside_and_nothing_else(tube2, dropout):
     # the bench simulator's tracker with bursts of interference and dropouts written as 0 or as its last reading

@@ -282,6 +282,16 @@ class Dataset:
                        {**self.extra, SPEED_COLUMN: self.stroke_speed_mm_s,
                         FORCE_SMOOTHED_COLUMN: self.force_smoothed_N})
 
+    def with_speed_of(self, record: "Dataset", rows: np.ndarray) -> "Dataset":
+        """This Dataset with the stroke speed of ``record`` at ``rows`` (one per row of this one) as the column
+        :data:`SPEED_COLUMN`: the rows set aside between two rows kept still had a sound stroke and time, and the
+        speed read across their gap would average a ramp's end, a dwell and the next ramp's start into one step.
+        Keeps the record this one was taken from (:meth:`rows_of_record`)."""
+        out = Dataset(self.sample, self.cycle, self.time_s, self.stroke_mm, self.force_N, self.angle_deg,
+                      {**self.extra, SPEED_COLUMN: record.stroke_speed_mm_s[rows]})
+        object.__setattr__(out, "taken_from", self.taken_from)
+        return out
+
     def take(self, mask: np.ndarray) -> "Dataset":
         """Rows where ``mask`` (bool or index array) selects (the copy knows them: :meth:`rows_of_record`)."""
         out = Dataset(
