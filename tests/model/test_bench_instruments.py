@@ -734,6 +734,27 @@ def test_the_drives_speed_is_read_across_the_rows_a_load_cell_at_its_limit_set_a
     assert np.array_equal(ins.data.extra[SPEED_COLUMN], speed[np.cumsum(sound)[ins.kept] - 1])
 
 
+def test_a_guides_hold_the_rows_kept_do_not_resolve_is_held_not_a_reason_to_refuse_it(tube2, tmp_path, capsys):
+    # friction at the guide in both samples, each load cell at its limit: the dwells at the top, where the guide's
+    # hold (what it keeps while the drive rests) shows, are set aside. capstan takes the error from 21x to the floor
+    # but its hold ended on its bound (-0.5, moving it across its range changes the error by 1.5 %), and nothing was
+    # recommended. Such a parameter is held at its start value, said, and held in the printed command
+    b = SampleBench(guide=Guide(mu=0.2), tracker=QUIET, load_cell=LoadCell(range_N=3.2))
+    proto = Protocol(n_cycles=16, ramp_s=2.0, dwell_s=1.0, rest_s=1.0, first_dwell_s=2.0)
+    rec = simulate_bench(tube2, b, proto, Clock(rate_hz=50.0, n_repeats=0), seed=5)
+    path = tmp_path / "guide.csv"
+    path.write_text(format_csv(rec.data))
+    out_json = tmp_path / "d.json"
+    assert main(["model", "diagnose", str(path), "--pattern", str(TUBE2), "--json", str(out_json)]) == 0
+    text = capsys.readouterr().out
+    doc = json.loads(out_json.read_text())
+    assert doc["recommended"][0] == "capstan", text
+    assert doc["held"] == {"capstan.hold": 0.5}
+    assert "capstan.hold held at 0.5: the rows kept barely depend on it" in text
+    assert "--fix capstan.hold=0.5" in text
+    assert doc["final"]["rmse_deg"] < 1.1 * rec.floor_deg
+
+
 @pytest.mark.parametrize("dropout", ["zero", "hold"])
 def test_the_simulators_bursts_and_dropouts_written_as_values_are_set_aside_and_nothing_else(tube2, dropout):
     # the bench simulator's tracker with bursts of interference and dropouts written as 0 or as its last reading

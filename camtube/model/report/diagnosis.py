@@ -21,7 +21,8 @@ report directory with an index is complete).
      "partial": [{"effect", "rmse_before_deg", "rmse_deg", "floor_ratio", "params"}],  # lower it, not a fix
      "waterfall": [{"effects", "rmse_deg", "per_sample"}],
      "per_sample": [name, ...], "held": {"name@S": value,   # per-sample copies held off (absent in S)
-                                          "name": value},    # a baseline effect a stand-in holds off
+                                          "name": value},    # a baseline effect a stand-in holds off, or a
+                                                             # parameter the rows kept barely depend on
      "final": {"effects", "rmse_deg", "params"}, "stop_reason", "command",
      "unexplained": null | {"share", "follows", "periodic": [{"variable", "period", "unit", "amplitude_deg"}],
                             "shape", "samples", ...}}   # camtube.model.unexplained
@@ -280,12 +281,28 @@ SIDES = {
 }
 
 
+def unresolved_held(d: Diagnosis) -> dict:
+    """The held values of the recommended effects' parameters that do not switch the effect off (not in its
+    ``off`` values): held because the rows barely depend on them, not because a sample does not show it."""
+    out = {}
+    for k, v in d.held.items():
+        (eff, _, pname), smp = k.split("@")[0].partition("."), k.partition("@")[2]
+        e = d.catalog.get(eff)
+        if eff not in d.recommended or e is None or pname in (e.off or {}):
+            continue
+        if smp and any(f"{eff}.{o}@{smp}" in d.held for o in (e.off or {})):
+            continue   # the effect is held off in that sample: all its copies there are held with it
+        out[k] = v
+    return out
+
+
 def answer_lines(d: Diagnosis) -> list[str]:
     """The answer first: what to add in order with the error before and after each step, what is left and what
     it follows, per sample, and the instruments' findings (rows set aside, lag)."""
     floor = d.noise_floor_deg
     steps = d.waterfall
     out = []
+    unresolved = unresolved_held(d)
     if d.recommended:
         label = f" ({d.explanation} explanation)" if d.explanation else ""
         out.append(f"answer: add {', then '.join(d.recommended)}{label}")
@@ -311,7 +328,8 @@ def answer_lines(d: Diagnosis) -> list[str]:
                          for k, name in enumerate(d.recommended, 1)]
                 out.append(f"  sample {smp}: " + "; ".join(gains) + " deg")
             for name in d.recommended:
-                off = sorted({k.split("@")[1] for k in d.held if "@" in k and k.split(".")[0] == name})
+                off = sorted({k.split("@")[1] for k in d.held if "@" in k and k.split(".")[0] == name
+                              and k not in unresolved})
                 if off:
                     on = [smp for smp in samples if smp not in off]
                     out.append(f"  {name}: in sample(s) {', '.join(on)} only; held off in {', '.join(off)} "
@@ -320,6 +338,10 @@ def answer_lines(d: Diagnosis) -> list[str]:
             if "@" not in k and k.split(".")[0] in d.baseline:
                 out.append(f"  {k.split('.')[0]} (the baseline) held at {k} = {v:g}: the recommended effects "
                            "explain the bent rest in its place")
+        for k, v in unresolved.items():
+            out.append(f"  {k} held at {v:g}: the rows kept barely depend on it (across its whole range the error "
+                       "moves by less than a candidate must gain), so it is not an estimate; the rows where it acts "
+                       "were set aside (a load cell at its limit sets aside the dwells at the top) or not measured")
     elif d.partial:
         out.append("answer: nothing the library has explains the misfit; the built-ins that lower it ("
                    + ", ".join(d.partial) + f") leave {_times(d.partial_steps[-1].rmse_deg, floor)} the noise floor "
