@@ -229,6 +229,11 @@ HELDOUT18_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost mo
 #: round from bench-heldout18), with the instruments of :func:`rougher_instruments`.
 HELDOUT19_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "creep", "backbone", "zero drift",
                    "lag", ("toe", "creep"), ("lost motion", "friction"), "friction", "tracker drift"]
+#: The twentieth fresh held-out batch (issue 19, after the drive's speed was read across the rows set aside and a
+#: parameter the rows kept barely depend on was held; bench-heldout18 and 19 looked at): the usual files, friction at
+#: the guide twice and beside a toe and a creeping tendon, with the instruments of :func:`rougher_instruments`.
+HELDOUT20_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
+                   "friction", "friction", ("friction", "toe"), ("creep", "friction"), "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -271,13 +276,16 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            # looked at), with the instruments of rougher_instruments (ROUGHER); run once
            "bench-heldout18": (20270924, HELDOUT18_KINDS),
            # drawn once the jumps' pairing within the noise was settled (every batch above looked at), ROUGHER; run once
-           "bench-heldout19": (20271026, HELDOUT19_KINDS)}
+           "bench-heldout19": (20271026, HELDOUT19_KINDS),
+           # drawn once the speed across rows set aside and the hold of what the rows do not resolve were settled
+           # (every batch above looked at), ROUGHER; run once
+           "bench-heldout20": (20271127, HELDOUT20_KINDS)}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
 #: Batches with those, interference lasting seconds and load cells that reach their range
 #: (:func:`rougher_instruments`).
-ROUGHER = {"bench-heldout17", "bench-heldout18", "bench-heldout19"}
+ROUGHER = {"bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20"}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
