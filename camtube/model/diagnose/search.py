@@ -1136,7 +1136,7 @@ class Search:
             f, ho, mse = self._fit_one(m, ch.names + new, start, ch.per_sample, grid=s.grid, grid_names=new,
                                        starts=[init] if init else ())
             held = None
-            unresolved = _unresolved(m, self.search, f, new, ch.fit, s.min_gain)
+            unresolved = _unresolved(m, self.search, f, eff, s.min_gain)
             if unresolved:
                 # a parameter that the rows kept barely depend on ended on a bound (a load cell at its limit sets
                 # aside the dwells at the top, where a guide's hold shows): held at its start value
@@ -1170,7 +1170,7 @@ class Search:
                     off = {**off, **off_all}   # per sample, it takes the baseline effect's place
                     names, ps = self._chain_names(off, new, new)
                     f2, ho2, mse2 = self._fit_one(m, names, f2.params, ps, held=off)
-                unresolved = _unresolved(m, self.search, f2, new, ch.fit, s.min_gain)
+                unresolved = _unresolved(m, self.search, f2, eff, s.min_gain)
                 if unresolved:   # a sample's copy its rows barely depend on, on a bound: held at its start value
                     off = {**off, **unresolved}
                     names, ps = self._chain_names(off, new, new)
@@ -1860,37 +1860,47 @@ def _off_at_bound(f: FitResult, off: Mapping[str, float]) -> bool:
     return any(n in f.at_bound and abs(float(f.params[n]) - v) <= 1e-6 * max(1.0, abs(v)) for n, v in off.items())
 
 
-def _unresolved(model: JointModel, data: Dataset, f: FitResult, new: Sequence[str], before: FitResult,
-                share: float) -> dict:
-    """Parameters of ``new`` (shared, or a sample's copy) that ``f``, a fit of ``model`` on ``data``, left on a bound
-    and that the rows barely depend on against what the effect does: moved across the parameter's whole range, the
-    others at ``f``'s values, the RMSE of the rows it acts on (its sample's, for a copy) changes by at most ``share``
-    of the fall of that RMSE from ``before`` (the fit without the effect) to ``f``. ``name -> start value``, the
-    value it is held at; empty when there are none. (A guide's hold where the dwells at the top were set aside moves
-    the error by 0.003 deg of a 4.5 deg fall; a time constant of an effect that does nothing moves it by all of its
-    fall, and stays a reason to refuse it.)"""
+def _unresolved(model: JointModel, data: Dataset, f: FitResult, eff: Effect, share: float) -> dict:
+    """Parameters of ``eff`` (shared, or a sample's copy) that ``f``, a fit of ``model`` on ``data``, left on a bound
+    and that the rows barely depend on against what the effect does there: moved across the parameter's whole range,
+    the others at ``f``'s values, the RMSE of the rows it acts on (its sample's, for a copy) changes by at most
+    ``share`` of what switching the effect off (its ``off`` values, in that sample for a copy) adds to that RMSE.
+    ``name -> start value``, the value it is held at; empty when there are none, or when ``eff`` has no ``off``
+    values. (A guide's hold where the dwells at the top were set aside moves the error by 0.003 deg of the 4.5 deg the
+    guide's law takes off; where an effect does little in a sample, or nothing, its copy there moves the error by as
+    much as the effect does, and the sample does not show it: :meth:`Search._absent`.)"""
+    if not eff.off:
+        return {}
     out = {}
     measured = np.asarray(data.angle_deg, float)
     slices = dict(data.sample_slices())
     start = None
+    mine = set(eff.full_names())
+
+    def rmse(vals: Mapping[str, float], sl: slice) -> float:
+        return float(np.sqrt(np.mean((measured[sl] - model.predict(data, vals)[sl]) ** 2)))
+
     for nm in f.at_bound:
         base, _, smp = nm.partition("@")
-        if base not in new or nm not in f.fitted:
+        if base not in mine or nm not in f.fitted:
             continue
         sl = slices.get(smp, slice(None)) if smp else slice(None)
-        spec = model.spec(nm)
-        vals = dict(f.params)
         fitted = float(np.sqrt(np.mean((measured[sl] - np.asarray(f.predicted, float)[sl]) ** 2)))
-        fall = float(np.sqrt(np.mean((measured[sl] - np.asarray(before.predicted, float)[sl]) ** 2))) - fitted
-        if not fall > 0.0:
+        off = dict(f.params)
+        for k, v in eff.off.items():
+            key = f"{eff.name}.{k}" + (f"@{smp}" if smp else "")
+            off.update({n: float(v) for n in off if n == key or (not smp and n.startswith(key + "@"))})
+        does = rmse(off, sl) - fitted
+        if not does > 0.0:
             continue
+        spec, vals = model.spec(nm), dict(f.params)
         moved = []
         for v in (spec.lo, spec.hi):
             vals[nm] = float(v)
-            moved.append(float(np.sqrt(np.mean((measured[sl] - model.predict(data, vals)[sl]) ** 2))))
-        if all(math.isfinite(r) and abs(r - fitted) <= share * fall for r in moved):
+            moved.append(rmse(vals, sl))
+        if all(math.isfinite(r) and abs(r - fitted) <= share * does for r in moved):
             start = start or model.initial_values(data, base={k: v for k, v in f.params.items()
-                                                              if k.split("@")[0] not in new})
+                                                              if k.split("@")[0] not in mine})
             out[nm] = float(start[base])
     return out
 
