@@ -234,6 +234,11 @@ HELDOUT19_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost mo
 #: the guide twice and beside a toe and a creeping tendon, with the instruments of :func:`rougher_instruments`.
 HELDOUT20_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
                    "friction", "friction", ("friction", "toe"), ("creep", "friction"), "tracker drift"]
+#: The twenty-first fresh held-out batch (issue 19, after an unresolved parameter was measured against what its effect
+#: does; bench-heldout18 .. 20 looked at): the usual files, lost motion twice and beside friction, a toe beside creep,
+#: friction beside a relaxing backbone, with the instruments of :func:`rougher_instruments`.
+HELDOUT21_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "creep", "backbone", "zero drift",
+                   "lag", "friction", ("lost motion", "friction"), ("toe", "creep"), ("friction", "backbone")]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -279,13 +284,16 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            "bench-heldout19": (20271026, HELDOUT19_KINDS),
            # drawn once the speed across rows set aside and the hold of what the rows do not resolve were settled
            # (every batch above looked at), ROUGHER; run once
-           "bench-heldout20": (20271127, HELDOUT20_KINDS)}
+           "bench-heldout20": (20271127, HELDOUT20_KINDS),
+           # drawn once an unresolved parameter was measured against what its effect does (every batch above looked
+           # at), ROUGHER; run once
+           "bench-heldout21": (20271228, HELDOUT21_KINDS)}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
 #: Batches with those, interference lasting seconds and load cells that reach their range
 #: (:func:`rougher_instruments`).
-ROUGHER = {"bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20"}
+ROUGHER = {"bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21"}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
