@@ -385,8 +385,21 @@ def run_batch(name: str) -> list:
 
 
 def write_file(batch: str, kind: str, path: str) -> None:
-    """Write the file of ``kind`` (its name in the batch's table) of ``batch`` as CSV, as a lab would have it."""
-    spec = next(s for s in batch_specs(batch) if s[0] == kind)
+    """Write the file of ``kind`` of ``batch`` as CSV, as a lab would have it: its name in the batch's table (the
+    first file of that name) or its 0-based index (a batch with two files of one name)."""
+    import sys
+
+    if batch not in BATCHES:
+        print(f"bench_real.py --write: no batch {batch!r}; fix: one of {', '.join(BATCHES)}", file=sys.stderr)
+        sys.exit(2)
+    specs = batch_specs(batch)
+    spec = next((s for s in specs if s[0] == kind), None)
+    if spec is None and kind.isdigit() and int(kind) < len(specs):
+        spec = specs[int(kind)]
+    if spec is None:
+        print(f"bench_real.py --write: {batch} has no file {kind!r}; fix: give a name or an index: "
+              + ", ".join(f"{i} {s[0]!r}" for i, s in enumerate(specs)), file=sys.stderr)
+        sys.exit(2)
     name, tube, rate, benches, _, sim_seed = spec
     pattern = load_pattern(ROOT / "patterns" / f"{tube}.yaml")
     rec = simulate_bench(pattern, benches, protocol_for(rate), Clock(rate_hz=rate), seed=sim_seed)
@@ -400,7 +413,7 @@ if __name__ == "__main__":
 
     args = sys.argv[1:]
     if args[:1] in (["-h"], ["--help"]):
-        print(__doc__ + "\nUsage: python scripts/bench_real.py [BATCH ...] | --write BATCH KIND OUT.csv\nBatches: "
+        print(__doc__ + "\nUsage: python scripts/bench_real.py [BATCH ...] | --write BATCH KIND|INDEX OUT.csv\nBatches: "
               + ", ".join(BATCHES))
     elif args[:1] == ["--write"]:  # --write BATCH KIND OUT.csv
         if len(args) != 4:
