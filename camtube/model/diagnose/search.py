@@ -734,20 +734,29 @@ def inert_in_sample(eff: Effect, model: JointModel, data: Dataset, values: Mappi
     (``predicted_deg`` ``(n,)``: the model at ``values`` on ``data``). The data do not depend on such copies, so
     they cannot be resolved (a carriage that the rail of that sample holds for a few rows only, at a ratio far
     below the other sample's): the sample does not show the effect. False when no copy of it has an off value."""
-    vals = dict(values)
-    moved = False
-    for p in eff.params:
-        nm = f"{eff.name}.{p.name}@{sample}"
-        if p.name in (eff.off or {}) and nm in vals:
-            vals[nm] = float(eff.off[p.name])
-            moved = True
+    vals = _switched_off(eff, values, sample)
     sl = next((s for name, s in data.sample_slices() if name == sample), None)
-    if not moved or sl is None:
+    if vals is None or sl is None:
         return False
     meas = np.asarray(data.angle_deg[sl], float)
     off = float(np.sqrt(np.mean((meas - model.predict(data, vals)[sl]) ** 2)))
     fitted = float(np.sqrt(np.mean((meas - np.asarray(predicted_deg, float)[sl]) ** 2)))
     return math.isfinite(off) and off <= (1.0 + INERT_SHARE) * fitted
+
+
+def _switched_off(eff: Effect, values: Mapping[str, float], sample: str = "") -> dict | None:
+    """``values`` with ``eff`` switched off: the parameters named in ``eff.off`` at their off values, in ``sample``
+    only (its copies ``name@S``) or, with no sample, the shared ones and every sample's copy; None when ``values`` has
+    none of them."""
+    vals = dict(values)
+    moved = False
+    for k, v in (eff.off or {}).items():
+        key = f"{eff.name}.{k}"
+        for nm in values:
+            if nm == f"{key}@{sample}" if sample else (nm == key or nm.startswith(key + "@")):
+                vals[nm] = float(v)
+                moved = True
+    return vals if moved else None
 
 
 def _step(r: FitResult, per_sample: Sequence[str] = (), init: Mapping[str, float] | None = None) -> Step:
@@ -1869,35 +1878,33 @@ def _unresolved(model: JointModel, data: Dataset, f: FitResult, eff: Effect, sha
     values. (A guide's hold where the dwells at the top were set aside moves the error by 0.003 deg of the 4.5 deg the
     guide's law takes off; where an effect does little in a sample, or nothing, its copy there moves the error by as
     much as the effect does, and the sample does not show it: :meth:`Search._absent`.)"""
-    if not eff.off:
-        return {}
     out = {}
     measured = np.asarray(data.angle_deg, float)
     slices = dict(data.sample_slices())
     start = None
     mine = set(eff.full_names())
+    does_in: dict = {}   # sample ("": all rows) -> (RMSE there at f, what switching the effect off adds to it)
 
-    def rmse(vals: Mapping[str, float], sl: slice) -> float:
-        return float(np.sqrt(np.mean((measured[sl] - model.predict(data, vals)[sl]) ** 2)))
+    def rmse(predicted: np.ndarray, sl: slice) -> float:
+        return float(np.sqrt(np.mean((measured[sl] - predicted[sl]) ** 2)))
 
     for nm in f.at_bound:
         base, _, smp = nm.partition("@")
         if base not in mine or nm not in f.fitted:
             continue
         sl = slices.get(smp, slice(None)) if smp else slice(None)
-        fitted = float(np.sqrt(np.mean((measured[sl] - np.asarray(f.predicted, float)[sl]) ** 2)))
-        off = dict(f.params)
-        for k, v in eff.off.items():
-            key = f"{eff.name}.{k}" + (f"@{smp}" if smp else "")
-            off.update({n: float(v) for n in off if n == key or (not smp and n.startswith(key + "@"))})
-        does = rmse(off, sl) - fitted
+        if smp not in does_in:
+            off = _switched_off(eff, f.params, smp)
+            fitted = rmse(np.asarray(f.predicted, float), sl)
+            does_in[smp] = (fitted, rmse(model.predict(data, off), sl) - fitted if off is not None else 0.0)
+        fitted, does = does_in[smp]
         if not does > 0.0:
             continue
         spec, vals = model.spec(nm), dict(f.params)
         moved = []
         for v in (spec.lo, spec.hi):
             vals[nm] = float(v)
-            moved.append(rmse(vals, sl))
+            moved.append(rmse(model.predict(data, vals), sl))
         if all(math.isfinite(r) and abs(r - fitted) <= share * does for r in moved):
             start = start or model.initial_values(data, base={k: v for k, v in f.params.items()
                                                               if k.split("@")[0] not in mine})

@@ -340,8 +340,9 @@ def answer_lines(d: Diagnosis) -> list[str]:
                            "explain the bent rest in its place")
         for k, v in unresolved.items():
             out.append(f"  {k} held at {v:g}: the rows kept barely depend on it (across its whole range the error "
-                       "moves by less than 2 % of what the effect does), so it is not an estimate; the rows where it acts "
-                       "were set aside (a load cell at its limit sets aside the dwells at the top) or not measured")
+                       "moves by less than a candidate must gain, counted against what the effect does), so it is not "
+                       "an estimate; the rows where it acts were set aside (a load cell at its limit sets aside the "
+                       "dwells at the top) or not measured")
     elif d.partial:
         out.append("answer: nothing the library has explains the misfit; the built-ins that lower it ("
                    + ", ".join(d.partial) + f") leave {_times(d.partial_steps[-1].rmse_deg, floor)} the noise floor "
