@@ -1073,8 +1073,9 @@ class Search:
 
     def _absent(self, eff: Effect, m: JointModel, f: FitResult) -> dict:
         """Per-sample copies of ``eff`` to hold off: in each sample where a copy of ``f`` (a per-sample fit) is
-        not resolved (on a bound, a time or length outside what the record resolves) or where its copies do nothing (:func:`inert_in_sample`), every copy of that sample, those named in
-        ``eff.off`` at their off values and the others where they are; empty when there
+        not resolved (on a bound, a time or length outside what the record resolves) or where its copies do nothing
+        (:func:`inert_in_sample`), every copy of that sample, those named in ``eff.off`` at their off values and the
+        others where they are; empty when there
         is no such sample, when ``eff`` has no ``off`` values, or when it would be off in every sample."""
         if not eff.off:
             return {}
