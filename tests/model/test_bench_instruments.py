@@ -819,6 +819,29 @@ def test_friction_beside_a_relaxing_backbone_with_the_guides_cell_at_its_limit_i
     assert d.final.rmse_deg < 1.25 * rec.floor_deg
 
 
+def test_a_guide_whose_friction_switches_within_a_row_is_read_as_its_law_at_the_sharp_limit(tube2):
+    # Coulomb's step at the guide (the bench's sliding state regularised over 1e-6 mm/s; 0.05 by default): capstan
+    # took the error from 21x the floor to 2x, but its slip speed ended on its lower bound and it was refused, and
+    # the partial list read friction, hardstop. A decade above that bound the error moves by 0.015 deg of the 4.5
+    # deg the guide's law takes off: the law at its sharp limit, held there, and the guide's law leads. (The file
+    # stays partial: where the logged stroke has stopped within its resolution the guide still slides for a row,
+    # one row per reversal off by the whole jump)
+    b = SampleBench(guide=Guide(mu=0.15, slip_mm_s=1e-6), tracker=Tracker(noise_deg=0.2, n_spikes=8, n_dropouts=4))
+    proto = Protocol(n_cycles=20, ramp_s=3.0, dwell_s=2.0, rest_s=2.0, first_dwell_s=2.0)
+    rec = simulate_bench(tube2, b, proto, Clock(rate_hz=50.0), seed=1)
+    ok = np.isfinite(rec.data.angle_deg)
+    ins = check_instruments(rec.data.take(ok))
+    from camtube.model.diagnose import diagnose
+
+    d = diagnose(model_for_pattern(tube2), ins.data, ["E_t"], pattern_values(tube2))
+    first = next(c for c in d.rounds[0] if c.effect == "capstan" and not c.replaces)
+    assert first.significant, first.why
+    assert (d.recommended or d.partial)[0] == "capstan", (d.recommended, d.partial)
+    steps = d.waterfall if d.recommended else d.partial_steps
+    assert steps[1].params["capstan.slip_mm_s"] == pytest.approx(1e-3)
+    assert steps[1].rmse_deg < 0.1 * steps[0].rmse_deg
+
+
 @pytest.mark.parametrize("dropout", ["zero", "hold"])
 def test_the_simulators_bursts_and_dropouts_written_as_values_are_set_aside_and_nothing_else(tube2, dropout):
     # the bench simulator's tracker with bursts of interference and dropouts written as 0 or as its last reading

@@ -57,7 +57,8 @@ class Param:
     kind : str
         What the data must resolve: ``time`` (between a few sample intervals and
         the record), ``length`` (within the stroke span), ``modulus`` (a
-        plausible E_t), or ``""`` (nothing checked).
+        plausible E_t), ``sharp`` (a scale whose lower bound is the law's sharp limit, a switch within a
+        row: a fit on it is that limit when a decade above it reads the same), or ``""`` (nothing checked).
     """
 
     name: str

@@ -1903,7 +1903,8 @@ def _off_at_bound(f: FitResult, off: Mapping[str, float]) -> bool:
 def _unresolved(model: JointModel, data: Dataset, f: FitResult, eff: Effect, share: float) -> dict:
     """Parameters of ``eff`` (shared, or a sample's copy) that ``f``, a fit of ``model`` on ``data``, left on a bound
     or with an infinite standard error (a guide's hold in the sample whose dwells at the top were set aside), and
-    that the rows barely depend on against what the effect does there: moved across the parameter's whole range,
+    that the rows barely depend on against what the effect does there (a parameter of kind ``sharp`` on its lower
+    bound, the law's sharp limit: held there when a decade above it moves the error by as little): moved across the parameter's whole range,
     the others at ``f``'s values, the RMSE of the rows it acts on (its sample's, for a copy) changes by at most
     ``share`` of what switching the effect off (its ``off`` values, in that sample for a copy) adds to that RMSE.
     ``name -> start value``, the value it is held at; empty when there are none, or when ``eff`` has no ``off``
@@ -1942,6 +1943,14 @@ def _unresolved(model: JointModel, data: Dataset, f: FitResult, eff: Effect, sha
             start = start or model.initial_values(data, base={k: v for k, v in f.params.items()
                                                               if k.split("@")[0] not in mine})
             out[nm] = float(start[base])
+        elif nm in f.at_bound and spec.kind == "sharp" and float(f.params[nm]) <= spec.lo * (1.0 + 1e-6):
+            # a law at its sharp limit: a decade above its lower bound the rows read the same (a guide whose
+            # friction switches within a row, its slip speed on the bound: a step), held there as that limit
+            at = float(f.params[nm])
+            vals[nm] = min(10.0 * spec.lo, spec.hi)
+            r = rmse(model.predict(data, vals), sl)
+            if math.isfinite(r) and abs(r - fitted) <= share * does:
+                out[nm] = at
     return out
 
 

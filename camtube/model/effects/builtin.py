@@ -373,8 +373,9 @@ CAPSTAN = Effect(
                   "exp(-mu_wrap) times the load cell's while pulling, exp(+mu_wrap) while releasing",
                   starts=(0.1, 0.3, 0.8)),
             Param("slip_mm_s", "mm/s", 1e-3, 10.0, 0.05,
-                  "tendon speed at which the friction is 76 % developed (tanh)", log=True,
-                  starts=(0.01, 0.1)),
+                  "tendon speed at which the friction is 76 % developed (tanh); on its lower bound: a guide "
+                  "whose friction switches within a row (Coulomb's step)", log=True, starts=(0.01, 0.1),
+                  kind="sharp"),
             Param("hold", "", -0.5, 1.0, 0.5,
                   "share of the sliding friction the guide keeps while the drive rests (1: static friction "
                   "keeps the last motion's state; 0: the guide releases; the range goes below 0 so that a "

@@ -296,6 +296,14 @@ def unresolved_held(d: Diagnosis) -> dict:
     return out
 
 
+def _at_sharp_limit(d: Diagnosis, key: str, value: float) -> bool:
+    """``key`` (``effect.param`` or ``effect.param@S``) is a parameter of kind ``sharp`` held at its lower bound."""
+    eff, _, pname = key.split("@")[0].partition(".")
+    e = d.catalog.get(eff)
+    spec = next((p for p in (e.params if e is not None else ()) if p.name == pname), None)
+    return spec is not None and spec.kind == "sharp" and value <= spec.lo * (1.0 + 1e-6)
+
+
 def answer_lines(d: Diagnosis) -> list[str]:
     """The answer first: what to add in order with the error before and after each step, what is left and what
     it follows, per sample, and the instruments' findings (rows set aside, lag)."""
@@ -339,6 +347,11 @@ def answer_lines(d: Diagnosis) -> list[str]:
                 out.append(f"  {k.split('.')[0]} (the baseline) held at {k} = {v:g}: the recommended effects "
                            "explain the bent rest in its place")
         for k, v in unresolved.items():
+            if _at_sharp_limit(d, k, v):
+                out.append(f"  {k} held at {v:g}, its lower bound: the law at its sharp limit (a decade above it the "
+                           "error moves by less than a candidate must gain, counted against what the effect does): "
+                           "it switches within a row, a step, so the value is a limit, not an estimate")
+                continue
             out.append(f"  {k} held at {v:g}: the rows kept barely depend on it (across its whole range the error "
                        "moves by less than a candidate must gain, counted against what the effect does), so it is not "
                        "an estimate; the rows where it acts were set aside (a load cell at its limit sets aside the "

@@ -15,8 +15,8 @@ The chain, per time step ``dt`` (the logger's own row times, 25-100 Hz):
 * **load cell** on the carriage (:class:`LoadCell`): tension at the carriage, plus a zero that can wander
   (a slow thermal ramp plus a random walk), plus white noise.
 * **guide** (:class:`Guide`): the tendon wraps a pin; capstan friction ``exp(mu wrap)`` between the load
-  cell's side and the joint's side, its sign following the tendon's sliding, regularised over 0.05 mm/s
-  (``tanh``): it fades as the carriage stops and is gone while it rests.
+  cell's side and the joint's side, its sign following the tendon's sliding, regularised over 0.05 mm/s by
+  default (``tanh``; ``Guide.slip_mm_s``): it fades as the carriage stops and is gone while it rests.
 * **braided tendon** (:class:`Tendon`): a bundle of fibres of equal stiffness with crimp lengths drawn
   from a gamma distribution (the toe: fibres become taut one by one); an optional loose length (slack);
   a power-law, strain-hardening creep ``de/dt = A (T/T1)^n / (1 + e/e_sat)^2`` that never recovers.
@@ -77,10 +77,12 @@ class LoadCell:
 
 @dataclass(frozen=True)
 class Guide:
-    """A pin the tendon wraps: friction coefficient ``mu`` over ``wrap_rad``."""
+    """A pin the tendon wraps: friction coefficient ``mu`` over ``wrap_rad``; its sign follows the tendon's
+    sliding, regularised over ``slip_mm_s`` (``tanh``; a value far below the drive's speeds: Coulomb's step)."""
 
     mu: float = 0.0
     wrap_rad: float = math.pi / 2
+    slip_mm_s: float = 0.05
 
 
 @dataclass(frozen=True)
@@ -332,10 +334,10 @@ def _run_sample(pattern: Pattern, b: SampleBench, t: np.ndarray, motor: np.ndarr
         alpha = arm / k_tot
         beta = (k_notch * set_n - q_carry) / k_tot
         a_sum, b_sum = float(alpha.sum()), float(beta.sum())
-        # sliding at the guide: friction in the direction of motion, regularised over 0.05 mm/s. It used to hold
+        # sliding at the guide: friction in the direction of motion, regularised over slip_mm_s. It used to hold
         # the last moving step's value at rest, which made each dwell's state the speed of one discrete step (a
         # random 0-0.3 of the full friction per dwell); the law's own value at rest is zero: the guide releases
-        slide = math.tanh(v / 0.05)
+        slide = math.tanh(v / b.guide.slip_mm_s)
         ratio = ewrap ** slide          # cell tension / joint tension
 
         def gap(tj: float) -> float:
