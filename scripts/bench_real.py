@@ -48,6 +48,7 @@ FAMILIES = {
     "tracker drift": (set(), "time"),  # the tracker's zero drifts: an instrument's, the library has no form for it
     "lag": (set(), None),
     "friction": ({"friction", "capstan"}, None),  # one family: friction at the guide
+    "sharp friction": ({"friction", "capstan"}, None),  # the same, its sign switching within a row (Coulomb's step)
 }
 
 
@@ -98,6 +99,8 @@ def dominant(kind: str, base: SampleBench, rng: np.random.Generator, strength: f
         return replace(base, tracker=replace(base.tracker, lag_ms=u(25, 80)))
     if kind == "friction":
         return replace(base, guide=Guide(mu=u(0.1, 0.2)))
+    if kind == "sharp friction":
+        return replace(base, guide=Guide(mu=u(0.1, 0.2), slip_mm_s=1e-6))
     if kind == "control":  # the paper's physics: nothing else (the instruments' artefacts stay)
         return SampleBench(tracker=base.tracker)
     raise ValueError(kind)
@@ -239,6 +242,11 @@ HELDOUT20_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 #: friction beside a relaxing backbone, with the instruments of :func:`rougher_instruments`.
 HELDOUT21_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "creep", "backbone", "zero drift",
                    "lag", "friction", ("lost motion", "friction"), ("toe", "creep"), ("friction", "backbone")]
+#: The twenty-second fresh held-out batch (issue 19, after a burst with a dropout in it, a parameter with an infinite
+#: standard error and a law at its sharp limit; bench-heldout18 .. 21 looked at): the usual files, a backbone of three
+#: arms, friction plain and switching within a row, a backbone beside friction, slack beside lost motion.
+HELDOUT22_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone3", "zero drift", "lag",
+                   "friction", "sharp friction", ("backbone", "friction"), ("slack", "lost motion"), "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -287,13 +295,17 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            "bench-heldout20": (20271127, HELDOUT20_KINDS),
            # drawn once an unresolved parameter was measured against what its effect does (every batch above looked
            # at), ROUGHER; run once
-           "bench-heldout21": (20271228, HELDOUT21_KINDS)}
+           "bench-heldout21": (20271228, HELDOUT21_KINDS),
+           # drawn once a burst with a dropout in it, an infinite standard error and a law at its sharp limit were
+           # settled (every batch above looked at), ROUGHER; run once
+           "bench-heldout22": (20280126, HELDOUT22_KINDS)}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
 #: Batches with those, interference lasting seconds and load cells that reach their range
 #: (:func:`rougher_instruments`).
-ROUGHER = {"bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21"}
+ROUGHER = {"bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21",
+           "bench-heldout22"}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
