@@ -1903,14 +1903,15 @@ def _off_at_bound(f: FitResult, off: Mapping[str, float]) -> bool:
 def _unresolved(model: JointModel, data: Dataset, f: FitResult, eff: Effect, share: float) -> dict:
     """Parameters of ``eff`` (shared, or a sample's copy) that ``f``, a fit of ``model`` on ``data``, left on a bound
     or with an infinite standard error (a guide's hold in the sample whose dwells at the top were set aside), and
-    that the rows barely depend on against what the effect does there (a parameter of kind ``sharp`` on its lower
-    bound, the law's sharp limit: held there when a decade above it moves the error by as little): moved across the parameter's whole range,
+    that the rows barely depend on against what the effect does there: moved across the parameter's whole range,
     the others at ``f``'s values, the RMSE of the rows it acts on (its sample's, for a copy) changes by at most
     ``share`` of what switching the effect off (its ``off`` values, in that sample for a copy) adds to that RMSE.
-    ``name -> start value``, the value it is held at; empty when there are none, or when ``eff`` has no ``off``
-    values. (A guide's hold where the dwells at the top were set aside moves the error by 0.003 deg of the 4.5 deg the
-    guide's law takes off; where an effect does little in a sample, or nothing, its copy there moves the error by as
-    much as the effect does, and the sample does not show it: :meth:`Search._absent`.)"""
+    A parameter of kind ``sharp`` on its lower bound (the law's sharp limit: a guide that switches within a row)
+    passes when a decade above the bound moves the error by as little. ``name -> value held``: the start value, or
+    the bound for a sharp limit; empty when there are none, or when ``eff`` has no ``off`` values. (A guide's hold
+    where the dwells at the top were set aside moves the error by 0.003 deg of the 4.5 deg the guide's law takes
+    off; where an effect does little in a sample, or nothing, its copy there moves the error by as much as the
+    effect does, and the sample does not show it: :meth:`Search._absent`.)"""
     out = {}
     measured = np.asarray(data.angle_deg, float)
     slices = dict(data.sample_slices())
