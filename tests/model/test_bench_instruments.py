@@ -678,6 +678,23 @@ def test_a_long_burst_with_a_dropout_in_it_is_set_aside_whole(tube2, where):
     assert (aside & ~off).sum() <= 12, int((aside & ~off).sum())      # (a row beside a jump, at most)
 
 
+def test_dropouts_on_ramps_without_interference_set_nothing_aside(tube2):
+    # the other side of the test above: 40 runs of 0.02-0.3 s of rows missing, on ramps (the joint moves degrees
+    # across a gap) and at the turns of the motion, no interference. Read row by row, a ramp's progress across a gap
+    # was a jump, and two gaps paired into a burst: 151 real rows set aside here (265 with gaps up to 0.15 s, 799 with
+    # 0.16-0.3 s). Read over the time each change spans, none. (Gaps of 0.3-0.5 s on a ramp still read as jumps: 142
+    # rows in 40 such gaps; the rate either side no longer tells the motion across them)
+    tr = Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0)
+    rec = simulate_bench(tube2, SampleBench(tracker=tr), SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=22)
+    d = rec.data
+    rng = np.random.default_rng(9)
+    keep = np.ones(len(d), bool)
+    for r0 in rng.choice(np.arange(100, len(d) - 100, 60), 40, replace=False):
+        keep[r0:r0 + int(rng.integers(2, 31))] = False
+    ins = check_instruments(d.take(keep))
+    assert sum(len(v) for v in ins.aside.values()) == 0, {k: len(v) for k, v in ins.aside.items()}
+
+
 def test_real_rows_between_a_long_burst_and_a_jump_of_the_joint_are_kept(tube2):
     # a 2 s burst of -3.6 deg ended 5 rows before the carriage slipped (the joint fell 1.2 deg at once, 10 noise
     # scales; here 8 and 3 deg under the short record's larger scale): the 5 real rows between stood above both their
