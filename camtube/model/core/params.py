@@ -71,6 +71,11 @@ class Param:
     starts: tuple = ()
     kind: str = ""
 
+    def at_sharp_limit(self, value: float) -> bool:
+        """``value`` is this parameter's sharp limit: a parameter of kind ``sharp`` on (within 1e-6 of) its lower
+        bound."""
+        return self.kind == "sharp" and float(value) <= self.lo * (1.0 + 1e-6)
+
     def initial(self, data, ctx) -> float:
         v = self.init(data, ctx) if callable(self.init) else float(self.init)
         return float(min(max(v, self.lo), self.hi))

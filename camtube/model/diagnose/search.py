@@ -734,14 +734,26 @@ def inert_in_sample(eff: Effect, model: JointModel, data: Dataset, values: Mappi
     (``predicted_deg`` ``(n,)``: the model at ``values`` on ``data``). The data do not depend on such copies, so
     they cannot be resolved (a carriage that the rail of that sample holds for a few rows only, at a ratio far
     below the other sample's): the sample does not show the effect. False when no copy of it has an off value."""
-    vals = _switched_off(eff, values, sample)
-    sl = next((s for name, s in data.sample_slices() if name == sample), None)
-    if vals is None or sl is None:
+    got = _on_and_off(eff, model, data, values, predicted_deg, sample)
+    if got is None:
         return False
+    fitted, off = got
+    return math.isfinite(off) and off <= (1.0 + INERT_SHARE) * fitted
+
+
+def _on_and_off(eff: Effect, model: JointModel, data: Dataset, values: Mapping[str, float],
+                predicted_deg: np.ndarray, sample: str = "") -> tuple[float, float] | None:
+    """``(RMSE, RMSE with eff switched off)`` on the rows of ``sample`` (every row: ``""``) at ``values``
+    (``predicted_deg`` ``(n,)``: the model at ``values`` on ``data``; switched off: :func:`_switched_off`); None when
+    ``values`` holds none of its ``off`` parameters there, or ``data`` no such sample."""
+    vals = _switched_off(eff, values, sample)
+    sl = next((s for name, s in data.sample_slices() if name == sample), None) if sample else slice(None)
+    if vals is None or sl is None:
+        return None
     meas = np.asarray(data.angle_deg[sl], float)
     off = float(np.sqrt(np.mean((meas - model.predict(data, vals)[sl]) ** 2)))
     fitted = float(np.sqrt(np.mean((meas - np.asarray(predicted_deg, float)[sl]) ** 2)))
-    return math.isfinite(off) and off <= (1.0 + INERT_SHARE) * fitted
+    return fitted, off
 
 
 def _switched_off(eff: Effect, values: Mapping[str, float], sample: str = "") -> dict | None:
@@ -1099,22 +1111,19 @@ class Search:
         does in the sample where it does most (what switching it off there adds to that sample's RMSE), every copy
         of that sample (:func:`_copies_off`); empty when there is none. (A guide's hold on its bound in the sample
         whose guide barely acts: the copies there add 0.001 deg, those of the other sample 1.8 deg.)"""
-        data, slices = r.data, dict(r.data.sample_slices())
-        meas, pred = np.asarray(data.angle_deg, float), np.asarray(r.predicted, float)
+        samples = list(r.data.samples)
+        unresolved = r.unidentified
         does, loose = {}, set()
-        for smp, sl in slices.items():
-            vals = _switched_off(eff, r.params, smp)
-            if vals is None:
+        for smp in samples:
+            got = _on_and_off(eff, m, r.data, r.params, r.predicted, smp)
+            if got is None:
                 return {}
-            fitted = float(np.sqrt(np.mean((meas[sl] - pred[sl]) ** 2)))
-            does[smp] = float(np.sqrt(np.mean((meas[sl] - m.predict(data, vals)[sl]) ** 2))) - fitted
-            if any(f"{n}@{smp}" in r.at_bound or (f"{n}@{smp}" in r.fitted
-                                                 and not math.isfinite(r.stderr.get(f"{n}@{smp}", math.inf)))
-                   for n in eff.full_names()):
+            does[smp] = got[1] - got[0]
+            if any(f"{n}@{smp}" in unresolved for n in eff.full_names()):
                 loose.add(smp)
         top = max(does.values(), default=0.0)
-        faint = [smp for smp in loose if does[smp] <= self.settings.min_gain * top]
-        if not faint or len(faint) == len(slices) or not top > 0.0:
+        faint = [smp for smp in samples if smp in loose and does[smp] <= self.settings.min_gain * top]
+        if not faint or len(faint) == len(samples) or not top > 0.0:
             return {}
         return _copies_off(eff, faint, r.params)
 
@@ -1922,16 +1931,15 @@ def _unresolved(model: JointModel, data: Dataset, f: FitResult, eff: Effect, sha
     def rmse(predicted: np.ndarray, sl: slice) -> float:
         return float(np.sqrt(np.mean((measured[sl] - predicted[sl]) ** 2)))
 
-    loose = [nm for nm in f.fitted if nm not in f.at_bound and not math.isfinite(f.stderr.get(nm, math.inf))]
-    for nm in (*f.at_bound, *loose):
+    # on a bound or with an infinite standard error (FitResult.unidentified), those on a bound first
+    for nm in sorted(f.unidentified, key=lambda n: n not in f.at_bound):
         base, _, smp = nm.partition("@")
-        if base not in mine or nm not in f.fitted:
+        if base not in mine:
             continue
         sl = slices.get(smp, slice(None)) if smp else slice(None)
         if smp not in does_in:
-            off = _switched_off(eff, f.params, smp)
-            fitted = rmse(np.asarray(f.predicted, float), sl)
-            does_in[smp] = (fitted, rmse(model.predict(data, off), sl) - fitted if off is not None else 0.0)
+            got = _on_and_off(eff, model, data, f.params, f.predicted, smp)
+            does_in[smp] = (got[0], got[1] - got[0]) if got is not None else (0.0, 0.0)
         fitted, does = does_in[smp]
         if not does > 0.0:
             continue
@@ -1944,7 +1952,7 @@ def _unresolved(model: JointModel, data: Dataset, f: FitResult, eff: Effect, sha
             start = start or model.initial_values(data, base={k: v for k, v in f.params.items()
                                                               if k.split("@")[0] not in mine})
             out[nm] = float(start[base])
-        elif nm in f.at_bound and spec.kind == "sharp" and float(f.params[nm]) <= spec.lo * (1.0 + 1e-6):
+        elif nm in f.at_bound and spec.at_sharp_limit(f.params[nm]):
             # a law at its sharp limit: a decade above its lower bound the rows read the same (a guide whose
             # friction switches within a row, its slip speed on the bound: a step), held there as that limit
             at = float(f.params[nm])

@@ -301,7 +301,7 @@ def _at_sharp_limit(d: Diagnosis, key: str, value: float) -> bool:
     eff, _, pname = key.split("@")[0].partition(".")
     e = d.catalog.get(eff)
     spec = next((p for p in (e.params if e is not None else ()) if p.name == pname), None)
-    return spec is not None and spec.kind == "sharp" and value <= spec.lo * (1.0 + 1e-6)
+    return spec is not None and spec.at_sharp_limit(value)
 
 
 def answer_lines(d: Diagnosis) -> list[str]:
