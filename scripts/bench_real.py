@@ -299,6 +299,9 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            # drawn once a burst with a dropout in it, an infinite standard error and a law at its sharp limit were
            # settled (every batch above looked at), ROUGHER; run once
            "bench-heldout22": (20280126, HELDOUT22_KINDS)}
+#: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
+#: carriage pulled off its rail's hold lands on the nut's flank in one step.
+SETTLED: set = set()
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -379,19 +382,30 @@ def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
     return out
 
 
-def batch_specs(name: str) -> list:
-    """The files of batch ``name`` (:func:`draw_batch`; the batches of :data:`ROUGH` with their trackers' artefacts)."""
+def settle_drives(specs: list) -> list:
+    """``specs`` with every sample's carriage settling (:attr:`Drive.settle`): pulled off its rail's hold, it
+    slides only until the tension is back at the friction, rather than landing on the nut's flank."""
+    return [(name, tube, rate, tuple(replace(b, drive=replace(b.drive, settle=True)) for b in benches), kinds, seed)
+            for name, tube, rate, benches, kinds, seed in specs]
+
+
+def batch_specs(name: str, settled: bool = False) -> list:
+    """The files of batch ``name`` (:func:`draw_batch`; the batches of :data:`ROUGH` with their trackers' artefacts;
+    those of :data:`SETTLED`, or all with ``settled``, with their carriages settling, :func:`settle_drives`)."""
     seed, kinds = BATCHES[name]
-    return draw_batch(seed, kinds, rough=name in ROUGH, rougher=name in ROUGHER)
+    specs = draw_batch(seed, kinds, rough=name in ROUGH, rougher=name in ROUGHER)
+    return settle_drives(specs) if settled or name in SETTLED else specs
 
 
-def run_batch(name: str) -> list:
+def run_batch(name: str, settled: bool = False, only: str = "") -> list:
+    specs = [s for s in batch_specs(name, settled) if only in s[0]]
     with tempfile.TemporaryDirectory() as tmp:
-        res = [run_file(s, Path(tmp)) for s in batch_specs(name)]
+        res = [run_file(s, Path(tmp)) for s in specs]
     n_ok = sum(r["ok"] for r in res)
     n_floor = sum(r["floor_ok"] for r in res)
     per_60k = [(r["s_instruments"] + r["s_diagnose"]) * 60_000 / r["rows"] for r in res]
-    print(f"{name}: {n_ok} of {len(res)} right; noise floor within 20 % of the true one in {n_floor} of {len(res)}; "
+    label = name + (" (carriages settling)" if settled and name not in SETTLED else "") + (f" ({only!r} only)" if only else "")
+    print(f"{label}: {n_ok} of {len(res)} right; noise floor within 20 % of the true one in {n_floor} of {len(res)}; "
           f"seconds per 60,000-row file: median {np.median(per_60k):.1f}, max {max(per_60k):.1f}")
     return res
 
@@ -425,7 +439,8 @@ if __name__ == "__main__":
 
     args = sys.argv[1:]
     if args[:1] in (["-h"], ["--help"]):
-        print(__doc__ + "\nUsage: python scripts/bench_real.py [BATCH ...] | --write BATCH KIND|INDEX OUT.csv\nBatches: "
+        print(__doc__ + "\nUsage: python scripts/bench_real.py [--settled] [--only NAME] [BATCH ...] | --write BATCH KIND|INDEX OUT.csv\n"
+              "--settled: every carriage settles (Drive.settle); --only: the files whose name holds NAME\nBatches: "
               + ", ".join(BATCHES))
     elif args[:1] == ["--write"]:  # --write BATCH KIND OUT.csv
         if len(args) != 4:
@@ -433,9 +448,19 @@ if __name__ == "__main__":
             sys.exit(2)
         write_file(*args[1:4])
     else:
+        settled = "--settled" in args
+        only = ""
+        if "--only" in args:
+            k = args.index("--only")
+            if k + 1 >= len(args):
+                print("bench_real.py --only: give part of a file's name, e.g. --only 'lost motion'", file=sys.stderr)
+                sys.exit(2)
+            only = args[k + 1]
+            del args[k:k + 2]
+        args = [a for a in args if a != "--settled"]
         unknown = [b for b in args if b not in BATCHES]
         if unknown:
             print(f"unknown batch {unknown[0]!r}; fix: give one of {', '.join(BATCHES)}", file=sys.stderr)
             sys.exit(2)
         for b in args or ["bench"]:
-            run_batch(b)
+            run_batch(b, settled, only)

@@ -57,10 +57,18 @@ class Drive:
         Gap of the nut's lug (lost motion after an unloading to low tension).
     rail_friction_N : float
         Carriage rail friction: below this tension the carriage sticks while the nut retreats.
+    settle : bool
+        How a held carriage moves once the tension exceeds the rail's friction (at a rest, the backbone's
+        recovery raises it). True: it slides toward the nut's flank only until the tension is back at the
+        friction (quasi-static: each step moves it by the excess tension times the tendon-and-joint compliance
+        there). False, the law of every batch drawn before it: it lands on the flank in one step, where the
+        tendon goes nearly slack; at one step per logged row that is hidden in the step's own error, but with a
+        fine step (:attr:`Clock.sim_step_ms`) it releases the joint at most rests, a stick-slip no rail shows.
     """
 
     backlash_mm: float = 0.0
     rail_friction_N: float = 0.05
+    settle: bool = False
 
 
 @dataclass(frozen=True)
@@ -164,11 +172,18 @@ class Tracker:
 
 @dataclass(frozen=True)
 class Clock:
-    """Logger clock: nominal rate, stamp jitter, repeated stamps."""
+    """Logger clock: nominal rate, stamp jitter, repeated stamps; and the simulation's own step.
+
+    ``sim_step_ms``: the longest step the bench's mechanics are integrated over (the logged rows are read from
+    that finer run). 0: one step per logged row, as every batch drawn before it had. At one step per row a
+    carriage sticks at the first row after its tension fell to the rail's friction, by up to a row's travel
+    past the crossing (0.03 mm at 25 Hz on a 3 s ramp of 2 mm): a random lost motion per cycle that comes from
+    the step, not from the bench."""
 
     rate_hz: float = 50.0
     jitter_ms: float = 1.0
     n_repeats: int = 3
+    sim_step_ms: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -280,6 +295,19 @@ def _stamps(clock: Clock, duration_s: float, rng: np.random.Generator) -> tuple[
     return t_true, logged, rep
 
 
+def _fine_grid(t: np.ndarray, step_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Times holding every one of ``t`` (sorted, (n,)) with at most ``step_s`` between neighbours, and the
+    index of each of ``t`` in them."""
+    gaps = np.diff(t)
+    parts = np.maximum(np.ceil(gaps / step_s - 1e-9).astype(np.int64), 1)
+    at = np.concatenate(([0], np.cumsum(parts)))
+    fine = np.empty(int(at[-1]) + 1)
+    fine[at] = t
+    for k in np.flatnonzero(parts > 1):
+        fine[at[k] + 1:at[k + 1]] = t[k] + gaps[k] * np.arange(1, parts[k]) / parts[k]
+    return fine, at
+
+
 def _run_sample(pattern: Pattern, b: SampleBench, t: np.ndarray, motor: np.ndarray,
                 rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """True bend (rad) of the joint, tension at the load cell (N) and the carriage's position (mm) at times ``t``
@@ -304,6 +332,7 @@ def _run_sample(pattern: Pattern, b: SampleBench, t: np.ndarray, motor: np.ndarr
     v_prev = 0.0
     slide = 0.0
     carriage_prev = 0.0
+    compliance_prev = 0.0
     out_theta = np.zeros(n)
     out_cell = np.zeros(n)
     out_carriage = np.zeros(n)
@@ -314,8 +343,13 @@ def _run_sample(pattern: Pattern, b: SampleBench, t: np.ndarray, motor: np.ndarr
         m_i = float(motor[i])
         # drive: the tension pulls the carriage onto the nut's pushing flank (carriage = nut); below the rail's
         # friction the carriage sticks and the gap of the lug (0 .. backlash) opens or closes
-        if cell > b.drive.rail_friction_N:
+        if cell > b.drive.rail_friction_N and not (b.drive.settle and carriage_prev > m_i and dt > 0):
             carriage = m_i
+        elif cell > b.drive.rail_friction_N:
+            # pulled off the rail's hold: it slides toward the flank by what brings the tension back to the
+            # friction (the last step's compliance, mm of carriage per N at the cell), never past the flank
+            carriage = max(m_i, min(carriage_prev, m_i + b.drive.backlash_mm)
+                           - (cell - b.drive.rail_friction_N) * compliance_prev)
         else:
             carriage = min(max(carriage_prev, m_i), m_i + b.drive.backlash_mm)
         v = (carriage - carriage_prev) / dt if dt > 0 else v_prev
@@ -358,6 +392,9 @@ def _run_sample(pattern: Pattern, b: SampleBench, t: np.ndarray, motor: np.ndarr
             moment = arm * tj
             over = max(moment / b.backbone.yield_nmm - 1.0, 0.0)
             set_n = set_n + dt * b.backbone.set_rate_per_s * over * (theta_n - set_n) / max(float(theta_n.sum()), 1e-9)
+        if b.drive.settle:   # d(carriage)/d(cell tension) at this state, for the next step's slide
+            dt_n = max(1e-4, 1e-3 * tj)
+            compliance_prev = (gap(tj + dt_n) - gap(tj)) / (dt_n * ratio) if tj > 0.0 else 0.0
         tension = tj
         cell = tj * ratio
         carriage_prev = carriage
@@ -402,7 +439,12 @@ def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | 
     for s, b in enumerate(per):
         t_true, logged, rep = _stamps(clock, duration, rng)
         motor, cycle = motor_profile(protocol, peak, t_true)
-        theta, cell, carriage = _run_sample(pattern, b, t_true, motor, rng)
+        if clock.sim_step_ms > 0.0:   # the mechanics on a finer grid holding every logged time, read at those
+            t_fine, at = _fine_grid(t_true, clock.sim_step_ms * 1e-3)
+            theta, cell, carriage = (x[at] for x in _run_sample(pattern, b, t_fine,
+                                                                motor_profile(protocol, peak, t_fine)[0], rng))
+        else:
+            theta, cell, carriage = _run_sample(pattern, b, t_true, motor, rng)
         n = t_true.size
         tr, lc = b.tracker, b.load_cell
         # the tracker reports the bend it saw lag_ms ago
