@@ -526,6 +526,38 @@ def test_the_joint_resting_bent_by_itself_is_refused_where_the_force_at_rest_sta
     assert _rest_angle_check(taut, pred, effects=(RELAXATION, REST_ANGLE)) == why
 
 
+def test_a_chain_that_drops_the_drive_keeps_the_joint_s_resting_effects_to_their_check():
+    """The search drops a chosen effect that a later one explains (:meth:`Search.drop_candidate`). A joint's
+    resting effects joined beside the drive's effect, whose taut tendon at rest their check allows; once the drive's
+    effect would go, the chain left must pass those checks again: rest_angle and a relaxation holding the joint bent
+    while the force at rest stays at 0.15 N contradict it, so the drive stays (bench-heldout22's lost motion with its
+    carriages settling: the drive was dropped for rest_angle, angle_bias and relaxation). The chain's other checks
+    (those that do not read the chain) are not run again."""
+    from camtube.model.core.model import check_reads_chain
+    from camtube.model.data.dataset import Dataset
+    from camtube.model.diagnose.search import _chain_form_problems
+    from camtube.model.effects.builtin import CARRIAGE_GAP, REST_ANGLE, RELAXATION, TOE
+    from camtube.model.core.predict import model_for_pattern
+
+    t = np.arange(0.0, 60.0, 0.02)
+    stroke = np.clip(np.sin(2 * np.pi * t / 10.0), 0.0, None) * 2.0
+    rng = np.random.default_rng(2)
+    force = 2.0 * stroke + rng.normal(0.0, 0.005, t.size)
+    pred = np.where(stroke == 0.0, 1.5, 10.0 * stroke)
+    n = t.size
+    taut = Dataset(sample=np.full(n, "S1", dtype=object), cycle=(t // 10).astype(int) + 1, time_s=t,
+                   stroke_mm=stroke, force_N=np.where(stroke == 0.0, force + 0.15, force), angle_deg=pred)
+    base = model_for_pattern(load_pattern(TUBE2))
+    left = base.with_effects([REST_ANGLE, RELAXATION])
+    problems = _chain_form_problems(left, taut, pred)
+    assert [p.split(":")[0] for p in problems] == ["rest_angle", "relaxation"], problems
+    assert all("the tendon is taut at rest" in p for p in problems)
+    assert _chain_form_problems(base.with_effects([CARRIAGE_GAP, REST_ANGLE, RELAXATION]), taut, pred) == []
+    assert _chain_form_problems(base.with_effects([REST_ANGLE]), taut, np.where(stroke == 0.0, 0.0, pred)) == []
+    assert check_reads_chain(REST_ANGLE) and not check_reads_chain(CARRIAGE_GAP)
+    assert TOE.check is None or not check_reads_chain(TOE)
+
+
 def test_a_force_at_rest_that_steps_from_rest_to_rest_is_not_taken_for_a_drifting_zero():
     """A carriage its rail holds at some rests and not at others puts the held tension at rest in one step, after
     half the record at zero: a line through the rests' readings has a resolved slope and a small scatter, but no

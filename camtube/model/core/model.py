@@ -323,6 +323,17 @@ def _short(value) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
+def check_reads_chain(effect: Effect) -> bool:
+    """Whether ``effect``'s check takes the fitted model's effects (keyword ``effects``): its verdict may change
+    with the rest of the chain."""
+    if effect.check is None:
+        return False
+    try:
+        return "effects" in inspect.signature(effect.check).parameters
+    except (TypeError, ValueError):  # a builtin or a callable without a signature: two arguments
+        return False
+
+
 def form_problem(effect: Effect, data, predicted_deg: np.ndarray, effects: Sequence[Effect] = ()) -> str:
     """Why ``data`` contradict ``effect``'s fitted form (its ``check``; empty when they do not, or it has none).
 
@@ -330,10 +341,7 @@ def form_problem(effect: Effect, data, predicted_deg: np.ndarray, effects: Seque
     A broken check in a user's file gets one line naming the effect, its file and the problem."""
     if effect.check is None:
         return ""
-    try:
-        takes = "effects" in inspect.signature(effect.check).parameters
-    except (TypeError, ValueError):  # a builtin or a callable without a signature: two arguments
-        takes = False
+    takes = check_reads_chain(effect)
     try:
         reason = effect.check(data, predicted_deg, effects=tuple(effects)) if takes else \
             effect.check(data, predicted_deg)

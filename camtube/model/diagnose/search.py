@@ -111,7 +111,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from camtube.model.core.fit import FitResult, fit
-from camtube.model.core.model import Effect, FitError, JointModel, form_problem
+from camtube.model.core.model import Effect, FitError, JointModel, check_reads_chain, form_problem
 from camtube.model.core.noise import ORDERS
 from camtube.model.core.parallel import map_forked
 from camtube.model.core.registry import Registry, builtin_registry
@@ -1434,6 +1434,8 @@ class Search:
                 continue
             if _resolution_problems(m, list(r.fitted), r.params, r.stderr, r.at_bound, data, s.modulus_range_gpa):
                 continue
+            if _chain_form_problems(m, data, r.predicted):
+                continue
             keep = [e for e in ch.chosen if e.name != old.name]
             steps = self.chain_steps(ch.model, keep, range(len(keep)), r.params, ps)
             steps.append(_step(r, ps, {k: v for k, v in init.items() if k in r.fitted}))
@@ -1974,6 +1976,18 @@ def _copies_off(eff: Effect, samples: Sequence[str], values: Mapping[str, float]
                 out[nm] = float(eff.off[p.name])
             elif nm in values:   # (not a parameter held for every sample: the rows do not resolve it)
                 out[nm] = float(values[nm])
+    return out
+
+
+def _chain_form_problems(m: JointModel, data: Dataset, predicted_deg: np.ndarray) -> list[str]:
+    """Why the data contradict an effect of ``m`` whose check reads the rest of the chain (``check`` taking
+    ``effects``), fitted as ``predicted_deg``: a joint's resting effect (friction, a relaxing backbone) the drive's
+    effect allowed beside a taut tendon at rest, once that drive effect is gone."""
+    out = []
+    for e in m.effects:
+        reason = form_problem(e, data, predicted_deg, m.effects) if check_reads_chain(e) else ""
+        if reason:
+            out.append(f"{e.name}: {reason}")
     return out
 
 
