@@ -247,6 +247,11 @@ HELDOUT21_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost mo
 #: arms, friction plain and switching within a row, a backbone beside friction, slack beside lost motion.
 HELDOUT22_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone3", "zero drift", "lag",
                    "friction", "sharp friction", ("backbone", "friction"), ("slack", "lost motion"), "tracker drift"]
+#: The twenty-third fresh held-out batch (issue 19, after the carriage that settles and a drive the chain may not drop
+#: beside a taut tendon at rest; bench-heldout18 .. 22 looked at): every carriage settles (:data:`SETTLED`); the usual
+#: files, lost motion twice, beside a toe and beside friction.
+HELDOUT23_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "creep", "backbone", "zero drift",
+                   "lag", "friction", ("lost motion", "toe"), ("friction", "lost motion"), "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -298,17 +303,20 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            "bench-heldout21": (20271228, HELDOUT21_KINDS),
            # drawn once a burst with a dropout in it, an infinite standard error and a law at its sharp limit were
            # settled (every batch above looked at), ROUGHER; run once
-           "bench-heldout22": (20280126, HELDOUT22_KINDS)}
+           "bench-heldout22": (20280126, HELDOUT22_KINDS),
+           # drawn once the carriage that settles and the drop kept to the resting effects' checks were settled
+           # (every batch above looked at), ROUGHER, SETTLED; run once
+           "bench-heldout23": (20280227, HELDOUT23_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
-SETTLED: set = set()
+SETTLED = {"bench-heldout23"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
 #: Batches with those, interference lasting seconds and load cells that reach their range
 #: (:func:`rougher_instruments`).
 ROUGHER = {"bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21",
-           "bench-heldout22"}
+           "bench-heldout22", "bench-heldout23"}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
