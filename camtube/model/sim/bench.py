@@ -175,10 +175,11 @@ class Clock:
     """Logger clock: nominal rate, stamp jitter, repeated stamps; and the simulation's own step.
 
     ``sim_step_ms``: the longest step the bench's mechanics are integrated over (the logged rows are read from
-    that finer run). 0: one step per logged row, as every batch drawn before it had. At one step per row a
-    carriage sticks at the first row after its tension fell to the rail's friction, by up to a row's travel
-    past the crossing (0.03 mm at 25 Hz on a 3 s ramp of 2 mm): a random lost motion per cycle that comes from
-    the step, not from the bench."""
+    that finer run). 0: one step per logged row, as every batch drawn before it had. There a carriage that lands
+    on the nut's flank (``Drive.settle`` off) sticks at the first row after its tension fell to the rail's
+    friction, up to a row's travel past the crossing (0.03 mm at 25 Hz on a 3 s ramp of 2 mm): a random lost
+    motion per cycle that comes from the step. A settling carriage slides back to the crossing, and one step per
+    row agrees with a 1 ms step to a micrometre (a check; the batches need no finer step)."""
 
     rate_hz: float = 50.0
     jitter_ms: float = 1.0
