@@ -252,6 +252,11 @@ HELDOUT22_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 #: files, lost motion twice, beside a toe and beside friction.
 HELDOUT23_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost motion", "creep", "backbone", "zero drift",
                    "lag", "friction", ("lost motion", "toe"), ("friction", "lost motion"), "tracker drift"]
+#: The twenty-fourth fresh held-out batch (issue 19, after the union of the samples' chains holds a copy the rows barely
+#: depend on; bench-heldout18 .. 23 looked at): every carriage settles; the usual files, and three of two samples that
+#: differ: a toe beside lost motion, slack beside creep, lost motion beside a relaxing backbone.
+HELDOUT24_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
+                   "friction", ("toe", "lost motion"), ("slack", "creep"), ("lost motion", "backbone"), "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
@@ -306,17 +311,20 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            "bench-heldout22": (20280126, HELDOUT22_KINDS),
            # drawn once the carriage that settles and the drop kept to the resting effects' checks were settled
            # (every batch above looked at), ROUGHER, SETTLED; run once
-           "bench-heldout23": (20280227, HELDOUT23_KINDS)}
+           "bench-heldout23": (20280227, HELDOUT23_KINDS),
+           # drawn once the union of the samples' chains held a copy the rows barely depend on (every batch above
+           # looked at), ROUGHER, SETTLED; run once
+           "bench-heldout24": (20280328, HELDOUT24_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
-SETTLED = {"bench-heldout23"}
+SETTLED = {"bench-heldout23", "bench-heldout24"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
 #: Batches with those, interference lasting seconds and load cells that reach their range
 #: (:func:`rougher_instruments`).
 ROUGHER = {"bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21",
-           "bench-heldout22", "bench-heldout23"}
+           "bench-heldout22", "bench-heldout23", "bench-heldout24"}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
