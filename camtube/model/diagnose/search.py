@@ -1667,7 +1667,7 @@ class Search:
             held.update(unresolved)
             fixed = {**self.fixed, **held}
             names = _drop_names(names, unresolved)
-            ps = [n for n in ps if n not in unresolved]   # (a sample's copy stays per sample, held in that one)
+            ps = list(_drop_names(ps, unresolved))   # (a sample's copy stays per sample, held in that one)
             init = {k: v for k, v in r.params.items() if k in r.fitted and k not in unresolved}
             r = refit_all_rows(m, data, names, fixed, init, s.grid, per_sample=ps, max_nfev=UNION_MAX_NFEV)
         if (r.nfev >= UNION_MAX_NFEV or not r.rmse < ch.all_rows.rmse
