@@ -1127,18 +1127,24 @@ class Search:
             return {}
         return _copies_off(eff, faint, r.params)
 
-    def _instead(self, eff: Effect, old: Effect, values: Mapping[str, float], initial: bool) -> list:
-        """``eff`` fitted in place of ``old`` (a swap): a row of :meth:`_fit_candidates`."""
+    def _instead_model(self, eff: Effect, old: Effect) -> tuple[JointModel, tuple, list]:
+        """The chain with ``eff`` in place of ``old``: ``(model, fitted names, per-sample names)``."""
+        ch = self.chain
+        m2, names2, ps2 = _without(ch.current, ch.names, ch.per_sample, [old])
+        return m2.with_effects(list(m2.effects) + [eff]), names2 + tuple(eff.full_names()), ps2
+
+    def _instead(self, eff: Effect, old: Effect, values: Mapping[str, float], initial: bool) -> tuple:
+        """``eff`` fitted in place of ``old`` (a swap): ``(fit without its model and rows, held-out RMSE, block MSE,
+        per-sample names of ``eff``, copies held off or None)`` (what crosses back from a worker;
+        :meth:`_instead_row` makes it a row of :meth:`_fit_candidates`)."""
         ch, grid = self.chain, self.settings.grid
         gone = set(old.full_names())
         new = eff.full_names()
-        m2, names2, ps2 = _without(ch.current, ch.names, ch.per_sample, [old])
-        m2 = m2.with_effects(list(m2.effects) + [eff])
-        names2 += tuple(new)
+        m2, names2, ps2 = self._instead_model(eff, old)
         kept = {k: v for k, v in values.items() if k.split("@")[0] not in gone}
         start = m2.initial_values(self.search, base=kept) if initial else kept
         f2, ho2, mse2 = self._fit_one(m2, names2, start, ps2, grid=grid, grid_names=new)
-        row = [eff, m2, new, f2, ho2, mse2, (), (old.name,)]
+        out = (f2, ho2, mse2, (), None)
         if any(n.split("@")[0] in gone for n in ch.per_sample) and eff.off:
             # the effect replaced was fitted per sample: so is its replacement, off where a sample does not show it
             ps3 = list(ps2) + list(new)
@@ -1147,18 +1153,29 @@ class Search:
             if held:
                 f3, ho3, mse3 = self._fit_held(m2, names2, f3.params, ps3, eff, held)
             if ho3 < ho2:
-                row = [eff, m2, new, f3, ho3, mse3, tuple(new), (old.name,)]
+                out = (f3, ho3, mse3, tuple(new), held)
+        return (replace(out[0], model=None, data=None),) + out[1:]
+
+    def _swaps(self, jobs: Sequence[tuple]) -> list:
+        """Rows of :meth:`_fit_candidates` for the swaps ``jobs`` (``(effect, old, values, initial)`` each, see
+        :meth:`_instead`), fitted one per core (speed; the same fits as one after another)."""
+        rows = []
+        for (eff, old, _, _), (f, ho, mse, eff_ps, held) in zip(jobs, map_forked(lambda i: self._instead(*jobs[i]),
+                                                                                   len(jobs))):
+            m2 = self._instead_model(eff, old)[0]
+            if held is not None:
                 self.cand_held[(eff.name, (old.name,))] = held
-        return row
+            rows.append([eff, m2, eff.full_names(), replace(f, model=m2, data=self.search), ho, mse, eff_ps,
+                         (old.name,)])
+        return rows
 
     def _fit_candidates(self, pool, try_per_sample, init, swappable, swap_all) -> list:
         """Rows ``[effect, model, new names, fit, held-out RMSE, block MSE, per-sample names(, replaces)]``."""
         ch, s = self.chain, self.settings
         self.cand_held = {}
         fits = []
-        for eff in (pool if swap_all else ()):
-            # instead of each effect of swappable only (the stop ratio is reached: nothing is to be added)
-            fits += [self._instead(eff, old, ch.fit.params, True) for old in swappable]
+        # instead of each effect of swappable only (the stop ratio is reached: nothing is to be added)
+        fits += self._swaps([(eff, old, ch.fit.params, True) for eff in (pool if swap_all else ()) for old in swappable])
         adding = list(() if swap_all else pool)
         models = [ch.current.with_effects(list(ch.current.effects) + [eff]) for eff in adding]
 
@@ -1195,43 +1212,54 @@ class Search:
                 self.cand_held[(eff.name, ())] = held
             fits.append([eff, m, eff.full_names(), replace(f, model=m, data=self.search), ho, mse, ()])
         if try_per_sample:
-            for row in sorted([r for r in fits if r[2]], key=lambda r: r[4])[:PER_SAMPLE_TRIES]:
-                eff, m, new, f, ho, mse, _ = row
-                off = self.cand_held.get((eff.name, ()), {})   # a baseline effect it stands in for
-                names, ps = self._chain_names(off, new, new)
-                f2, ho2, mse2 = self._fit_one(m, names, f.params, ps, held=off)
-                off_all = self._baseline_off(eff)
-                if off_all and not set(off_all) <= set(off) and _off_at_bound(f2, off_all):
-                    off = {**off, **off_all}   # per sample, it takes the baseline effect's place
-                    names, ps = self._chain_names(off, new, new)
-                    f2, ho2, mse2 = self._fit_one(m, names, f2.params, ps, held=off)
-                unresolved = _unresolved(m, self.search, f2, eff, s.min_gain)
-                if unresolved:   # a sample's copy its rows barely depend on, on a bound: held at its start value
-                    off = {**off, **unresolved}
-                    names, ps = self._chain_names(off, new, new)
-                    f2, ho2, mse2 = self._fit_one(m, names, f2.params, ps, held=off)
-                # in a sample that does not show the effect its copies are not resolved (a time constant on a
-                # bound, a stand-in for another effect): the effect fitted in the other samples only
-                held = self._absent(eff, m, f2)
-                if held:
-                    f3, ho3, mse3 = self._fit_held(m, names, f2.params, ps, eff, {**off, **held})
-                    dm, se = _gain(mse, mse3, self.strata)
-                    if dm > s.z * se and f3.bic < f.bic - s.bic_threshold:
-                        row[3:7] = [f3, ho3, mse3, tuple(new)]
-                        self.cand_held[(eff.name, ())] = {**off, **held}
-                    # a per-sample version with unresolved copies does not replace the shared one
-                    continue
-                dm, se = _gain(mse, mse2, self.strata)
-                if dm > s.z * se and f2.bic < f.bic - s.bic_threshold:
-                    row[3:7] = [f2, ho2, mse2, tuple(new)]
-                    if off:
-                        self.cand_held[(eff.name, ())] = off
+            tries = sorted([r for r in fits if r[2]], key=lambda r: r[4])[:PER_SAMPLE_TRIES]
+            # the tries are independent: one per core (speed; the same fits as one after another)
+            for row, got in zip(tries, map_forked(lambda i: self._per_sample_try(tries[i]), len(tries))):
+                if got is not None:
+                    f2, ho2, mse2, held = got
+                    row[3:7] = [replace(f2, model=row[1], data=self.search), ho2, mse2, tuple(row[2])]
+                    if held:
+                        self.cand_held[(row[0].name, ())] = held
+        jobs = []
         for row in ([] if swap_all else list(fits)):
             eff, m, new, f = row[:4]
             for old in swappable:
                 if any(n.split("@")[0] in set(old.full_names()) for n in f.at_bound):
-                    fits.append(self._instead(eff, old, f.params, False))
-        return fits
+                    jobs.append((eff, old, f.params, False))
+        return fits + self._swaps(jobs)
+
+    def _per_sample_try(self, row: list):
+        """The candidate of ``row`` (a row of :meth:`_fit_candidates`, shared) fitted with per-sample parameters:
+        ``(fit without its model and rows, held-out RMSE, block MSE, copies held off)`` when that version replaces the
+        shared one (its held-out gain significant and its BIC lower), else None."""
+        s = self.settings
+        eff, m, new, f, ho, mse, _ = row
+        off = self.cand_held.get((eff.name, ()), {})   # a baseline effect it stands in for
+        names, ps = self._chain_names(off, new, new)
+        f2, ho2, mse2 = self._fit_one(m, names, f.params, ps, held=off)
+        off_all = self._baseline_off(eff)
+        if off_all and not set(off_all) <= set(off) and _off_at_bound(f2, off_all):
+            off = {**off, **off_all}   # per sample, it takes the baseline effect's place
+            names, ps = self._chain_names(off, new, new)
+            f2, ho2, mse2 = self._fit_one(m, names, f2.params, ps, held=off)
+        unresolved = _unresolved(m, self.search, f2, eff, s.min_gain)
+        if unresolved:   # a sample's copy its rows barely depend on, on a bound: held at its start value
+            off = {**off, **unresolved}
+            names, ps = self._chain_names(off, new, new)
+            f2, ho2, mse2 = self._fit_one(m, names, f2.params, ps, held=off)
+        # in a sample that does not show the effect its copies are not resolved (a time constant on a bound, a
+        # stand-in for another effect): the effect fitted in the other samples only
+        held = self._absent(eff, m, f2)
+        if held:
+            f3, ho3, mse3 = self._fit_held(m, names, f2.params, ps, eff, {**off, **held})
+            dm, se = _gain(mse, mse3, self.strata)
+            if dm > s.z * se and f3.bic < f.bic - s.bic_threshold:
+                return replace(f3, model=None, data=None), ho3, mse3, {**off, **held}
+            return None   # a per-sample version with unresolved copies does not replace the shared one
+        dm, se = _gain(mse, mse2, self.strata)
+        if dm > s.z * se and f2.bic < f.bic - s.bic_threshold:
+            return replace(f2, model=None, data=None), ho2, mse2, off
+        return None
 
     def _judge(self, eff, m, new, f, ho, mse, eff_ps, *swap) -> Candidate:
         """A fitted candidate against the current chain: significant? trusted? (see the module docstring)."""
@@ -1416,12 +1444,22 @@ class Search:
         the RMSE: ``(effect, model, names, per-sample names, fit on all rows, waterfall, search fit, held-out
         RMSE, block MSE)``; None when every effect is needed."""
         ch, s, data = self.chain, self.settings, self.data
-        tries = []
-        for old in ch.chosen:
+
+        def without(i: int):
+            """The chain without its ``i``-th chosen effect, fitted on the search rows and cross-validated (the fit
+            without its model and rows: what crosses back from a worker)."""
+            old = ch.chosen[i]
             gone = set(old.full_names())
             m, names, ps = _without(ch.current, ch.names, ch.per_sample, [old])
             start = {k: v for k, v in ch.fit.params.items() if k.split("@")[0] not in gone}
             f, ho, mse = self._fit_one(m, names, start, ps)
+            return replace(f, model=None, data=None), ho, mse
+
+        tries = []
+        # the chosen effects' removals are independent: one per core (speed; the same fits as one after another)
+        for old, (f, ho, mse) in zip(ch.chosen, map_forked(without, len(ch.chosen))):
+            m, names, ps = _without(ch.current, ch.names, ch.per_sample, [old])
+            f = replace(f, model=m, data=self.search)
             dm, se = _gain(mse, ch.block_mse, self.strata)  # what keeping the effect gains
             tries.append((not (dm > s.z * se or f.bic - ch.fit.bic >= s.bic_threshold), ho, old, m, names, ps, f,
                           mse))
