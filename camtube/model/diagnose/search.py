@@ -1440,8 +1440,8 @@ class Search:
     def drop_candidate(self):
         """The chosen effect whose removal costs least, if the chain is not significantly better with it
         (held-out gain within ``z`` standard errors and search BIC within ``bic_threshold``, or all-rows BIC
-        within ``bic_threshold``) and the chain without it passes the all-rows checks with every step lowering
-        the RMSE: ``(effect, model, names, per-sample names, fit on all rows, waterfall, search fit, held-out
+        within ``bic_threshold``) and the chain without it passes the all-rows checks (its refit converged within
+        :data:`CHECK_MAX_NFEV` steps, as an added candidate's must) with every step lowering the RMSE: ``(effect, model, names, per-sample names, fit on all rows, waterfall, search fit, held-out
         RMSE, block MSE)``; None when every effect is needed."""
         ch, s, data = self.chain, self.settings, self.data
 
@@ -1465,7 +1465,12 @@ class Search:
                           mse))
         for held_out_ok, ho, old, m, names, ps, f, mse in sorted(tries, key=lambda t: (not t[0], t[1], t[2].name)):
             init = {k: v for k, v in f.params.items() if k in names or k.split("@")[0] in names}
-            r = refit_all_rows(m, data, names, self._fx(m), init, s.grid, per_sample=ps)
+            r = refit_all_rows(m, data, names, self._fx(m), init, s.grid, per_sample=ps, max_nfev=CHECK_MAX_NFEV)
+            if r.nfev >= CHECK_MAX_NFEV:
+                # not converged: a direction the data barely resolve without the effect, refused as an added
+                # candidate's refit would be (speed too: uncapped, one such refit of bench-heldout24's toe beside lost
+                # motion took 518 steps, 17 s of a 106 s diagnosis, and was not the drop)
+                continue
             # the thinned search rows see a coarser history (a play operator that misses the stroke's peaks):
             # an effect that helps only there is not needed either when every row does without it (BIC)
             if not held_out_ok and r.bic - ch.all_rows.bic >= s.bic_threshold:
