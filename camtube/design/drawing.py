@@ -259,11 +259,11 @@ def _settings_raw(overrides: list[str], file: str, folder: Path) -> dict:
         raise PatternError(bad)
     raw: dict = {}
     if process_file is not None:
-        from camtube.design.loader import _process_file
+        from camtube.design.loader import find_process_file
 
         # as given (from the working directory), else beside the drawing or shipped, as a YAML pattern's process:
-        found = Path(process_file) if Path(process_file).is_file() else _process_file(process_file, folder / "_",
-                                                                                          file, None)
+        found = Path(process_file) if Path(process_file).is_file() else find_process_file(process_file, folder,
+                                                                                              file, None)
         praw, _, _ = read_yaml(found)
         raw["process"] = dict(praw.get("process", praw))
     return apply_overrides(raw, plain, file)

@@ -405,7 +405,7 @@ def load(path: str | os.PathLike, overrides: Iterable[str] = ()) -> Loaded:
     raw, lines, file = read_yaml(path)
     proc = raw.get("process")
     if isinstance(proc, str):
-        praw, _, _ = read_yaml(_process_file(proc, Path(path), file, lines.get("process")))
+        praw, _, _ = read_yaml(find_process_file(proc, Path(path).parent, file, lines.get("process")))
         raw = dict(raw)
         raw["process"] = praw.get("process", praw)
     raw = apply_overrides(raw, overrides, file)
@@ -430,21 +430,22 @@ def load_text(text: str, path: str | os.PathLike) -> Loaded:
     lines = line_map(text)
     proc = raw.get("process")
     if isinstance(proc, str):
-        praw, _, _ = read_yaml(_process_file(proc, Path(path), file, lines.get("process")))
+        praw, _, _ = read_yaml(find_process_file(proc, Path(path).parent, file, lines.get("process")))
         raw = dict(raw)
         raw["process"] = praw.get("process", praw)
     return build(raw, file, lines, name=Path(path).stem)
 
 
-def _process_file(name: str, pattern_path: Path, file: str, line: int | None) -> Path:
-    """The process YAML that ``process: NAME`` names: beside the pattern, else a shipped preset."""
-    folders = (pattern_path.parent, PRESETS_DIR)
+def find_process_file(name: str, folder: Path, file: str, line: int | None) -> Path:
+    """The process YAML that ``process: NAME`` names: in ``folder`` (the pattern's or the drawing's), else a
+    shipped preset; a :class:`PatternError` naming ``file`` (and ``line``) and where it looked when neither has it."""
+    folders = (folder, PRESETS_DIR)
     for folder in folders:
         for cand in (folder / name, folder / f"{name}.yaml"):
             if cand.is_file():
                 return cand
     raise PatternError([Issue("process", "names a process file that is not there", name,
-                              f"a process YAML in {pattern_path.parent} or a shipped one: "
+                              f"a process YAML in {folder} or a shipped one: "
                               + ", ".join(_shipped()[1]), "put the file beside the pattern, name a "
                               "shipped process, or write the process keys under 'process:'", file, line)])
 
