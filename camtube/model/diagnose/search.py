@@ -1136,7 +1136,7 @@ class Search:
     def _instead(self, eff: Effect, old: Effect, values: Mapping[str, float], initial: bool) -> tuple:
         """``eff`` fitted in place of ``old`` (a swap): ``(fit without its model and rows, held-out RMSE, block MSE,
         per-sample names of ``eff``, copies held off or None)`` (what crosses back from a worker;
-        :meth:`_instead_row` makes it a row of :meth:`_fit_candidates`)."""
+        :meth:`_swaps` makes it a row of :meth:`_fit_candidates`)."""
         ch, grid = self.chain, self.settings.grid
         gone = set(old.full_names())
         new = eff.full_names()
