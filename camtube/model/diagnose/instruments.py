@@ -574,19 +574,22 @@ def _paired_jumps(rows: np.ndarray, size: np.ndarray, longest: int, noise: float
         left.append(free[i])
         i += 1
     free = left
-    i, left = 0, []
+    i = 0
     while i < len(free):  # 4. a jump and the jump back with smaller ones between (inside the displacement)
-        j = i + 1
-        while j < len(free) and rows[free[j]] - rows[free[i]] <= longest and not match(free[i], free[j]):
-            if abs(size[free[j]]) >= SMALLER_INSIDE * abs(size[free[i]]):
-                j = len(free)   # a jump as large as the first one between: not one displacement
+        back = None
+        for j in range(i + 1, len(free)):
+            if rows[free[j]] - rows[free[i]] > longest:
                 break
-            j += 1
-        if j < len(free) and rows[free[j]] - rows[free[i]] <= longest and match(free[i], free[j]):
-            out.append((rows[free[i]], rows[free[j]]))
-            i = j + 1
-        else:
+            if match(free[i], free[j]):
+                back = j
+                break
+            if abs(size[free[j]]) >= SMALLER_INSIDE * abs(size[free[i]]):
+                break   # a jump as large as the first one between: not one displacement
+        if back is None:
             i += 1
+        else:
+            out.append((rows[free[i]], rows[free[back]]))
+            i = back + 1
     return out
 
 
