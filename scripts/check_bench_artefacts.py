@@ -6,7 +6,9 @@ Per file: the spikes found against the true ones (those not in a dropout), the r
 bursts), the dropouts the tracker wrote as 0 or its last reading that were set aside (those while the joint was
 bent and the motor moved, and those written as 0 while it stood bent in a dwell: at rest a zero or a held value is
 no error, nor is a held value in a dwell), the repeated stamps, and any row set aside that carries no artefact
-("false"; the rows a load cell read the end of its range in count as artefacts).
+("false"; the rows a load cell read the end of its range in count as artefacts), and the rows whose force jumped
+before the logged stroke moved (listed apart, with the guide's slip speed: a guide that switches within a row makes
+them).
 """
 import argparse
 
@@ -49,8 +51,13 @@ for batch in batches or ["bench", "bench-heldout"]:
             limit |= (smp == name_s) & (rec.data.force_N >= b.load_cell.range_N)
         artefact = spikes | bursts | drops | set(rec.repeat_rows.tolist()) | set(np.flatnonzero(limit).tolist())
         shifted = aside.get("end of record after the lag shift", set()) | aside.get("row before a gap after the lag shift", set())
+        # rows whose force jumped before the logged stroke moved: no artefact of an instrument but of the stroke's
+        # resolution at a start; listed on their own, with the sharpest guide's slip speed (mm/s)
+        ahead = aside.get("force ahead of the stroke row", set())
+        slip = min(b.guide.slip_mm_s for b in benches if b.guide.mu > 0) if any(b.guide.mu > 0 for b in benches) else None
         print(f"{batch} {name}: spikes {len(aside['angle spike'] & spikes)} of {len(spikes)}; burst rows "
               f"{len(every & bursts)} of {len(bursts)}; dropouts written as values, while bent and moving, "
               f"{len(every & bent)} of {len(bent)}, written as 0 in a dwell {len(every & dwell)} of {len(dwell)}; repeats {len(aside['repeated time stamp'] & set(rec.repeat_rows))}"
               f" of {len(rec.repeat_rows)}; force spikes {len(aside['force spike'])}; false "
-              f"{len(every - artefact - shifted)}", flush=True)
+              f"{len(every - artefact - shifted - ahead)}; force ahead of the stroke {len(ahead)}"
+              + (f" (guide slip {slip:g} mm/s)" if slip is not None else " (no guide friction)"), flush=True)

@@ -935,9 +935,9 @@ def test_a_guide_whose_friction_switches_within_a_row_is_read_as_its_law_at_the_
     # Coulomb's step at the guide (the bench's sliding state regularised over 1e-6 mm/s; 0.05 by default): capstan
     # took the error from 21x the floor to 2x, but its slip speed ended on its lower bound and it was refused, and
     # the partial list read friction, hardstop. A decade above that bound the error moves by 0.015 deg of the 4.5
-    # deg the guide's law takes off: the law at its sharp limit, held there, and the guide's law leads. (The file
-    # stays partial: where the logged stroke has stopped within its resolution the guide still slides for a row,
-    # one row per reversal off by the whole jump)
+    # deg the guide's law takes off: the law at its sharp limit, held there, and the guide's law leads. (The rows
+    # where the logged stroke and the guide disagree on when the drive started or stopped are set aside by the
+    # instruments' check: see the test after the next)
     b = SampleBench(guide=Guide(mu=0.15, slip_mm_s=1e-6), tracker=Tracker(noise_deg=0.2, n_spikes=8, n_dropouts=4))
     proto = Protocol(n_cycles=20, ramp_s=3.0, dwell_s=2.0, rest_s=2.0, first_dwell_s=2.0)
     rec = simulate_bench(tube2, b, proto, Clock(rate_hz=50.0), seed=1)
@@ -950,7 +950,10 @@ def test_a_guide_whose_friction_switches_within_a_row_is_read_as_its_law_at_the_
     assert first.significant, first.why
     assert (d.recommended or d.partial)[0] == "capstan", (d.recommended, d.partial)
     steps = d.waterfall if d.recommended else d.partial_steps
-    assert steps[1].params["capstan.slip_mm_s"] == pytest.approx(1e-3)
+    from camtube.model.effects.builtin import CAPSTAN
+
+    sharp = next(p for p in CAPSTAN.params if p.name == "slip_mm_s")
+    assert steps[1].params["capstan.slip_mm_s"] == pytest.approx(sharp.lo)   # held on the bound, the sharp limit
     assert steps[1].rmse_deg < 0.1 * steps[0].rmse_deg
 
 
@@ -996,3 +999,75 @@ def test_a_tracker_that_filters_its_readings_leaves_a_control_clean(tube2):
     assert not d.recommended and not d.partial and not unexplained_report.of_diagnosis(d)
     assert d.noise_lag_rows > 1
     assert abs(d.noise_floor_deg / rec.floor_deg - 1.0) < 0.1
+
+
+SHARP = Protocol(n_cycles=12, ramp_s=2.0, dwell_s=1.0, rest_s=1.0, first_dwell_s=2.0)
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_rows_whose_force_reads_a_guides_switch_the_stroke_has_not_logged_are_set_aside(tube2, seed):
+    # a guide whose friction switches within a row (Coulomb's step): where the drive starts by less than the stroke
+    # resolves, the load cell already reads the reversed tension with the stroke at rest; where it stops, the row
+    # after its last step can still read the sliding guide. No law of the rows' stamps fits them (13 deg off in
+    # rows of bench-heldout25, and a false lag of 25 ms): they are set aside, and the guide's law then fits at the
+    # floor; a smooth guide and a control have no such row
+    b = SampleBench(guide=Guide(mu=0.15, slip_mm_s=1e-6), tracker=QUIET)
+    rec = simulate_bench(tube2, b, SHARP, Clock(rate_hz=50.0, n_repeats=0), seed=seed)
+    ins = check_instruments(rec.data)
+    ahead = ins.aside["force ahead of the stroke row"]
+    assert 6 <= ahead.size <= 2 * 2 * SHARP.n_cycles          # at most one per start and stop
+    s = rec.data.stroke_mm
+    # each one next to a start or a stop of the stroke: it rests on one side of the row and moves on the other
+    assert all((s[i] == s[i - 1]) != (s[i + 1] == s[i]) or (s[i - 1] == s[i - 2]) != (s[i] == s[i - 1])
+               for i in ahead)
+    assert any("force ahead of the stroke" in line for line in ins.lines())
+    model, fixed = model_for_pattern(tube2, ["capstan"]), pattern_values(tube2)
+    names = ["E_t", "capstan.mu_wrap", "capstan.slip_mm_s", "capstan.hold"]
+    kept = fit(model, ins.data, names, fixed).rmse
+    every = fit(model, rec.data, names, fixed).rmse
+    assert kept < 1.15 * rec.floor_deg < 1.5 * rec.floor_deg < every
+    assert ins.lag.applied_ms == 0.0
+    for guide in (Guide(mu=0.15), Guide()):
+        smooth = simulate_bench(tube2, SampleBench(guide=guide, tracker=QUIET), SHARP,
+                                Clock(rate_hz=50.0, n_repeats=0), seed=seed)
+        assert "force ahead of the stroke row" not in check_instruments(smooth.data).aside
+
+
+def test_an_angle_the_check_missed_does_not_shift_the_lag(tube2):
+    # the lag regression reads every k-th row; it shifted the angle, so which angles it read changed with the shift,
+    # and a burst's remnant the check missed (11 rows 6 deg off, bench-heldout25) was left out by a shift of one row
+    # and not by none: a false lag of 25 ms, corrected. The angles are now the same for every shift
+    rec = simulate_bench(tube2, SampleBench(tracker=QUIET), SHORT, Clock(rate_hz=50.0, n_repeats=0), seed=3)
+    d = rec.data
+    a = d.angle_deg.copy()
+    moving = np.flatnonzero(np.abs(np.gradient(d.stroke_mm)) > 0)
+    for r in moving[200::600][:6]:
+        a[r] -= 6.0                     # single rows off: what a missed remnant leaves
+    off = Dataset(d.sample, d.cycle, d.time_s, d.stroke_mm, d.force_N, a)
+    from camtube.model.diagnose.instruments import estimate_lag
+
+    lag = estimate_lag(off, max_rows=len(off) // 5)
+    assert abs(lag.lag_ms) < max(3.0 * lag.se_ms, 5.0), lag
+
+
+def test_a_burst_with_the_joints_own_jump_inside_it_is_set_aside_whole(tube2):
+    # interference of -5 deg over the top of a stroke where a guide that switches within a row moves the joint 3 deg
+    # in one row as it releases: the joint's jump inside the burst stopped the jump in and the jump back from being
+    # paired, and 10 rows 5 deg off were kept (bench-heldout25). The load cell jumps in that row too, so the angle's
+    # jump there is the joint's, not an edge of the interference
+    b = SampleBench(guide=Guide(mu=0.15, slip_mm_s=1e-6), tracker=QUIET)
+    rec = simulate_bench(tube2, b, SHARP, Clock(rate_hz=50.0, n_repeats=0), seed=1)
+    d = rec.data
+    s, f = d.stroke_mm, d.force_N
+    # the first release at the top: the row where the stroke starts down
+    top = int(np.flatnonzero((np.diff(s) < 0) & (s[:-1] == s.max()))[0]) + 1
+    own = abs(rec.angle_true_deg[top + 1] - rec.angle_true_deg[top - 2])
+    assert own > 2.5 and abs(f[top + 1] - f[top - 2]) > 0.2      # the joint's own jump, the cell's with it
+    a = d.angle_deg.copy()
+    r0, r1 = top - 15, top + 20
+    a[r0:r1] -= 5.0
+    ins = check_instruments(Dataset(d.sample, d.cycle, d.time_s, s, f, a))
+    aside = {int(i) for k, v in ins.aside.items() if k != "force ahead of the stroke row" for i in v}
+    displaced = set(range(r0, r1))
+    assert displaced <= aside, sorted(displaced - aside)
+    assert len(aside - displaced) <= 2, sorted(aside - displaced)

