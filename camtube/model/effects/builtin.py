@@ -372,7 +372,7 @@ CAPSTAN = Effect(
                   "friction coefficient times the wrap angle (rad) of the guide: the joint-side tension is "
                   "exp(-mu_wrap) times the load cell's while pulling, exp(+mu_wrap) while releasing",
                   starts=(0.1, 0.3, 0.8)),
-            Param("slip_mm_s", "mm/s", 1e-3, 10.0, 0.05,
+            Param("slip_mm_s", "mm/s", 1e-6, 10.0, 0.05,
                   "tendon speed at which the friction is 76 % developed (tanh); on its lower bound: a guide "
                   "whose friction switches within a row (Coulomb's step)", log=True, starts=(0.01, 0.1),
                   kind="sharp"),
