@@ -1133,10 +1133,20 @@ class Search:
         m2, names2, ps2 = _without(ch.current, ch.names, ch.per_sample, [old])
         return m2.with_effects(list(m2.effects) + [eff]), names2 + tuple(eff.full_names()), ps2
 
+    def _forked_fits(self, fn, models: Sequence[JointModel]) -> list:
+        """``[fn(0), ..., fn(n - 1)]`` one per core (speed; the same fits as one after another), each a tuple whose
+        first item is a fit, or None. The fit crosses back from its worker without its model and rows (a model need
+        not pickle: a user's effect file may hold lambdas) and is given ``models[i]`` and the search rows here."""
+        def stripped(i: int):
+            got = fn(i)
+            return None if got is None else (replace(got[0], model=None, data=None),) + tuple(got[1:])
+
+        return [None if got is None else (replace(got[0], model=m, data=self.search),) + got[1:]
+                for m, got in zip(models, map_forked(stripped, len(models)))]
+
     def _instead(self, eff: Effect, old: Effect, values: Mapping[str, float], initial: bool) -> tuple:
-        """``eff`` fitted in place of ``old`` (a swap): ``(fit without its model and rows, held-out RMSE, block MSE,
-        per-sample names of ``eff``, copies held off or None)`` (what crosses back from a worker;
-        :meth:`_swaps` makes it a row of :meth:`_fit_candidates`)."""
+        """``eff`` fitted in place of ``old`` (a swap): ``(fit, held-out RMSE, block MSE, per-sample names of ``eff``,
+        copies held off or None)`` (:meth:`_swaps` makes it a row of :meth:`_fit_candidates`)."""
         ch, grid = self.chain, self.settings.grid
         gone = set(old.full_names())
         new = eff.full_names()
@@ -1154,19 +1164,18 @@ class Search:
                 f3, ho3, mse3 = self._fit_held(m2, names2, f3.params, ps3, eff, held)
             if ho3 < ho2:
                 out = (f3, ho3, mse3, tuple(new), held)
-        return (replace(out[0], model=None, data=None),) + out[1:]
+        return out
 
     def _swaps(self, jobs: Sequence[tuple]) -> list:
         """Rows of :meth:`_fit_candidates` for the swaps ``jobs`` (``(effect, old, values, initial)`` each, see
         :meth:`_instead`), fitted one per core (speed; the same fits as one after another)."""
         rows = []
-        for (eff, old, _, _), (f, ho, mse, eff_ps, held) in zip(jobs, map_forked(lambda i: self._instead(*jobs[i]),
-                                                                                   len(jobs))):
-            m2 = self._instead_model(eff, old)[0]
+        models = [self._instead_model(eff, old)[0] for eff, old, _, _ in jobs]
+        for (eff, old, _, _), m2, (f, ho, mse, eff_ps, held) in zip(
+                jobs, models, self._forked_fits(lambda i: self._instead(*jobs[i]), models)):
             if held is not None:
                 self.cand_held[(eff.name, (old.name,))] = held
-            rows.append([eff, m2, eff.full_names(), replace(f, model=m2, data=self.search), ho, mse, eff_ps,
-                         (old.name,)])
+            rows.append([eff, m2, eff.full_names(), f, ho, mse, eff_ps, (old.name,)])
         return rows
 
     def _fit_candidates(self, pool, try_per_sample, init, swappable, swap_all) -> list:
@@ -1180,8 +1189,8 @@ class Search:
         models = [ch.current.with_effects(list(ch.current.effects) + [eff]) for eff in adding]
 
         def added(i: int):
-            """``adding[i]`` added to the chain and fitted: ``(fit without its model and rows, held-out RMSE, block
-            MSE, the baseline's values it holds off or None)`` (what crosses back from a worker)."""
+            """``adding[i]`` added to the chain and fitted: ``(fit, held-out RMSE, block MSE, the baseline's values it
+            holds off or None)``."""
             eff, m = adding[i], models[i]
             new = eff.full_names()
             start = m.initial_values(self.search, base=ch.fit.params)
@@ -1204,20 +1213,21 @@ class Search:
                                               grid_names=_drop_names(new, both), starts=[init] if init else ())
                 if ho2 < ho or _off_at_bound(f, off):
                     f, ho, mse, held = f2, ho2, mse2, both
-            return replace(f, model=None, data=None), ho, mse, held
+            return f, ho, mse, held
 
-        # the candidates are independent: one per core (speed; the same fits as one after another)
-        for eff, m, (f, ho, mse, held) in zip(adding, models, map_forked(added, len(adding))):
+        # the candidates are independent: one per core
+        for eff, m, (f, ho, mse, held) in zip(adding, models, self._forked_fits(added, models)):
             if held is not None:
                 self.cand_held[(eff.name, ())] = held
-            fits.append([eff, m, eff.full_names(), replace(f, model=m, data=self.search), ho, mse, ()])
+            fits.append([eff, m, eff.full_names(), f, ho, mse, ()])
         if try_per_sample:
             tries = sorted([r for r in fits if r[2]], key=lambda r: r[4])[:PER_SAMPLE_TRIES]
-            # the tries are independent: one per core (speed; the same fits as one after another)
-            for row, got in zip(tries, map_forked(lambda i: self._per_sample_try(tries[i]), len(tries))):
+            # the tries are independent: one per core
+            for row, got in zip(tries, self._forked_fits(lambda i: self._per_sample_try(tries[i]),
+                                                         [r[1] for r in tries])):
                 if got is not None:
                     f2, ho2, mse2, held = got
-                    row[3:7] = [replace(f2, model=row[1], data=self.search), ho2, mse2, tuple(row[2])]
+                    row[3:7] = [f2, ho2, mse2, tuple(row[2])]
                     if held:
                         self.cand_held[(row[0].name, ())] = held
         jobs = []
@@ -1230,8 +1240,9 @@ class Search:
 
     def _per_sample_try(self, row: list):
         """The candidate of ``row`` (a row of :meth:`_fit_candidates`, shared) fitted with per-sample parameters:
-        ``(fit without its model and rows, held-out RMSE, block MSE, copies held off)`` when that version replaces the
-        shared one (its held-out gain significant and its BIC lower), else None."""
+        ``(fit, held-out RMSE, block MSE, copies held off)`` when that version replaces the
+        shared one (its held-out gain significant and its BIC lower), else None (the fit's model and rows are
+        given back by :meth:`_forked_fits`)."""
         s = self.settings
         eff, m, new, f, ho, mse, _ = row
         off = self.cand_held.get((eff.name, ()), {})   # a baseline effect it stands in for
@@ -1254,11 +1265,11 @@ class Search:
             f3, ho3, mse3 = self._fit_held(m, names, f2.params, ps, eff, {**off, **held})
             dm, se = _gain(mse, mse3, self.strata)
             if dm > s.z * se and f3.bic < f.bic - s.bic_threshold:
-                return replace(f3, model=None, data=None), ho3, mse3, {**off, **held}
+                return f3, ho3, mse3, {**off, **held}
             return None   # a per-sample version with unresolved copies does not replace the shared one
         dm, se = _gain(mse, mse2, self.strata)
         if dm > s.z * se and f2.bic < f.bic - s.bic_threshold:
-            return replace(f2, model=None, data=None), ho2, mse2, off
+            return f2, ho2, mse2, off
         return None
 
     def _judge(self, eff, m, new, f, ho, mse, eff_ps, *swap) -> Candidate:
@@ -1445,21 +1456,18 @@ class Search:
         RMSE, block MSE)``; None when every effect is needed."""
         ch, s, data = self.chain, self.settings, self.data
 
+        rest = [_without(ch.current, ch.names, ch.per_sample, [old]) for old in ch.chosen]
+
         def without(i: int):
-            """The chain without its ``i``-th chosen effect, fitted on the search rows and cross-validated (the fit
-            without its model and rows: what crosses back from a worker)."""
-            old = ch.chosen[i]
-            gone = set(old.full_names())
-            m, names, ps = _without(ch.current, ch.names, ch.per_sample, [old])
+            """The chain without its ``i``-th chosen effect, fitted on the search rows and cross-validated."""
+            gone = set(ch.chosen[i].full_names())
+            m, names, ps = rest[i]
             start = {k: v for k, v in ch.fit.params.items() if k.split("@")[0] not in gone}
-            f, ho, mse = self._fit_one(m, names, start, ps)
-            return replace(f, model=None, data=None), ho, mse
+            return self._fit_one(m, names, start, ps)
 
         tries = []
-        # the chosen effects' removals are independent: one per core (speed; the same fits as one after another)
-        for old, (f, ho, mse) in zip(ch.chosen, map_forked(without, len(ch.chosen))):
-            m, names, ps = _without(ch.current, ch.names, ch.per_sample, [old])
-            f = replace(f, model=m, data=self.search)
+        # the chosen effects' removals are independent: one per core
+        for old, (m, names, ps), (f, ho, mse) in zip(ch.chosen, rest, self._forked_fits(without, [r[0] for r in rest])):
             dm, se = _gain(mse, ch.block_mse, self.strata)  # what keeping the effect gains
             tries.append((not (dm > s.z * se or f.bic - ch.fit.bic >= s.bic_threshold), ho, old, m, names, ps, f,
                           mse))
