@@ -264,7 +264,13 @@ HELDOUT24_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 HELDOUT25_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone3", "zero drift", "lag",
                    "sharp friction", ("friction", "backbone"), ("creep", "lost motion"), ("toe", "slack"),
                    "tracker drift"]
-BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
+#: A tuning batch of guides whose friction switches within a row (Coulomb's step), alone and beside the other
+#: mechanisms, with the instruments of ``ROUGHER``: drawn to tune the rows the load cell reads ahead of the stroke
+#: (issue 19, after the twenty-fifth batch); looked at, not held out.
+SHARP_KINDS = ["sharp friction", "sharp friction", "sharp friction", ("sharp friction", "toe"),
+               ("sharp friction", "backbone"), ("lost motion", "sharp friction"), ("sharp friction", "creep"),
+               ("slack", "sharp friction")]
+BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
            # batch's composition, a seed not used before; run once
@@ -325,13 +331,13 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-heldout": (20261207, HELDOUT_
            "bench-heldout25": (20280521, HELDOUT25_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
-SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25"}
+SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-sharp"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
 #: Batches with those, interference lasting seconds and load cells that reach their range
 #: (:func:`rougher_instruments`).
-ROUGHER = {"bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21",
+ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21",
            "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25"}
 
 
