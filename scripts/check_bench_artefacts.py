@@ -54,7 +54,8 @@ for batch in batches or ["bench", "bench-heldout"]:
         # rows whose force jumped before the logged stroke moved: no artefact of an instrument but of the stroke's
         # resolution at a start; listed on their own, with the sharpest guide's slip speed (mm/s)
         ahead = aside.get("force ahead of the stroke row", set())
-        slip = min(b.guide.slip_mm_s for b in benches if b.guide.mu > 0) if any(b.guide.mu > 0 for b in benches) else None
+        slips = [b.guide.slip_mm_s for b in benches if b.guide.mu > 0]
+        slip = min(slips) if slips else None
         print(f"{batch} {name}: spikes {len(aside['angle spike'] & spikes)} of {len(spikes)}; burst rows "
               f"{len(every & bursts)} of {len(bursts)}; dropouts written as values, while bent and moving, "
               f"{len(every & bent)} of {len(bent)}, written as 0 in a dwell {len(every & dwell)} of {len(dwell)}; repeats {len(aside['repeated time stamp'] & set(rec.repeat_rows))}"

@@ -27,11 +27,11 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
   reading is set aside and the level is stated. A force quantised by the logger repeats its top value only where
   the stroke rests (a dwell), so it does not qualify.
 * **The force ahead of the stroke**: a row where the stroke starts to move only after it (its step into the row at
-  most :data:`AHEAD_STEP` of its step out) while the force has already jumped the way that motion takes it (by more
-  than :data:`SPIKE_Z` noise scales of the force at rest, and :data:`AHEAD_OUT` times its change to the next row):
-  the drive started within the row by less than the stroke resolves, and something that switches at once (a
-  guide's Coulomb friction) moved the tension. The row's stamp has no state a model can use; it is set aside
-  (:func:`_force_ahead`).
+  most :data:`AHEAD_STEP` of its step out) while the force has already changed the way that motion takes it (by
+  more than :data:`SPIKE_Z` noise scales of the force at rest); or the first row at rest after a motion whose force
+  jumps only into the next row, against the motion that ended. The drive moved by less than the stroke resolves,
+  and something that switches at once (a guide's Coulomb friction) moved the tension: the row's stamp has no state a
+  model can use, so it is set aside (:func:`_force_ahead`).
 * **Repeated time stamps**: a row whose stamp equals the previous row's (the logger wrote one instant
   twice) is set aside. Rows whose stamp goes backwards, and rows with a missing value, are dropped when
   the file is read (:func:`camtube.model.data.read_measurements`), and counted there.
@@ -101,7 +101,7 @@ FROZEN_STROKE = 0.01
 #: after the drive moved (see :func:`_force_ahead`) ...
 AHEAD_STEP = 0.1
 #: ... and the first row at rest after a motion whose force jumps only into the next row (by this many times its
-#: changes either side) one the stroke's log had stopped before the carriage did.
+#: changes either side) is one where the stroke's log had stopped before the carriage did.
 AHEAD_OUT = 2.0
 #: The largest ``--lag-ms`` taken (ms): a tracker's delay is tens of milliseconds; more is clocks not aligned.
 MAX_GIVEN_LAG_MS = 2000.0
@@ -374,8 +374,8 @@ class Instruments:
                   "smaller stroke, measures them")
         ahead = self.aside.get("force ahead of the stroke row", ())
         if len(ahead):
-            out.append(f"force ahead of the stroke: in {len(ahead)} row(s) the load cell and the stroke disagree on when "
-                       "the drive started or stopped (the tension jumped a row before the stroke moved, or a row "
+            out.append(f"force ahead of the stroke: in {len(ahead)} row(s) the load cell and the stroke disagree on "
+                       "when the drive started or stopped (the tension jumped a row before the stroke moved, or a row "
                        "after it stopped: the drive moved by less than the stroke resolves, and something that "
                        "switches at once with the motion, such as a guide's Coulomb friction, moved the tension); no "
                        "model of the rows' stamps fits them, so they are set aside; a stroke logged at a finer "
@@ -703,8 +703,8 @@ def _force_ahead(force: np.ndarray, stroke: np.ndarray, t: np.ndarray, slices: l
     tension misses by the guide's whole ratio: 13 deg in rows of ``bench-heldout25``), nor does a delay (a false
     lag of 25 ms there). A smooth start or stop moves the force with the stroke, so it does not qualify, nor does a
     row beside a gap in the record (every change read is one row's step of time: across 0.1 s of missing rows the
-    stroke's step looks like a start). ``t`` (n,): the rows' times. ``known``: rows already set aside (skipped as the row itself; a neighbour set aside still counts as read: a load
-    cell at its limit before the release)."""
+    stroke's step looks like a start). ``t`` (n,): the rows' times. ``known``: rows already set aside (skipped as
+    the row itself; a neighbour set aside still counts as read: a load cell at its limit before the release)."""
     out = np.zeros(force.size, bool)
     for _, sl in slices:
         f, s = force[sl], stroke[sl]

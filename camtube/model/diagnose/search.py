@@ -1983,8 +1983,8 @@ def _unresolved(model: JointModel, data: Dataset, f: FitResult, eff: Effect, sha
     ``share`` of what switching the effect off (its ``off`` values, in that sample for a copy) adds to that RMSE.
     A parameter of kind ``sharp`` (the law's sharp limit is its lower bound: a guide that switches within a row)
     passes when its lower bound and a decade above it move the error by as little. ``name -> value held``: the start
-    value, or the bound for a sharp limit; empty when there are none, or when ``eff`` has no ``off`` values. (A guide's hold
-    where the dwells at the top were set aside moves the error by 0.003 deg of the 4.5 deg the guide's law takes
+    value, or the bound for a sharp limit; empty when there are none, or when ``eff`` has no ``off`` values. (A
+    guide's hold where the dwells at the top were set aside moves the error by 0.003 deg of the 4.5 deg the guide's law takes
     off; where an effect does little in a sample, or nothing, its copy there moves the error by as much as the
     effect does, and the sample does not show it: :meth:`Search._absent`.)"""
     out = {}
