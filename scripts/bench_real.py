@@ -270,7 +270,13 @@ HELDOUT25_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 SHARP_KINDS = ["sharp friction", "sharp friction", "sharp friction", ("sharp friction", "toe"),
                ("sharp friction", "backbone"), ("lost motion", "sharp friction"), ("sharp friction", "creep"),
                ("slack", "sharp friction")]
-BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS), "bench-heldout": (20261207, HELDOUT_KINDS),
+#: The twenty-sixth fresh held-out batch (issue 19, after the rows whose force reads a switch the stroke has not
+#: logged): guides that switch within a row alone and beside creep and a backbone, a toe beside lost motion.
+HELDOUT26_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone3", "zero drift", "lag",
+                   "sharp friction", ("sharp friction", "creep"), ("backbone", "sharp friction"),
+                   ("toe", "lost motion"), "tracker drift"]
+BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
+           "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
            # drawn once each sample diagnosed alone was settled (bench-heldout3 had been looked at): the third
            # batch's composition, a seed not used before; run once
@@ -328,17 +334,20 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            # drawn once the union of the samples' chains held a copy the rows barely depend on (every batch above
            # looked at), ROUGHER, SETTLED; run once
            "bench-heldout24": (20280328, HELDOUT24_KINDS),
-           "bench-heldout25": (20280521, HELDOUT25_KINDS)}
+           "bench-heldout25": (20280521, HELDOUT25_KINDS),
+           # drawn once the rows the load cell reads ahead of (or behind) the stroke, the lag regression's same angles
+           # and the guide's sharp limit were settled (every batch above looked at, bench-sharp tuned on); run once
+           "bench-heldout26": (20280622, HELDOUT26_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
-SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-sharp"}
+SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-sharp"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
 #: Batches with those, interference lasting seconds and load cells that reach their range
 #: (:func:`rougher_instruments`).
 ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21",
-           "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25"}
+           "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26"}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
@@ -365,10 +374,14 @@ def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
         right |= FAMILIES[k][0]
     first = rec_list[0] if rec_list else "-"
     if kinds[0] == "lag":
-        # an instrument property: found and corrected (within 3 standard errors or 20 %), never offered as a
-        # joint effect; the secondary mechanisms may still be explained, to the floor
-        lag_ok = (ins.lag.applied_ms > 0 and abs(ins.lag.applied_ms - benches[0].tracker.lag_ms)
-                  <= max(3.0 * ins.lag.se_ms, 0.2 * benches[0].tracker.lag_ms))
+        # an instrument property: found (within 3 standard errors or 20 %) and corrected (by whole rows: within one
+        # row of the estimate), never offered as a joint effect; the secondary mechanisms may still be explained,
+        # to the floor. (Until bench-heldout25 the whole rows applied were compared with the truth within 3 standard
+        # errors: a lag of 27 ms read 27.3 +- 0.8 and applied as one row of 20 ms at 50 Hz counted wrong)
+        row_ms = 1e3 / rate
+        lag_ok = (ins.lag.applied_ms > 0 and abs(ins.lag.lag_ms - benches[0].tracker.lag_ms)
+                  <= max(3.0 * ins.lag.se_ms, 0.2 * benches[0].tracker.lag_ms)
+                  and abs(ins.lag.applied_ms - ins.lag.lag_ms) <= row_ms + 1e-6)
         ok = lag_ok and (not rec_list or final <= 1.15 * floor_true)
     elif kinds[0] == "zero drift" and ins.rezeroed:
         # an instrument property read at the rests and corrected (as a lag is); what the bench's other mechanisms
