@@ -72,10 +72,9 @@ class Param:
     kind: str = ""
 
     def at_sharp_limit(self, value: float) -> bool:
-        """``value`` may be this parameter's sharp limit: a parameter of kind ``sharp`` within the decade above its
-        lower bound (a fit ends anywhere there when the rows cannot tell the values apart; whether they can is the
-        caller's check, a decade above the bound against the fit)."""
-        return self.kind == "sharp" and float(value) < 10.0 * self.lo
+        """``value`` is this parameter's sharp limit: a parameter of kind ``sharp`` on (within 1e-6 of) its lower
+        bound."""
+        return self.kind == "sharp" and float(value) <= self.lo * (1.0 + 1e-6)
 
     def initial(self, data, ctx) -> float:
         v = self.init(data, ctx) if callable(self.init) else float(self.init)

@@ -1981,8 +1981,8 @@ def _unresolved(model: JointModel, data: Dataset, f: FitResult, eff: Effect, sha
     that the rows barely depend on against what the effect does there: moved across the parameter's whole range,
     the others at ``f``'s values, the RMSE of the rows it acts on (its sample's, for a copy) changes by at most
     ``share`` of what switching the effect off (its ``off`` values, in that sample for a copy) adds to that RMSE.
-    A parameter of kind ``sharp`` (the law's sharp limit is its lower bound: a guide that switches within a row)
-    passes when its lower bound and a decade above it move the error by as little. ``name -> value held``: the start
+    A parameter of kind ``sharp`` on its lower bound (the law's sharp limit: a guide that switches within a row)
+    passes when the bound and a decade above it move the error by as little. ``name -> value held``: the start
     value, or the bound for a sharp limit; empty when there are none, or when ``eff`` has no ``off`` values. (A
     guide's hold where the dwells at the top were set aside moves the error by 0.003 deg of the 4.5 deg the guide's law takes
     off; where an effect does little in a sample, or nothing, its copy there moves the error by as much as the
@@ -2018,11 +2018,12 @@ def _unresolved(model: JointModel, data: Dataset, f: FitResult, eff: Effect, sha
             start = start or model.initial_values(data, base={k: v for k, v in f.params.items()
                                                               if k.split("@")[0] not in mine})
             out[nm] = float(start[base])
-        elif spec.kind == "sharp":
-            # a law at its sharp limit: on the lower bound and a decade above it the rows read as the fit does (a
-            # guide whose friction switches within a row: its slip speed on the bound, or anywhere below the
-            # slowest speed the rows kept log, where the law is a step in every row: an infinite standard error,
-            # 1.2e-3 mm/s in a 25 Hz file of bench-sharp), held on the bound as that limit
+        elif spec.kind == "sharp" and nm in f.at_bound:
+            # a law at its sharp limit: its fit on the lower bound, and the bound and a decade above it read as the
+            # fit does (a guide whose friction switches within a row), held on the bound as that limit. Only where
+            # the fit reached the bound: held wherever it is unresolved (an infinite standard error below the
+            # slowest speed the rows log), a guide's law stood in for a joint's play on a triangle of constant
+            # speed (test_diagnose_replace)
             read = []
             for v in (spec.lo, min(10.0 * spec.lo, spec.hi)):
                 vals[nm] = float(v)
