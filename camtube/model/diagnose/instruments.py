@@ -410,7 +410,12 @@ class Instruments:
 def _noise_scale(v: np.ndarray) -> float:
     """The white-noise scale of ``v`` from its row-to-row changes: ``1.4826 MAD(diff v) / sqrt(2)`` (robust to
     spikes and to the motion's steady changes)."""
-    return 1.4826 * float(np.median(np.abs(np.diff(v)))) / math.sqrt(2.0)
+    return _change_scale(np.diff(v))
+
+
+def _change_scale(d: np.ndarray) -> float:
+    """The white-noise scale of a signal from its row-to-row changes ``d``: ``1.4826 median |d| / sqrt(2)``."""
+    return 1.4826 * float(np.median(np.abs(d))) / math.sqrt(2.0)
 
 
 def _spikes(x: np.ndarray, slices: list) -> np.ndarray:
@@ -723,7 +728,7 @@ def _force_ahead(force: np.ndarray, stroke: np.ndarray, t: np.ndarray, slices: l
         rest = (step[1:] == 0.0) & (step[:-1] == 0.0) & (df[1:] != 0.0)
         if rest.sum() < 20:   # no rests to read the force's noise from
             continue
-        scale = 1.4826 * float(np.median(np.abs(df[1:][rest]))) / math.sqrt(2.0)
+        scale = _change_scale(df[1:][rest])
         if scale <= 0.0:
             continue
         # row k = 1 .. n-2 of the sample: step and force change into it (index k-1) and out of it (index k)
