@@ -773,6 +773,38 @@ def test_a_long_burst_with_a_dropout_in_it_is_set_aside_whole(tube2, where):
     assert (aside & ~off).sum() <= 12, int((aside & ~off).sum())      # (a row beside a jump, at most)
 
 
+@pytest.mark.parametrize("beside", ["a repeated stamp before it", "a spike before it", "a repeated stamp after it"])
+def test_a_long_burst_beside_a_row_set_aside_is_set_aside_whole(tube2, beside):
+    # bench-heldout26's three-arm backbone at 100 Hz: a repeated time stamp one row before a 1.5 s burst of +7.9 deg on
+    # a ramp. Read across the line between its neighbours, the row set aside split the jump into two (4.1 and
+    # 2.6 deg), neither the size of the jump back (-7.8), and 146 rows 8 deg off were kept (2.5x the floor). Left
+    # out, the change across it is one jump, read over the rows it spans
+    tr = Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0)
+    rec = simulate_bench(tube2, SampleBench(tracker=tr), SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=26)
+    d = rec.data
+    rate = np.abs(np.gradient(rec.angle_true_deg))
+    rng = np.random.default_rng(26)
+    t, a = d.time_s.copy(), d.angle_deg.copy()
+    displaced = np.zeros(len(d), bool)
+    for r0 in np.sort(rng.choice(np.arange(300, len(d) - 400, 600), 5, replace=False)):
+        r0 = int(r0 + np.argmax(rate[r0:r0 + 300] > 0.1))          # on a ramp
+        r1 = r0 + int(rng.integers(100, 160))
+        a[r0:r1] += 7.9
+        displaced[r0:r1] = True
+        if beside == "a repeated stamp before it":
+            t[r0 - 1] = t[r0 - 2]
+        elif beside == "a spike before it":
+            a[r0 - 1] -= 9.0
+        else:
+            t[r1] = t[r1 - 1]
+    ins = check_instruments(Dataset(d.sample, d.cycle, t, d.stroke_mm, d.force_N, a))
+    aside = np.zeros(len(d), bool)
+    for v in ins.aside.values():
+        aside[v] = True
+    assert aside[displaced].all(), int((displaced & ~aside).sum())
+    assert (aside & ~displaced).sum() <= 10, int((aside & ~displaced).sum())   # (the rows beside, at most)
+
+
 def test_dropouts_on_ramps_without_interference_set_nothing_aside(tube2):
     # the other side of the test above: 40 runs of 0.02-0.3 s of rows missing, on ramps (the joint moves degrees
     # across a gap) and at the turns of the motion, no interference. Read row by row, a ramp's progress across a gap
