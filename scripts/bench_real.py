@@ -275,6 +275,11 @@ SHARP_KINDS = ["sharp friction", "sharp friction", "sharp friction", ("sharp fri
 HELDOUT26_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone3", "zero drift", "lag",
                    "sharp friction", ("sharp friction", "creep"), ("backbone", "sharp friction"),
                    ("toe", "lost motion"), "tracker drift"]
+#: The twenty-seventh fresh held-out batch (issue 19, after a long burst's jumps were read on the rows kept and beside
+#: the joint's own jump under a cell at its limit, and a lag the blocks disagree on was left unresolved): both
+#: backbones, guides smooth and sharp beside a toe and a three-arm backbone, a lag beside creep.
+HELDOUT27_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
+                   "lag", ("friction", "toe"), ("backbone3", "sharp friction"), ("lag", "creep"), "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -337,17 +342,21 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            "bench-heldout25": (20280521, HELDOUT25_KINDS),
            # drawn once the rows the load cell reads ahead of (or behind) the stroke, the lag regression's same angles
            # and the guide's sharp limit were settled (every batch above looked at, bench-sharp tuned on); run once
-           "bench-heldout26": (20280622, HELDOUT26_KINDS)}
+           "bench-heldout26": (20280622, HELDOUT26_KINDS),
+           # drawn once those were settled (every batch above looked at, bench-heldout26 traced); run once
+           "bench-heldout27": (20281129, HELDOUT27_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
-SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-sharp"}
+SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
+           "bench-sharp"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
 #: Batches with those, interference lasting seconds and load cells that reach their range
 #: (:func:`rougher_instruments`).
 ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21",
-           "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26"}
+           "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26",
+           "bench-heldout27"}
 
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:

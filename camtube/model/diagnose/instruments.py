@@ -403,8 +403,8 @@ class Instruments:
         else:
             out.append(f"angle lag: {lg.lag_ms:.2g} +- {lg.se_ms:.2g} ms against the load cell: none to correct"
                        if math.isfinite(lg.se_ms) else "angle lag: not resolved by these data (no minimum within "
-                       "+-250 ms, or half the blocks of cycles with their minimum more than 3 rows from the whole's): none "
-                       "corrected; give --lag-ms if it is known")
+                       "+-250 ms, or half the blocks of cycles with their minimum more than 3 rows from the "
+                       "whole's): none corrected; give --lag-ms if it is known")
         return out
 
 
@@ -537,8 +537,8 @@ def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: n
     """Rows of ``x`` (n,) displaced together for longer than a burst, up to :data:`LONG_BURST_S`: a jump
     (:func:`_steps`) and, within that time, the next jump, back by the same amount (within
     :data:`STEP_MATCH` of it). ``known`` (n,) bool: rows already set aside, left out (the change across them is one
-    change, read over the rows it spans). ``t`` (n,), optional: the rows' times, so that a change across missing rows is read over the time
-    it spans (:func:`_steps`). Interference that lasts a second displaces the angle through a ramp, so the range
+    change, read over the rows it spans). ``t`` (n,), optional: the rows' times, so that a change across missing rows
+    is read over the time it spans (:func:`_steps`). Interference that lasts a second displaces the angle through a ramp, so the range
     test of :func:`_bursts` does not see it; the jumps into it and out of it stand out at any speed of the motion.
     ``force`` (n,), optional: a jump of the angle in the row of a jump of the force is the joint's own (the
     tension switched: a guide's Coulomb friction at a reversal moves the joint 3 deg within a row), so it is neither
