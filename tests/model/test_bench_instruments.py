@@ -763,6 +763,23 @@ def test_a_burst_a_few_times_the_noise_is_paired_though_its_two_jumps_read_diffe
     assert len(aside - displaced) <= 24    # (a row beside a jump, at most)
 
 
+def _ramp_rows(rec, rng, k: int, end_margin: int = 300) -> list[int]:
+    """``k`` rows, 600 apart at least, each the first row on a ramp (the joint moving) after a random row."""
+    rate = np.abs(np.gradient(rec.angle_true_deg))
+    out = []
+    for r0 in np.sort(rng.choice(np.arange(300, len(rec.data) - end_margin, 600), k, replace=False)):
+        out.append(int(r0 + np.argmax(rate[r0:r0 + 300] > 0.1)))
+    return out
+
+
+def _aside_mask(ins, n: int) -> np.ndarray:
+    """(n,) bool: the rows the instruments' check set aside, for any reason."""
+    aside = np.zeros(n, bool)
+    for v in ins.aside.values():
+        aside[v] = True
+    return aside
+
+
 @pytest.mark.parametrize("where", ["inside", "at its start"])
 def test_a_long_burst_with_a_dropout_in_it_is_set_aside_whole(tube2, where):
     # a 0.9 s burst of +4.4 deg on a ramp at 100 Hz, the tracker lost for 0.1 s within it (the reader drops those
@@ -773,22 +790,16 @@ def test_a_long_burst_with_a_dropout_in_it_is_set_aside_whole(tube2, where):
     tr = Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0)
     rec = simulate_bench(tube2, SampleBench(tracker=tr), SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=21)
     d = rec.data
-    rate = np.abs(np.gradient(rec.angle_true_deg))
-    rng = np.random.default_rng(5)
     a = d.angle_deg.copy()
     keep = np.ones(len(d), bool)
     displaced = np.zeros(len(d), bool)
-    for r0 in np.sort(rng.choice(np.arange(300, len(d) - 300, 600), 6, replace=False)):
-        r0 = int(r0 + np.argmax(rate[r0:r0 + 300] > 0.1))          # on a ramp
+    for r0 in _ramp_rows(rec, np.random.default_rng(5), 6):
         a[r0:r0 + 90] += 4.4
         displaced[r0:r0 + 90] = True
         g0 = r0 + (40 if where == "inside" else 0)
         keep[g0:g0 + 10] = False                                     # the tracker lost: those rows dropped
     data = Dataset(d.sample, d.cycle, d.time_s, d.stroke_mm, d.force_N, a).take(keep)
-    ins = check_instruments(data)
-    aside = np.zeros(len(data), bool)
-    for v in ins.aside.values():
-        aside[v] = True
+    aside = _aside_mask(check_instruments(data), len(data))
     off = displaced[keep]
     assert aside[off].all(), int((off & ~aside).sum())
     assert (aside & ~off).sum() <= 12, int((aside & ~off).sum())      # (a row beside a jump, at most)
@@ -803,12 +814,10 @@ def test_a_long_burst_beside_a_row_set_aside_is_set_aside_whole(tube2, beside):
     tr = Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0)
     rec = simulate_bench(tube2, SampleBench(tracker=tr), SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=26)
     d = rec.data
-    rate = np.abs(np.gradient(rec.angle_true_deg))
     rng = np.random.default_rng(26)
     t, a = d.time_s.copy(), d.angle_deg.copy()
     displaced = np.zeros(len(d), bool)
-    for r0 in np.sort(rng.choice(np.arange(300, len(d) - 400, 600), 5, replace=False)):
-        r0 = int(r0 + np.argmax(rate[r0:r0 + 300] > 0.1))          # on a ramp
+    for r0 in _ramp_rows(rec, rng, 5, end_margin=400):
         r1 = r0 + int(rng.integers(100, 160))
         a[r0:r1] += 7.9
         displaced[r0:r1] = True
@@ -819,9 +828,7 @@ def test_a_long_burst_beside_a_row_set_aside_is_set_aside_whole(tube2, beside):
         else:
             t[r1] = t[r1 - 1]
     ins = check_instruments(Dataset(d.sample, d.cycle, t, d.stroke_mm, d.force_N, a))
-    aside = np.zeros(len(d), bool)
-    for v in ins.aside.values():
-        aside[v] = True
+    aside = _aside_mask(ins, len(d))
     assert aside[displaced].all(), int((displaced & ~aside).sum())
     assert (aside & ~displaced).sum() <= 10, int((aside & ~displaced).sum())   # (the rows beside, at most)
 
@@ -853,9 +860,7 @@ def test_a_long_burst_over_the_joints_own_jump_under_a_cell_at_its_limit_is_set_
     own = [float(np.abs(np.diff(rec.angle_true_deg[r - 1:r + 4])).max()) for r in stops]
     assert np.median(own) > 2.0, own             # the joint's own jump, within a few rows of a stop
     ins = check_instruments(Dataset(d.sample, d.cycle, d.time_s, d.stroke_mm, force, a))
-    aside = np.zeros(len(d), bool)
-    for why, v in ins.aside.items():
-        aside[v] = True
+    aside = _aside_mask(ins, len(d))
     assert aside[displaced].all(), int((displaced & ~aside).sum())
     burst = np.zeros(len(d), bool)
     burst[ins.aside["angle burst row"]] = True
@@ -884,9 +889,7 @@ def test_a_long_burst_that_begins_as_the_stroke_starts_under_a_cell_at_its_limit
         displaced[r:r1] = True
     assert displaced.sum() > 300 and (force[displaced] < force.max()).any()
     ins = check_instruments(Dataset(d.sample, d.cycle, d.time_s, d.stroke_mm, force, a))
-    aside = np.zeros(len(d), bool)
-    for v in ins.aside.values():
-        aside[v] = True
+    aside = _aside_mask(ins, len(d))
     assert aside[displaced].all(), int((displaced & ~aside).sum())
 
 
