@@ -14,7 +14,8 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
   puts the run's first and last rows within a row's change of the rows beside them, so it does not qualify.
   Interference lasting longer, up to :data:`LONG_BURST_S`, displaces the angle through a ramp, where the range
   test does not see it: a jump (a row-to-row change off the changes either side of it, by more than
-  :data:`SPIKE_Z` noise scales) and the next jump, back by the same amount, set aside the rows between.
+  :data:`SPIKE_Z` noise scales, read on the rows not yet set aside) and the next jump, back by the same amount,
+  set aside the rows between.
 * **A frozen tracker**: :data:`FROZEN_REPEATS` or more rows in a row repeating the angle before them exactly while
   the stroke moves (more than :data:`FROZEN_STROKE` of the sample's stroke range across the run): the tracker
   held its last value; the repeats are set aside, the first value kept unless the angle jumped to it (a tracker
@@ -54,12 +55,12 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
   is refined by a parabola through the best three shifts. A shift is of time, not of rows: a row whose trial
   shifts reach across rows set aside (a load cell at its limit sets aside a chunk of every cycle) is left out, the
   same rows for every shift; once corrected, a row whose angle a lag later was set aside is set aside too. Its
-  standard error is the spread of the same
-  estimate over blocks of
-  cycles (``sd / sqrt(blocks)``). It is a property of the instruments: it is corrected (the angle read
-  ``lag`` later) when it exceeds three standard errors and a quarter of the sampling interval, is a minimum inside
-  the range tried (+-250 ms) and lowers the regression's residual RMS by :data:`MIN_FALL` (2 %), or when the
-  user gives ``--lag-ms``, and it is never offered as an effect of the joint.
+  standard error is the spread of the same estimate over blocks of cycles (``sd / sqrt(blocks)``, each block
+  scanned 3 rows either side of the whole's lag); where half the blocks or more have their minimum at the edge of
+  that window, they do not agree on a delay and it is not resolved. It is a property of the instruments: it is
+  corrected (the angle read ``lag`` later) when it exceeds three standard errors and a quarter of the sampling
+  interval, is a minimum inside the range tried (+-250 ms) and lowers the regression's residual RMS by
+  :data:`MIN_FALL` (1 %), or when the user gives ``--lag-ms``, and it is never offered as an effect of the joint.
 """
 from __future__ import annotations
 
