@@ -893,6 +893,36 @@ def test_a_long_burst_that_begins_as_the_stroke_starts_under_a_cell_at_its_limit
     assert aside[displaced].all(), int((displaced & ~aside).sum())
 
 
+@pytest.mark.parametrize("where", ["end", "start"])
+def test_interference_the_record_ends_or_begins_in_at_rest_is_set_aside(tube2, where):
+    # bench-heldout27's three-arm backbone beside a guide: 6.7 deg for the last 68 rows of a sample, the joint at
+    # rest: one jump and no jump back, kept as the joint's own (0.2 deg RMS over the sample; nothing recommended,
+    # three effects partial at 1.8x the floor). A joint at rest under a steady tension does not jump by itself: the
+    # rows from the jump to the record's end (from its start to the jump back) are set aside, and only they
+    tr = Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0)
+    rec = simulate_bench(tube2, SampleBench(tracker=tr), SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=29)
+    d = rec.data
+    if where == "start":   # (the protocol starts with a pull: each sample's record taken from its first rest on)
+        keep = np.zeros(len(d), bool)
+        for _, sl in d.sample_slices():
+            s_ = d.stroke_mm[sl]
+            keep[sl.start + int(np.argmax((s_ == 0.0) & (np.arange(s_.size) > 100))):sl.stop] = True
+        d = d.take(keep)
+    a = d.angle_deg.copy()
+    displaced = np.zeros(len(d), bool)
+    for smp, sl in d.sample_slices():
+        rows = np.arange(sl.start, sl.stop)
+        part, rest = (rows[-70:], rows[-80:]) if where == "end" else (rows[:40], rows[:50])
+        assert np.ptp(d.stroke_mm[rest]) == 0.0            # (at rest, from a few rows before the jump)
+        a[part] += 6.7 if smp == "S1" else -5.5
+        displaced[part] = True
+    ins = check_instruments(Dataset(d.sample, d.cycle, d.time_s, d.stroke_mm, d.force_N, a))
+    aside = _aside_mask(ins, len(d))
+    assert aside[displaced].all(), int((displaced & ~aside).sum())
+    assert not (aside & ~displaced).any(), int((aside & ~displaced).sum())
+    assert sum(len(v) for v in check_instruments(d).aside.values()) == 0   # (the clean record: nothing)
+
+
 def test_dropouts_on_ramps_without_interference_set_nothing_aside(tube2):
     # the other side of the test above: 40 runs of 0.02-0.3 s of rows missing, on ramps (the joint moves degrees
     # across a gap) and at the turns of the motion, no interference. Read row by row, a ramp's progress across a gap

