@@ -549,7 +549,8 @@ def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: n
     range (``limit``) it cannot show the switch, so a jump of the angle within :data:`STEP_SIDE` rows after the
     stroke stops or starts may be the joint's own there: the displacements are read with those jumps and without
     them (``bench-sharp``: the guide let go as the stroke reached the top, the joint rose 2.7 deg with the cell at
-    its limit, inside a 5.2 deg burst, and 96 rows were kept)."""
+    its limit, inside a 5.2 deg burst, and 96 rows were kept). With the force read, a single jump at rest at a
+    sample's end or start is interference the record ends or begins in (:func:`_open_ends`)."""
     out = np.zeros(x.size, bool)
     for (_, sl), step in zip(slices, steps_s):
         v = x[sl]
