@@ -787,8 +787,7 @@ def test_a_long_burst_with_a_dropout_in_it_is_set_aside_whole(tube2, where):
     # did not pair and 79 rows stayed 4.4 deg off (bench-heldout20's lost-motion file: 1.26x the floor, partial).
     # Read over the time each change spans, the gap is the ramp's and the burst is set aside whole; a dropout that
     # opens the burst leaves its jump in, read across the gap
-    tr = Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0)
-    rec = simulate_bench(tube2, SampleBench(tracker=tr), SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=21)
+    rec = simulate_bench(tube2, SampleBench(tracker=QUIET), SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=21)
     d = rec.data
     a = d.angle_deg.copy()
     keep = np.ones(len(d), bool)
@@ -811,8 +810,7 @@ def test_a_long_burst_beside_a_row_set_aside_is_set_aside_whole(tube2, beside):
     # a ramp. Read across the line between its neighbours, the row set aside split the jump into two (4.1 and
     # 2.6 deg), neither the size of the jump back (-7.8), and 146 rows 8 deg off were kept (2.5x the floor). Left
     # out, the change across it is one jump, read over the rows it spans
-    tr = Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0)
-    rec = simulate_bench(tube2, SampleBench(tracker=tr), SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=26)
+    rec = simulate_bench(tube2, SampleBench(tracker=QUIET), SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=26)
     d = rec.data
     rng = np.random.default_rng(26)
     t, a = d.time_s.copy(), d.angle_deg.copy()
@@ -839,7 +837,7 @@ def test_a_long_burst_over_the_joints_own_jump_under_a_cell_at_its_limit_is_set_
     # a 5 deg burst as a third jump and the burst's two did not pair (bench-sharp's 100 Hz file: 96 rows 5 deg off
     # kept). Within a few rows of the stroke stopping or starting, where the cell reads its limit, the jump is the
     # joint's; the bursts are set aside whole and nothing else is
-    b = SampleBench(guide=Guide(mu=0.15, slip_mm_s=1e-6), tracker=Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0))
+    b = SampleBench(guide=Guide(mu=0.15, slip_mm_s=1e-6), tracker=QUIET)
     rec = simulate_bench(tube2, b, SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=27)
     d = rec.data
     force = np.minimum(d.force_N, 0.8 * float(d.force_N.max()))
@@ -871,7 +869,7 @@ def test_a_long_burst_that_begins_as_the_stroke_starts_under_a_cell_at_its_limit
     # the other side of the test above: no guide to switch, interference that begins in the row the stroke starts
     # back from the top, the cell still at its limit. Its jump in is not the joint's; read without it the burst's
     # rows below the limit were kept (4 rows 7.8 deg off in bench-heldout25's control)
-    b = SampleBench(tracker=Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0))
+    b = SampleBench(tracker=QUIET)
     rec = simulate_bench(tube2, b, SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=28)
     d = rec.data
     force = np.minimum(d.force_N, 0.8 * float(d.force_N.max()))
@@ -899,8 +897,7 @@ def test_interference_the_record_ends_or_begins_in_at_rest_is_set_aside(tube2, w
     # rest: one jump and no jump back, kept as the joint's own (0.2 deg RMS over the sample; nothing recommended,
     # three effects partial at 1.8x the floor). A joint at rest under a steady tension does not jump by itself: the
     # rows from the jump to the record's end (from its start to the jump back) are set aside, and only they
-    tr = Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0)
-    rec = simulate_bench(tube2, SampleBench(tracker=tr), SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=29)
+    rec = simulate_bench(tube2, SampleBench(tracker=QUIET), SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=29)
     d = rec.data
     if where == "start":   # (the protocol starts with a pull: each sample's record taken from its first rest on)
         keep = np.zeros(len(d), bool)
@@ -929,8 +926,7 @@ def test_dropouts_on_ramps_without_interference_set_nothing_aside(tube2):
     # was a jump, and two gaps paired into a burst: 151 real rows set aside here (265 with gaps up to 0.15 s, 799 with
     # 0.16-0.3 s). Read over the time each change spans, none. (Gaps of 0.3-0.5 s on a ramp still read as jumps: 142
     # rows in 40 such gaps; the rate either side no longer tells the motion across them)
-    tr = Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0)
-    rec = simulate_bench(tube2, SampleBench(tracker=tr), SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=22)
+    rec = simulate_bench(tube2, SampleBench(tracker=QUIET), SHORT, Clock(rate_hz=100.0, n_repeats=0), seed=22)
     d = rec.data
     rng = np.random.default_rng(9)
     keep = np.ones(len(d), bool)
