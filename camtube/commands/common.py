@@ -29,6 +29,29 @@ def path_value(value: str) -> str:
     return value
 
 
+def lag_value(value: str) -> float | dict[str, float]:
+    """argparse ``type`` of ``--lag-ms``: one lag for every sample (``20``) or one per sample (``S1=76,S2=0``)."""
+    text = value.strip()
+    if "=" not in text:
+        try:
+            return float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{value!r} is not a number of ms: give e.g. 20, or S1=76,S2=0 for "
+                                             "one lag per sample") from None
+    out: dict[str, float] = {}
+    for part in text.split(","):
+        smp, eq, ms = part.partition("=")
+        smp = smp.strip()
+        try:
+            out[smp] = float(ms)
+        except ValueError:
+            smp = ""
+        if not eq or not smp:
+            raise argparse.ArgumentTypeError(f"{part.strip()!r} in {value!r} is not SAMPLE=MS: give e.g. S1=76,S2=0 "
+                                             "(one lag per sample), or one number for all") from None
+    return out
+
+
 def add_pattern_argument(parser: argparse.ArgumentParser) -> None:
     """Add ``PATTERN``, repeatable ``--set KEY=VALUE``, ``-q`` and the drawing options to a sub-command."""
     parser.add_argument("pattern", type=path_value, metavar="PATTERN",

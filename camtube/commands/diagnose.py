@@ -10,7 +10,7 @@ import dataclasses
 import shlex
 from pathlib import Path
 
-from camtube.commands.common import path_value
+from camtube.commands.common import lag_value, path_value
 
 
 def register(model_sub) -> None:
@@ -62,9 +62,10 @@ def register(model_sub) -> None:
     d.add_argument("--strict", action="store_true",
                    help="refuse rows with a missing value (nan, empty) or a time stamp that goes backwards, naming "
                         "the file and line (default: drop them and say how many)")
-    d.add_argument("--lag-ms", type=float, default=None, metavar="MS",
-                   help="lag of the angle channel behind stroke and force (ms) to correct (default: estimated "
-                        "from the data and corrected when resolved; 0 = none)")
+    d.add_argument("--lag-ms", type=lag_value, default=None, metavar="MS",
+                   help="lag of the angle channel behind stroke and force (ms) to correct, or one per sample "
+                        "(S1=76,S2=0) (default: estimated from the data, per sample where the samples differ, and "
+                        "corrected when resolved; 0 = none)")
     d.add_argument("--no-rezero", dest="rezero", action="store_false",
                    help="keep the force as read where the load cell's zero drifts (default: re-zero it at every rest, "
                         "motor at zero and tendon slack, when the rests show a smooth drift from a zeroed cell)")
@@ -96,9 +97,9 @@ def fit_command_prefix(args: argparse.Namespace, instruments=None) -> str:
     for o in args.overrides:
         parts += ["--set", o]
     parts += ["--cycles", args.cycles, "--branch", "both", "--no-deadband"]
-    if instruments is not None and (instruments.n_aside or instruments.n_dropped or instruments.lag.applied_ms
+    if instruments is not None and (instruments.n_aside or instruments.n_dropped or instruments.lag.corrected
                                     or instruments.rezeroed):
-        parts += ["--set-aside", "--lag-ms", f"{instruments.lag.applied_ms:.6g}"]
+        parts += ["--set-aside", "--lag-ms", instruments.lag.as_option()]
         if instruments.rezeroed:
             parts += ["--rezero"]
     for f in args.effect_file:

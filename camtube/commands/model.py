@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 import importlib
 
-from camtube.commands.common import no_subcommand, path_value
+from camtube.commands.common import lag_value, no_subcommand, path_value
 from camtube.errors import CamtubeError
 from camtube.model import EFFECT_NAMES
 
@@ -65,8 +65,9 @@ def register(sub) -> None:
     f.add_argument("--set-aside", action="store_true",
                    help="read the file as model diagnose does: drop rows with a missing value or a backward time "
                         "stamp, set aside spikes and repeated stamps, and correct the angle's lag (--lag-ms)")
-    f.add_argument("--lag-ms", type=float, default=0.0, metavar="MS",
-                   help="with --set-aside: lag of the angle channel to correct (ms; default 0)")
+    f.add_argument("--lag-ms", type=lag_value, default=0.0, metavar="MS",
+                   help="with --set-aside: lag of the angle channel to correct (ms; default 0), or one per sample "
+                        "(S1=76,S2=0)")
     f.add_argument("--rezero", action="store_true",
                    help="with --set-aside: re-zero the force at every rest where the load cell's zero drifts, as "
                         "model diagnose does")

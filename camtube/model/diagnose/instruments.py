@@ -64,9 +64,10 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
 """
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field, replace
-from typing import Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 
@@ -142,6 +143,10 @@ class Lag:
     model_rmse_deg : tuple
         ``(without, with)``: the current model's RMSE without the lag and with the lag applied, when the model
         confirmed a lag the regression resolved but did not lower enough (:func:`confirm_lag`); else empty.
+    per_sample : tuple
+        ``(sample, lag_ms, se_ms, fall, applied_ms)`` for each sample when the samples' lags differ
+        (:func:`estimate_lags`: two tubes logged in two sessions, each with its own alignment of the tracker's
+        clock), each corrected on its own; empty when one lag serves every sample (``lag_ms``, ``applied_ms``).
     """
 
     lag_ms: float
@@ -150,6 +155,25 @@ class Lag:
     applied_ms: float = 0.0
     fall: float = 0.0
     model_rmse_deg: tuple = ()
+    per_sample: tuple = ()
+
+    def applied_for(self, sample: str) -> float:
+        """The lag corrected in ``sample`` (ms): its own where the samples' lags differ, else :attr:`applied_ms`."""
+        for smp, _, _, _, applied in self.per_sample:
+            if smp == sample:
+                return applied
+        return self.applied_ms
+
+    @property
+    def corrected(self) -> bool:
+        """A lag was corrected in some sample."""
+        return bool(self.applied_ms) or any(p[4] for p in self.per_sample)
+
+    def as_option(self) -> str:
+        """The correction as ``--lag-ms`` takes it: ``20`` for every sample, ``S1=76,S2=0`` one per sample."""
+        if self.per_sample:
+            return ",".join(f"{smp}={applied:.6g}" for smp, _, _, _, applied in self.per_sample)
+        return f"{self.applied_ms:.6g}"
 
 
 #: The load cell's zero, read at the rests: a drift is corrected when it exceeds this many standard errors ...
@@ -388,7 +412,9 @@ class Instruments:
         out.extend(self.rate_changes)
         out.extend(zero_lines(self.zeros, self.rezero))
         lg = self.lag
-        if lg.given:
+        if lg.per_sample:
+            out.append(_per_sample_lag_line(lg))
+        elif lg.given:
             out.append(f"angle lag: {lg.lag_ms:.4g} ms as given (--lag-ms); the angle is read {lg.applied_ms:.4g} ms "
                        "later (whole rows)")
         elif lg.applied_ms and lg.model_rmse_deg:
@@ -407,6 +433,20 @@ class Instruments:
                        "+-250 ms, or half the blocks of cycles with their minimum more than 3 rows from the "
                        "whole's): none corrected; give --lag-ms if it is known")
         return out
+
+
+def _per_sample_lag_line(lg: Lag) -> str:
+    """The findings' line on a lag that differs between the samples (each corrected on its own)."""
+    if lg.given:
+        return ("angle lag, per sample as given (--lag-ms): "
+                + ", ".join(f"{smp} read {applied:.4g} ms later" for smp, _, _, _, applied in lg.per_sample)
+                + " (whole rows)")
+    each = "; ".join(f"{smp} {ms:.3g} +- {se:.2g} ms" + (f", corrected: read {applied:.3g} ms later" if applied
+                                                          else ", none to correct")
+                     for smp, ms, se, _, applied in lg.per_sample)
+    return (f"angle lag: differs between the samples ({each}; one lag over both reads {lg.lag_ms:.2g} ms): an "
+            "instrument property, not the joint's (each sample's tracker clock aligned to the load cell's on its "
+            f"own); --lag-ms {lg.as_option()} gives the same, --lag-ms 0 keeps the angle as logged")
 
 
 def _noise_scale(v: np.ndarray) -> float:
@@ -977,32 +1017,73 @@ def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_
     return Lag(est * dt * 1e3, se * dt * 1e3, fall=fall)
 
 
-def shift_angle(data: Dataset, lag_ms: float) -> tuple[Dataset, np.ndarray, float, np.ndarray]:
+#: The samples' lags differ (each is then corrected on its own) when two of them are further apart than this many
+#: standard errors of their difference ...
+LAG_SPLIT_Z = 4.0
+#: ... and than this many rows: a difference the whole rows of a correction barely show is no difference. (And one
+#: sample's own lag at least must be corrected, :func:`check_instruments`: a split that corrects nothing says nothing.)
+LAG_SPLIT_ROWS = 1.0
+
+
+def estimate_lags(data: Dataset) -> Lag:
+    """The angle's lag (:func:`estimate_lag`) over every sample, and per sample where the samples differ.
+
+    Two tubes are often logged in two sessions, each with its own alignment of the tracker's clock to the load
+    cell's, so their lags need not agree: one lag over both reads neither (76 ms in one sample beside none in the
+    other read as 8 ms, ``bench-heldout27``). Each sample's lag is estimated on its own rows; when every one is
+    resolved and two differ by more than :data:`LAG_SPLIT_Z` standard errors of their difference and
+    :data:`LAG_SPLIT_ROWS` rows, the result holds each (:attr:`Lag.per_sample`, none applied yet)."""
+    pooled = estimate_lag(data)
+    samples = list(data.samples)
+    if len(samples) < 2:
+        return pooled
+    sample = np.asarray(data.sample)
+    own = {}
+    for smp in samples:
+        sub = data.take(sample == smp)
+        if len(sub) < 200:
+            return pooled
+        own[smp] = (estimate_lag(sub), float(np.median(np.diff(sub.time_s))) * 1e3)
+    if not all(math.isfinite(lg.se_ms) for lg, _ in own.values()):
+        return pooled
+    differ = any(abs(a.lag_ms - b.lag_ms) > LAG_SPLIT_Z * math.hypot(a.se_ms, b.se_ms)
+                 and abs(a.lag_ms - b.lag_ms) > LAG_SPLIT_ROWS * max(ha, hb)
+                 for (a, ha), (b, hb) in itertools.combinations(own.values(), 2))
+    if not differ:
+        return pooled
+    return replace(pooled, per_sample=tuple((smp, lg.lag_ms, lg.se_ms, lg.fall, 0.0) for smp, (lg, _) in own.items()))
+
+
+def shift_angle(data: Dataset, lag_ms: float | Mapping[str, float]) -> tuple[Dataset, np.ndarray, float, np.ndarray]:
     """``data`` with the angle read ``lag_ms`` later, by whole rows of each sample (interpolating between rows
     would average the tracker's noise and hide it from the noise floor); a row whose later angle is past the
-    record, or not that many rows of time later (across rows set aside), is dropped.
+    record, or not that many rows of time later (across rows set aside), is dropped. ``lag_ms`` is one lag for
+    every sample or ``{sample: lag_ms}`` (a sample not named: none).
 
     Returns
     -------
     data : Dataset
     kept : (n,) bool
         Rows of the input kept.
-    applied_ms : float
-        The shift applied: whole rows times the median sampling interval (within half a row of ``lag_ms``).
+    applied_ms : float or dict
+        The shift applied: whole rows times the median sampling interval (within half a row of ``lag_ms``); the
+        mean over the samples, or ``{sample: shift}`` when ``lag_ms`` is given per sample.
     past_end : (n,) bool
         Rows dropped because their later angle is past the record (the others dropped: across a gap).
     """
-    if lag_ms == 0.0:
+    each = isinstance(lag_ms, Mapping)
+    if not each and lag_ms == 0.0:
         return data, np.ones(len(data), bool), 0.0, np.zeros(len(data), bool)
     ang = data.angle_deg.copy()
     keep = np.ones(len(data), bool)
     past_end = np.zeros(len(data), bool)
-    applied = []
-    for _, sl in data.sample_slices():
+    applied = {}
+    for smp, sl in data.sample_slices():
         t = data.time_s[sl]
         dt = float(np.median(np.diff(t))) if t.size > 1 else 0.0
-        k = int(round(lag_ms * 1e-3 / dt)) if dt > 0 else 0
-        applied.append(k * dt * 1e3)
+        ms = float(lag_ms.get(smp, 0.0)) if each else lag_ms
+        k = int(round(ms * 1e-3 / dt)) if dt > 0 else 0
+        applied[smp] = k * dt * 1e3
         if k == 0:
             continue
         idx = np.arange(sl.start, sl.stop)
@@ -1011,18 +1092,21 @@ def shift_angle(data: Dataset, lag_ms: float) -> tuple[Dataset, np.ndarray, floa
         past_end[idx] = (idx + k < sl.start) | (idx + k >= sl.stop)
         # the angle k rows later must be k rows of time later: not past the record, nor across rows set aside
         keep[idx] = ~past_end[idx] & (np.abs(data.time_s[src] - t - k * dt) < 0.5 * dt)
-    return data.with_angle(ang).take(keep), keep, float(np.mean(applied)), past_end
+    out = applied if each else float(np.mean(list(applied.values())))
+    return data.with_angle(ang).take(keep), keep, out, past_end
 
-def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str = "", n_dropped: int = 0,
-                      rezero: bool = True) -> Instruments:
+def check_instruments(data: Dataset, lag_ms: float | Mapping[str, float] | None = None, dropped: str = "",
+                      n_dropped: int = 0, rezero: bool = True) -> Instruments:
     """Find the instruments' artefacts, set them aside, estimate (or apply) the angle's lag.
 
     Parameters
     ----------
     data : Dataset
         The rows as read (``n`` rows).
-    lag_ms : float, optional
-        The angle channel's lag (ms) to correct; ``None``: estimate it and correct it when it is resolved.
+    lag_ms : float or dict, optional
+        The angle channel's lag (ms) to correct, one for every sample or ``{sample: lag_ms}`` (a sample not named:
+        none); ``None``: estimate it (per sample where the samples differ, :func:`estimate_lags`) and correct it
+        where it is resolved.
     dropped, n_dropped : str, int
         The reader's line on dropped rows and their count (stated in the findings).
     rezero : bool
@@ -1032,14 +1116,21 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     -------
     Instruments
     """
-    if lag_ms is not None and not math.isfinite(lag_ms):
-        raise DataError(f"--lag-ms {lag_ms}: the angle channel's lag must be a finite number of ms; fix: give e.g. "
-                        "--lag-ms 20, or 0 for none")
-    if lag_ms is not None and abs(lag_ms) > MAX_GIVEN_LAG_MS:
-        raise DataError(f"--lag-ms {lag_ms:g}: a lag of more than {MAX_GIVEN_LAG_MS:g} ms between the tracker and the "
-                        "load cell is not an instrument's delay but clocks that were not aligned; fix: give the "
-                        "tracker's delay in ms (e.g. --lag-ms 20, 0 for none), and align the logs' clocks first "
-                        "(camtube model ingest)")
+    given = {} if lag_ms is None else dict(lag_ms) if isinstance(lag_ms, Mapping) else {"": lag_ms}
+    for smp, ms in given.items():
+        what = f"--lag-ms {smp}={ms:g}" if smp else f"--lag-ms {ms:g}"
+        if not math.isfinite(ms):
+            raise DataError(f"{what}: the angle channel's lag must be a finite number of ms; fix: give e.g. "
+                            "--lag-ms 20, or 0 for none")
+        if abs(ms) > MAX_GIVEN_LAG_MS:
+            raise DataError(f"{what}: a lag of more than {MAX_GIVEN_LAG_MS:g} ms between the tracker and the "
+                            "load cell is not an instrument's delay but clocks that were not aligned; fix: give the "
+                            "tracker's delay in ms (e.g. --lag-ms 20, 0 for none), and align the logs' clocks first "
+                            "(camtube model ingest)")
+    unknown = sorted(smp for smp in given if smp and smp not in set(data.samples))
+    if unknown:
+        raise DataError(f"--lag-ms {unknown[0]}=...: no sample {unknown[0]!r} in the data (samples: "
+                        f"{', '.join(map(str, data.samples))}); fix: name a sample of the file, or give one lag for all")
     slices = data.sample_slices()
     aside: dict[str, np.ndarray] = {}
     rep = np.zeros(len(data), bool)
@@ -1084,17 +1175,34 @@ def check_instruments(data: Dataset, lag_ms: float | None = None, dropped: str =
     zeros = read_zero(clean)
     if rezero:
         clean, zeros = rezero_force(clean, zeros)
-    if lag_ms is not None:
+    if isinstance(lag_ms, Mapping):   # one per sample, as given (whole rows below)
+        per = tuple((smp, float(lag_ms.get(smp, 0.0)), 0.0, 0.0, float(lag_ms.get(smp, 0.0))) for smp in data.samples)
+        lag = Lag(0.0, 0.0, given=True, per_sample=per)
+    elif lag_ms is not None:
         lag = Lag(float(lag_ms), 0.0, given=True, applied_ms=float(lag_ms))  # whole rows below
     else:
         with one_blas_thread():   # speed: the lag scan's regressions are tall and thin (camtube.model.core.threads)
-            lag = estimate_lag(clean)
-        dt_ms = 1e3 / max(np.median(list(rates.values())) if rates else 1.0, 1e-9)
-        if abs(lag.lag_ms) > 3.0 * lag.se_ms and abs(lag.lag_ms) > 0.25 * dt_ms and lag.fall >= MIN_FALL:
+            lag = estimate_lags(clean)
+
+        def resolved(ms: float, se: float, fall: float, smp: str | None = None) -> bool:
+            hz = rates.get(smp) if smp is not None else None
+            hz = hz or (np.median(list(rates.values())) if rates else 1.0)
+            return abs(ms) > 3.0 * se and abs(ms) > 0.25 * 1e3 / max(hz, 1e-9) and fall >= MIN_FALL
+
+        if lag.per_sample:
+            lag = replace(lag, per_sample=tuple((smp, ms, se, fall, ms if resolved(ms, se, fall, smp) else 0.0)
+                                                for smp, ms, se, fall, _ in lag.per_sample))
+            if not lag.corrected:   # the samples differ, but neither's own lag is resolved: one lag over both
+                lag = replace(lag, per_sample=())
+        if not lag.per_sample and resolved(lag.lag_ms, lag.se_ms, lag.fall):
             lag = Lag(lag.lag_ms, lag.se_ms, applied_ms=lag.lag_ms, fall=lag.fall)
-    shifted, k2, applied, ends = shift_angle(clean, lag.applied_ms)
-    if lag.applied_ms:
-        lag = Lag(lag.lag_ms, lag.se_ms, lag.given, applied, lag.fall)
+    if lag.per_sample:
+        shifted, k2, applied, ends = shift_angle(clean, {p[0]: p[4] for p in lag.per_sample})
+        lag = replace(lag, per_sample=tuple(p[:4] + (applied.get(p[0], 0.0),) for p in lag.per_sample))
+    else:
+        shifted, k2, applied, ends = shift_angle(clean, lag.applied_ms)
+        if lag.applied_ms:
+            lag = Lag(lag.lag_ms, lag.se_ms, lag.given, applied, lag.fall)
     idx = np.flatnonzero(kept)
     kept[idx[~k2]] = False
     # a row whose angle a lag later is past the record's end, or across rows set aside (no reading there)
@@ -1136,13 +1244,12 @@ def with_aside(ins: Instruments, predicted_deg: np.ndarray, floor_deg: float) ->
     extra = 0.0
     aside = np.flatnonzero(~ins.kept)
     raw = ins.raw
-    lag_s = ins.lag.applied_ms * 1e-3
     counted = 0
     for smp, sl in clean.sample_slices():
         a = aside[raw.sample[aside] == smp]
         if not a.size:
             continue
-        t = raw.time_s[a] - lag_s
+        t = raw.time_s[a] - ins.lag.applied_for(smp) * 1e-3
         inside = (t >= clean.time_s[sl][0]) & (t <= clean.time_s[sl][-1])
         r = raw.angle_deg[a][inside] - np.interp(t[inside], clean.time_s[sl], predicted_deg[sl])
         extra += float(r @ r)
@@ -1185,7 +1292,7 @@ def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Ins
     from camtube.model.core.noise import white_noise_sd
 
     lg = ins.lag
-    if lg.given or lg.applied_ms or not math.isfinite(lg.se_ms) or not ins.rates_hz:
+    if lg.given or lg.corrected or lg.per_sample or not math.isfinite(lg.se_ms) or not ins.rates_hz:
         return ins
     dt_ms = 1e3 / float(np.median(list(ins.rates_hz.values())))
     if not (abs(lg.lag_ms) > 3.0 * lg.se_ms and abs(lg.lag_ms) > 0.25 * dt_ms):

@@ -175,6 +175,8 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
             "rates_hz": {k: _num(v) for k, v in ins.rates_hz.items()}, "rate_changes": list(ins.rate_changes),
             "lag_ms": _num(ins.lag.lag_ms), "lag_se_ms": _num(ins.lag.se_ms), "lag_given": bool(ins.lag.given),
             "lag_applied_ms": _num(ins.lag.applied_ms),
+            "lag_per_sample": {smp: {"lag_ms": _num(ms), "se_ms": _num(se), "applied_ms": _num(applied)}
+                               for smp, ms, se, _, applied in ins.lag.per_sample},
             "load_cell_zero": {smp: {"rests": z.n_rests, "start_N": _num(z.start_N), "end_N": _num(z.end_N),
                                      "change_N": _num(z.change_N), "change_se_N": _num(z.se_N),
                                      "scatter_N": _num(z.scatter_N), "rezeroed": bool(z.applied)}
@@ -569,7 +571,9 @@ def artefacts_png(d: Diagnosis, max_samples: int = 4) -> bytes | None:
     axes[-1].set_xlabel("time (s)")
     lag = ins.lag
     axes[0].set_title(f"rows read {len(raw)}; set aside {ins.n_aside}; dropped before (missing values, backward "
-                      f"stamps) {ins.n_dropped}; angle lag corrected {lag.applied_ms:.3g} ms", fontsize=9)
+                      f"stamps) {ins.n_dropped}; angle lag corrected "
+                      + (", ".join(f"{smp} {a:.3g} ms" for smp, _, _, _, a in lag.per_sample) if lag.per_sample
+                         else f"{lag.applied_ms:.3g} ms"), fontsize=9)
     fig.tight_layout()
     return _png(fig)
 
