@@ -61,6 +61,9 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
   corrected (the angle read ``lag`` later) when it exceeds three standard errors and a quarter of the sampling
   interval, is a minimum inside the range tried (+-250 ms) and lowers the regression's residual RMS by
   :data:`MIN_FALL` (1 %), or when the user gives ``--lag-ms``, and it is never offered as an effect of the joint.
+  Each sample's lag is also read on its own rows (two tubes logged in two sessions, each tracker's clock aligned on
+  its own); where the samples differ by far more than their errors (:func:`estimate_lags`), each is corrected by
+  its own (``--lag-ms S1=76,S2=0``).
 """
 from __future__ import annotations
 
@@ -444,7 +447,7 @@ def _per_sample_lag_line(lg: Lag) -> str:
     each = "; ".join(f"{smp} {ms:.3g} +- {se:.2g} ms" + (f", corrected: read {applied:.3g} ms later" if applied
                                                           else ", none to correct")
                      for smp, ms, se, _, applied in lg.per_sample)
-    return (f"angle lag: differs between the samples ({each}; one lag over both reads {lg.lag_ms:.2g} ms): an "
+    return (f"angle lag: differs between the samples ({each}; one lag over all of them reads {lg.lag_ms:.2g} ms): an "
             "instrument property, not the joint's (each sample's tracker clock aligned to the load cell's on its "
             f"own); --lag-ms {lg.as_option()} gives the same, --lag-ms 0 keeps the angle as logged")
 
