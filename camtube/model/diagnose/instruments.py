@@ -150,6 +150,11 @@ class Lag:
         ``(sample, lag_ms, se_ms, fall, applied_ms)`` for each sample when the samples' lags differ
         (:func:`estimate_lags`: two tubes logged in two sessions, each with its own alignment of the tracker's
         clock), each corrected on its own; empty when one lag serves every sample (``lag_ms``, ``applied_ms``).
+        With them, ``model_rmse_deg`` is ``((sample, without, with), ...)`` for the samples whose lag the current
+        model confirmed (:func:`confirm_lag`).
+    own : tuple
+        ``(sample, lag_ms, se_ms, fall)``: each sample's lag estimated on its own rows (several samples, each
+        resolved; else empty).
     """
 
     lag_ms: float
@@ -159,6 +164,7 @@ class Lag:
     fall: float = 0.0
     model_rmse_deg: tuple = ()
     per_sample: tuple = ()
+    own: tuple = ()
 
     def applied_for(self, sample: str) -> float:
         """The lag corrected in ``sample`` (ms): its own where the samples' lags differ, else :attr:`applied_ms`."""
@@ -444,8 +450,11 @@ def _per_sample_lag_line(lg: Lag) -> str:
         return ("angle lag, per sample as given (--lag-ms): "
                 + ", ".join(f"{smp} read {applied:.4g} ms later" for smp, _, _, _, applied in lg.per_sample)
                 + " (whole rows)")
+    by_model = {smp: (a, b) for smp, a, b in lg.model_rmse_deg}
     each = "; ".join(f"{smp} {ms:.3g} +- {se:.2g} ms" + (f", corrected: read {applied:.3g} ms later" if applied
                                                           else ", none to correct")
+                     + (f" (the current model's RMSE in {smp} falls from {by_model[smp][0]:.3f} to "
+                        f"{by_model[smp][1]:.3f} deg with it)" if smp in by_model else "")
                      for smp, ms, se, _, applied in lg.per_sample)
     return (f"angle lag: differs between the samples ({each}; one lag over all of them reads {lg.lag_ms:.2g} ms): an "
             "instrument property, not the joint's (each sample's tracker clock aligned to the load cell's on its "
@@ -1026,6 +1035,9 @@ def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_
 #: in one file, 33 +- 6.9 beside -0.5 +- 1.5 in another, 7.7 and 4.8 standard errors apart; a tracker 76 ms late
 #: beside one on time read 71 +- 2.8 and -15 +- 2.8, 22 apart: bench-heldout27) ...
 LAG_SPLIT_Z = 10.0
+#: Closer than that, but more than this many standard errors apart, the current model decides (:func:`confirm_lag`):
+#: a sample's own lag is corrected where the model fitted to that sample's rows confirms it.
+LAG_SPLIT_MODEL_Z = 4.0
 #: ... and than this many rows: a difference the whole rows of a correction barely show is no difference. (And one
 #: sample's own lag at least must be corrected, :func:`check_instruments`: a split that corrects nothing says nothing.)
 LAG_SPLIT_ROWS = 1.0
@@ -1052,12 +1064,18 @@ def estimate_lags(data: Dataset) -> Lag:
         own[smp] = (estimate_lag(sub), float(np.median(np.diff(sub.time_s))) * 1e3)
     if not all(math.isfinite(lg.se_ms) for lg, _ in own.values()):
         return pooled
-    differ = any(abs(a.lag_ms - b.lag_ms) > LAG_SPLIT_Z * math.hypot(a.se_ms, b.se_ms)
-                 and abs(a.lag_ms - b.lag_ms) > LAG_SPLIT_ROWS * max(ha, hb)
-                 for (a, ha), (b, hb) in itertools.combinations(own.values(), 2))
-    if not differ:
+    pooled = replace(pooled, own=tuple((smp, lg.lag_ms, lg.se_ms, lg.fall) for smp, (lg, _) in own.items()))
+    if not _lags_differ(own.values(), LAG_SPLIT_Z):
         return pooled
     return replace(pooled, per_sample=tuple((smp, lg.lag_ms, lg.se_ms, lg.fall, 0.0) for smp, (lg, _) in own.items()))
+
+
+def _lags_differ(own, z: float) -> bool:
+    """Two of ``own`` (``(Lag, row_ms)`` each) further apart than ``z`` standard errors of their difference and
+    :data:`LAG_SPLIT_ROWS` rows."""
+    return any(abs(a.lag_ms - b.lag_ms) > z * math.hypot(a.se_ms, b.se_ms)
+               and abs(a.lag_ms - b.lag_ms) > LAG_SPLIT_ROWS * max(ha, hb)
+               for (a, ha), (b, hb) in itertools.combinations(own, 2))
 
 
 def shift_angle(data: Dataset, lag_ms: float | Mapping[str, float]) -> tuple[Dataset, np.ndarray, float, np.ndarray]:
@@ -1201,14 +1219,14 @@ def check_instruments(data: Dataset, lag_ms: float | Mapping[str, float] | None 
             if not lag.corrected:   # the samples differ, but neither's own lag is resolved: one lag over both
                 lag = replace(lag, per_sample=())
         if not lag.per_sample and resolved(lag.lag_ms, lag.se_ms, lag.fall):
-            lag = Lag(lag.lag_ms, lag.se_ms, applied_ms=lag.lag_ms, fall=lag.fall)
+            lag = replace(lag, applied_ms=lag.lag_ms)
     if lag.per_sample:
         shifted, k2, applied, ends = shift_angle(clean, {p[0]: p[4] for p in lag.per_sample})
         lag = replace(lag, per_sample=tuple(p[:4] + (applied.get(p[0], 0.0),) for p in lag.per_sample))
     else:
         shifted, k2, applied, ends = shift_angle(clean, lag.applied_ms)
         if lag.applied_ms:
-            lag = Lag(lag.lag_ms, lag.se_ms, lag.given, applied, lag.fall)
+            lag = replace(lag, applied_ms=applied)
     idx = np.flatnonzero(kept)
     kept[idx[~k2]] = False
     # a row whose angle a lag later is past the record's end, or across rows set aside (no reading there)
@@ -1282,6 +1300,61 @@ def lag_misfit_deg(data: Dataset, lag_ms: float) -> float:
     return out
 
 
+def _model_lag(model, data: Dataset, fixed: dict, fit_names, lag_ms: float, dt_ms: float) -> tuple | None:
+    """``(RMSE without, RMSE with, lag applied ms)`` when the current model fitted to ``data`` confirms the lag
+    ``lag_ms`` (see :func:`confirm_lag`), else None."""
+    from camtube.model.core.fit import FitError, fit
+    from camtube.model.core.noise import white_noise_sd
+
+    try:
+        r0 = fit(model, data, list(fit_names), fixed)
+        noise = min(white_noise_sd(r0.residuals[sl]) for _, sl in data.sample_slices())
+        own = lag_misfit_deg(data, lag_ms)
+        if not (noise > 0.0 and r0.rmse <= MODEL_LAG_MAX_RATIO * math.hypot(noise, own)):
+            return None
+        k0 = int(round(lag_ms / dt_ms))
+        sign = 1 if lag_ms > 0 else -1
+        best = (r0.rmse, 0.0)
+        for k in sorted({k0 - sign, k0, k0 + sign}):
+            if k == 0 or (k > 0) != (lag_ms > 0):
+                continue
+            shifted = shift_angle(data, k * dt_ms)[0]
+            rk = fit(model, shifted, list(fit_names), fixed).rmse
+            if rk < best[0]:
+                best = (rk, k * dt_ms)
+    except FitError:
+        return None
+    if not best[1] or best[0] > (1.0 - MODEL_LAG_FALL) * r0.rmse:
+        return None
+    return r0.rmse, best[0], best[1]
+
+
+def _confirm_per_sample(ins: Instruments, model, fixed: dict, fit_names) -> Instruments | None:
+    """The instruments' check with each sample's own lag that the current model confirms on that sample's rows
+    corrected (:func:`confirm_lag`), where the samples' own lags differ by more than :data:`LAG_SPLIT_MODEL_Z`
+    standard errors; None when none is confirmed."""
+    lg = ins.lag
+    rows_ms = {smp: 1e3 / hz for smp, hz in ins.rates_hz.items() if hz > 0}
+    if len(lg.own) < 2 or not all(smp in rows_ms for smp, *_ in lg.own) or not _lags_differ(
+            [(Lag(ms, se), rows_ms[smp]) for smp, ms, se, _ in lg.own], LAG_SPLIT_MODEL_Z):
+        return None
+    sample = np.asarray(ins.data.sample)
+    confirmed, rmse = {}, []
+    for smp, ms, se, _ in lg.own:
+        if not (abs(ms) > 3.0 * se and abs(ms) > 0.25 * rows_ms[smp]):
+            continue
+        got = _model_lag(model, ins.data.take(sample == smp), fixed, fit_names, ms, rows_ms[smp])
+        if got is not None:
+            confirmed[smp] = got[2]
+            rmse.append((smp, got[0], got[1]))
+    if not confirmed:
+        return None
+    new = check_instruments(ins.raw, lag_ms={smp: confirmed.get(smp, 0.0) for smp, *_ in lg.own},
+                            dropped=ins.dropped, n_dropped=ins.n_dropped, rezero=ins.rezero)
+    per = tuple((smp, ms, se, fall, new.lag.applied_for(smp)) for smp, ms, se, fall in lg.own)
+    return replace(new, lag=Lag(lg.lag_ms, lg.se_ms, False, 0.0, lg.fall, tuple(rmse), per_sample=per, own=lg.own))
+
+
 def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Instruments:
     """The instruments' check with a lag the regression resolved but did not correct tested against the current
     model.
@@ -1292,39 +1365,27 @@ def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Ins
     model fits within :data:`MODEL_LAG_MAX_RATIO` x the angle's white noise and the misfit the estimated lag itself
     leaves (:func:`lag_misfit_deg`), taken together, the model is fitted to the angle read
     the estimate's whole rows later (and one row either side); the best of those is corrected when it lowers the
-    RMSE by :data:`MODEL_LAG_FALL`. Otherwise ``ins`` is returned as it is.
+    RMSE by :data:`MODEL_LAG_FALL`. Where the samples' own lags differ by more than :data:`LAG_SPLIT_MODEL_Z`
+    standard errors (too few for :func:`estimate_lags` to split them alone: a backbone's relaxation biases one
+    sample's estimate by tens of ms), each sample's own lag is tested so on that sample's rows first, and those
+    confirmed are corrected, each by its own. Otherwise ``ins`` is returned as it is.
     """
-    from camtube.model.core.fit import FitError, fit
-    from camtube.model.core.noise import white_noise_sd
-
     lg = ins.lag
-    if lg.given or lg.corrected or lg.per_sample or not math.isfinite(lg.se_ms) or not ins.rates_hz:
+    if lg.given or lg.corrected or lg.per_sample or not ins.rates_hz:
+        return ins
+    split = _confirm_per_sample(ins, model, fixed, fit_names)
+    if split is not None:
+        return split
+    if not math.isfinite(lg.se_ms):
         return ins
     dt_ms = 1e3 / float(np.median(list(ins.rates_hz.values())))
     if not (abs(lg.lag_ms) > 3.0 * lg.se_ms and abs(lg.lag_ms) > 0.25 * dt_ms):
         return ins
-    try:
-        r0 = fit(model, ins.data, list(fit_names), fixed)
-        noise = min(white_noise_sd(r0.residuals[sl]) for _, sl in ins.data.sample_slices())
-        own = lag_misfit_deg(ins.data, lg.lag_ms)
-        if not (noise > 0.0 and r0.rmse <= MODEL_LAG_MAX_RATIO * math.hypot(noise, own)):
-            return ins
-        k0 = int(round(lg.lag_ms / dt_ms))
-        sign = 1 if lg.lag_ms > 0 else -1
-        best = (r0.rmse, 0.0)
-        for k in sorted({k0 - sign, k0, k0 + sign}):
-            if k == 0 or (k > 0) != (lg.lag_ms > 0):
-                continue
-            shifted = shift_angle(ins.data, k * dt_ms)[0]
-            rk = fit(model, shifted, list(fit_names), fixed).rmse
-            if rk < best[0]:
-                best = (rk, k * dt_ms)
-    except FitError:
+    got = _model_lag(model, ins.data, fixed, fit_names, lg.lag_ms, dt_ms)
+    if got is None:
         return ins
-    if not best[1] or best[0] > (1.0 - MODEL_LAG_FALL) * r0.rmse:
-        return ins
-    new = check_instruments(ins.raw, lag_ms=best[1], dropped=ins.dropped, n_dropped=ins.n_dropped,
+    new = check_instruments(ins.raw, lag_ms=got[2], dropped=ins.dropped, n_dropped=ins.n_dropped,
                             rezero=ins.rezero)
     return Instruments(new.data, new.raw, new.aside, new.kept, new.rates_hz, new.rate_changes,
-                       Lag(lg.lag_ms, lg.se_ms, False, new.lag.applied_ms, lg.fall, (r0.rmse, best[0])),
+                       Lag(lg.lag_ms, lg.se_ms, False, new.lag.applied_ms, lg.fall, (got[0], got[1]), own=lg.own),
                        new.dropped, new.n_dropped, new.zeros, new.rezero, new.limits)
