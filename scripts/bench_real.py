@@ -285,6 +285,11 @@ HELDOUT27_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 #: beside a relaxing backbone; the instruments of bench-heldout17 and every carriage settling.
 HELDOUT28_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
                    "lag", ("lag", "toe"), ("lag", "backbone"), ("friction", "backbone"), "tracker drift"]
+#: The twenty-ninth fresh held-out batch (issue 19, after the samples' own lags a few errors apart were tested against
+#: the current model): a lag in one sample beside slack, and beside lost motion, in the other; a guide that switches
+#: within a row beside creep.
+HELDOUT29_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
+                   "lag", ("lag", "slack"), ("lag", "lost motion"), ("sharp friction", "creep"), "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -351,12 +356,13 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            # drawn once those were settled (every batch above looked at, bench-heldout26 traced); run once
            "bench-heldout27": (20281129, HELDOUT27_KINDS),
            # drawn once the lag per sample was settled (bench-heldout27 traced); run once
-           "bench-heldout28": (20281201, HELDOUT28_KINDS)}
+           "bench-heldout28": (20281201, HELDOUT28_KINDS),
+           # drawn once the model's test of the samples' own lags was settled (bench-heldout28 traced); run once
+           "bench-heldout29": (20281202, HELDOUT29_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
-           "bench-heldout28",
-           "bench-sharp"}
+           "bench-heldout28", "bench-heldout29", "bench-sharp"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -364,7 +370,7 @@ ROUGH = {"bench-heldout15", "bench-heldout16"}
 #: (:func:`rougher_instruments`).
 ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21",
            "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26",
-           "bench-heldout27", "bench-heldout28"}
+           "bench-heldout27", "bench-heldout28", "bench-heldout29"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
