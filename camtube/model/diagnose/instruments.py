@@ -1035,12 +1035,13 @@ def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_
 #: in one file, 33 +- 6.9 beside -0.5 +- 1.5 in another, 7.7 and 4.8 standard errors apart; a tracker 76 ms late
 #: beside one on time read 71 +- 2.8 and -15 +- 2.8, 22 apart: bench-heldout27) ...
 LAG_SPLIT_Z = 10.0
-#: Closer than that, but more than this many standard errors apart, the current model decides (:func:`confirm_lag`):
-#: a sample's own lag is corrected where the model fitted to that sample's rows confirms it.
-LAG_SPLIT_MODEL_Z = 4.0
 #: ... and than this many rows: a difference the whole rows of a correction barely show is no difference. (And one
 #: sample's own lag at least must be corrected, :func:`check_instruments`: a split that corrects nothing says nothing.)
 LAG_SPLIT_ROWS = 1.0
+#: Closer than :data:`LAG_SPLIT_Z`, but more than this many standard errors apart (and that many rows), the current
+#: model decides (:func:`confirm_lag`): a sample's own lag is corrected where the model fitted to that sample's rows
+#: confirms it.
+LAG_SPLIT_MODEL_Z = 4.0
 
 
 def estimate_lags(data: Dataset) -> Lag:
@@ -1065,17 +1066,21 @@ def estimate_lags(data: Dataset) -> Lag:
     if not all(math.isfinite(lg.se_ms) for lg, _ in own.values()):
         return pooled
     pooled = replace(pooled, own=tuple((smp, lg.lag_ms, lg.se_ms, lg.fall) for smp, (lg, _) in own.items()))
-    if not _lags_differ(own.values(), LAG_SPLIT_Z):
+    if not _lags_differ([(lg.lag_ms, lg.se_ms, row_ms) for lg, row_ms in own.values()], LAG_SPLIT_Z):
         return pooled
     return replace(pooled, per_sample=tuple((smp, lg.lag_ms, lg.se_ms, lg.fall, 0.0) for smp, (lg, _) in own.items()))
 
 
-def _lags_differ(own, z: float) -> bool:
-    """Two of ``own`` (``(Lag, row_ms)`` each) further apart than ``z`` standard errors of their difference and
-    :data:`LAG_SPLIT_ROWS` rows."""
-    return any(abs(a.lag_ms - b.lag_ms) > z * math.hypot(a.se_ms, b.se_ms)
-               and abs(a.lag_ms - b.lag_ms) > LAG_SPLIT_ROWS * max(ha, hb)
-               for (a, ha), (b, hb) in itertools.combinations(own, 2))
+def _lags_differ(own: Sequence[tuple[float, float, float]], z: float) -> bool:
+    """Two of ``own`` (``(lag_ms, se_ms, row_ms)`` each) further apart than ``z`` standard errors of their difference
+    and :data:`LAG_SPLIT_ROWS` rows."""
+    return any(abs(a - b) > z * math.hypot(sa, sb) and abs(a - b) > LAG_SPLIT_ROWS * max(ha, hb)
+               for (a, sa, ha), (b, sb, hb) in itertools.combinations(own, 2))
+
+
+def _resolved(lag_ms: float, se_ms: float, row_ms: float) -> bool:
+    """A lag the data resolve: beyond three standard errors and a quarter of a row."""
+    return abs(lag_ms) > 3.0 * se_ms and abs(lag_ms) > 0.25 * row_ms
 
 
 def shift_angle(data: Dataset, lag_ms: float | Mapping[str, float]) -> tuple[Dataset, np.ndarray, float, np.ndarray]:
@@ -1211,7 +1216,7 @@ def check_instruments(data: Dataset, lag_ms: float | Mapping[str, float] | None 
         def resolved(ms: float, se: float, fall: float, smp: str | None = None) -> bool:
             hz = rates.get(smp) if smp is not None else None
             hz = hz or (np.median(list(rates.values())) if rates else 1.0)
-            return abs(ms) > 3.0 * se and abs(ms) > 0.25 * 1e3 / max(hz, 1e-9) and fall >= MIN_FALL
+            return _resolved(ms, se, 1e3 / max(hz, 1e-9)) and fall >= MIN_FALL
 
         if lag.per_sample:
             lag = replace(lag, per_sample=tuple((smp, ms, se, fall, ms if resolved(ms, se, fall, smp) else 0.0)
@@ -1336,12 +1341,12 @@ def _confirm_per_sample(ins: Instruments, model, fixed: dict, fit_names) -> Inst
     lg = ins.lag
     rows_ms = {smp: 1e3 / hz for smp, hz in ins.rates_hz.items() if hz > 0}
     if len(lg.own) < 2 or not all(smp in rows_ms for smp, *_ in lg.own) or not _lags_differ(
-            [(Lag(ms, se), rows_ms[smp]) for smp, ms, se, _ in lg.own], LAG_SPLIT_MODEL_Z):
+            [(ms, se, rows_ms[smp]) for smp, ms, se, _ in lg.own], LAG_SPLIT_MODEL_Z):
         return None
     sample = np.asarray(ins.data.sample)
     confirmed, rmse = {}, []
     for smp, ms, se, _ in lg.own:
-        if not (abs(ms) > 3.0 * se and abs(ms) > 0.25 * rows_ms[smp]):
+        if not _resolved(ms, se, rows_ms[smp]):
             continue
         got = _model_lag(model, ins.data.take(sample == smp), fixed, fit_names, ms, rows_ms[smp])
         if got is not None:
@@ -1379,7 +1384,7 @@ def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Ins
     if not math.isfinite(lg.se_ms):
         return ins
     dt_ms = 1e3 / float(np.median(list(ins.rates_hz.values())))
-    if not (abs(lg.lag_ms) > 3.0 * lg.se_ms and abs(lg.lag_ms) > 0.25 * dt_ms):
+    if not _resolved(lg.lag_ms, lg.se_ms, dt_ms):
         return ins
     got = _model_lag(model, ins.data, fixed, fit_names, lg.lag_ms, dt_ms)
     if got is None:
