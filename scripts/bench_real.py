@@ -384,7 +384,7 @@ def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, r
 
 def lag_right(lag, true_ms: list, row_ms: float) -> bool:
     """The instruments' lag against the samples' true lags: each sample's own where they were read per sample, else
-    the one lag against the first sample's (both samples' trackers lag alike in a "lag" file)."""
+    the one lag against their common lag (wrong where the samples' trackers lag differently)."""
     if lag.per_sample:
         return all(_lag_found(ms, se, applied, true, row_ms)
                    for (_, ms, se, _, applied), true in zip(lag.per_sample, true_ms))

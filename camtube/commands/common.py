@@ -41,14 +41,14 @@ def lag_value(value: str) -> float | dict[str, float]:
     out: dict[str, float] = {}
     for part in text.split(","):
         smp, eq, ms = part.partition("=")
-        smp = smp.strip()
         try:
-            out[smp] = float(ms)
+            lag = float(ms)
         except ValueError:
-            smp = ""
-        if not eq or not smp:
+            lag = None
+        if not eq or not smp.strip() or lag is None:
             raise argparse.ArgumentTypeError(f"{part.strip()!r} in {value!r} is not SAMPLE=MS: give e.g. S1=76,S2=0 "
-                                             "(one lag per sample), or one number for all") from None
+                                             "(one lag per sample), or one number for all")
+        out[smp.strip()] = lag
     return out
 
 
