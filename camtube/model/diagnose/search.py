@@ -274,8 +274,10 @@ class Diagnosis:
     noise_floor_parts_deg : (float, float)
         Statistical and systematic parts of ``noise_floor_se_deg`` (see :func:`noise_floor_parts`).
     noise_lag_rows : int
-        The row spacing the floor is read at (:func:`noise_lag`; 1: white noise, else noise correlated between
+        The largest row spacing the floor is read at (:func:`noise_lag`; 1: white noise, else noise correlated between
         neighbouring rows, read from rows this far apart), on the final model's residual.
+    noise_lags_rows : dict[str, int]
+        Each sample's row spacing the floor is read at (:func:`noise_lags`), on the final model's residual.
     replaced : tuple[tuple[tuple[str, ...], str], ...]
         Effects chosen earlier and dropped for a later one that explains what they did: ``((old, ...), new)``.
     chosen_round : dict
@@ -333,6 +335,7 @@ class Diagnosis:
     instruments: object = None
     held: dict = field(default_factory=dict)
     noise_lag_rows: int = 1
+    noise_lags_rows: dict = field(default_factory=dict)
     cache: Cache = field(default_factory=Cache, init=False, compare=False, repr=False)
 
     @property
@@ -428,35 +431,52 @@ def _every(parts: list, lag: int) -> list:
     return parts if lag <= 1 else [seg[p::lag] for seg in parts for p in range(lag)]
 
 
-def _spaced_estimates(data: Dataset, parts: list) -> tuple[int, dict]:
-    """``(L, estimates)``: the row spacing :func:`noise_lag` gives and :func:`_floor_estimates` of the residual
-    ``parts`` (one run per sample) at that spacing (those computed to choose it, not again)."""
-    near_est = _floor_estimates(parts)
-    dts = [h for h in data.median_steps_s(positive=True) if h > 0]
-    if not dts:
-        return 1, near_est
+def _sample_spacing(dt_s: float, part: np.ndarray) -> int:
+    """The row spacing one sample's residual ``part`` (rows ``dt_s`` apart) is read at: 1 for white noise; for noise
+    correlated from row to row (the estimate of :func:`_floor_estimates`, ``("wmad", k)``, smallest over the orders,
+    rises by :data:`NOISE_CORR_RISE` from 1 to :data:`NOISE_CORR_PROBE` rows apart) the largest power of 2 within
+    :data:`NOISE_CORR_MAX_S`, when the orders agree there (:data:`NOISE_CORR_AGREE`)."""
+    if not dt_s > 0:
+        return 1
     widest = 1
-    while 2 * widest * float(np.median(dts)) <= NOISE_CORR_MAX_S:
+    while 2 * widest * dt_s <= NOISE_CORR_MAX_S:
         widest *= 2
     if widest < 2:
-        return 1, near_est
-    near = _smallest(near_est, "wmad")
-    probe = _smallest(_floor_estimates(_every(parts, min(NOISE_CORR_PROBE, widest))), "wmad")
+        return 1
+    near = _smallest(_floor_estimates([part]), "wmad")
+    probe = _smallest(_floor_estimates(_every([part], min(NOISE_CORR_PROBE, widest))), "wmad")
     if not (math.isfinite(near) and near > 0.0 and probe > (1.0 + NOISE_CORR_RISE) * near):
-        return 1, near_est
-    far_est = _floor_estimates(_every(parts, widest))
-    far = [v for (kind, _), v in far_est.items() if kind == "wmad"]
+        return 1
+    far = [v for (kind, _), v in _floor_estimates(_every([part], widest)).items() if kind == "wmad"]
     if len(far) < 2 or not max(far) <= (1.0 + NOISE_CORR_AGREE) * min(far):
-        return 1, near_est
-    return widest, far_est
+        return 1
+    return widest
+
+
+def _spaced_estimates(data: Dataset, parts: list) -> tuple[tuple[int, ...], dict]:
+    """``(spacings, estimates)``: each sample's row spacing (:func:`_sample_spacing`, in the order of
+    :meth:`Dataset.sample_slices`) and :func:`_floor_estimates` of the residual ``parts`` (one run per sample), each
+    read at its sample's spacing.
+
+    The test is made per sample: two samples logged by two trackers, one filtering its readings and one not, are
+    not one kind of noise (pooled, the white sample's estimate diluted the filtered one's rise below the test's line
+    and the floor read 15 % low: ``bench-heldout29``'s tracker drift)."""
+    steps = data.median_steps_s(positive=True)
+    lags = tuple(_sample_spacing(dt, p) for dt, p in zip(steps, parts))
+    if all(L == 1 for L in lags):
+        return lags, _floor_estimates(parts)
+    return lags, _floor_estimates([seg for p, L in zip(parts, lags) for seg in _every([p], L)])
+
+
+def noise_lags(data: Dataset, parts: list) -> tuple[int, ...]:
+    """Each sample's row spacing the floor of the residual ``parts`` (one run per sample) is read at
+    (:func:`_sample_spacing`): 1 for white noise, more for noise correlated from row to row."""
+    return _spaced_estimates(data, parts)[0]
 
 
 def noise_lag(data: Dataset, parts: list) -> int:
-    """The row spacing ``L`` the floor of the residual ``parts`` (one run per sample) is read at: 1 for white noise;
-    for noise correlated from row to row (the estimate of :func:`_floor_estimates`, ``("wmad", k)``, smallest over
-    the orders, rises by :data:`NOISE_CORR_RISE` from 1 to :data:`NOISE_CORR_PROBE` rows apart) the largest power of
-    2 within :data:`NOISE_CORR_MAX_S`, when the orders agree there (:data:`NOISE_CORR_AGREE`)."""
-    return _spaced_estimates(data, parts)[0]
+    """The largest of :func:`noise_lags`: 1 when every sample's noise is white."""
+    return max(noise_lags(data, parts), default=1)
 
 
 def _smallest(est: dict, kind: str) -> float:
@@ -509,7 +529,9 @@ def noise_floor_parts(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarra
     not known from the data, so their whole range is the systematic uncertainty.
     """
     r = np.asarray(residual_deg, float)
-    lag, est_at = _spaced_estimates(data, [r[sl] for _, sl in data.sample_slices()])
+    lags, est_at = _spaced_estimates(data, [r[sl] for _, sl in data.sample_slices()])
+    lag_of = dict(zip((smp for smp, _ in data.sample_slices()), lags))
+    sample = np.asarray(data.sample)
     est = list(est_at.values())
     systematic = float(max(est) - min(est)) if len(est) > 1 else 0.0
     vals = []
@@ -517,7 +539,8 @@ def noise_floor_parts(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarra
         idx = np.flatnonzero(blocks == b)
         # contiguous runs only (a block is contiguous within a sample)
         cut = np.flatnonzero(np.diff(idx) > 1) + 1
-        v = _smallest(_floor_estimates(_every([r[seg] for seg in np.split(idx, cut)], lag)), "wmad")
+        v = _smallest(_floor_estimates(_every([r[seg] for seg in np.split(idx, cut)], lag_of[sample[idx[0]]])),
+                      "wmad")
         if math.isfinite(v):
             vals.append(v)
     if len(vals) < 3:
@@ -1852,6 +1875,8 @@ class Search:
                      f"recommended (listed as partial)")
             recommended, steps, ps_names = [], steps[:1], []
             notes = [f"partial model: {n}" for n in notes]
+        lags = dict(zip((smp for smp, _ in self.data.sample_slices()),
+                        noise_lags(self.data, [steps[-1].residuals[sl] for _, sl in self.data.sample_slices()])))
         return Diagnosis(self.data, ch.model, floor, self.base_rmse, self.base_ho, tuple(self.rounds),
                          tuple(recommended), tuple(steps), tuple(s.fit_params), stop, self.fixed, secs, catalog,
                          self.floor_se, tuple({rc.label: w for rc, w in self.rejected}.items()), tuple(ps_names),
@@ -1861,8 +1886,7 @@ class Search:
                          held={k: v for k, v in self.held.items() if k.split(".")[0] in set(recommended)
                                or ("@" in k and recommended and k.split(".")[0] in set(self.baseline_added))
                                or set(BASELINE_STAND_INS.get(k.split(".")[0], ())) & set(recommended)},
-                         noise_lag_rows=noise_lag(self.data, [steps[-1].residuals[sl]
-                                                              for _, sl in self.data.sample_slices()]))
+                         noise_lag_rows=max(lags.values(), default=1), noise_lags_rows=lags)
 
 
 def _sample_notes(model: JointModel, r: FitResult, samples: Sequence[str], ps: Sequence[str]) -> list[str]:

@@ -10,6 +10,7 @@ report directory with an index is complete).
     {"schema", "noise_floor_deg", "noise_floor_se_deg",
      "noise_floor_se_parts_deg": {"statistical", "systematic"},
      "noise_lag_rows",                          # 1: white noise; L: correlated, the floor read from rows L apart
+     "noise_lags_rows": {sample: L},            # the same, each sample's (two trackers may filter differently)
      "base": {"effects", "rmse_deg", "heldout_rmse_deg", "per_sample", "params"},   # with the baseline
      "given": {"effects", "rmse_deg", "per_sample"},          # the model as given (before the baseline)
      "baseline": [{"effect", "meaning", "joined_chain", "rmse_before_deg", "rmse_deg", "params"}],  # rest_angle
@@ -191,6 +192,7 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
                                    "unit": final.units.get(k, "")} for k, v in final.params.items()}}
     out["noise_floor_se_deg"] = _num(d.noise_floor_se_deg)
     out["noise_lag_rows"] = int(d.noise_lag_rows)
+    out["noise_lags_rows"] = {smp: int(v) for smp, v in d.noise_lags_rows.items()}
     if len(d.noise_floor_parts_deg) == 2:
         out["noise_floor_se_parts_deg"] = {"statistical": _num(d.noise_floor_parts_deg[0]),
                                            "systematic": _num(d.noise_floor_parts_deg[1])}
@@ -408,7 +410,10 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
     cur = ", ".join(given.effects) or "none"
     parts = d.noise_floor_parts_deg
     what = ("white noise in the residual" if d.noise_lag_rows <= 1 else
-            f"the noise in the residual, correlated from row to row: read from rows {d.noise_lag_rows} apart")
+            f"the noise in the residual, correlated from row to row: read from rows {d.noise_lag_rows} apart"
+            if len(set(d.noise_lags_rows.values())) <= 1 else
+            "the noise in the residual, correlated from row to row in some samples: read from rows "
+            + ", ".join(f"{smp} {v}" for smp, v in d.noise_lags_rows.items()) + " apart")
     lines.append(f"noise floor ({what}): {floor:.3f} +- {d.noise_floor_se_deg:.3f} deg"
                  + (f" (statistical {parts[0]:.3f}, systematic {parts[1]:.3f})" if len(parts) == 2 else ""))
     lines.append(f"current model (effects: {cur}): RMSE {given.rmse_deg:.3f} deg = "
