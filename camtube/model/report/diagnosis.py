@@ -279,7 +279,9 @@ SIDES = {
                   "and shows while it pulls: a dwell with the tendon slack, the joint filmed, tells)",
     "relaxation2": "joint (its polymer backbone relaxes on a fast and a slow time scale; the tendon's own creep "
                    "lengthens it under load instead, and shows while it pulls: a long dwell with the tendon slack, "
-                   "the joint filmed, tells)",
+                   "the joint filmed, tells); or the instruments: a tracker whose zero drifts as it warms up reads "
+                   "as a slow relaxation over 50 even cycles (a second sensor fixed to the base, or the tracker "
+                   "logging the still joint for as long as the test, tells)",
     "hardstop": "joint (the notches close)",
     "kerf": "joint geometry", "flat_walls": "joint geometry", "chords": "joint geometry",
 }
