@@ -136,6 +136,17 @@ def _record(x: np.ndarray, rate_hz: float, cycles: int = 30) -> Dataset:
     return Dataset(sample, cycle, t, np.zeros(n), np.zeros(n), x)
 
 
+def _filtered(rng: np.random.Generator, sigma: float, rho: float, n: int) -> np.ndarray:
+    """Noise of standard deviation ``sigma`` through a first-order filter (correlation ``rho`` between neighbouring
+    rows), stationary from row 0: a tracker that filters its readings."""
+    w = rng.normal(0.0, sigma * math.sqrt(1.0 - rho * rho), n)
+    e = np.empty(n)
+    e[0] = rng.normal(0.0, sigma)
+    for i in range(1, n):
+        e[i] = rho * e[i - 1] + w[i]
+    return e
+
+
 @pytest.mark.parametrize("rate_hz, tau_ms", [(100.0, 15.0), (100.0, 45.0), (50.0, 40.0), (25.0, 30.0)])
 def test_floor_of_noise_correlated_from_row_to_row_is_its_standard_deviation(rate_hz, tau_ms):
     """A tracker that filters its readings (first order, time constant tau): the noise of neighbouring rows is
@@ -144,11 +155,7 @@ def test_floor_of_noise_correlated_from_row_to_row_is_its_standard_deviation(rat
     rng = np.random.default_rng(int(rate_hz + tau_ms))
     n = 60000
     rho = math.exp(-1e3 / (rate_hz * tau_ms))
-    w = rng.normal(0.0, 0.2 * math.sqrt(1.0 - rho * rho), n)
-    e = np.empty(n)
-    e[0] = rng.normal(0.0, 0.2)
-    for i in range(1, n):
-        e[i] = rho * e[i - 1] + w[i]
+    e = _filtered(rng, 0.2, rho, n)
     phase = 2.0 * math.pi * np.arange(n) / 600.0           # 600 rows a cycle, as on the bench
     x = e + 0.5 * np.sin(phase) ** 3                       # a model's smooth leftover error
     x[rng.choice(n, 12, replace=False)] += rng.choice([-1.0, 1.0], 12) * rng.uniform(3.0, 8.0, 12)
@@ -177,11 +184,7 @@ def test_floor_of_filtered_noise_beside_white_noise():
     rng = np.random.default_rng(17)
     n = 60000
     rho = math.exp(-10.0 / 42.0)
-    w = rng.normal(0.0, 0.12 * math.sqrt(1.0 - rho * rho), n)
-    c = np.empty(n)
-    c[0] = rng.normal(0.0, 0.12)
-    for i in range(1, n):
-        c[i] = rho * c[i - 1] + w[i]
+    c = _filtered(rng, 0.12, rho, n)
     e = c + rng.normal(0.0, 0.14, n)
     x = e + 0.3 * np.sin(2.0 * math.pi * np.arange(n) / 600.0) ** 3
     data = _record(x, 100.0)
@@ -197,12 +200,7 @@ def test_floor_of_two_trackers_one_filtered_is_read_per_sample():
     rng = np.random.default_rng(29)
     half = 30000
     rho = math.exp(-10.0 / 35.0)
-    w = rng.normal(0.0, 0.14 * math.sqrt(1.0 - rho * rho), half)
-    c = np.empty(half)
-    c[0] = rng.normal(0.0, 0.14)
-    for i in range(1, half):
-        c[i] = rho * c[i - 1] + w[i]
-    filtered = c + rng.normal(0.0, 0.11, half)
+    filtered = _filtered(rng, 0.14, rho, half) + rng.normal(0.0, 0.11, half)
     white = rng.normal(0.0, 0.20, half)
     e = np.concatenate([filtered, white])
     x = e + 0.3 * np.sin(2.0 * math.pi * np.arange(2 * half) / 600.0) ** 3
