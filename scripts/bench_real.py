@@ -294,6 +294,10 @@ HELDOUT29_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 #: beside creep, lost motion beside a relaxing backbone, a three-arm backbone beside slack.
 HELDOUT30_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
                    "lag", ("toe", "creep"), ("lost motion", "backbone"), ("backbone3", "slack"), "tracker drift"]
+#: The thirty-first fresh held-out batch (issue 19, after a better model's reading from rows further apart replaced the
+#: floor): creep beside slack, a relaxing backbone beside a toe, lost motion beside creep.
+HELDOUT31_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
+                   "lag", ("creep", "slack"), ("backbone", "toe"), ("lost motion", "creep"), "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -364,11 +368,15 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            # drawn once the model's test of the samples' own lags was settled (bench-heldout28 traced); run once
            "bench-heldout29": (20281202, HELDOUT29_KINDS),
            # drawn once the floor's spacing per sample was settled (bench-heldout29 rerun); run once
-           "bench-heldout30": (20281203, HELDOUT30_KINDS)}
+           "bench-heldout30": (20281203, HELDOUT30_KINDS),
+           # drawn once the floor read further apart by a better model was settled (bench-heldout27, 29, 30 rerun);
+           # run once
+           "bench-heldout31": (20281204, HELDOUT31_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
-           "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-sharp"}
+           "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
+           "bench-sharp"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -376,7 +384,7 @@ ROUGH = {"bench-heldout15", "bench-heldout16"}
 #: (:func:`rougher_instruments`).
 ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21",
            "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26",
-           "bench-heldout27", "bench-heldout28", "bench-heldout29", "bench-heldout30"}
+           "bench-heldout27", "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
