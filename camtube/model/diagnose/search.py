@@ -1369,7 +1369,8 @@ class Search:
     def check_all_rows(self, c: Candidate, eff: Effect):
         """The candidate ``c`` (of effect ``eff``) refitted on every row, exactly as the printed command does:
         ``(c, eff, model, names, fit, init, per-sample names, kept effects, waterfall without the replaced,
-        floor, floor se, floor parts)`` when it passes, else the reasons (list of str)."""
+        floor (typical size), floor se, floor parts, floor (root mean square), each sample's spacing)`` when it passes
+        (the floor as :func:`floor_seen` takes it with this model), else the reasons (list of str)."""
         ch, s, data = self.chain, self.settings, self.data
         keep = [e for e in ch.chosen if e.name not in c.replaces]
         m, names, ps = _without(ch.current, ch.names, ch.per_sample, [e for e in ch.chosen if e.name in c.replaces])
@@ -1453,7 +1454,8 @@ class Search:
         c, eff, m, names, r, init, ps, keep, inter, f_c, se_c, parts_c, rms_c, lags_c = accepted
         ch = self.chain
         self.swaps_tried = False
-        self.floor, self.floor_se, self.floor_parts, self.floor_rms, self.floor_lags = f_c, se_c, parts_c, rms_c, lags_c
+        self.floor, self.floor_se, self.floor_parts = f_c, se_c, parts_c
+        self.floor_rms, self.floor_lags = rms_c, lags_c
         ch.per_sample = ps
         self.rejected = [(rc, w) for rc, w in self.rejected if rc.effect != eff.name]
         self.held = {k: v for k, v in self.held.items() if k.split(".")[0] not in set(c.replaces) | {eff.name}}
