@@ -485,11 +485,19 @@ def _smallest(est: dict, kind: str) -> float:
     return min(vals) if vals else math.inf
 
 
-def noise_reading(data: Dataset, residual_deg: np.ndarray) -> tuple[float, float, tuple[int, ...]]:
-    """``(floor, typical size, spacings)``: :func:`noise_levels` and each sample's row spacing they were read at
-    (:func:`noise_lags`), from one pass."""
+def _spaced_residual(data: Dataset, residual_deg: np.ndarray) -> tuple[tuple[int, ...], dict]:
+    """:func:`_spaced_estimates` of a residual ``(n,)``, one run per sample: what :func:`noise_reading` and
+    :func:`noise_floor_parts` both read (computed once where a caller needs both)."""
     r = np.asarray(residual_deg, float)
-    lags, est = _spaced_estimates(data, [r[sl] for _, sl in data.sample_slices()])
+    return _spaced_estimates(data, [r[sl] for _, sl in data.sample_slices()])
+
+
+def noise_reading(data: Dataset, residual_deg: np.ndarray,
+                  spaced: tuple[tuple[int, ...], dict] | None = None) -> tuple[float, float, tuple[int, ...]]:
+    """``(floor, typical size, spacings)``: :func:`noise_levels` and each sample's row spacing they were read at
+    (:func:`noise_lags`), from one pass (``spaced``: :func:`_spaced_residual` of this residual, when at hand)."""
+    r = np.asarray(residual_deg, float)
+    lags, est = spaced if spaced is not None else _spaced_residual(data, r)
     out = [_smallest(est, kind) for kind in ("wmad", "mad")]
     floor, typical = (v if math.isfinite(v) else float(np.std(r)) for v in out)
     return floor, typical, lags
@@ -538,8 +546,10 @@ def noise_typical(data: Dataset, residual_deg: np.ndarray) -> float:
     return noise_levels(data, residual_deg)[1]
 
 
-def noise_floor_parts(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarray) -> tuple[float, float]:
-    """The two parts (deg) of the uncertainty of :func:`noise_floor`: ``(statistical, systematic)``.
+def noise_floor_parts(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarray,
+                      spaced: tuple[tuple[int, ...], dict] | None = None) -> tuple[float, float]:
+    """The two parts (deg) of the uncertainty of :func:`noise_floor`: ``(statistical, systematic)`` (``spaced``:
+    :func:`_spaced_residual` of this residual, when at hand).
 
     *Statistical*: the standard error of the estimate from its spread over the ``blocks`` ``(n,)`` int of
     the rows (blocks of cycles).
@@ -554,7 +564,7 @@ def noise_floor_parts(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarra
     not known from the data, so their whole range is the systematic uncertainty.
     """
     r = np.asarray(residual_deg, float)
-    lags, est_at = _spaced_estimates(data, [r[sl] for _, sl in data.sample_slices()])
+    lags, est_at = spaced if spaced is not None else _spaced_residual(data, r)
     lag_of = dict(zip((smp for smp, _ in data.sample_slices()), lags))
     sample = np.asarray(data.sample)
     est = list(est_at.values())
@@ -1006,8 +1016,9 @@ class Search:
         names = _names_for(self.given_model, s.fit_params)
         base_full = refit_all_rows(self.given_model, data, names, self.fixed, {}, s.grid)
         self.block_all, _ = cycle_blocks(data)
-        self.floor_rms, self.floor, self.floor_lags = noise_reading(data, base_full.residuals)
-        self.floor_parts = noise_floor_parts(data, base_full.residuals, self.block_all)
+        spaced = _spaced_residual(data, base_full.residuals)
+        self.floor_rms, self.floor, self.floor_lags = noise_reading(data, base_full.residuals, spaced)
+        self.floor_parts = noise_floor_parts(data, base_full.residuals, self.block_all, spaced)
         self.floor_se = math.hypot(*self.floor_parts)
         self.clock["base"] = time.perf_counter()
         self.search = thin(data, s.max_rows)
@@ -1405,9 +1416,10 @@ class Search:
         problems += _resolution_problems(m, list(r.fitted), r.params, r.stderr, r.at_bound, data,
                                          s.modulus_range_gpa)
         # the floor seen through this model's residual (a model error inflates the estimate a little)
+        spaced = _spaced_residual(data, r.residuals)
         rms_c, f_c, lags_c = floor_seen((self.floor_rms, self.floor, self.floor_lags),
-                                        noise_reading(data, r.residuals))
-        parts_c = noise_floor_parts(data, r.residuals, self.block_all)
+                                        noise_reading(data, r.residuals, spaced))
+        parts_c = noise_floor_parts(data, r.residuals, self.block_all, spaced)
         se_c = math.hypot(*parts_c)
         if r.rmse < f_c - 2.0 * se_c:
             problems.append(f"its RMSE {r.rmse:.3f} deg undercuts the noise's typical size {f_c:.3f} +- "
