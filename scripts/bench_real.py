@@ -298,6 +298,10 @@ HELDOUT30_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 #: floor): creep beside slack, a relaxing backbone beside a toe, lost motion beside creep.
 HELDOUT31_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
                    "lag", ("creep", "slack"), ("backbone", "toe"), ("lost motion", "creep"), "tracker drift"]
+#: The thirty-second fresh held-out batch (issue 19, after a swap's replacement took the place of the effect it
+#: replaced): a toe beside a three-arm backbone, slack beside a smooth guide, creep beside a relaxing backbone.
+HELDOUT32_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
+                   "lag", ("toe", "backbone3"), ("slack", "friction"), ("creep", "backbone"), "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -371,12 +375,15 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            "bench-heldout30": (20281203, HELDOUT30_KINDS),
            # drawn once the floor read further apart by a better model was settled (bench-heldout27, 29, 30 rerun);
            # run once
-           "bench-heldout31": (20281204, HELDOUT31_KINDS)}
+           "bench-heldout31": (20281204, HELDOUT31_KINDS),
+           # drawn once a swap's replacement in the place of what it replaces was settled (bench-heldout27 .. 31
+           # rerun); run once
+           "bench-heldout32": (20281205, HELDOUT32_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
            "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
-           "bench-sharp"}
+           "bench-heldout32", "bench-sharp"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -384,7 +391,8 @@ ROUGH = {"bench-heldout15", "bench-heldout16"}
 #: (:func:`rougher_instruments`).
 ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21",
            "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26",
-           "bench-heldout27", "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31"}
+           "bench-heldout27", "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
+           "bench-heldout32"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
