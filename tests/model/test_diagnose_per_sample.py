@@ -3,6 +3,7 @@ simulator (camtube.model.sim.bench), whose tendon laws the effect library does n
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from camtube.design.loader import load_pattern
 from camtube.model.core.fit import fit
@@ -272,3 +273,30 @@ def test_a_sample_s_copy_the_rows_barely_depend_on_does_not_refuse_the_union_of_
     assert d.final.rmse_deg <= 1.15 * rec.floor_deg
     assert any(k.startswith("carriage_gap.") and k.endswith("@S2") for k in d.held)
     assert any(n.startswith("each sample diagnosed alone") for n in d.sample_notes)
+
+
+def test_a_sample_s_copy_that_ends_at_its_effect_s_off_value_is_held_off_in_the_union():
+    """bench-heldout32's toe beside a three-arm backbone: the union of the samples' chains was refused because the
+    joint's rest angle in the toe's sample ended on its bound at 0, its off value (beside toe_shape and capstan that
+    sample does not need it). The union's fit holds such a copy off there, as the result holds one. Here on the truth
+    simulator: one joint without friction (no rest angle), one with."""
+    from camtube.model.diagnose.search import Search, SearchSettings, _names_for, refit_all_rows
+    from camtube.model.sim.truth import Hidden, simulate
+
+    p = load_pattern(PATTERNS / "tube1.yaml")
+    sim = simulate(p, [Hidden(joint_friction_nmm=0.0), Hidden(joint_friction_nmm=0.1)], n_samples=2, n_cycles=20,
+                   rate_hz=10.0, seed=4243, dwell_s=2.0)
+    model = model_for_pattern(p)
+    s = Search(model, sim.data, SearchSettings(("E_t",), pattern_values(p))).fit_base()
+    rest = builtin_registry()["rest_angle"]
+    m = model.with_effects([rest])
+    names, ps = _names_for(m, ("E_t",)), list(rest.full_names())
+    first, second = (f"rest_angle.rest_deg@{smp}" for smp in sim.data.samples)
+    # the case: fitted per sample, the frictionless sample's copy ends on its bound at 0
+    plain = refit_all_rows(m, sim.data, names, s.fixed, {}, 3, per_sample=ps)
+    assert first in plain.at_bound and plain.params[first] < 1e-9 and plain.params[second] > 0.5
+    r, names2, ps2, held = s._union_fit(m, names, ps, {}, {}, [rest])
+    assert held == {first: 0.0}
+    assert first not in r.fitted and second in r.fitted and second not in r.at_bound
+    assert r.params[second] == pytest.approx(plain.params[second], rel=0.02)
+    assert r.rmse <= 1.02 * plain.rmse

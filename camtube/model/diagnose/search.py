@@ -1715,6 +1715,41 @@ class Search:
                 explained[e] = explained.get(e, 0.0) + g
         return chains, bases, inits, explained
 
+    def _union_fit(self, m: JointModel, names: tuple, ps: list, held: dict, init: dict, effs: Sequence[Effect]):
+        """The union of :meth:`try_sample_wise` (model ``m``, its effects ``effs``, each copy of ``held`` off) fitted on
+        every row: ``(fit, fitted names, per-sample names, held)``, with the copies the rows barely depend on, and those
+        that end at their effect's off value, held."""
+        s, data = self.settings, self.data
+        r = refit_all_rows(m, data, names, {**self.fixed, **held}, init, s.grid, per_sample=ps,
+                           max_nfev=UNION_MAX_NFEV)
+        unresolved = {}
+        for e in effs:
+            unresolved.update(_unresolved(m, data, r, e, s.min_gain))
+        # a sample's copy the rows barely depend on (a toe's shape where the toe is 0.01 mm) is held, as in a
+        # candidate's check on all rows, not a reason to refuse the union (bench-heldout23's lost motion beside
+        # a toe: the union at 0.96x the floor refused for toe_shape.shape@S1 on its bound, nothing recommended).
+        # Then a sample's copy that ends on its bound at its effect's off value: beside the other effects that
+        # sample does not need it, so it is held off there (as the result holds such a copy), not a reason to refuse
+        # the union either (bench-heldout32's toe beside a three-arm backbone: the joint's rest angle in the toe's
+        # sample went to 0 beside toe_shape and capstan, and the union, 0.21 deg against the chain's 1.74, was
+        # refused for it)
+        r, names, ps, held = self._union_held(m, r, names, ps, held, unresolved)
+        off = _off_on_bound({e.name: e for e in effs}, {k: v for k, v in r.params.items() if k in r.fitted})
+        return self._union_held(m, r, names, ps, held, off)
+
+    def _union_held(self, m: JointModel, r: FitResult, names: tuple, ps: list, held: dict, more: dict):
+        """The union's fit ``r`` refitted with the copies ``more`` held too (itself when there are none):
+        ``(fit, fitted names, per-sample names, held)``."""
+        if not more:
+            return r, names, ps, held
+        held = {**held, **more}
+        names = _drop_names(names, more)
+        ps = list(_drop_names(ps, more))   # (a sample's copy stays per sample, held in that one)
+        init = {k: v for k, v in r.params.items() if k in r.fitted and k not in more}
+        r = refit_all_rows(m, self.data, names, {**self.fixed, **held}, init, self.settings.grid, per_sample=ps,
+                           max_nfev=UNION_MAX_NFEV)
+        return r, names, ps, held
+
     def try_sample_wise(self) -> bool:
         """When the chain leaves the error above :data:`REACH_RATIO` x the floor and there are several samples:
         diagnose each sample alone; when each is explained (something recommended, or nothing to add) and they
@@ -1770,21 +1805,8 @@ class Search:
         for smp in samples:
             init.update({f"{k}@{smp}": v for k, v in inits[smp].items()
                          if "@" not in k and k in ps and f"{k}@{smp}" not in held})
+        r, names, ps, held = self._union_fit(m, names, ps, held, init, base_split + base_new + effects)
         fixed = {**self.fixed, **held}
-        r = refit_all_rows(m, data, names, fixed, init, s.grid, per_sample=ps, max_nfev=UNION_MAX_NFEV)
-        unresolved = {}
-        for e in base_split + base_new + effects:
-            unresolved.update(_unresolved(m, data, r, e, s.min_gain))
-        if unresolved:
-            # a sample's copy the rows barely depend on (a toe's shape where the toe is 0.01 mm) is held, as in a
-            # candidate's check on all rows, not a reason to refuse the union (bench-heldout23's lost motion beside
-            # a toe: the union at 0.96x the floor refused for toe_shape.shape@S1 on its bound, nothing recommended)
-            held.update(unresolved)
-            fixed = {**self.fixed, **held}
-            names = _drop_names(names, unresolved)
-            ps = list(_drop_names(ps, unresolved))   # (a sample's copy stays per sample, held in that one)
-            init = {k: v for k, v in r.params.items() if k in r.fitted and k not in unresolved}
-            r = refit_all_rows(m, data, names, fixed, init, s.grid, per_sample=ps, max_nfev=UNION_MAX_NFEV)
         if (r.nfev >= UNION_MAX_NFEV or not r.rmse < ch.all_rows.rmse
                 or not r.bic < ch.all_rows.bic - s.bic_threshold
                 or _resolution_problems(m, list(r.fitted), r.params, r.stderr, r.at_bound, data, s.modulus_range_gpa)):
