@@ -302,6 +302,10 @@ HELDOUT31_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 #: replaced): a toe beside a three-arm backbone, slack beside a smooth guide, creep beside a relaxing backbone.
 HELDOUT32_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
                    "lag", ("toe", "backbone3"), ("slack", "friction"), ("creep", "backbone"), "tracker drift"]
+#: The thirty-third fresh held-out batch (issue 19, after the union of the samples' chains held a copy at its off
+#: value): a toe beside a relaxing backbone, lost motion beside a three-arm backbone, slack beside creep.
+HELDOUT33_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
+                   "lag", ("toe", "backbone"), ("lost motion", "backbone3"), ("slack", "creep"), "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -378,12 +382,14 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            "bench-heldout31": (20281204, HELDOUT31_KINDS),
            # drawn once a swap's replacement in the place of what it replaces was settled (bench-heldout27 .. 31
            # rerun); run once
-           "bench-heldout32": (20281205, HELDOUT32_KINDS)}
+           "bench-heldout32": (20281205, HELDOUT32_KINDS),
+           # drawn once the union's copy held at its off value was settled (bench-heldout32 traced); run once
+           "bench-heldout33": (20281206, HELDOUT33_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
            "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
-           "bench-heldout32", "bench-sharp"}
+           "bench-heldout32", "bench-heldout33", "bench-sharp"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -392,7 +398,7 @@ ROUGH = {"bench-heldout15", "bench-heldout16"}
 ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21",
            "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26",
            "bench-heldout27", "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
-           "bench-heldout32"}
+           "bench-heldout32", "bench-heldout33"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
