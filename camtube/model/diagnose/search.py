@@ -1379,12 +1379,13 @@ class Search:
     # ------------------------------------------------------------------ the all-rows check and the chain
     def check_all_rows(self, c: Candidate, eff: Effect):
         """The candidate ``c`` (of effect ``eff``) refitted on every row, exactly as the printed command does:
-        ``(c, eff, model, names, fit, init, per-sample names, the chain's effects in order (a replacement among them),
-        the waterfall's steps before the last,
-        floor (typical size), floor se, floor parts, floor (root mean square), each sample's spacing)`` when it passes
+        ``(c, eff, model, names, fit, init, per-sample names, the chain's effects in order with the candidate among
+        them, the waterfall's steps before the last, floor (typical size), floor se, floor parts, floor (root mean
+        square), each sample's spacing)`` when it passes
         (the floor as :func:`floor_seen` takes it with this model), else the reasons (list of str)."""
         ch, s, data = self.chain, self.settings, self.data
-        keep = [e for e in ch.chosen if e.name not in c.replaces]
+        # the chain's effects in order once the candidate joins: at the end, or as below for a replacement
+        keep = [e for e in ch.chosen if e.name not in c.replaces] + [eff]
         m, names, ps = _without(ch.current, ch.names, ch.per_sample, [e for e in ch.chosen if e.name in c.replaces])
         m = m.with_effects(list(m.effects) + [eff])
         names = _drop_names(names + eff.full_names(), c.held)
@@ -1435,7 +1436,7 @@ class Search:
             at = min(i for i, e in enumerate(ch.chosen) if e.name in c.replaces)
             in_place = [e for e in ch.chosen[:at] if e.name not in c.replaces] + [eff] + \
                 [e for e in ch.chosen[at:] if e.name not in c.replaces]
-            for order in (in_place, keep + [eff]) if in_place[-1] is not eff else (in_place,):
+            for order in (in_place, keep) if in_place != keep else (in_place,):
                 steps = self.chain_steps(ch.model, order, range(1, len(order)), r.params, ps)
                 if _each_lower([ch.steps[0].rmse_deg] + [x.rmse_deg for x in steps] + [r.rmse]):
                     keep, inter = order, steps
@@ -1476,12 +1477,9 @@ class Search:
         self.held.update(c.held)
         if c.replaces:
             self.replaced.append((tuple(c.replaces), eff.name))
-            ch.chosen = keep
-            self.recommended = [e.name for e in keep]
             ch.steps = ch.steps[:1] + inter
-        if eff not in ch.chosen:  # a replacement may take the replaced effect's place in the chain
-            self.recommended.append(eff.name)
-            ch.chosen.append(eff)
+        ch.chosen = keep
+        self.recommended = [e.name for e in keep]
         self.chosen_round[eff.name] = len(self.rounds) - 1
         ch.current, ch.names, ch.all_rows = m, names, r
         ch.steps.append(_step(r, ch.per_sample, init))
