@@ -121,6 +121,9 @@ from camtube.model.data.dataset import Cache, Dataset
 
 #: Parameter correlation above which two parameters cannot be told apart.
 CORR_LIMIT = 0.99
+#: A gain's fall on the log scale of the blocks' MSE (:func:`_significant`) must clear ``z`` by this many standard
+#: errors more than its plain fall: a second look at one gain (with it, noise passes about as often as before).
+LOG_SCALE_EXTRA_Z = 1.0
 #: Held-out RMSEs within this fraction of each other: the data cannot tell the candidates apart.
 EQUAL_HELDOUT = 0.03
 #: A sample's per-sample copies of an effect whose off values raise that sample's RMSE by at most this share do
@@ -1322,12 +1325,10 @@ class Search:
         held = self._absent(eff, m, f2)
         if held:
             f3, ho3, mse3 = self._fit_held(m, names, f2.params, ps, eff, {**off, **held})
-            dm, se = _gain(mse, mse3, self.strata)
-            if dm > s.z * se and f3.bic < f.bic - s.bic_threshold:
+            if _significant(_gain_zs(mse, mse3, self.strata), s.z) and f3.bic < f.bic - s.bic_threshold:
                 return f3, ho3, mse3, {**off, **held}
             return None   # a per-sample version with unresolved copies does not replace the shared one
-        dm, se = _gain(mse, mse2, self.strata)
-        if dm > s.z * se and f2.bic < f.bic - s.bic_threshold:
+        if _significant(_gain_zs(mse, mse2, self.strata), s.z) and f2.bic < f.bic - s.bic_threshold:
             return f2, ho2, mse2, off
         return None
 
@@ -1350,16 +1351,17 @@ class Search:
         why = []
         gain = 1.0 - ho / cur_ho if cur_ho > 0 else 0.0
         excess = cur_ho**2 - floor**2
-        dm, se = _gain(ch.block_mse, mse, self.strata)
-        gz = dm / se if se > 0 and math.isfinite(se) else (math.inf if dm > 0 else 0.0)
+        zs = _gain_zs(ch.block_mse, mse, self.strata)
+        gz = zs[0]
         if not dbic < -s.bic_threshold:
             why.append(f"delta BIC {dbic:+.1f} is not below -{s.bic_threshold:g}")
         if gain < s.min_gain:
             why.append(f"held-out RMSE falls by {100 * gain:.1f}% < {100 * s.min_gain:g}%")
         elif excess > 0 and (cur_ho**2 - ho**2) < s.min_excess * excess:
             why.append(f"explains only {100 * (cur_ho**2 - ho**2) / excess:.0f}% of the error above the noise floor")
-        if gain >= s.min_gain and not gz > s.z:
-            why.append(f"the held-out gain is {gz:.1f} standard errors, not more than {s.z:g} (within the noise)")
+        if gain >= s.min_gain and not _significant(zs, s.z):
+            why.append(f"the held-out gain is {gz:.1f} standard errors ({zs[1]:.1f} on the log scale), not more than "
+                       f"{s.z:g} ({s.z + LOG_SCALE_EXTRA_Z:g}) (within the noise)")
         if new and not why:
             why += _resolution_problems(m, list(f.fitted), f.params, f.stderr, f.at_bound, self.data,
                                         s.modulus_range_gpa)
@@ -1530,8 +1532,8 @@ class Search:
         tries = []
         # the chosen effects' removals are independent: one per core
         for old, (m, names, ps), (f, ho, mse) in zip(ch.chosen, rest, self._forked_fits(without, [r[0] for r in rest])):
-            dm, se = _gain(mse, ch.block_mse, self.strata)  # what keeping the effect gains
-            tries.append((not (dm > s.z * se or f.bic - ch.fit.bic >= s.bic_threshold), ho, old, m, names, ps, f,
+            keeps = _significant(_gain_zs(mse, ch.block_mse, self.strata), s.z)  # what keeping the effect gains
+            tries.append((not (keeps or f.bic - ch.fit.bic >= s.bic_threshold), ho, old, m, names, ps, f,
                           mse))
         for held_out_ok, ho, old, m, names, ps, f, mse in sorted(tries, key=lambda t: (not t[0], t[1], t[2].name)):
             init = {k: v for k, v in f.params.items() if k in names or k.split("@")[0] in names}
@@ -1857,8 +1859,7 @@ class Search:
                 continue
             trial = ps + [n for n in eff.full_names() if n not in ps]
             f, ho, mse = self._fit_one(ch.current, ch.names, base_fit.params, trial)
-            dm, se = _gain(base_mse, mse, self.strata)
-            if dm > s.z * se and f.bic - base_fit.bic < -s.bic_threshold:
+            if _significant(_gain_zs(base_mse, mse, self.strata), s.z) and f.bic - base_fit.bic < -s.bic_threshold:
                 ps = trial
                 base_fit, base_mse = f, mse
                 changed = True
@@ -2227,13 +2228,11 @@ def _mark_rejected(ranked, rejected):
             yield c
 
 
-def _gain(cur_mse: np.ndarray, new_mse: np.ndarray, strata: np.ndarray | None = None) -> tuple[float, float]:
-    """Mean fall of the per-block held-out MSE and its standard error (paired over blocks).
-
-    With ``strata`` (the sample of each block) the standard error is the stratified one: samples may differ
-    (an effect present in one sample only), only the spread within a sample is noise.
-    """
-    d = np.asarray(cur_mse) - np.asarray(new_mse)
+def _paired(d: np.ndarray, strata: np.ndarray | None = None) -> tuple[float, float]:
+    """Mean of the per-block differences ``d`` and its standard error (stratified by ``strata``, the sample of
+    each block, when there are several: samples may differ, an effect present in one only; only the spread within a
+    sample is noise)."""
+    d = np.asarray(d, float)
     if d.size < 2:
         return float(d.mean()) if d.size else 0.0, math.inf
     if strata is None or np.unique(strata).size < 2:
@@ -2244,5 +2243,37 @@ def _gain(cur_mse: np.ndarray, new_mse: np.ndarray, strata: np.ndarray | None = 
         v = float(ds.var(ddof=1)) if ds.size > 1 else float(d.var(ddof=1))
         var += ds.size * v
     return float(d.mean()), math.sqrt(var) / d.size
+
+
+def _gain(cur_mse: np.ndarray, new_mse: np.ndarray, strata: np.ndarray | None = None) -> tuple[float, float]:
+    """Mean fall of the per-block held-out MSE and its standard error (paired over blocks, stratified by
+    ``strata``: :func:`_paired`)."""
+    return _paired(np.asarray(cur_mse, float) - np.asarray(new_mse, float), strata)
+
+
+def _z(mean: float, se: float) -> float:
+    return mean / se if se > 0 and math.isfinite(se) else (math.inf if mean > 0 else 0.0)
+
+
+def _gain_zs(cur_mse: np.ndarray, new_mse: np.ndarray, strata: np.ndarray | None = None) -> tuple[float, float]:
+    """How many standard errors the held-out error falls by over the blocks of cycles: ``(z of the fall of the
+    per-block MSE (:func:`_gain`), z of the fall of its logarithm, paired the same way)``. See :func:`_significant`."""
+    cur, new = np.asarray(cur_mse, float), np.asarray(new_mse, float)
+    tiny = 1e-12 * max(float(np.max(cur, initial=0.0)), float(np.max(new, initial=0.0)), 1e-300)
+    return _z(*_gain(cur, new, strata)), _z(*_paired(np.log((cur + tiny) / (new + tiny)), strata))
+
+
+def _significant(zs: tuple[float, float], z: float) -> bool:
+    """Whether a gain ``zs`` (:func:`_gain_zs`) is beyond the noise: the fall of the MSE by more than ``z`` standard
+    errors, or that of its logarithm by more than ``z +`` :data:`LOG_SCALE_EXTRA_Z`.
+
+    Why the log scale: a block's MSE scales with its misfit, so the plain fall is carried by the blocks with the most
+    (a first cycle that differs, a load cell's limit leaving a few rows of a cycle) and their spread can hide a fall
+    in every block: ``bench-heldout33``'s three-arm backbone, every block's error 2.3-100 times lower with
+    ``relaxation2``, read 1.5 standard errors. On the log scale each block counts by the factor it falls by (5.5 there).
+    It is a second look at one gain, so it must clear more: together the two refuse noise as often as the plain one
+    alone (``tests/model/test_diagnose_gain.py``), and a fall of a few per cent in every block beside one block explained
+    (a stand-in for a first cycle that differs) stays refused as before."""
+    return zs[0] > z or zs[1] > z + LOG_SCALE_EXTRA_Z
 
 
