@@ -35,7 +35,8 @@ Method
    and the best point of a grid over each new parameter's declared range,
    log-spaced for scales). A candidate is **significant** when
    its held-out mean squared error falls by more than ``z`` times the
-   standard error of that fall (paired over the blocks), ``delta BIC`` is
+   standard error of that fall (paired over the blocks), or its logarithm
+   by more than ``z + 1`` (:func:`_significant`), ``delta BIC`` is
    below ``-bic_threshold`` and the fall is a real share of the error above
    the floor. It is **trusted** when its new parameters are off their bounds
    with finite standard errors and the data can resolve them: time
