@@ -306,6 +306,10 @@ HELDOUT32_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 #: value): a toe beside a relaxing backbone, lost motion beside a three-arm backbone, slack beside creep.
 HELDOUT33_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
                    "lag", ("toe", "backbone"), ("lost motion", "backbone3"), ("slack", "creep"), "tracker drift"]
+#: The thirty-fourth fresh held-out batch (issue 19, after a gain judged on the log scale too and a lag confirmed in
+#: one sample tested in another): creep beside a three-arm backbone, a backbone beside slack, a toe beside lost motion.
+HELDOUT34_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
+                   "lag", ("creep", "backbone3"), ("backbone", "slack"), ("toe", "lost motion"), "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -384,12 +388,15 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            # rerun); run once
            "bench-heldout32": (20281205, HELDOUT32_KINDS),
            # drawn once the union's copy held at its off value was settled (bench-heldout32 traced); run once
-           "bench-heldout33": (20281206, HELDOUT33_KINDS)}
+           "bench-heldout33": (20281206, HELDOUT33_KINDS),
+           # drawn once the gain on the log scale and the lag tested in another sample were settled (bench-heldout32 and
+           # 33 traced); run once
+           "bench-heldout34": (20281207, HELDOUT34_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
            "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
-           "bench-heldout32", "bench-heldout33", "bench-sharp"}
+           "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-sharp"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -398,7 +405,7 @@ ROUGH = {"bench-heldout15", "bench-heldout16"}
 ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21",
            "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26",
            "bench-heldout27", "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
-           "bench-heldout32", "bench-heldout33"}
+           "bench-heldout32", "bench-heldout33", "bench-heldout34"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
