@@ -1303,3 +1303,27 @@ def test_a_sample_whose_own_lag_is_unresolved_is_tested_with_the_lag_another_sam
     by_model = {smp: (before, after) for smp, before, after in out.lag.model_rmse_deg}
     assert by_model["S2"][1] < 0.95 * by_model["S2"][0]
     assert any("S2 -12 +- 5 ms, unresolved, corrected by the lag another sample shows" in line for line in out.lines())
+
+
+@pytest.mark.parametrize("s2_lag_ms", [0.0, 60.0])
+def test_a_sample_the_regression_s_split_left_uncorrected_is_tested_against_the_model(tube2, s2_lag_ms):
+    """The regression split the samples' lags (bench-heldout34's lag: S1 52.2 +- 1.4 ms corrected, S2 30.2 +- 1.6,
+    resolved but lowering its residual by less than MIN_FALL, left as it was; one tracker 51 ms late in both). S2's
+    own lag is then tested against the model on its rows, as a lag the regression leaves uncorrected is where the
+    samples agree: corrected where its tracker is late, refused where it is on time."""
+    from camtube.model.diagnose.instruments import Lag, confirm_lag
+
+    prot = Protocol(n_cycles=8, ramp_s=4.0, dwell_s=2.0, rest_s=2.0, first_dwell_s=3.0)
+    benches = (SampleBench(tracker=dc_replace(QUIET, lag_ms=60.0)), SampleBench(tracker=dc_replace(QUIET, lag_ms=s2_lag_ms)))
+    rec = simulate_bench(tube2, benches, prot, Clock(rate_hz=50.0, n_repeats=0), seed=8)
+    ins = check_instruments(rec.data, lag_ms={"S1": 60.0})
+    own = (("S1", 60.0, 1.4, 0.02), ("S2", 35.0, 1.6, 0.001))
+    ins = dc_replace(ins, lag=Lag(45.0, 3.0, fall=0.01, per_sample=(own[0] + (60.0,), own[1] + (0.0,)), own=own))
+    out = confirm_lag(ins, model_for_pattern(tube2), pattern_values(tube2))
+    if s2_lag_ms:
+        applied = {smp: a for smp, _, _, _, a in out.lag.per_sample}
+        assert applied["S1"] == pytest.approx(60.0) and abs(applied["S2"] - s2_lag_ms) <= 20.0 + 1e-9
+        (smp, before, after), = out.lag.model_rmse_deg
+        assert smp == "S2" and after < 0.95 * before
+    else:
+        assert out is ins and out.lag.applied_for("S2") == 0.0
