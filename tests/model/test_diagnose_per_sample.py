@@ -73,16 +73,29 @@ def test_two_samples_with_different_mechanisms_get_each_its_own():
     assert np.isclose(r.rmse, d.final.rmse_deg, rtol=1e-3)
 
 
-def test_samples_that_each_need_a_different_first_effect_are_diagnosed_one_at_a_time():
-    # sample 1: a slack tendon; sample 2: a tendon that creeps under load. Searched together, a stand-in that
-    # serves both samples wins the first round; each sample diagnosed alone shows its own effect, and the
-    # union, each effect held off where its sample does not show it, is the answer
+def test_samples_that_each_need_a_different_first_effect_get_each_effect_in_its_own_sample():
+    # sample 1: a slack tendon; sample 2: a tendon that creeps under load. Until a gain was judged on the log scale too
+    # (issue 19, after bench-heldout33), a stand-in serving both samples won the first round, and each sample
+    # diagnosed alone gave the answer: their union, each effect held off where its sample does not show it (that path
+    # has its own tests below). Now the joint search's per-sample fits reach it: each sample's mechanism is fitted in
+    # its own sample, and the other sample's copy is an order of magnitude smaller there
     _, rec, d = _two_samples(Tendon(slack_mm=0.15), CREEPING)
     assert "slack" in d.recommended and set(d.recommended) & CREEP_FAMILY, d.recommended
     assert d.final.rmse_deg <= 1.15 * rec.floor_deg
-    assert d.held.get("slack.deadband_mm@S2") == 0.0
-    assert any(k.endswith("@S1") and k.split(".")[0] in CREEP_FAMILY for k in d.held)
-    assert any(n.startswith("each sample diagnosed alone: S1 shows slack; S2 shows creep") for n in d.sample_notes)
+    values = {**d.final.params, **d.held}
+
+    def copies(name: str) -> tuple[float, float]:
+        return tuple(float(values.get(f"{name}@{smp}", values.get(name, np.nan))) for smp in ("S1", "S2"))
+
+    slack_s1, slack_s2 = copies("slack.deadband_mm")
+    assert abs(slack_s1 / 0.15 - 1.0) < 0.1 and slack_s2 < 0.1 * slack_s1
+    creep = next(iter(set(d.recommended) & CREEP_FAMILY))
+    size = next(iter(builtin_registry()[creep].off))
+    creep_s1, creep_s2 = copies(f"{creep}.{size}")
+    assert creep_s2 > 0 and creep_s1 < 0.1 * creep_s2
+    assert any(n.startswith("samples differ in slack.deadband_mm") or n.startswith("each sample diagnosed alone: S1 "
+                                                                                   "shows slack")
+               for n in d.sample_notes)
 
 
 def test_a_copy_left_on_the_bound_where_its_effect_is_off_is_held_there():
