@@ -1325,5 +1325,7 @@ def test_a_sample_the_regression_s_split_left_uncorrected_is_tested_against_the_
         assert applied["S1"] == pytest.approx(60.0) and abs(applied["S2"] - s2_lag_ms) <= 20.0 + 1e-9
         (smp, before, after), = out.lag.model_rmse_deg
         assert smp == "S2" and after < 0.95 * before
+        # its own lag, resolved, confirmed by the model (not another sample's)
+        assert any("S2 35 +- 1.6 ms, corrected: read" in line for line in out.lines())
     else:
         assert out is ins and out.lag.applied_for("S2") == 0.0

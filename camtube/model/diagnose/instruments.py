@@ -452,7 +452,7 @@ def _per_sample_lag_line(lg: Lag) -> str:
                 + " (whole rows)")
     by_model = {smp: (a, b) for smp, a, b in lg.model_rmse_deg}
     each = "; ".join(f"{smp} {ms:.3g} +- {se:.2g} ms"
-                     + ((", unresolved, corrected by the lag another sample shows" if abs(applied - ms) > 3 * se
+                     + ((", unresolved, corrected by the lag another sample shows" if not abs(ms) > 3 * se
                          else ", corrected") + f": read {applied:.3g} ms later" if applied else ", none to correct")
                      + (f" (the current model's RMSE in {smp} falls from {by_model[smp][0]:.3f} to "
                         f"{by_model[smp][1]:.3f} deg with it)" if smp in by_model else "")
