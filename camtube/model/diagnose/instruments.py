@@ -422,7 +422,7 @@ class Instruments:
         out.extend(zero_lines(self.zeros, self.rezero))
         lg = self.lag
         if lg.per_sample:
-            out.append(_per_sample_lag_line(lg))
+            out.append(_per_sample_lag_line(lg, self.rates_hz))
         elif lg.given:
             out.append(f"angle lag: {lg.lag_ms:.4g} ms as given (--lag-ms); the angle is read {lg.applied_ms:.4g} ms "
                        "later (whole rows)")
@@ -444,16 +444,18 @@ class Instruments:
         return out
 
 
-def _per_sample_lag_line(lg: Lag) -> str:
-    """The findings' line on a lag that differs between the samples (each corrected on its own)."""
+def _per_sample_lag_line(lg: Lag, rates_hz: Mapping[str, float]) -> str:
+    """The findings' line on a lag that differs between the samples (each corrected on its own; a sample whose own
+    lag is unresolved, :func:`_resolved` at its rate ``rates_hz``, only by the lag another sample shows)."""
     if lg.given:
         return ("angle lag, per sample as given (--lag-ms): "
                 + ", ".join(f"{smp} read {applied:.4g} ms later" for smp, _, _, _, applied in lg.per_sample)
                 + " (whole rows)")
     by_model = {smp: (a, b) for smp, a, b in lg.model_rmse_deg}
     each = "; ".join(f"{smp} {ms:.3g} +- {se:.2g} ms"
-                     + ((", unresolved, corrected by the lag another sample shows" if not abs(ms) > 3 * se
-                         else ", corrected") + f": read {applied:.3g} ms later" if applied else ", none to correct")
+                     + ((", corrected" if _resolved(ms, se, 1e3 / rates_hz[smp] if rates_hz.get(smp) else 0.0)
+                         else ", unresolved, corrected by the lag another sample shows")
+                        + f": read {applied:.3g} ms later" if applied else ", none to correct")
                      + (f" (the current model's RMSE in {smp} falls from {by_model[smp][0]:.3f} to "
                         f"{by_model[smp][1]:.3f} deg with it)" if smp in by_model else "")
                      for smp, ms, se, _, applied in lg.per_sample)
