@@ -578,8 +578,14 @@ def test_a_carriage_held_within_a_gap_that_binds_is_lost_motion_in_the_drive(tub
     assert d.final.rmse_deg <= 1.15 * rec.floor_deg
     gap = [v for k, v in d.final.params.items() if k.startswith("carriage_gap.gap_mm@S1")]
     assert gap and gap[0] == pytest.approx(0.11, rel=0.15), d.final.params
-    refused = {c.effect: c.why for c in d.candidates if "the tendon is taut at rest" in c.why}
-    assert {"relaxation", "relaxation2"} & set(refused), {c.effect: c.why for c in d.candidates}
+    # the joint's resting effects never hold S1's joint bent beside its taut tendon: refused, saying why, or (since an
+    # effect one sample refuses is fitted in the others, after bench-heldout34) held off in S1, far behind the drive
+    first = {c.effect: c for c in d.rounds[0]}
+    for name in ("relaxation", "relaxation2"):
+        c = first[name]
+        held_off = c.held.get(f"{name}.fraction@S1") == 0.0
+        assert "the tendon is taut at rest" in c.why or (
+            held_off and c.heldout_rmse_deg > 2.0 * first["carriage_hold"].heldout_rmse_deg), (name, c.why, c.held)
 
 
 def test_the_joint_resting_bent_by_itself_is_refused_where_the_force_at_rest_stays():

@@ -112,7 +112,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from camtube.model.core.fit import FitResult, fit
-from camtube.model.core.model import Effect, FitError, JointModel, check_reads_chain, form_problem
+from camtube.model.core.model import Effect, FitError, JointModel, check_reads_chain, form_problem, sample_views
 from camtube.model.core.noise import ORDERS
 from camtube.model.core.parallel import map_forked
 from camtube.model.core.registry import Registry, builtin_registry
@@ -1168,6 +1168,51 @@ class Search:
             return {}
         return _copies_off(eff, bad, f.params)
 
+    def _refused(self, eff: Effect, m: JointModel, shared: FitResult, f: FitResult, held: Mapping[str, float]) -> dict:
+        """Per-sample copies of ``eff`` to hold off where the shared version ``shared`` (``eff`` fitted for every
+        sample) is refused in some samples only, as :meth:`_absent` holds them: where the data refuse its form (its
+        ``check``), every copy of each sample whose own rows refuse ``f`` (``eff`` fitted per sample); else every
+        copy of each sample where it takes an effect of the chain's place (:meth:`_crowded`). Empty when ``eff``
+        has no ``off`` values, or when no sample would keep it (``held``: copies already held off)."""
+        if not eff.off:
+            return {}
+        samples = list(self.search.samples)
+        gone = {k.partition("@")[2] for k in held}
+        if eff.check is not None and form_problem(eff, shared.data, shared.predicted, m.effects):
+            pred = np.asarray(f.predicted, float)
+            bad = [smp for smp, sl, sub in sample_views(f.data) if form_problem(eff, sub, pred[sl], m.effects)]
+        else:
+            bad = self._crowded(shared)
+        bad = [smp for smp in bad if smp not in gone]
+        if not bad or len(gone | set(bad)) >= len(samples):
+            return {}
+        return _copies_off(eff, bad, f.params)
+
+    def _crowded(self, shared: FitResult) -> list[str]:
+        """The samples where a candidate, fitted for every sample as ``shared``, takes an effect of the chain's
+        place: an effect of the chain whose parameters the chain's fit resolves and ``shared`` does not (an infinite
+        standard error), which does its work in one sample (switched off, it raises the other samples' RMSE by at
+        most ``min_gain`` of what it raises that sample's): that sample (a joint's relaxation that stands in, in the
+        sample whose carriage its rail holds, for the drive's effect; the candidate's own sample is another)."""
+        ch = self.chain
+        resolved = {n for n, se in ch.fit.stderr.items() if math.isfinite(se)}
+        loose = {n.split("@")[0].partition(".")[0] for n in shared.fitted
+                 if n in resolved and not math.isfinite(shared.stderr.get(n, 0.0))}
+        out = []
+        for e in ch.current.effects:
+            vals = _switched_off(e, ch.fit.params) if e.name in loose else None
+            if vals is None:
+                continue
+            meas = np.asarray(ch.fit.data.angle_deg, float)
+            off = meas - ch.current.predict(ch.fit.data, vals)
+            on = meas - np.asarray(ch.fit.predicted, float)
+            rise = {smp: float(np.sqrt(np.mean(off[sl] ** 2)) - np.sqrt(np.mean(on[sl] ** 2)))
+                    for smp, sl in ch.fit.data.sample_slices()}
+            top = max(rise, key=rise.get)
+            if rise[top] > 0.0 and all(v <= self.settings.min_gain * rise[top] for k, v in rise.items() if k != top):
+                out.append(top)
+        return out
+
     def _faint(self, eff: Effect, m: JointModel, r: FitResult) -> dict:
         """Per-sample copies of ``eff`` to hold off after its refit ``r`` on every row: in each sample where a copy
         is unresolved (on a bound, an infinite standard error) and the effect does at most ``min_gain`` of what it
@@ -1324,8 +1369,17 @@ class Search:
         # in a sample that does not show the effect its copies are not resolved (a time constant on a bound, a
         # stand-in for another effect): the effect fitted in the other samples only
         held = self._absent(eff, m, f2)
+        # where the shared version is refused for what it does in some samples only (its form: a joint resting bent
+        # by itself beside a tendon its carriage holds taut at rest; an effect of the chain whose place it takes
+        # there): held off in those, the effect in the others only
+        refused = self._refused(eff, m, f, f2, held)
+        held = {**held, **refused}
         if held:
-            f3, ho3, mse3 = self._fit_held(m, names, f2.params, ps, eff, {**off, **held})
+            # (where it took the place of another effect in a sample, that effect starts from the chain's values)
+            start = {**f2.params, **self.chain.fit.params} if refused else f2.params
+            f3, ho3, mse3 = self._fit_held(m, names, start, ps, eff, {**off, **held})
+            if refused and not form_problem(eff, f3.data, f3.predicted, m.effects):
+                return f3, ho3, mse3, {**off, **held}   # judged against the chain as any candidate is
             if _significant(_gain_zs(mse, mse3, self.strata), s.z) and f3.bic < f.bic - s.bic_threshold:
                 return f3, ho3, mse3, {**off, **held}
             return None   # a per-sample version with unresolved copies does not replace the shared one
