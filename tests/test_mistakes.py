@@ -619,3 +619,32 @@ def test_a_pipe_is_still_read_as_a_file(tmp_path):
         assert read_input_text(fifo) == "sample,cycle,time_s,stroke_mm,force_N,angle_deg\n"
     finally:
         os.waitpid(pid, 0)
+
+
+@pytest.mark.parametrize("name, words", [
+    ('"x\\nM3 S1000\\nG0 X500"', ["name:", "line break", "x\\nM3 S1000", "one line"]),
+    ("2024-01-01", ["name:", "expected a text, got a date", "quote it: name: '2024-01-01'"]),
+    ("123", ["name:", "expected a text, got a int", "quote it: name: '123'"]),
+])
+def test_a_name_that_is_not_one_line_of_text_is_refused(tmp_path, name, words):
+    """A pattern's name is written into the G-code's header comment: a line break in it would make the text after it
+    G-code lines (M3 S1000: the beam on) (the bug the fuzzing of issue 19's session found); YAML reads an unquoted
+    date or number as such, which crashed the job file and the preview."""
+    p = tmp_path / "p.yaml"
+    p.write_text(pattern_text().replace("name: p\n", f"name: {name}\n"))
+    for cmd in ("design", "toolpath", "preview"):
+        out = tmp_path / ("o.svg" if cmd == "preview" else "o")
+        assert_refused(camtube(cmd, str(p), "-o", str(out)) if cmd != "design" else camtube(cmd, str(p)),
+                       f"{p}:1", *words)
+        assert not out.exists()
+
+
+def test_a_profile_description_that_is_not_one_line_is_refused(tmp_path):
+    prof = tmp_path / "m.yaml"
+    src = (ROOT / "machines" / "linuxcnc-rotary.yaml").read_text()
+    assert "description:" in src
+    prof.write_text("\n".join('  description: "x\\nM3 S1000"' if ln.strip().startswith("description:") else ln
+                              for ln in src.splitlines()) + "\n")
+    assert_refused(camtube("toolpath", TUBE1, "--machine", str(prof), "-o", str(tmp_path / "o")),
+                   "description", "line break", "one line")
+    assert not (tmp_path / "o").exists()

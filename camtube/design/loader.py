@@ -322,6 +322,13 @@ def check_name(r: _Reader, name) -> None:
     if isinstance(name, (dict, list, tuple)):
         r.issue("name", "expected a text", name, "a plain file name (letters, digits, '-', '_', '.')",
                 "write e.g. name: tube2")
+    elif not isinstance(name, str):   # YAML reads name: 2024-01-01 as a date, name: 123 as a number
+        r.issue("name", f"expected a text, got a {type(name).__name__}", name,
+                "a plain file name (letters, digits, '-', '_', '.')", f"quote it: name: '{name}'")
+    elif any(ord(c) < 32 or ord(c) in (127, 0x85, 0x2028, 0x2029) for c in name):
+        r.issue("name", "holds a line break or another control character (it is written into the G-code's and the "
+                "job file's headers)", name,
+                "letters, digits, '-', '_', '.' on one line", "write the name on one line, e.g. name: tube2")
     elif any(c in str(name) for c in "/\\\0") or str(name).strip() in (".", ".."):
         r.issue("name", "names the output files (NAME.ngc, NAME.job.json, ...), so it must be a plain file name",
                 name, "letters, digits, '-', '_', '.'; no '/' or '\\'", "drop the folder part, e.g. name: tube2 "

@@ -29,6 +29,10 @@ from dataclasses import dataclass
 from typing import Any
 
 
+#: Control characters (and Unicode's line and paragraph separators) as spaces: :meth:`Dialect.comment_line`.
+ONE_LINE = {**dict.fromkeys(range(32), " "), 127: " ", 0x85: " ", 0x2028: " ", 0x2029: " "}
+
+
 @dataclass(frozen=True)
 class Dialect:
     """A G-code post-processor, as data: the codes of one G-code family for one machine profile.
@@ -116,7 +120,10 @@ class Dialect:
         return any("pulses_per_mm" in x for x in self.settings)
 
     def comment_line(self, text: str) -> str:
-        """``text`` as a comment line (parentheses removed from paren comments)."""
+        """``text`` as one comment line (parentheses removed from paren comments). A line break or another control
+        character in it (a pattern's name, a profile's description) becomes a space: a comment never ends its line,
+        so no text a user gives can become a G-code line (``M3 S1000`` after a line break in a name)."""
+        text = str(text).translate(ONE_LINE)
         if self.comment == "paren":
             return "(" + text.replace("(", "[").replace(")", "]") + ")"
         return "; " + text

@@ -407,6 +407,10 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
     desc = m.get("description", "")
     if not isinstance(desc, str):
         ck.add("description", "must be text", desc, "text", "quote it")
+    elif any(ord(c) < 32 or ord(c) in (127, 0x85, 0x2028, 0x2029) for c in desc):
+        ck.add("description", "holds a line break or another control character (it is written into the G-code's "
+               "header)", desc, "text on one line",
+               "write the description on one line (a YAML '>' block folds its lines into one)")
     if ck.issues:
         raise PatternError(ck.issues)
     return MachineProfile(

@@ -103,3 +103,17 @@ def test_dialect_is_frozen_data():
     lines = text.splitlines()
     assert lines.count("M3 S2.0") == 352 and "M62 P0" not in lines
     assert isinstance(m3, Dialect)
+
+
+@pytest.mark.parametrize("dialect", list(DIALECTS.values()), ids=lambda d: d.name)
+def test_no_text_a_user_gives_becomes_a_gcode_line(dialect):
+    """A name or description with line breaks (here set past the loader's check, as a DXF file's name reaches it)
+    stays inside its one header comment: the job's lines are those of the plain name, the name's text in one line."""
+    p = load_pattern(PATTERNS / "tube1.yaml")
+    plain = gcode(plan_job(p), dialect).splitlines()
+    evil = gcode(plan_job(dataclasses.replace(p, name="x\nM3 S1000\r\nG0 X500\u2028M5")), dialect).splitlines()
+    assert len(evil) == len(plain)
+    assert all(b.startswith(("(", ";")) for a, b in zip(plain, evil) if a != b)   # only comments differ
+    assert not any(ln.strip() in ("M3 S1000", "G0 X500") for ln in evil)
+    assert "x M3 S1000  G0 X500 M5" in evil[0]
+    assert dialect.comment_line("a\nb\tc\x00d") in ("(a b c d)", "; a b c d")
