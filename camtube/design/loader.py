@@ -226,7 +226,8 @@ class _Reader:
         lo_bad = x <= f.lo if f.lo_open else x < f.lo
         hi_bad = x >= f.hi if f.hi_open else x > f.hi
         if lo_bad or hi_bad:
-            fix = "use a positive value" if f.lo == 0 and f.lo_open else "bring it inside the allowed range"
+            fix = ("use a positive value" if lo_bad and f.lo == 0 and f.lo_open
+                   else f"use a value {'<' if f.hi_open else '<='} {f.hi:g}" if hi_bad else "bring it inside the allowed range")
             self.issue(key, "out of range", v, f.allowed(), fix)
             return None
         return int(x) if integer else x

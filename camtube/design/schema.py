@@ -74,9 +74,11 @@ _RULE_ROW = (
 SCHEMA: dict[str, dict[str, Field]] | dict = {
     "name": Field("str", "", "pattern name (defaults to the file name)", None),
     "tube": {
-        "outer_radius": Field("float", "mm", "outer radius r_o", ..., **POS),
-        "inner_radius": Field("float", "mm", "inner radius r_i (< r_o)", ..., **POS),
-        "length": Field("float", "mm", "length of the modelled segment from the tip", ..., **POS),
+        # (upper bounds far above any tube a rotary stage holds: a radius of 1e103 mm overflowed the geometry, a
+        # length of 1e7 mm wrote a preview of 227 MB)
+        "outer_radius": Field("float", "mm", "outer radius r_o", ..., 0.0, 50.0, True),
+        "inner_radius": Field("float", "mm", "inner radius r_i (< r_o)", ..., 0.0, 50.0, True),
+        "length": Field("float", "mm", "length of the modelled segment from the tip", ..., 0.0, 2000.0, True),
         "material": Field("choice", "", "tube material (sets the strain limit's meaning)", "polyimide",
                           choices=("polyimide", "pebax", "nitinol", "other")),
     },

@@ -36,8 +36,8 @@ _ARC_ROW = (
 GOAL_SCHEMA: dict = {
     "name": Field("str", "", "name of the written pattern (defaults to the goal file's name)", None),
     "tube": {
-        "outer_radius": Field("float", "mm", "outer radius r_o of the stock", ..., **POS),
-        "inner_radius": Field("float", "mm", "inner radius r_i (< r_o)", ..., **POS),
+        "outer_radius": Field("float", "mm", "outer radius r_o of the stock", ..., 0.0, 50.0, True),
+        "inner_radius": Field("float", "mm", "inner radius r_i (< r_o)", ..., 0.0, 50.0, True),
         "material": Field("choice", "", "tube material", "polyimide",
                           choices=("polyimide", "pebax", "nitinol", "other")),
         "modulus_gpa": Field("float", "GPa", "Young's modulus of the tube (default: 2.5 for polyimide)", None, **POS),

@@ -38,7 +38,7 @@ def base_raw():
 CASES = [
     # (overrides, key named, words in the message)
     (["tube.inner_radius=0.8"], "tube.inner_radius", ["smaller than the outer radius", "0.8", "< tube.outer_radius = 0.75"]),
-    (["tube.length=-3"], "tube.length", ["out of range", "-3", "> 0 mm", "positive"]),
+    (["tube.length=-3"], "tube.length", ["out of range", "-3", "> 0 and <= 2000 mm", "positive"]),
     (["notch.width=0"], "notch.width", ["out of range", "> 0 mm"]),
     ([".nan"], None, None),  # placeholder replaced below
     (["notch.arc=.inf"], "notch.arc", ["must be finite"]),
