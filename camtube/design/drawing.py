@@ -29,7 +29,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable
+from typing import Iterable, Sequence
 
 from camtube.design.loader import Loaded, apply_overrides, build_settings, parse_override, read_yaml
 from camtube.design.pattern import Cut, Pattern, drawn, sort_cuts
@@ -447,6 +447,8 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
 def _control_polygon(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
     """A degree-1 SPLINE is its control polygon (closed when the spline is flagged closed or ends where it began)."""
     cps = [tuple(v) for v in entity.control_points]
+    if _not_finite(rd, ent, [c for v in cps for c in v]):
+        return
     zs = [v[2] if len(v) > 2 else 0.0 for v in cps]
     if max(zs) - min(zs) > TOL.gap / rd.factor:
         rd.refuse(ent.describe(), "is not drawn in the XY plane (its z varies by "
@@ -463,6 +465,16 @@ def _control_polygon(rd: _Reading, entity, ent: _Entity, layer: str, role: str) 
     rd.pieces.append(_Piece(pts, closed, [ent], layer, role))
 
 
+def _not_finite(rd: _Reading, ent: _Entity, coords: Sequence[float]) -> bool:
+    """Refuse ``ent`` when one of its coordinates is not a finite number (nan, inf: a damaged file, or one written
+    by a program that failed); True when refused."""
+    if all(math.isfinite(float(c)) for c in coords):
+        return False
+    rd.refuse(ent.describe(), "has a coordinate that is not a finite number (nan or inf)",
+              "redraw or delete it (the file may be damaged: export it again)", entities=[ent])
+    return True
+
+
 def _flatten(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
     from ezdxf import path as ezpath
 
@@ -476,6 +488,8 @@ def _flatten(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
         return
     distance = TOL.chord / rd.factor
     found = False
+    if _not_finite(rd, ent, [c for v in p.control_vertices() for c in v]):
+        return
     for sub in (p.sub_paths() if p.has_sub_paths else [p]):
         vs = list(sub.flattening(distance, segments=4))
         if len(vs) < 2:
