@@ -5,6 +5,7 @@ Writers return text; the command writes files.
 """
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass, replace
 
@@ -40,7 +41,7 @@ def pattern_yaml(design: Design, process: object | None = None) -> str:
         f"# Check: camtube design THIS.yaml --stroke {g.bends[0].stroke_mm:g} --overcut {design.mechanics.kerf_mm:g}"
         + (f" --hinge {design.mechanics.hinge}" if design.mechanics.hinge != "fe_row" else "")
         + (" --calibration FIT.json (the same fit)" if design.mechanics.source != "defaults" else ""),
-        f"name: {p.name}",
+        f"name: {json.dumps(p.name)}",   # quoted: a name YAML would read as a date or a number stays text
         f"tube: {{outer_radius: {_num(t.outer_radius_mm)}, inner_radius: {_num(t.inner_radius_mm)}, "
         f"length: {_num(t.length_mm)}, material: {t.material}}}",
         "notch:",

@@ -231,6 +231,10 @@ def _solve_count_at(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget
     side = np.array([hinge_side_factor(goal.tube.outer_radius_mm, w, mech.hinge) for w in webs])
 
     lim = goal.limits
+    if not grid.s_hi > grid.s_lo:   # the backbone's smallest arc leaves no notch that reaches the lumen
+        return _Fail("limits.min_backbone_arc", f"a notch must reach the lumen (an arc of {grid.s_lo:.3f} mm or more), "
+                     f"and limits.min_backbone_arc = {lim.min_backbone_arc_mm:g} mm (or the process's deepest cut) "
+                     f"leaves at most {grid.s_hi:.3f} mm of the tube's {goal.tube.circumference_mm:.3f} mm", "bend")
     shares = np.array(shares_from_tip(goal, n))
     th = np.radians(target.bend_deg) * shares[::-1]  # base to tip
     wrap = np.cumsum(th) - th

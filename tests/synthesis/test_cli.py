@@ -195,3 +195,29 @@ def test_3d_centerline_mistakes_one_line_each(tmp_path, edit, words):
     r = camtube("synthesize", str(g), "-o", str(tmp_path / "p.yaml"))
     assert_refused(r, str(g), *words)
     assert listing(tmp_path) == ["g.yaml"]
+
+
+def test_a_goal_named_like_a_date_writes_a_pattern_whose_name_stays_text(tmp_path):
+    """The written pattern held ``name: 2024-01-01`` unquoted, which YAML reads back as a date (a traceback in the
+    job file then; refused since): the name is written quoted, and the pattern builds."""
+    goal = tmp_path / "g.yaml"
+    text = (GOALS / "01-tube1-uniform-60.yaml").read_text()
+    goal.write_text("name: '2024-01-01'\n" + "\n".join(ln for ln in text.splitlines() if not ln.startswith("name:")))
+    out = tmp_path / "p.yaml"
+    r = camtube("synthesize", str(goal), "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    assert load_pattern(out).name == "2024-01-01"
+    r = camtube("toolpath", str(out), "-o", str(tmp_path / "job"))
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "job" / "2024-01-01.job.json").is_file()
+
+
+def test_a_backbone_arc_that_leaves_no_notch_is_refused_with_one_line(tmp_path):
+    """limits.min_backbone_arc 4.7 mm on a tube of 4.712 mm circumference leaves no notch arc: the solver's bounds
+    crossed (a scipy traceback). Refused as infeasible, naming the limit."""
+    goal = tmp_path / "g.yaml"
+    goal.write_text((GOALS / "01-tube1-uniform-60.yaml").read_text().replace("min_backbone_arc: 0.3",
+                                                                            "min_backbone_arc: 4.7"))
+    out = tmp_path / "p.yaml"
+    assert_refused(camtube("synthesize", str(goal), "-o", str(out)), "limits.min_backbone_arc", "reach the lumen")
+    assert not out.exists()
