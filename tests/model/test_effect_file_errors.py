@@ -176,3 +176,30 @@ def test_an_effect_or_parameter_name_that_is_not_an_identifier_is_refused(tmp_pa
     for w in words:
         assert w in err, err
     assert not js.exists()
+
+
+# a Param written wrong (its arguments after name, unit): (arguments, words the message must hold)
+PARAMS = [
+    ('0.0, 2.0, "one", "g"', ["init must be a finite number", "'one'"]),
+    ('"0", "2", 1.0, "g"', ["lo and hi must be numbers"]),
+    ('0.0, 2.0, float("nan"), "g"', ["init must be a finite number", "nan"]),
+    ('0.0, 2.0, 1.0, "g", starts=("a",)', ["starts must be a tuple of finite numbers"]),
+    ('0.0, 2.0, lambda d, c: float("nan"), "g"', ["mine.gain", "its init gave nan"]),
+    ('0.0, 2.0, lambda d, c: 1 / 0, "g"', ["mine.gain", "its init function raised ZeroDivisionError"]),
+]
+
+
+@pytest.mark.parametrize("args,words", PARAMS)
+def test_a_param_written_wrong_is_one_line_naming_it(tmp_path, capsys, data_csv, args, words):
+    """Found by fuzzing (issue 19's session): a string or nan init, string bounds, bad starts and an init function that
+    raises or gives nan were tracebacks in the fit."""
+    f = tmp_path / "eff.py"
+    f.write_text(HEAD + "    return x\n\n\nMINE = Effect(name=\"mine\", stage=\"stroke\", params=(Param(\"gain\", \"\", "
+                 + args + "),), apply=_apply)\n", encoding="utf-8")
+    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--effect-file", str(f),
+                 "--effects", "mine"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "Traceback" not in err and len(err.splitlines()) == 1, err
+    assert "eff.py" in err and "fix:" in err, err
+    for w in words:
+        assert w in err, (w, err)

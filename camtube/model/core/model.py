@@ -421,8 +421,25 @@ class JointModel:
         ctx = self.context(data, vals)
         for name, spec in self.param_specs.items():
             if name not in vals:
-                vals[name] = spec.initial(data, ctx)
+                vals[name] = self._initial(name, spec, data, ctx)
         return vals
+
+    def _initial(self, name: str, spec, data: Dataset, ctx) -> float:
+        """``spec.initial``; a user's init function that raises or gives no finite number: one line naming the
+        parameter and its effect's file."""
+        eff = next((e for e in self.effects if name.startswith(e.name + ".")), None)
+        source = eff.source if eff is not None else ""
+        try:
+            v = spec.initial(data, ctx)
+        except Exception as exc:  # noqa: BLE001 - a user's init function may raise anything: report it with its file
+            if not source:
+                raise
+            raise FitError(f"parameter {name!r} ({source}): its init function raised {type(exc).__name__}: {exc}; "
+                           "fix: correct the function, or give a number") from None
+        if not math.isfinite(v):
+            raise FitError(f"parameter {name!r}{f' ({source})' if source else ''}: its init gave {v}, not a finite "
+                           "number; fix: make init give a value between lo and hi") from None
+        return v
 
     def make_params(
         self,
