@@ -648,3 +648,32 @@ def test_a_profile_description_that_is_not_one_line_is_refused(tmp_path):
     assert_refused(camtube("toolpath", TUBE1, "--machine", str(prof), "-o", str(tmp_path / "o")),
                    "description", "line break", "one line")
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("value", ["nan", "inf"])
+def test_a_drawn_coordinate_that_is_not_a_number_is_refused_naming_the_entity(tmp_path, value):
+    """A LINE on a cut layer ending at nan was read as a slit, and the job file then failed with a traceback; one at
+    inf was set aside as of zero length. Both are a damaged drawing: refused, naming the entity."""
+    import ezdxf
+
+    doc = ezdxf.new(units=4)
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0.0, 0.0), (10.0, 0.0), (10.0, 4.712389), (0.0, 4.712389)], close=True,
+                       dxfattribs={"layer": "OUTLINE"})   # the unrolled tube, r_o 0.75 mm
+    msp.add_lwpolyline([(1.0, 0.5), (1.5, 0.5), (1.5, 3.3), (1.0, 3.3)], close=True, dxfattribs={"layer": "NOTCH"})
+    msp.add_line((3.0, 1.0), (float(value), 2.0), dxfattribs={"layer": "SLIT"})
+    path = tmp_path / "d.dxf"
+    doc.saveas(path)
+    for cmd in ("design", "toolpath"):
+        args = [cmd, str(path)] + (["-o", str(tmp_path / "o")] if cmd == "toolpath" else [])
+        assert_refused(camtube(*args), "d.dxf", "LINE", "on layer SLIT", "not a finite number")
+    assert listing(tmp_path) == ["d.dxf"]
+
+
+def test_a_tube_far_larger_than_any_stage_holds_is_refused_not_overflowed(tmp_path):
+    """A radius of 1e103 mm overflowed the geometry (a traceback); the tube's sizes have an upper bound now."""
+    assert_refused(camtube("design", TUBE1, "--set", "tube.outer_radius=1e103"), "tube.outer_radius",
+                   "<= 50 mm", "fix: use a value <= 50")
+    assert_refused(camtube("preview", TUBE1, "--set", "tube.length=1e9", "-o", str(tmp_path / "p.svg")),
+                   "tube.length", "fix: use a value <= 2000")
+    assert listing(tmp_path) == []
