@@ -7,6 +7,15 @@ from __future__ import annotations
 
 import math
 
+#: Control characters (and Unicode's line and paragraph separators) as spaces: :func:`one_line`.
+ONE_LINE = {**dict.fromkeys(range(32), " "), 127: " ", 0x85: " ", 0x2028: " ", 0x2029: " "}
+
+
+def one_line(text: str) -> str:
+    """``text`` with every line break and other control character as a space: text a user gives (a pattern's name,
+    a profile's description) that is written into a one-line header (a G-code comment) stays on its line."""
+    return str(text).translate(ONE_LINE)
+
 
 def hms(seconds: float) -> str:
     """``h:mm:ss`` of ``seconds`` (rounded to the nearest second; hours are not wrapped at 24).

@@ -21,6 +21,7 @@ from camtube.design.generate import notch_row
 from camtube.design.pattern import Pattern, Process, RepeatRule, Rules, Tendon, Tube, hole, notch, sort_cuts
 from camtube.design.schema import SCHEMA, Field
 from camtube.errors import Issue, PatternError
+from camtube.fmt import one_line
 from camtube.yamltext import NumberTooLongError, closest, line_map, parse_yaml, read_yaml_file
 
 #: The shipped presets (package data): tube patterns and the process files they name.
@@ -227,7 +228,8 @@ class _Reader:
         hi_bad = x >= f.hi if f.hi_open else x > f.hi
         if lo_bad or hi_bad:
             fix = ("use a positive value" if lo_bad and f.lo == 0 and f.lo_open
-                   else f"use a value {'<' if f.hi_open else '<='} {f.hi:g}" if hi_bad else "bring it inside the allowed range")
+                   else f"use a value {'<' if f.hi_open else '<='} {f.hi:g}" if hi_bad
+                   else "bring it inside the allowed range")
             self.issue(key, "out of range", v, f.allowed(), fix)
             return None
         return int(x) if integer else x
@@ -326,7 +328,7 @@ def check_name(r: _Reader, name) -> None:
     elif not isinstance(name, str):   # YAML reads name: 2024-01-01 as a date, name: 123 as a number
         r.issue("name", f"expected a text, got a {type(name).__name__}", name,
                 "a plain file name (letters, digits, '-', '_', '.')", f"quote it: name: '{name}'")
-    elif any(ord(c) < 32 or ord(c) in (127, 0x85, 0x2028, 0x2029) for c in name):
+    elif one_line(name) != name:
         r.issue("name", "holds a line break or another control character (it is written into the G-code's and the "
                 "job file's headers)", name,
                 "letters, digits, '-', '_', '.' on one line", "write the name on one line, e.g. name: tube2")

@@ -28,9 +28,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-
-#: Control characters (and Unicode's line and paragraph separators) as spaces: :meth:`Dialect.comment_line`.
-ONE_LINE = {**dict.fromkeys(range(32), " "), 127: " ", 0x85: " ", 0x2028: " ", 0x2029: " "}
+from camtube.fmt import one_line
 
 
 @dataclass(frozen=True)
@@ -123,7 +121,7 @@ class Dialect:
         """``text`` as one comment line (parentheses removed from paren comments). A line break or another control
         character in it (a pattern's name, a profile's description) becomes a space: a comment never ends its line,
         so no text a user gives can become a G-code line (``M3 S1000`` after a line break in a name)."""
-        text = str(text).translate(ONE_LINE)
+        text = one_line(text)
         if self.comment == "paren":
             return "(" + text.replace("(", "[").replace(")", "]") + ")"
         return "; " + text

@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from camtube.errors import Issue, PatternError
+from camtube.fmt import one_line
 from camtube.yamltext import closest, line_map, read_yaml_file
 
 #: Folder of the shipped profiles (package data; ``machines/`` at the top of the repository links to it).
@@ -407,7 +408,7 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
     desc = m.get("description", "")
     if not isinstance(desc, str):
         ck.add("description", "must be text", desc, "text", "quote it")
-    elif any(ord(c) < 32 or ord(c) in (127, 0x85, 0x2028, 0x2029) for c in desc):
+    elif one_line(desc) != desc:
         ck.add("description", "holds a line break or another control character (it is written into the G-code's "
                "header)", desc, "text on one line",
                "write the description on one line (a YAML '>' block folds its lines into one)")

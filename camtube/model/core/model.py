@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import inspect
 import math
+import numbers
 import struct
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -239,6 +240,7 @@ class Effect:
                 raise ValueError(f"effect {self.name!r}: two parameters are named {q.name!r}; fix: give each Param "
                                  "a name of its own")
             seen.add(q.name)
+            _check_param_values(self.name, q)
             if q.lo != q.lo or q.hi != q.hi:  # NaN: every comparison with it is false, no bound would hold
                 raise ValueError(f"effect {self.name!r}: parameter {q.name!r} has a NaN bound (lo {q.lo:g}, hi "
                                  f"{q.hi:g}); fix: give numbers (Param(name, unit, lo, hi, init))")
@@ -258,6 +260,23 @@ class Effect:
 
     def full_names(self) -> tuple[str, ...]:
         return tuple(f"{self.name}.{p.name}" for p in self.params)
+
+
+def _check_param_values(effect: str, q: Param) -> None:
+    """A Param's bounds numbers, its ``init`` a finite number or a function, its ``starts`` finite numbers: a user's
+    effect file writes these, and a wrong one is refused here (the loader names its file and line), not as a
+    traceback in a fit. (A nan bound and lo > hi: :class:`Effect`'s own checks, after this.)"""
+    def number(x) -> bool:
+        return isinstance(x, numbers.Real) and not isinstance(x, bool)
+
+    where = f"effect {effect!r}: parameter {q.name!r}"
+    if not (number(q.lo) and number(q.hi)):
+        raise ValueError(f"{where}: lo and hi must be numbers, got {q.lo!r} and {q.hi!r}; fix: give numbers "
+                         "(Param(name, unit, lo, hi, init))")
+    if not (callable(q.init) or (number(q.init) and math.isfinite(float(q.init)))):
+        raise ValueError(f"{where}: init must be a finite number or a function of the data, got {q.init!r}")
+    if not (isinstance(q.starts, (tuple, list)) and all(number(v) and math.isfinite(float(v)) for v in q.starts)):
+        raise ValueError(f"{where}: starts must be a tuple of finite numbers, got {q.starts!r}")
 
 
 #: Base parameters (no prefix). ``E_t`` is fitted by default.
@@ -427,17 +446,20 @@ class JointModel:
     def _initial(self, name: str, spec, data: Dataset, ctx) -> float:
         """``spec.initial``; a user's init function that raises or gives no finite number: one line naming the
         parameter and its effect's file."""
-        eff = next((e for e in self.effects if name.startswith(e.name + ".")), None)
-        source = eff.source if eff is not None else ""
+        def source() -> str:   # (looked up only for the message: this runs for every parameter of every fit)
+            eff = next((e for e in self.effects if name.startswith(e.name + ".")), None)
+            return eff.source if eff is not None else ""
+
         try:
             v = spec.initial(data, ctx)
         except Exception as exc:  # noqa: BLE001 - a user's init function may raise anything: report it with its file
-            if not source:
+            if not source():
                 raise
-            raise FitError(f"parameter {name!r} ({source}): its init function raised {type(exc).__name__}: {exc}; "
+            raise FitError(f"parameter {name!r} ({source()}): its init function raised {type(exc).__name__}: {exc}; "
                            "fix: correct the function, or give a number") from None
         if not math.isfinite(v):
-            raise FitError(f"parameter {name!r}{f' ({source})' if source else ''}: its init gave {v}, not a finite "
+            src = source()
+            raise FitError(f"parameter {name!r}{f' ({src})' if src else ''}: its init gave {v}, not a finite "
                            "number; fix: make init give a value between lo and hi") from None
         return v
 

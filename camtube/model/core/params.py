@@ -19,7 +19,6 @@ The tendon defaults and compliance are written here once:
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass, field, replace
 from typing import Callable, Iterable, Iterator, Mapping
 
@@ -71,21 +70,6 @@ class Param:
     log: bool = False
     starts: tuple = ()
     kind: str = ""
-
-    def __post_init__(self) -> None:
-        # a user's effect file writes these: a wrong type or a nan is refused where the Param is made (its file and
-        # line reported by the loader), not as a traceback in a fit
-        def number(x) -> bool:   # (a nan bound is the Effect's to refuse, naming the effect)
-            return isinstance(x, numbers.Real) and not isinstance(x, bool)
-
-        where = f"Param {self.name!r}"
-        if not (number(self.lo) and number(self.hi)):
-            raise ValueError(f"{where}: lo and hi must be numbers, got {self.lo!r} and {self.hi!r}")
-        if not (callable(self.init) or (number(self.init) and math.isfinite(float(self.init)))):
-            raise ValueError(f"{where}: init must be a finite number or a function of the data, got {self.init!r}")
-        if not (isinstance(self.starts, (tuple, list)) and all(number(v) and math.isfinite(float(v))
-                                                                for v in self.starts)):
-            raise ValueError(f"{where}: starts must be a tuple of finite numbers, got {self.starts!r}")
 
     def at_sharp_limit(self, value: float) -> bool:
         """``value`` is this parameter's sharp limit: a parameter of kind ``sharp`` on (within 1e-6 of) its lower

@@ -1178,7 +1178,7 @@ class Search:
             return {}
         samples = list(self.search.samples)
         gone = {k.partition("@")[2] for k in held}
-        if eff.check is not None and form_problem(eff, shared.data, shared.predicted, m.effects):
+        if form_problem(eff, shared.data, shared.predicted, m.effects):
             pred = np.asarray(f.predicted, float)
             bad = [smp for smp, sl, sub in sample_views(f.data) if form_problem(eff, sub, pred[sl], m.effects)]
         else:
@@ -1198,16 +1198,17 @@ class Search:
         resolved = {n for n, se in ch.fit.stderr.items() if math.isfinite(se)}
         loose = {n.split("@")[0].partition(".")[0] for n in shared.fitted
                  if n in resolved and not math.isfinite(shared.stderr.get(n, 0.0))}
+        data = ch.fit.data
+        meas = np.asarray(data.angle_deg, float)
+        on = meas - np.asarray(ch.fit.predicted, float)
+        fitted = {smp: float(np.sqrt(np.mean(on[sl] ** 2))) for smp, sl in data.sample_slices()}
         out = []
         for e in ch.current.effects:
             vals = _switched_off(e, ch.fit.params) if e.name in loose else None
             if vals is None:
                 continue
-            meas = np.asarray(ch.fit.data.angle_deg, float)
-            off = meas - ch.current.predict(ch.fit.data, vals)
-            on = meas - np.asarray(ch.fit.predicted, float)
-            rise = {smp: float(np.sqrt(np.mean(off[sl] ** 2)) - np.sqrt(np.mean(on[sl] ** 2)))
-                    for smp, sl in ch.fit.data.sample_slices()}
+            off = meas - ch.current.predict(data, vals)
+            rise = {smp: float(np.sqrt(np.mean(off[sl] ** 2))) - fitted[smp] for smp, sl in data.sample_slices()}
             top = max(rise, key=rise.get)
             if rise[top] > 0.0 and all(v <= self.settings.min_gain * rise[top] for k, v in rise.items() if k != top):
                 out.append(top)
