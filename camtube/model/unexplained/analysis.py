@@ -6,7 +6,7 @@ arrays (it does not depend on how the model was built or fitted):
 ``residual_deg`` (n,)
     measured - model angle of the final model, deg.
 ``variables``
-    ``stroke`` (mm, motor stroke), ``angle`` (deg, measured), ``force`` (N),
+    ``stroke`` (mm, motor stroke), ``angle`` (deg: the model's, see :func:`variables_of`), ``force`` (N),
     ``direction`` (+1 loading, -1 unloading), ``cycle``, ``time`` (s since the
     sample's start), ``sample`` (ids); ``first_cycle`` is derived (each
     sample's first cycle) when absent. Rows of one sample in time order.
@@ -99,9 +99,17 @@ def first_cycle_mask(sample: np.ndarray, cycle: np.ndarray) -> np.ndarray:
     return out
 
 
-def variables_of(data) -> dict[str, np.ndarray]:
-    """The variables :func:`analyse` reads, from a :class:`~camtube.model.data.dataset.Dataset`-like object."""
-    return {"stroke": np.asarray(data.stroke_mm, float), "angle": np.asarray(data.angle_deg, float),
+def variables_of(data, residual_deg=None) -> dict[str, np.ndarray]:
+    """The variables :func:`analyse` reads, from a :class:`~camtube.model.data.dataset.Dataset`-like object.
+
+    With ``residual_deg`` (n,), a model's residual, the bend angle is that model's (measured - residual), as the
+    analysis of a diagnosis reads it (the model it starts from): the measured angle holds the residual's own noise and
+    any drift of the tracker's zero, so where the model is flat (the rests, the dwells) bins of it sort the residual
+    by itself, and a drift in time reads as following the angle (``bench-heldout35``'s tracker drift)."""
+    angle = np.asarray(data.angle_deg, float)
+    if residual_deg is not None:
+        angle = angle - np.asarray(residual_deg, float)
+    return {"stroke": np.asarray(data.stroke_mm, float), "angle": angle,
             "force": np.asarray(data.force_N, float), "direction": np.asarray(data.direction, int),
             "cycle": np.asarray(data.cycle, int), "time": np.asarray(data.time_s, float),
             "sample": np.asarray(data.sample).astype(str)}

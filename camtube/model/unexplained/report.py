@@ -26,7 +26,10 @@ def of_diagnosis(d) -> dict | None:
     # but not recommended because the error stays above the floor), else after the recommended ones
     steps = getattr(d, "partial_steps", ())
     residual = steps[-1].residuals if getattr(d, "partial", ()) and steps else d.final.residuals
-    u = analyse(residual, variables_of(d.data), d.noise_floor_deg)
+    # the bend angle it is read against: the model's the diagnosis starts from (with its baseline), noise-free and
+    # smooth in the stroke and force; a partial chain's may be flattened by an effect of the wrong form (a hardstop
+    # took the angle's lead to the stroke on the arm that changes with the angle)
+    u = analyse(residual, variables_of(d.data, d.waterfall[0].residuals), d.noise_floor_deg)
     if cache is not None:
         cache.set("unexplained", u)
     return u
