@@ -11,7 +11,8 @@ outputs too large to hold); this layer puts them on disk.
   job file). The set is written into a sibling staging directory; a new output
   directory is then renamed into place, an existing one is swapped with it in
   one ``renameat2(RENAME_EXCHANGE)`` call (Linux), keeping the entries of the
-  old directory that the new set does not replace.
+  old directory that the new set does not replace. An output directory given as
+  a symbolic link gets the set in the folder it links to; the link is kept.
 - :func:`write_together`: the outputs of one command that go to different places
   (``--json`` and ``--plot``, a CSV and a ``--report`` folder): every file and
   set is staged first, then all are published, or none (a file already
@@ -307,7 +308,8 @@ def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload]) -> list[P
     ----------
     outdir : path
         Output directory; created if missing. Entries already in it that the
-        set does not replace are kept.
+        set does not replace are kept. A symbolic link to a directory is
+        followed: the set goes into the directory, the link stays.
     files : mapping of file name -> str | bytes | iterable of chunks
         File names relative to ``outdir`` (no sub-directories). Iterables are
         consumed once, chunk by chunk, so a large output is never held whole.
@@ -380,6 +382,15 @@ def _keep_old(path: Path) -> Path | None:
     return keep
 
 
+def _followed(out: Path) -> Path:
+    """The folder a set given as ``out`` goes into: ``out``, or the folder it links to when it is a symbolic link.
+
+    A link to the output folder is the user's way of naming it (``-o current -> jobs/2024-05``): the set is written
+    into the folder the link names, and the link is kept (the swap would otherwise replace the link itself).
+    """
+    return Path(os.path.realpath(out)) if out.is_symlink() else out
+
+
 def _check_apart(targets: list[Path], is_set: list[bool]) -> None:
     """Refuse two outputs at one path, or an output inside another output that is a file."""
     where = [Path(os.path.normpath(t.absolute())) for t in targets]
@@ -438,7 +449,7 @@ def write_together(outputs) -> list:
         for i in order:
             path, data = outputs[i]
             if is_set[i]:
-                _stage_set(path, data, staged)
+                _stage_set(_followed(path), data, staged)
             else:
                 _stage_file(path, data, staged)
         try:
@@ -446,7 +457,7 @@ def write_together(outputs) -> list:
                 for i, tmp in zip(order, staged):
                     path, data = outputs[i]
                     if is_set[i]:
-                        leftover = _swap_in(tmp, path, data)
+                        leftover = _swap_in(tmp, _followed(path), data)
                         results[i] = [path / name for name in data]
                     else:
                         done.append((path, _keep_old(path)))
