@@ -66,25 +66,47 @@ class PublishedInterrupt(KeyboardInterrupt):
         self.paths = list(paths)
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (``kill``, a job scheduler, a closed session) arrived: the command stops as for Ctrl-C.
+
+    A ``KeyboardInterrupt``, so that every clean-up that Ctrl-C runs (staging folders and temporary
+    files removed, nothing half-published) runs for it too. Raised by :func:`raise_terminated`, the
+    SIGTERM handler the command line installs.
+    """
+
+
+def raise_terminated(signum, frame) -> None:
+    """SIGTERM handler: raise :class:`Terminated` in the main thread, where the command runs."""
+    raise Terminated()
+
+
 @contextmanager
 def _uninterrupted():
-    """Hold Ctrl-C (SIGINT) back while the body runs; one that came meanwhile is raised at the end.
+    """Hold Ctrl-C (SIGINT) and SIGTERM back while the body runs; one that came meanwhile is raised at the end.
 
-    The Python-level handler is swapped for one that only notes the signal (whichever thread the
-    operating system delivered it to, Python runs handlers in the main thread), then put back and
-    called. Only in the main thread, where handlers can be set; elsewhere the body runs as is.
+    Each signal with a Python-level handler (SIGINT's default raises ``KeyboardInterrupt``, the command
+    line's SIGTERM handler :class:`Terminated`) has it swapped for one that only notes the signal
+    (whichever thread the operating system delivered it to, Python runs handlers in the main thread),
+    then put back and called. Only in the main thread, where handlers can be set; elsewhere the body
+    runs as is.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     noted: list[tuple[int, object]] = []
-    old = signal.signal(signal.SIGINT, lambda signum, frame: noted.append((signum, frame)))
+    old = {}
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        handler = signal.getsignal(signum)
+        if callable(handler):
+            old[signum] = signal.signal(signum, lambda signum, frame: noted.append((signum, frame)))
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, old)
-        if noted and callable(old):
-            old(*noted[0])  # the default handler raises KeyboardInterrupt here
+        for signum, handler in old.items():
+            signal.signal(signum, handler)
+        if noted:
+            signum, frame = noted[0]
+            old[signum](signum, frame)  # raises KeyboardInterrupt (or Terminated) here
 
 
 class OutputError(CamtubeError, OSError):
