@@ -11,7 +11,12 @@ outputs too large to hold); this layer puts them on disk.
   job file). The set is written into a sibling staging directory; a new output
   directory is then renamed into place, an existing one is swapped with it in
   one ``renameat2(RENAME_EXCHANGE)`` call (Linux), keeping the entries of the
-  old directory that the new set does not replace.
+  old directory that the new set does not replace. An output directory given as
+  a symbolic link gets the set in the folder it links to; the link is kept.
+- :func:`write_together`: the outputs of one command that go to different places
+  (``--json`` and ``--plot``, a CSV and a ``--report`` folder): every file and
+  set is staged first, then all are published, or none (a file already
+  published is put back as it was when a later one fails).
 
 Every failure to write is raised as :class:`OutputError`, which names the path,
 the reason and the fix.
@@ -61,25 +66,47 @@ class PublishedInterrupt(KeyboardInterrupt):
         self.paths = list(paths)
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (``kill``, a job scheduler, a closed session) arrived: the command stops as for Ctrl-C.
+
+    A ``KeyboardInterrupt``, so that every clean-up that Ctrl-C runs (staging folders and temporary
+    files removed, nothing half-published) runs for it too. Raised by :func:`raise_terminated`, the
+    SIGTERM handler the command line installs.
+    """
+
+
+def raise_terminated(signum, frame) -> None:
+    """SIGTERM handler: raise :class:`Terminated` in the main thread, where the command runs."""
+    raise Terminated()
+
+
 @contextmanager
 def _uninterrupted():
-    """Hold Ctrl-C (SIGINT) back while the body runs; one that came meanwhile is raised at the end.
+    """Hold Ctrl-C (SIGINT) and SIGTERM back while the body runs; one that came meanwhile is raised at the end.
 
-    The Python-level handler is swapped for one that only notes the signal (whichever thread the
-    operating system delivered it to, Python runs handlers in the main thread), then put back and
-    called. Only in the main thread, where handlers can be set; elsewhere the body runs as is.
+    Each signal with a Python-level handler (SIGINT's default raises ``KeyboardInterrupt``, the command
+    line's SIGTERM handler :class:`Terminated`) has it swapped for one that only notes the signal
+    (whichever thread the operating system delivered it to, Python runs handlers in the main thread),
+    then put back and called. Only in the main thread, where handlers can be set; elsewhere the body
+    runs as is.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     noted: list[tuple[int, object]] = []
-    old = signal.signal(signal.SIGINT, lambda signum, frame: noted.append((signum, frame)))
+    old = {}
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        handler = signal.getsignal(signum)
+        if callable(handler):
+            old[signum] = signal.signal(signum, lambda signum, frame: noted.append((signum, frame)))
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, old)
-        if noted and callable(old):
-            old(*noted[0])  # the default handler raises KeyboardInterrupt here
+        for signum, handler in old.items():
+            signal.signal(signum, handler)
+        if noted:
+            signum, frame = noted[0]
+            old[signum](signum, frame)  # raises KeyboardInterrupt (or Terminated) here
 
 
 class OutputError(CamtubeError, OSError):
@@ -303,7 +330,8 @@ def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload]) -> list[P
     ----------
     outdir : path
         Output directory; created if missing. Entries already in it that the
-        set does not replace are kept.
+        set does not replace are kept. A symbolic link to a directory is
+        followed: the set goes into the directory, the link stays.
     files : mapping of file name -> str | bytes | iterable of chunks
         File names relative to ``outdir`` (no sub-directories). Iterables are
         consumed once, chunk by chunk, so a large output is never held whole.
@@ -319,8 +347,11 @@ def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload]) -> list[P
         ``outdir`` cannot be created or written (it names a file, the location is
         read-only, ...); nothing of the new set is visible then.
     """
-    _not_empty(outdir, "directory")
-    out = Path(outdir)
+    return write_together([(outdir, files)])[0]
+
+
+def _check_set(out: Path, files: Mapping[str, Payload]) -> None:
+    """Refuse, before anything is written, a set :func:`_stage_set` could not publish into ``out``."""
     if out.exists() and not out.is_dir():
         raise OutputError(out, "a file of that name exists", "name a directory (new or existing), not a file")
     for name in files:
@@ -330,30 +361,155 @@ def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload]) -> list[P
             # the swap would replace the folder and everything in it with the new file
             raise OutputError(out / name, "a folder of that name is in the way of the output file",
                               "move or rename the folder, or choose another output directory")
+
+
+def _stage_set(out: Path, files: Mapping[str, Payload], staged: list) -> None:
+    """Write ``files`` into a new staging folder beside ``out``, noted in ``staged`` as soon as it exists."""
     parent = out.absolute().parent
-    stage = None
+    parent.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".staging", dir=parent))
+    staged.append(stage)
+    for name, data in files.items():
+        with open(stage / name, "wb") as fh:
+            _write_payload(fh, data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(stage / name, 0o666 & ~_umask())
+
+
+def _stage_file(path: Path, data: Payload, staged: list) -> None:
+    """Write ``data`` into a temporary file beside ``path``, noted in ``staged`` as soon as it exists."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    staged.append(Path(tmp))
+    with os.fdopen(fd, "wb") as fh:
+        _write_payload(fh, data)
+        fh.flush()
+        os.fsync(fh.fileno())
+
+
+def _keep_old(path: Path) -> Path | None:
+    """A hard link (or copy) of the file at ``path`` in a new hidden folder beside it, to put back; None if none."""
+    if not os.path.lexists(path):
+        return None
+    keep = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".old", dir=path.parent))
+    try:
+        if path.is_symlink():
+            os.symlink(os.readlink(path), keep / path.name)
+        else:
+            _link_or_copy(path, keep / path.name)
+    except BaseException:
+        shutil.rmtree(keep, ignore_errors=True)
+        raise
+    return keep
+
+
+def _followed(out: Path) -> Path:
+    """The folder a set given as ``out`` goes into: ``out``, or the folder it links to when it is a symbolic link.
+
+    A link to the output folder is the user's way of naming it (``-o current -> jobs/2024-05``): the set is written
+    into the folder the link names, and the link is kept (the swap would otherwise replace the link itself).
+    """
+    return Path(os.path.realpath(out)) if out.is_symlink() else out
+
+
+def _check_apart(targets: list[Path], is_set: list[bool]) -> None:
+    """Refuse two outputs at one path, or an output inside another output that is a file."""
+    where = [Path(os.path.normpath(t.absolute())) for t in targets]
+    for i, a in enumerate(where):
+        for j, b in enumerate(where):
+            if i == j:
+                continue
+            if a == b and i < j:
+                raise OutputError(targets[j], f"it is also the path of another output ({targets[i]})",
+                                  "give each output a path of its own")
+            if not is_set[j] and b in a.parents:
+                raise OutputError(targets[i], f"it lies inside {targets[j]}, which is written as a file",
+                                  f"give it a path outside {targets[j]}")
+
+
+def write_together(outputs) -> list:
+    """Write the outputs of one command (files and sets, in different places) all together or not at all.
+
+    Parameters
+    ----------
+    outputs : sequence of (path, payload)
+        A payload that is a mapping of file name -> payload is a set, written into the directory ``path`` as
+        :func:`write_set` does (at most one set, published last); any other payload is one file at ``path``.
+
+    Returns
+    -------
+    list
+        Per output, in the order given: the file's ``Path``, or the list of a set's paths.
+
+    Raises
+    ------
+    OutputError
+        An output cannot be written; nothing new is visible then: files already published are put back
+        as they were.
+    """
+    is_set = [isinstance(data, Mapping) for _, data in outputs]
+    if sum(is_set) > 1:
+        raise ValueError("write_together: at most one set of files")
+    for (path, _), s in zip(outputs, is_set):
+        _not_empty(path, "directory" if s else "file")  # (before Path(''), which is '.')
+    outputs = [(Path(p), data) for p, data in outputs]
+    for (path, data), s in zip(outputs, is_set):
+        if s:
+            _check_set(path, data)
+        else:
+            _check_file_target(path)
+    _check_apart([p for p, _ in outputs], is_set)
+    order = [i for i, s in enumerate(is_set) if not s] + [i for i, s in enumerate(is_set) if s]
+    staged: list[Path] = []       # temporary files and staging folders, in the order of ``order``
+    done: list[tuple[Path, Path | None]] = []   # files published: (path, the folder keeping the old file)
+    leftover: Path | None = None
+    results: list = [None] * len(outputs)
+    path = outputs[order[0]][0] if outputs else None
     published = False
     try:
-        parent.mkdir(parents=True, exist_ok=True)
-        stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".staging", dir=parent))
-        for name, data in files.items():
-            with open(stage / name, "wb") as fh:
-                _write_payload(fh, data)
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.chmod(stage / name, 0o666 & ~_umask())
-        paths = [out / name for name in files]
+        for i in order:
+            path, data = outputs[i]
+            if is_set[i]:
+                _stage_set(_followed(path), data, staged)
+            else:
+                _stage_file(path, data, staged)
         try:
-            with _uninterrupted():  # the swap runs whole: a Ctrl-C now is answered once it is done
-                stage = _swap_in(stage, out, files)
+            with _uninterrupted():  # publishing runs whole: a Ctrl-C now is answered once it is done
+                for i, tmp in zip(order, staged):
+                    path, data = outputs[i]
+                    if is_set[i]:
+                        leftover = _swap_in(tmp, _followed(path), data)
+                        results[i] = [path / name for name in data]
+                    else:
+                        done.append((path, _keep_old(path)))
+                        _publish(str(tmp), path)
+                        results[i] = path
                 published = True
         except KeyboardInterrupt:
             if published:
-                raise PublishedInterrupt(paths) from None
+                raise PublishedInterrupt([q for r in results for q in (r if isinstance(r, list) else [r])]) from None
             raise
-        return paths
+        return results
     except OSError as exc:
-        raise output_error(out, exc) from None
+        raise output_error(path, exc) from None
     finally:
-        if stage is not None and stage.exists():
-            shutil.rmtree(stage, ignore_errors=True)
+        if not published:
+            for target, keep in reversed(done):   # put back what was there before
+                try:
+                    if keep is not None:
+                        os.replace(keep / target.name, target)
+                    else:
+                        os.unlink(target)
+                except OSError:
+                    pass
+        for tmp in staged:
+            if tmp.is_dir() and not tmp.is_symlink():
+                shutil.rmtree(tmp, ignore_errors=True)
+            else:
+                _discard(str(tmp))
+        for _, keep in done:
+            if keep is not None:
+                shutil.rmtree(keep, ignore_errors=True)
+        if leftover is not None and leftover.exists():
+            shutil.rmtree(leftover, ignore_errors=True)

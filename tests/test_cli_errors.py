@@ -119,6 +119,47 @@ def test_ctrl_c_exits_130_and_publishes_nothing(tmp_path):
     assert listing(tmp_path) == []
 
 
+def test_sigterm_while_the_set_is_written_exits_143_and_leaves_no_staging(tmp_path):
+    """Bug 27: SIGTERM (kill, a scheduler) while the G-code was being written into ``.big.*.staging`` ended
+    the process at once and left the staging folder behind. Now it cleans up as Ctrl-C does."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    p = subprocess.Popen([sys.executable, "-m", "camtube", "toolpath", TUBE1, "--set", "notch.count=300",
+                          "--set", "tube.length=310", "-o", str(tmp_path / "big"), "-q"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, env=env)
+    deadline = time.monotonic() + 60
+    while not any(n.endswith(".staging") for n in os.listdir(tmp_path)):
+        assert p.poll() is None and time.monotonic() < deadline, "the set was never staged while the command ran"
+        time.sleep(0.02)
+    p.send_signal(signal.SIGTERM)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 143, (p.returncode, err)
+    assert "Traceback" not in err and err.strip().splitlines() == [
+        "camtube: terminated (SIGTERM); no output of this command was published"]
+    assert listing(tmp_path) == []
+
+
+def test_sigterm_during_the_swap_is_held_until_the_set_is_whole(tmp_path):
+    """Bug 27: SIGTERM in the middle of the swap waits for it, like Ctrl-C: the set is published whole, exit 0."""
+    script = (
+        "import os, signal, sys\n"
+        "import camtube.io as io\n"
+        "from camtube.commands import main\n"
+        "swap = io._swap_in\n"
+        "def terminated_swap(stage, out, files):\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)\n"
+        "    return swap(stage, out, files)\n"
+        "io._swap_in = terminated_swap\n"
+        "sys.exit(main(sys.argv[1:]))\n")
+    (tmp_path / "o").mkdir()
+    (tmp_path / "o" / "notes.txt").write_text("mine")
+    r = subprocess.run([sys.executable, "-c", script, "toolpath", TUBE1, "-o", str(tmp_path / "o"), "-q"],
+                       capture_output=True, text=True, timeout=120, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert r.returncode == 0, (r.returncode, r.stderr)
+    assert "interrupted after the outputs were published" in r.stderr and "Traceback" not in r.stderr
+    assert listing(tmp_path) == ["o", "o/notes.txt", "o/tube1.job.json", "o/tube1.nc", "o/tube1.ngc",
+                                 "o/tube1.toolpath.dxf"]
+
+
 def test_failed_verification_is_not_success(tmp_path):
     """A beam 5x wider than the kerf the job compensates for cuts outside the design: FAIL -> exit 1."""
     bad = ("--kerf", "0.1", "--set", "process.kerf=0.02")

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import os
 import stat
+from pathlib import Path
 
 import pytest
 
@@ -77,3 +78,60 @@ def test_write_set_refuses_a_file_as_directory(tmp_path):
     with pytest.raises(OutputError, match="a file of that name exists"):
         write_set(tmp_path / "f", {"a": "b"})
     assert (tmp_path / "f").read_text() == "x"
+
+
+def test_write_together_puts_back_a_published_file_when_the_set_fails(tmp_path, monkeypatch):
+    """Bug 13: the outputs of one command in different places (a JSON, a report folder) appear all or none."""
+    import camtube.io as io
+
+    (tmp_path / "d.json").write_text("old")
+    paths = io.write_together([(tmp_path / "d.json", "new"), (tmp_path / "rep", {"index.html": "<p>"}),
+                               (tmp_path / "p.png", b"png")])
+    assert paths == [tmp_path / "d.json", [tmp_path / "rep" / "index.html"], tmp_path / "p.png"]
+    assert (tmp_path / "d.json").read_text() == "new" and (tmp_path / "rep" / "index.html").read_text() == "<p>"
+
+    def swap_fails(stage, out, files):
+        raise OSError(13, "Permission denied")
+
+    monkeypatch.setattr(io, "_swap_in", swap_fails)
+    with pytest.raises(io.OutputError, match="rep: cannot write: Permission denied"):
+        io.write_together([(tmp_path / "d.json", "newer"), (tmp_path / "new.png", b"x"),
+                           (tmp_path / "rep", {"index.html": "<p>2"})])
+    assert (tmp_path / "d.json").read_text() == "new"  # put back, not "newer" beside the old report
+    assert sorted(os.listdir(tmp_path)) == ["d.json", "p.png", "rep"]  # no new.png, no staging, no kept copies
+    assert (tmp_path / "rep" / "index.html").read_text() == "<p>"
+
+
+def test_write_together_refuses_an_output_inside_another_output_file(tmp_path):
+    from camtube.io import OutputError, write_together
+
+    with pytest.raises(OutputError, match="lies inside"):
+        write_together([(tmp_path / "a.json", "{}"), (tmp_path / "a.json" / "rep", {"index.html": "x"})])
+    with pytest.raises(OutputError, match="also the path of another output"):
+        write_together([(tmp_path / "a.json", "{}"), (tmp_path / "a.json", "[]")])
+    with pytest.raises(OutputError, match="the path is empty"):
+        write_together([(tmp_path / "a.json", "{}"), ("", {"index.html": "x"})])  # not '.', the working folder
+    assert os.listdir(tmp_path) == []
+
+
+def test_write_set_into_a_link_to_a_folder_writes_into_the_folder_and_keeps_the_link(tmp_path):
+    """Bug 14: ``-o current`` where current -> jobs/v2: the swap replaced the link with a real folder (the
+    link was left as a ``.current.*.staging`` entry) and jobs/v2 never got the set."""
+    from camtube.io import write_set
+
+    target = tmp_path / "jobs" / "v2"
+    target.mkdir(parents=True)
+    (target / "notes.txt").write_text("mine")
+    (target / "j.ngc").write_text("old")
+    link = tmp_path / "current"
+    link.symlink_to(Path("jobs") / "v2")
+    assert write_set(link, {"j.ngc": "G0 X1\n", "j.job.json": "{}"}) == [link / "j.ngc", link / "j.job.json"]
+    assert link.is_symlink() and os.readlink(link) == str(Path("jobs") / "v2")
+    assert sorted(os.listdir(target)) == ["j.job.json", "j.ngc", "notes.txt"]
+    assert (target / "j.ngc").read_text() == "G0 X1\n" and (target / "notes.txt").read_text() == "mine"
+    assert sorted(os.listdir(tmp_path)) == ["current", "jobs"]  # no staging left beside the link
+    assert sorted(os.listdir(tmp_path / "jobs")) == ["v2"]  # nor beside the folder
+    # a link to a folder not made yet: the folder is made, the link kept
+    (tmp_path / "next").symlink_to(tmp_path / "jobs" / "v3")
+    write_set(tmp_path / "next", {"j.ngc": "G0 X3\n"})
+    assert (tmp_path / "next").is_symlink() and (tmp_path / "jobs" / "v3" / "j.ngc").read_text() == "G0 X3\n"

@@ -677,3 +677,17 @@ def test_a_tube_far_larger_than_any_stage_holds_is_refused_not_overflowed(tmp_pa
     assert_refused(camtube("preview", TUBE1, "--set", "tube.length=1e9", "-o", str(tmp_path / "p.svg")),
                    "tube.length", "fix: use a value <= 2000")
     assert listing(tmp_path) == []
+
+
+def test_output_folder_given_as_a_link_gets_the_files_and_stays_a_link(tmp_path, capsys):
+    """Bug 14: ``toolpath -o current`` (current -> jobs/v2) replaced the link with a new folder and left the
+    link behind as ``.current.*.staging``; jobs/v2 kept its old files."""
+    (tmp_path / "jobs" / "v2").mkdir(parents=True)
+    (tmp_path / "jobs" / "v2" / "tube1.ngc").write_text("old")
+    (tmp_path / "current").symlink_to(tmp_path / "jobs" / "v2")
+    assert main(["toolpath", TUBE1, "-o", str(tmp_path / "current"), "-q"]) == 0
+    assert f"wrote {tmp_path / 'current' / 'tube1.ngc'}" in capsys.readouterr().out
+    assert (tmp_path / "current").is_symlink()
+    assert listing(tmp_path) == ["current", "jobs", "jobs/v2", "jobs/v2/tube1.job.json", "jobs/v2/tube1.nc",
+                                 "jobs/v2/tube1.ngc", "jobs/v2/tube1.toolpath.dxf"]
+    assert (tmp_path / "jobs" / "v2" / "tube1.ngc").read_text() != "old"

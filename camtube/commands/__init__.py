@@ -11,11 +11,14 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import signal
 import sys
+import threading
+from contextlib import contextmanager
 
 from camtube import __version__
 from camtube.errors import CamtubeError
-from camtube.io import PublishedInterrupt
+from camtube.io import PublishedInterrupt, Terminated, raise_terminated
 
 #: Command modules, each with ``register(subparsers)``, in the order ``--help`` lists them.
 COMMAND_MODULES = (
@@ -50,45 +53,70 @@ def main(argv: list[str] | None = None) -> int:
 
     0 success; 1 the command ran but its result failed a check (e.g. a CAD
     verification); 2 a user mistake or unsafe job, printed as one clear
-    message (no traceback); 130 interrupted (Ctrl-C).
+    message (no traceback); 130 interrupted (Ctrl-C); 143 terminated (SIGTERM).
     """
     parser = build_parser()
     try:
-        args = parser.parse_args(argv)
-        if not getattr(args, "func", None):   # no command: a usage mistake, as argparse's own (exit 2)
-            from camtube.commands.common import no_subcommand
+        with _sigterm_as_interrupt():
+            args = parser.parse_args(argv)
+            if not getattr(args, "func", None):   # no command: a usage mistake, as argparse's own (exit 2)
+                from camtube.commands.common import no_subcommand
 
-            return no_subcommand(parser, "camtube", "command")
-        return _run(args)
+                return no_subcommand(parser, "camtube", "command")
+            return _run(args)
     except PublishedInterrupt as exc:
         where = os.path.dirname(exc.paths[0]) if exc.paths else "the output folder"
         print(f"camtube: interrupted after the outputs were published: the set in {where} is complete and new",
               file=sys.stderr)
         return 0
-    except KeyboardInterrupt:
-        print("camtube: interrupted; no output of this command was published", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        return _stopped(exc)
     except BrokenPipeError:
         # the reader of our output went away (e.g. `camtube design ... | head -1`): stop quietly
         _silence_stdout()
         return 0
     except Exception as exc:  # noqa: BLE001: only to tell an interrupted import from a failure; re-raised
-        if not _interrupted(exc):
+        interrupt = _interrupted(exc)
+        if interrupt is None:
             raise
-        print("camtube: interrupted; no output of this command was published", file=sys.stderr)
-        return 130
+        return _stopped(interrupt)
 
 
-def _interrupted(exc: BaseException) -> bool:
-    """True when ``exc`` was caused by a Ctrl-C (an extension module's import fails with an
+@contextmanager
+def _sigterm_as_interrupt():
+    """While the command runs, SIGTERM raises :class:`~camtube.io.Terminated` (a ``KeyboardInterrupt``), so it
+    cleans up as Ctrl-C does (the default action ends the process at once, leaving staging folders behind).
+    Only in the main thread and over the default action (a handler someone else set is kept); put back after."""
+    if (threading.current_thread() is not threading.main_thread()
+            or signal.getsignal(signal.SIGTERM) != signal.SIG_DFL):
+        yield
+        return
+    signal.signal(signal.SIGTERM, raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _stopped(exc: KeyboardInterrupt) -> int:
+    """Say that the command was stopped before it published anything; 143 for SIGTERM, 130 for Ctrl-C."""
+    if isinstance(exc, Terminated):
+        print("camtube: terminated (SIGTERM); no output of this command was published", file=sys.stderr)
+        return 143
+    print("camtube: interrupted; no output of this command was published", file=sys.stderr)
+    return 130
+
+
+def _interrupted(exc: BaseException) -> KeyboardInterrupt | None:
+    """The Ctrl-C (or SIGTERM) that caused ``exc``, or None (an extension module's import fails with an
     ``ImportError`` whose context is the ``KeyboardInterrupt`` that stopped it)."""
     seen = set()
     while exc is not None and id(exc) not in seen:
         if isinstance(exc, KeyboardInterrupt):
-            return True
+            return exc
         seen.add(id(exc))
         exc = exc.__cause__ or exc.__context__
-    return False
+    return None
 
 
 def _run(args: argparse.Namespace) -> int:

@@ -185,6 +185,23 @@ def refuse_output_over_input(output: str, option: str, inputs) -> None:
                                "fix: name another output file")
 
 
+def check_outputs_apart(outputs) -> None:
+    """Refuse, before any work, an output of a command that is, or lies inside, another output written as a file
+    (``--json a.json --plot a.json/p.png``): it could only be written by destroying the other.
+
+    ``outputs`` holds ``(option, path or None, is_file)`` triples.
+    """
+    from pathlib import Path
+
+    given = [(opt, path, Path(path).resolve(), is_file) for opt, path, is_file in outputs if path]
+    for i, (opt, path, where, _) in enumerate(given):
+        for j, (other, other_path, other_where, other_is_file) in enumerate(given):
+            if i != j and other_is_file and (where == other_where or other_where in where.parents):
+                raise CamtubeError(f"{opt} {path}: {'is' if where == other_where else 'lies inside'} the {other} "
+                                   f"file {other_path}, so writing one would destroy the other; fix: give {opt} a "
+                                   f"path of its own, outside {other_path}")
+
+
 def check_output_file(path: str, option: str) -> None:
     """Refuse, before any work, an output file that names a directory or lies where nothing can be written."""
     from camtube.io import OutputError, check_writable_dir

@@ -119,10 +119,10 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 
 def _diagnose(args: argparse.Namespace) -> int:
     from camtube.commands.common import (
-        check_output_dir, check_output_file, load_joint_pattern, refuse_output_over_input,
+        check_output_dir, check_output_file, check_outputs_apart, load_joint_pattern, refuse_output_over_input,
     )
     from camtube.errors import DataError
-    from camtube.io import write_atomic, write_set
+    from camtube.io import write_together
     from camtube.model.core.build import build_registry, check_suffix, fitted_and_held, parse_in_range, split_names
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import check_fittable, read_measurements, select_cycles
@@ -146,6 +146,7 @@ def _diagnose(args: argparse.Namespace) -> int:
                                                                      *Path(args.json).resolve().parents):
             raise DataError(f"--json {args.json}: is or lies in the --report folder {args.report}; fix: write the "
                             "JSON beside the report folder, not inside it")
+    check_outputs_apart([("--json", args.json, True), ("--report", args.report, False)])
     for opt, v, eg in (("--max-rows", args.max_rows, "4000 (0 = all rows)"), ("--max-effects", args.max_effects, "4")):
         if v < 0:
             raise DataError(f"{opt} {v}: must be >= 0; fix: e.g. {opt} {eg}")
@@ -186,9 +187,12 @@ def _diagnose(args: argparse.Namespace) -> int:
     print(diagnosis_text(d, prefix, title))
     meta = {"pattern": pattern.name, "data": str(args.data), "cycles": args.cycles}
     files = report_files(d, prefix, title) if args.report else None  # made before anything is written
-    if args.json:
-        print(f"wrote {write_atomic(args.json, diagnosis_json(d, prefix, meta))}")
+    outputs = [(args.json, diagnosis_json(d, prefix, meta))] if args.json else []
     if files is not None:
-        write_set(args.report, files)
+        outputs.append((args.report, files))
+    write_together(outputs)  # the JSON and the report both, or neither
+    if args.json:
+        print(f"wrote {Path(args.json)}")
+    if files is not None:
         print(f"wrote {Path(args.report) / 'index.html'}")
     return 0

@@ -135,8 +135,10 @@ def _add_pattern_option(p: argparse.ArgumentParser) -> None:
 
 
 def cmd_fit(args: argparse.Namespace) -> int:
-    from camtube.commands.common import check_output_file, load_joint_pattern, refuse_output_over_input
-    from camtube.io import write_atomic
+    from camtube.commands.common import (
+        check_output_file, check_outputs_apart, load_joint_pattern, refuse_output_over_input,
+    )
+    from camtube.io import write_together
     from camtube.model.core.build import (
         build_registry, fitted_and_held, history_warning, parse_in_range, split_names,
     )
@@ -154,6 +156,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
         if path is not None:
             check_output_file(path, opt)
             refuse_output_over_input(path, opt, inputs)
+    check_outputs_apart([("--json", args.json, True), ("--plot", args.plot, True)])
     if not 0 <= args.starts <= 50:
         raise DataError(f"--starts {args.starts}: allowed 0..50 grid points per parameter; fix: e.g. --starts 3 "
                         "(0: one start)")
@@ -229,10 +232,11 @@ def cmd_fit(args: argparse.Namespace) -> int:
         if args.deadband:
             full = remove_deadband(raw, args.deadband_threshold)
         png = fit_png(result, full, title=f"{pattern.name}: model vs measurement ({sel})")
-    if args.json:
-        print(f"wrote {write_atomic(args.json, fit_json(result, meta))}")
+    outputs = [(args.json, fit_json(result, meta))] if args.json else []
     if png is not None:
-        print(f"wrote {write_atomic(args.plot, png)}")
+        outputs.append((args.plot, png))
+    for path in write_together(outputs):  # both, or neither
+        print(f"wrote {path}")
     return 0
 
 
@@ -255,8 +259,8 @@ def cmd_synth(args: argparse.Namespace) -> int:
 def cmd_ingest(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from camtube.commands.common import check_output_dir, refuse_output_over_input
-    from camtube.io import check_writable_dir, write_atomic, write_set
+    from camtube.commands.common import check_output_dir, check_outputs_apart, refuse_output_over_input
+    from camtube.io import check_writable_dir, write_together
     from camtube.model.data.csvfile import format_csv
     from camtube.model.ingest.merge import ingest_files
     from camtube.model.ingest.series import load_bench_map
@@ -274,6 +278,7 @@ def cmd_ingest(args: argparse.Namespace) -> int:
         if Path(args.report).resolve() == Path(args.output).resolve():
             raise CamtubeError(f"--report {args.report}: is also the -o file; fix: give the report a folder of its "
                                f"own, e.g. --report {Path(args.output).with_suffix('')}-report")
+        check_outputs_apart([("-o", args.output, True), ("--report", args.report, False)])
     bench = load_bench_map(args.bench, args.map_overrides)
     first = args.tracker or args.angle_log
     ing = ingest_files(first, args.daq, args.motor, bench, args.sample, max_lag_s=args.max_lag,
@@ -288,8 +293,8 @@ def cmd_ingest(args: argparse.Namespace) -> int:
 
     for line in summary_lines(ing):
         print(line)
-    print(f"wrote {write_atomic(args.output, text)}")
+    write_together([(args.output, text)] + ([(args.report, files)] if files is not None else []))  # all, or none
+    print(f"wrote {Path(args.output)}")
     if files is not None:
-        write_set(args.report, files)
         print(f"wrote {Path(args.report) / 'index.html'} (+ alignment.png, angle.png, dropouts.png)")
     return 0

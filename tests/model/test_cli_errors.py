@@ -401,3 +401,52 @@ def test_a_huge_angle_that_varies_is_refused_with_its_line_not_a_traceback(data_
     lines = [x for x in r.stderr.splitlines() if x.strip()]
     assert r.returncode == 2 and len(lines) == 1 and "Traceback" not in r.stderr, r.stderr
     assert "'angle_deg' holds" in lines[0] and "beyond" in lines[0] and "; fix: " in lines[0], r.stderr
+
+
+BENCH = ROOT / "examples" / "bench"
+
+
+def _two_outputs(cmd, data_csv, tmp_path, first, second):
+    """argv of ``cmd`` writing two outputs: ``first`` (a file) and ``second`` (a file or a report folder)."""
+    if cmd == "ingest":
+        return ["model", "ingest", "--tracker", str(BENCH / "aurora-export.csv"), "--daq", str(BENCH / "daq.csv"),
+                "--motor", str(BENCH / "motor.csv"), "--bench", str(BENCH / "bench.yaml"),
+                "-o", str(tmp_path / first), "--report", str(tmp_path / second)]
+    tail = (["--plot", str(tmp_path / second)] if cmd == "fit"
+            else ["--report", str(tmp_path / second), "--candidates", "slack", "--no-per-sample"])
+    return ["model", cmd, str(data_csv), "--pattern", TUBE2, "-q", "--json", str(tmp_path / first), *tail]
+
+
+@pytest.mark.parametrize("cmd,first,second", [("fit", "f.json", "f.png"), ("diagnose", "d.json", "rep"),
+                                              ("ingest", "m.csv", "rep")])
+def test_a_later_output_that_cannot_be_written_leaves_no_earlier_one(data_csv, tmp_path, capsys, monkeypatch,
+                                                                     cmd, first, second):
+    """Bug 13: the JSON (or CSV) was published, then the plot (or report) failed: a mixed set of outputs, exit 2.
+    Now every output is staged before any is published: all of them, or none."""
+    import errno
+
+    import camtube.io as io
+
+    write, calls = io._write_payload, []
+
+    def disk_full_at_the_second_output(fh, data):
+        calls.append(1)
+        if len(calls) == 2:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return write(fh, data)
+
+    monkeypatch.setattr(io, "_write_payload", disk_full_at_the_second_output)
+    line = _one_line_with_fix(_two_outputs(cmd, data_csv, tmp_path, first, second), capsys, "No space left")
+    assert "free some disk space" in line
+    assert not list(tmp_path.iterdir())  # neither output, no staging left
+
+
+@pytest.mark.parametrize("cmd,first,second", [("fit", "a.json", "a.json/p.png"), ("diagnose", "a.json", "a.json/rep"),
+                                              ("ingest", "m.csv", "m.csv/rep")])
+def test_an_output_inside_another_output_file_is_refused_before_the_work(data_csv, tmp_path, capsys, cmd, first,
+                                                                         second):
+    """Bug 13: ``--json a.json --plot a.json/p.png`` wrote a.json, then failed on the plot ('File exists')."""
+    option = {"fit": "--plot", "diagnose": "--report", "ingest": "--report"}[cmd]
+    _one_line_with_fix(_two_outputs(cmd, data_csv, tmp_path, first, second), capsys,
+                       f"{option} {tmp_path / second}: lies inside", str(tmp_path / first))
+    assert not list(tmp_path.iterdir())

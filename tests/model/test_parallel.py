@@ -61,3 +61,35 @@ def test_camtube_workers_caps_the_cores(monkeypatch):
     assert parallel.cores() >= 1
     monkeypatch.setenv("CAMTUBE_WORKERS", "many")  # not a count: ignored
     assert parallel.cores() >= 1
+
+
+@pytest.mark.skipif(parallel.cores() < 2, reason="one core: the pieces run here, no workers to stop")
+def test_sigterm_in_the_parent_stops_the_workers_at_once(tmp_path):
+    """Bug 27: SIGTERM is an interrupt (camtube.io.Terminated) for a command; leaving the executor waited for every
+    piece to finish first (a long diagnosis went on for minutes). Now the workers are ended and it stops at once."""
+    import os
+    import signal
+    import threading
+    import time
+
+    from camtube.io import Terminated, raise_terminated
+
+    def piece(i: int):
+        (tmp_path / f"{i}.pid").write_text(str(os.getpid()))
+        time.sleep(30)
+        return i
+
+    old = signal.signal(signal.SIGTERM, raise_terminated)
+    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGTERM))
+    t0 = time.monotonic()
+    try:
+        timer.start()
+        with pytest.raises(Terminated):
+            parallel.map_forked(piece, 4)
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGTERM, old)
+    assert time.monotonic() - t0 < 10
+    for f in tmp_path.glob("*.pid"):  # the workers are gone
+        with pytest.raises(ProcessLookupError):
+            os.kill(int(f.read_text()), 0)

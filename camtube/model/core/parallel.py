@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
 import sys
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
@@ -30,6 +31,24 @@ def cores() -> int:
     return max(1, min(n, int(cap))) if cap.isdigit() else n
 
 
+def _worker_start() -> None:
+    """In a new worker: SIGTERM ends it at once, as before the command line made SIGTERM an interrupt in the
+    process the worker was forked from (a killed worker is a broken pool, whose pieces then run in the parent)."""
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _stop_workers(ex: ProcessPoolExecutor, futures) -> None:
+    """Ctrl-C or SIGTERM in the parent: cancel the pieces not started and end the workers now (leaving the
+    executor would otherwise wait for every piece to finish)."""
+    for f in futures:
+        f.cancel()
+    for proc in list((getattr(ex, "_processes", None) or {}).values()):
+        try:
+            proc.kill()
+        except (OSError, ValueError, AttributeError):
+            pass
+
+
 def _run(i: int):
     from camtube.model.core.threads import one_blas_thread
 
@@ -47,9 +66,14 @@ def map_forked(fn: Callable[[int], T], n: int) -> list[T]:
         return [fn(i) for i in range(n)]   # (and never nested: a worker runs its pieces in turn)
     _JOB = fn
     try:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork")) as ex:
+        with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
+                                 initializer=_worker_start) as ex:
             futures = [ex.submit(_run, i) for i in range(n)]
-            return [f.result() for f in futures]
+            try:
+                return [f.result() for f in futures]
+            except KeyboardInterrupt:
+                _stop_workers(ex, futures)
+                raise
     except BrokenProcessPool:  # a worker died (killed, out of memory): the pieces again, here
         pass
     finally:
