@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 import signal
+import time
 
 import pytest
 
@@ -233,6 +234,40 @@ def test_yaml_nested_too_deeply_is_a_yaml_error_not_a_recursion_traceback(tmp_pa
     r = camtube("design", str(f)) if where == "pattern" else camtube("synthesize", str(f), "-o", str(tmp_path / "o.yaml"))
     assert_refused(r, str(f), "nested too deeply", "fix: remove the runaway brackets")
     assert listing(tmp_path) == ["f.yaml"]
+
+
+def billion_laughs(levels: int = 9) -> str:
+    """Anchors each aliased ten times in the next: a few lines that expand to 10**levels values."""
+    lines = ["l0: &l0 [x, x, x, x, x, x, x, x, x, x]"]
+    lines += [f"l{i}: &l{i} [{', '.join([f'*l{i - 1}'] * 10)}]" for i in range(1, levels)]
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize("where", ["pattern", "goal"])
+@pytest.mark.parametrize("kind,words", [
+    ("bomb", ("aliases repeat more than 100000 values", "*l3 here", "fix: write the values out")),
+    ("self", ("the alias *a stands inside the value of its own anchor", "fix: point the alias")),
+])
+def test_a_yaml_alias_bomb_is_refused_at_once_not_expanded(tmp_path, where, kind, words):
+    """A "billion laughs" pattern (nested anchors, each aliased ten times) hung the loader, which walked every
+    expanded value to map the keys' lines; an alias inside its own anchor was a RecursionError traceback."""
+    f = tmp_path / "f.yaml"
+    f.write_text(pattern_text() + (billion_laughs() if kind == "bomb" else "a: &a [1, *a]\n"))
+    t0 = time.monotonic()
+    r = (camtube("design", str(f), timeout=60) if where == "pattern"
+         else camtube("synthesize", str(f), "-o", str(tmp_path / "o.yaml"), timeout=60))
+    assert_refused(r, f"{f}:{9 if kind == 'bomb' else 5}: yaml: refused YAML", *words)
+    assert time.monotonic() - t0 < 30
+    assert listing(tmp_path) == ["f.yaml"]
+
+
+def test_anchors_and_aliases_used_sensibly_still_work(tmp_path):
+    f = tmp_path / "p.yaml"
+    f.write_text(pattern_text().replace("width: 0.5, spacing: 0.5", "width: &w 0.5, spacing: *w")
+                 + "holes:\n  - &h {x: 0.75, size: 0.3, angle_deg: 180}\n  - {<<: *h, x: 13}\n")
+    r = camtube("design", str(f))
+    assert r.returncode == 0, r.stderr
+    assert "3 / 2" in r.stdout
 
 
 @pytest.mark.parametrize("value,words", [("1e400", ("notch.count", "must be finite")),
