@@ -45,8 +45,8 @@ def register(model_sub) -> None:
     d.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
                    help="hold a parameter at a value (E_t GPa, L0 mm); repeatable")
     d.add_argument("--max-rows", type=int, default=4000, metavar="N",
-                   help="rows used by the candidate search, thinned evenly in time (default 4000; at least 25 per "
-                        "cycle, up to 4x this; 0 = all)")
+                   help="rows used by the candidate search, thinned evenly in time (default 4000, at least 100; "
+                        "at least 25 per cycle, up to 4x this; 0 = all)")
     d.add_argument("--max-effects", type=int, default=4, metavar="N", help="most effects recommended (default 4)")
     d.add_argument("--modulus-range", default="1,300", metavar="LO,HI",
                    help="plausible tendon E_t in GPa; a fit outside is not trusted (default 1,300)")
@@ -129,6 +129,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     from camtube.model.data.csvfile import check_force_identifies
     from camtube.model.diagnose import diagnose
     from camtube.model.diagnose.instruments import check_instruments, confirm_lag
+    from camtube.model.diagnose.search import MIN_SEARCH_ROWS
     from camtube.model.report.diagnosis import diagnosis_json, diagnosis_text, report_files
 
     check_suffix(args.json, (".json",), "--json")
@@ -146,9 +147,12 @@ def _diagnose(args: argparse.Namespace) -> int:
                                                                      *Path(args.json).resolve().parents):
             raise DataError(f"--json {args.json}: is or lies in the --report folder {args.report}; fix: write the "
                             "JSON beside the report folder, not inside it")
-    for opt, v, eg in (("--max-rows", args.max_rows, "4000 (0 = all rows)"), ("--max-effects", args.max_effects, "4")):
-        if v < 0:
-            raise DataError(f"{opt} {v}: must be >= 0; fix: e.g. {opt} {eg}")
+    if args.max_rows != 0 and not MIN_SEARCH_ROWS <= args.max_rows:
+        raise DataError(f"--max-rows {args.max_rows}: too few rows for the candidate search (each candidate is fitted "
+                        f"on half the cycles and tested on the others); allowed: 0 (all rows) or {MIN_SEARCH_ROWS} or "
+                        "more; fix: e.g. --max-rows 4000 (the default), or 0 for all rows")
+    if args.max_effects < 0:
+        raise DataError(f"--max-effects {args.max_effects}: must be >= 0; fix: e.g. --max-effects 4")
     try:
         lo, hi = (float(v) for v in args.modulus_range.split(","))
     except ValueError:

@@ -278,6 +278,17 @@ def test_synth_suffix_mistake_says_the_fix(tmp_path, capsys):
     assert not list(tmp_path.iterdir())
 
 
+@pytest.mark.parametrize("value", ["1", "99", "-3"])
+def test_diagnose_refuses_a_row_limit_too_small_to_search(data_csv, tmp_path, capsys, value):
+    """``--max-rows 1`` ran: the search thinned the rows to 4, then failed with '4 data rows cannot fit 4 parameters;
+    fix: give more rows (--cycles all ...)', which does not name the option; 5 ran a 'search' on 20 rows."""
+    js = tmp_path / "d.json"
+    line = _one_line_with_fix(["model", "diagnose", str(data_csv), "--pattern", TUBE2, "-q", "--max-rows", value,
+                               "--json", str(js)], capsys, f"--max-rows {value}: too few rows",
+                              "allowed: 0 (all rows) or 100 or more", "fix: e.g. --max-rows 4000")
+    assert "Traceback" not in line and not js.exists()
+
+
 @pytest.mark.parametrize("tail,words", [
     ([], ["--from DIAG.json"]), (["--from", "{tmp}/nosuch.json"], ["nosuch.json", "no such diagnosis file"]),
     (["--from", "{tmp}/bad.json"], ["bad.json", "not a diagnosis JSON"]),
