@@ -109,6 +109,27 @@ def fit_command_prefix(args: argparse.Namespace, instruments=None) -> str:
     return shlex.join(parts)
 
 
+def _check_init_names(init: dict, specs: dict, samples=None) -> None:
+    """Refuse an ``--init`` start for no parameter of the model or a candidate (``specs``), or, once the data are
+    read, for a sample they do not have (``NAME@S``): the search would drop it unseen."""
+    import difflib
+
+    from camtube.errors import DataError
+    from camtube.model.core.params import split_name
+
+    for name in init:
+        base, smp = split_name(name)
+        if base not in specs:
+            near = difflib.get_close_matches(base, list(specs), n=1)
+            raise DataError(f"--init {name}: unknown parameter {base!r}" + (f"; did you mean {near[0]!r}?" if near else "")
+                            + f" (the model's and the candidates' parameters: {', '.join(specs)}); fix: use one of "
+                            "these names (an effect's as EFFECT.param), or give the file of its effect with "
+                            "--effect-file")
+        if samples is not None and smp is not None and smp not in samples:
+            raise DataError(f"--init {name}: the data have no sample {smp!r} (samples: {', '.join(samples)}); "
+                            "fix: use NAME@SAMPLE with one of these samples, or NAME for all")
+
+
 def cmd_diagnose(args: argparse.Namespace) -> int:
     from camtube.model.core.threads import one_blas_thread
 
@@ -167,11 +188,13 @@ def _diagnose(args: argparse.Namespace) -> int:
     # every parameter the model or a candidate has (its range), checked before the data are read
     specs = {**{f"{e.name}.{q.name}": q for e in reg.values() for q in e.params}, **model.param_specs}
     init = parse_in_range(args.init, "--init", specs)
+    _check_init_names(init, specs)
     meas = read_measurements(args.data, strict=args.strict)
     rows = select_cycles(meas.data, args.cycles)
     ins = check_instruments(rows, lag_ms=args.lag_ms, dropped=meas.summary(),
                             n_dropped=int(meas.missing_lines.size + meas.backward_lines.size), rezero=args.rezero)
     check_fittable(ins.data, _rows_left(args, meas, ins))
+    _check_init_names(init, specs, ins.data.samples)
     fit_names, held = fitted_and_held(model, args.fit_params, args.fix, with_effects=False)
     check_force_identifies(ins.data, args.data, fit_names)
     fixed = pattern_values(pattern)

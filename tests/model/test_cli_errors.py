@@ -358,6 +358,21 @@ def test_an_init_value_outside_its_parameter_range_is_refused(data_csv, tmp_path
     assert not js.exists()
 
 
+@pytest.mark.parametrize("item,words", [
+    ("nosuch.x=1", ["--init nosuch.x: unknown parameter 'nosuch.x'", "creep.tau_s, ", "fix: use one of these names"]),
+    ("creep.tau=3", ["--init creep.tau: unknown parameter", "did you mean 'creep.tau_s'?"]),
+    ("E_t@S9=30", ["--init E_t@S9: the data have no sample 'S9'", "samples: 1, 2"]),
+])
+def test_diagnose_refuses_an_init_for_no_parameter_it_has(data_csv, tmp_path, capsys, item, words):
+    """``model diagnose --init nosuch.x=1`` (or a misspelt candidate parameter, or an unknown sample) ran the whole
+    search without it and said nothing, while ``model fit`` refuses the same name."""
+    js = tmp_path / "o.json"
+    line = _one_line_with_fix(["model", "diagnose", str(data_csv), "--pattern", TUBE2, "-q", "--init", item,
+                               "--json", str(js)], capsys, *words)
+    assert str(data_csv) not in line   # about the option, not the measurement file
+    assert not js.exists()
+
+
 @pytest.mark.parametrize("extra", [[], ["--set-aside"]])
 def test_fit_of_a_constant_time_column_is_refused_like_diagnose(data_csv, tmp_path, capsys, extra):
     """Before: model fit ignored time_s and fitted; model diagnose refused the same file."""
