@@ -582,6 +582,25 @@ def test_a_calibration_with_an_unphysical_value_names_it(tmp_path, params, words
     assert_refused(r, str(cal), *words)
 
 
+@pytest.mark.parametrize("doc,words", [
+    ('{"params": {"E_t": NaN, "L0": 70}}', ("params.E_t: not a finite number (got NaN)",)),
+    ('{"params": {"E_t": {"value": "28"}}}', ("params.E_t.value: not a finite number (got \"28\")",)),
+    ('{"final": {"params": {"E_t": {"value": 28}, "slack.deadband_mm@2": {"value": null}}}}',
+     ("final.params.slack.deadband_mm@2.value: not a finite number (got null)",)),
+    ('{"params": {"arm_scale": Infinity}}', ("params.arm_scale", "(got Infinity)")),
+], ids=["nan", "text", "null-per-sample", "infinity"])
+def test_a_calibration_value_that_is_not_a_number_names_the_key(tmp_path, doc, words):
+    """A NaN, text or null parameter value in a calibration was skipped silently: the joint was computed with the
+    pattern's value instead, exit 0."""
+    cal = tmp_path / "c.json"
+    cal.write_text(doc)
+    for argv in (["design", TUBE1, "-q", "--stroke", "1"],
+                 ["synthesize", str(ROOT / "examples" / "goals" / "01-tube1-uniform-60.yaml"), "-o",
+                  str(tmp_path / "p.yaml")]):
+        assert_refused(camtube(*argv, "--calibration", str(cal)), f"{cal}: ", *words, "fix: write the fitted value")
+    assert listing(tmp_path) == ["c.json"]
+
+
 def test_a_goal_with_an_empty_list_of_shares(tmp_path):
     """``goal.distribution: []`` was a ValueError traceback from numpy ('zero-size array to reduction')."""
     goal = tmp_path / "g.yaml"
