@@ -559,6 +559,64 @@ def test_a_block_that_places_itself_is_refused_not_a_recursion_traceback(tmp_pat
     assert listing(tmp_path) == ["d.dxf"]
 
 
+def _drawing_with_a_block(path, layer_table: bool = True, scale: str | None = None):
+    """A tube outline, a notch block placed on layer NOTCH (by an INSERT scaled 1.25 x 1.75, whose X or Y scale
+    ``scale`` replaces in the file: ezdxf does not write a zero scale) and a hole on layer CUTS (not in the layer
+    table unless ``layer_table``)."""
+    import math
+
+    import ezdxf
+
+    doc = ezdxf.new("R2013", setup=False)
+    doc.header["$INSUNITS"] = 4
+    if layer_table:
+        doc.layers.add("CUTS")
+    msp = doc.modelspace()
+    c = 2 * math.pi
+    msp.add_lwpolyline([(0, 0), (10, 0), (10, c), (0, c)], close=True, dxfattribs={"layer": "OUTLINE"})
+    msp.add_lwpolyline([(1, 3), (1.3, 3), (1.3, 3.3), (1, 3.3)], close=True, dxfattribs={"layer": "CUTS"})
+    blk = doc.blocks.new("N")
+    blk.add_lwpolyline([(0, 0), (0.4, 0), (0.4, 1.2), (0, 1.2)], close=True)
+    ins = msp.add_blockref("N", (4, 2.5), dxfattribs={"layer": "NOTCH", "xscale": 1.25, "yscale": 1.75})
+    doc.saveas(path)
+    if scale is not None:
+        axis, value = scale.split("=")
+        text = path.read_text()
+        old = " 41\n1.25\n 42\n1.75\n"
+        assert text.count(old) == 1
+        path.write_text(text.replace(old, old.replace("1.25" if axis == "x" else "1.75", value)))
+    return ins.dxf.handle
+
+
+@pytest.mark.parametrize("scale,words", [("x=0.0", ("by 0 along X (xscale)", "flattens it")),
+                                         ("y=0", ("by 0 along Y (yscale)", "flattens it")),
+                                         ("x=1e-300", ("by 1e-300 along X", "too small to cut"))])
+def test_an_insert_of_zero_scale_is_refused_naming_it(tmp_path, scale, words):
+    """An INSERT with xscale or yscale 0 (or 1e-300) was a ZeroDivisionError traceback from ezdxf's placing of it."""
+    drawing = tmp_path / "d.dxf"
+    handle = _drawing_with_a_block(drawing, scale=scale)
+    r = camtube("toolpath", str(drawing), "-q", "-o", str(tmp_path / "o"))
+    assert_refused(r, f"{drawing}: INSERT #{handle} on layer NOTCH: scales block 'N'", *words,
+                   "fix: set the INSERT's X and Y scale")
+    assert listing(tmp_path) == ["d.dxf"]
+
+
+def test_a_layer_that_entities_are_on_but_the_layer_table_lacks_can_be_given_a_role(tmp_path):
+    """A drawing (from a script or an old program) with entities on layer CUTS but no CUTS in its layer table:
+    ``--layer CUTS=hole`` was refused 'the drawing has no such layer; allowed: 0' (the layers listed were the
+    table's only, not CUTS). A layer in neither is refused listing the drawing's layers."""
+    drawing = tmp_path / "d.dxf"
+    _drawing_with_a_block(drawing, layer_table=False)
+    r = camtube("design", str(drawing), "-q", "--layer", "cuts=hole")
+    assert r.returncode == 0, r.stderr
+    assert "1 / 1" in r.stdout   # the notch of the block and the hole on CUTS
+    r = camtube("design", str(drawing), "-q", "--layer", "CUT=hole")
+    assert_refused(r, f"{drawing}: --layer CUT=hole: the drawing has no such layer", "CUTS, ", "NOTCH, OUTLINE",
+                   "fix: did you mean 'CUTS'?")
+    r = camtube("design", str(drawing), "-q", "--layer", "ZZZ=ignore")
+    assert_refused(r, "--layer ZZZ=ignore", "fix: name one of the drawing's layers")
+
+
 def test_a_drawing_finds_a_shipped_process_and_names_a_missing_one(tmp_path):
     """With a DXF, ``--set process=femto-polyimide.yaml`` (the shipped process a YAML pattern finds anywhere) and
     ``--set process=nothere.yaml`` were both 'file: cannot read pattern: No such file or directory'."""
