@@ -23,7 +23,55 @@ class StrictLoader(yaml.SafeLoader):
     - A key given twice in one mapping is an error (PyYAML keeps the last one silently).
     - Every number YAML 1.2 accepts is a number: ``5e-1`` and ``1E3`` as well as ``5.0e-1``
       (PyYAML follows YAML 1.1 there and reads ``5e-1`` as a string).
+    - Aliases may repeat at most :data:`MAX_ALIAS_VALUES` values in all, and never the value they are inside
+      (:class:`AliasError`): a "billion laughs" document of nested anchors, each aliased ten times, is a few
+      lines that expand to billions of values, which every later walk over the data would follow.
     """
+
+    def __init__(self, stream):
+        super().__init__(stream)
+        self._open_anchors: list[str] = []        # anchors of the collections being composed (outermost first)
+        self._values: dict[int, int] = {}         # id(node) -> values it holds, aliases expanded
+        self._repeated = 0                        # values the aliases read so far repeat
+
+    def compose_node(self, parent, index):
+        event = self.peek_event()
+        if isinstance(event, yaml.AliasEvent):
+            node = self.anchors.get(event.anchor)
+            if node is not None:
+                if event.anchor in self._open_anchors:
+                    raise AliasError(f"the alias *{event.anchor} stands inside the value of its own anchor "
+                                     f"&{event.anchor} (a value holding itself)", event.start_mark, recursive=True)
+                self._repeated += self._count(node)
+                if self._repeated > MAX_ALIAS_VALUES:
+                    raise AliasError(f"aliases repeat more than {MAX_ALIAS_VALUES} values (*{event.anchor} here "
+                                     "brings them over; anchors aliased within anchors multiply)", event.start_mark)
+            return super().compose_node(parent, index)
+        if getattr(event, "anchor", None) is None or isinstance(event, yaml.ScalarEvent):
+            return super().compose_node(parent, index)
+        self._open_anchors.append(event.anchor)
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self._open_anchors.pop()
+
+    def _count(self, root) -> int:
+        """Values in ``root`` with its aliases expanded (memoised; no recursion, so no depth limit). Capped just
+        above :data:`MAX_ALIAS_VALUES`, so a count stays a small number however far the aliases multiply."""
+        sizes = self._values
+        stack = [(root, False)]
+        while stack:
+            node, children_done = stack.pop()
+            if id(node) in sizes:
+                continue
+            kids = ([n for kv in node.value for n in kv] if isinstance(node, yaml.MappingNode)
+                    else node.value if isinstance(node, yaml.SequenceNode) else [])
+            if children_done:
+                sizes[id(node)] = min(1 + sum(sizes[id(k)] for k in kids), MAX_ALIAS_VALUES + 1)
+            else:
+                stack.append((node, True))
+                stack.extend((k, False) for k in kids if id(k) not in sizes)
+        return sizes[id(root)]
 
     def construct_mapping(self, node, deep=False):
         if isinstance(node, yaml.MappingNode):
@@ -62,6 +110,24 @@ StrictLoader.add_implicit_resolver(
     "tag:yaml.org,2002:float",
     re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9][0-9_]*)[eE][-+]?[0-9]+$"),
     list("-+.0123456789"))
+
+
+#: Most values the aliases of one YAML document may repeat in all (a pattern has hundreds of values; a
+#: "billion laughs" document repeats billions).
+MAX_ALIAS_VALUES = 100_000
+
+
+class AliasError(yaml.YAMLError):
+    """An alias that repeats too much in all (a "billion laughs" document) or stands inside its own anchor."""
+
+    def __init__(self, problem: str, mark, recursive: bool = False):
+        super().__init__(problem)
+        self.problem = problem
+        self.problem_mark = mark
+        self.recursive = recursive
+
+    def __str__(self) -> str:
+        return self.problem
 
 
 class TooDeepError(yaml.YAMLError):
@@ -119,8 +185,14 @@ def read_yaml_file(path: str | os.PathLike, what: str, fix: str | Callable[[], s
         fix_ = ("keep one of the two (a later key would silently replace the earlier one)" if "given twice" in problem
                 else "remove the runaway brackets or indentation (the file's keys nest a few levels)"
                 if isinstance(exc, TooDeepError) else "write a number in the key's allowed range (camtube schema)"
-                if isinstance(exc, NumberTooLongError) else "fix the syntax at the line shown")
-        raise PatternError([Issue("yaml", f"not valid YAML: {problem}", None, "YAML mapping", fix_, file,
+                if isinstance(exc, NumberTooLongError) else "point the alias at an anchor defined before it, "
+                "outside its own value" if isinstance(exc, AliasError) and exc.recursive
+                else "write the values out, or alias fewer (an alias of an anchor that holds aliases repeats all of "
+                "them)" if isinstance(exc, AliasError) else "fix the syntax at the line shown")
+        allowed = (f"at most {MAX_ALIAS_VALUES} values repeated by aliases, none inside its own anchor"
+                   if isinstance(exc, AliasError) else "YAML mapping")
+        what = "refused YAML" if isinstance(exc, AliasError) else "not valid YAML"
+        raise PatternError([Issue("yaml", f"{what}: {problem}", None, allowed, fix_, file,
                                   mark.line + 1 if mark else None)]) from None
     return raw, text
 

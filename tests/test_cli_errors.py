@@ -241,3 +241,35 @@ def test_a_command_without_its_subcommand_is_a_usage_mistake(argv):
     assert r.returncode == 2, r.stdout + r.stderr
     assert r.stdout.startswith("usage:")
     assert len(r.stderr.strip().splitlines()) == 1 and "fix: give one of the" in r.stderr
+
+
+def test_quiet_keeps_library_warnings_off_stderr(tmp_path):
+    """With ``-q``, numpy's RuntimeWarning ('invalid value encountered in divide', two lines each: the warning and
+    the source line) reached stderr around the one error line; and ezdxf's log record 'Found non-unique entity
+    handle' was printed for a drawing that imports fine."""
+    import csv
+
+    data = tmp_path / "d.csv"
+    assert camtube("model", "synth", "--pattern", "tube2", "-o", str(data), "--cycles", "2", "-q").returncode == 0
+    with open(data, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    for row in rows:   # forces of 1e-200 N: the deadband search divides by a noise level that underflows to 0
+        row["force_N"] = repr(float(row["force_N"]) * 1e-200)
+    tiny = tmp_path / "tiny.csv"
+    with open(tiny, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    r = camtube("model", "fit", str(tiny), "--pattern", "tube2", "-q")
+    lines = [x for x in r.stderr.splitlines() if x.strip()]
+    assert r.returncode == 2 and len(lines) == 1 and "fix:" in lines[0], r.stderr
+    assert "Warning" not in r.stderr
+
+    drawing = tmp_path / "dup.dxf"   # two entities of one handle (a hand-edited or merged file)
+    text = (ROOT / "examples" / "dxf" / "outline_layer0.dxf").read_text().splitlines(keepends=True)
+    handles = [i + 1 for i in range(len(text) - 1) if text[i].strip() == "5" and text[i - 1].strip() == "LWPOLYLINE"]
+    assert len(handles) >= 2
+    text[handles[1]] = text[handles[0]]
+    drawing.write_text("".join(text))
+    r = camtube("design", str(drawing), "-q")
+    assert r.returncode == 0 and r.stderr == "", r.stderr

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 import signal
+import time
 
 import pytest
 
@@ -233,6 +234,40 @@ def test_yaml_nested_too_deeply_is_a_yaml_error_not_a_recursion_traceback(tmp_pa
     r = camtube("design", str(f)) if where == "pattern" else camtube("synthesize", str(f), "-o", str(tmp_path / "o.yaml"))
     assert_refused(r, str(f), "nested too deeply", "fix: remove the runaway brackets")
     assert listing(tmp_path) == ["f.yaml"]
+
+
+def billion_laughs(levels: int = 9) -> str:
+    """Anchors each aliased ten times in the next: a few lines that expand to 10**levels values."""
+    lines = ["l0: &l0 [x, x, x, x, x, x, x, x, x, x]"]
+    lines += [f"l{i}: &l{i} [{', '.join([f'*l{i - 1}'] * 10)}]" for i in range(1, levels)]
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize("where", ["pattern", "goal"])
+@pytest.mark.parametrize("kind,words", [
+    ("bomb", ("aliases repeat more than 100000 values", "*l3 here", "fix: write the values out")),
+    ("self", ("the alias *a stands inside the value of its own anchor", "fix: point the alias")),
+])
+def test_a_yaml_alias_bomb_is_refused_at_once_not_expanded(tmp_path, where, kind, words):
+    """A "billion laughs" pattern (nested anchors, each aliased ten times) hung the loader, which walked every
+    expanded value to map the keys' lines; an alias inside its own anchor was a RecursionError traceback."""
+    f = tmp_path / "f.yaml"
+    f.write_text(pattern_text() + (billion_laughs() if kind == "bomb" else "a: &a [1, *a]\n"))
+    t0 = time.monotonic()
+    r = (camtube("design", str(f), timeout=60) if where == "pattern"
+         else camtube("synthesize", str(f), "-o", str(tmp_path / "o.yaml"), timeout=60))
+    assert_refused(r, f"{f}:{9 if kind == 'bomb' else 5}: yaml: refused YAML", *words)
+    assert time.monotonic() - t0 < 30
+    assert listing(tmp_path) == ["f.yaml"]
+
+
+def test_anchors_and_aliases_used_sensibly_still_work(tmp_path):
+    f = tmp_path / "p.yaml"
+    f.write_text(pattern_text().replace("width: 0.5, spacing: 0.5", "width: &w 0.5, spacing: *w")
+                 + "holes:\n  - &h {x: 0.75, size: 0.3, angle_deg: 180}\n  - {<<: *h, x: 13}\n")
+    r = camtube("design", str(f))
+    assert r.returncode == 0, r.stderr
+    assert "3 / 2" in r.stdout
 
 
 @pytest.mark.parametrize("value,words", [("1e400", ("notch.count", "must be finite")),
@@ -524,6 +559,64 @@ def test_a_block_that_places_itself_is_refused_not_a_recursion_traceback(tmp_pat
     assert listing(tmp_path) == ["d.dxf"]
 
 
+def _drawing_with_a_block(path, layer_table: bool = True, scale: str | None = None):
+    """A tube outline, a notch block placed on layer NOTCH (by an INSERT scaled 1.25 x 1.75, whose X or Y scale
+    ``scale`` replaces in the file: ezdxf does not write a zero scale) and a hole on layer CUTS (not in the layer
+    table unless ``layer_table``)."""
+    import math
+
+    import ezdxf
+
+    doc = ezdxf.new("R2013", setup=False)
+    doc.header["$INSUNITS"] = 4
+    if layer_table:
+        doc.layers.add("CUTS")
+    msp = doc.modelspace()
+    c = 2 * math.pi
+    msp.add_lwpolyline([(0, 0), (10, 0), (10, c), (0, c)], close=True, dxfattribs={"layer": "OUTLINE"})
+    msp.add_lwpolyline([(1, 3), (1.3, 3), (1.3, 3.3), (1, 3.3)], close=True, dxfattribs={"layer": "CUTS"})
+    blk = doc.blocks.new("N")
+    blk.add_lwpolyline([(0, 0), (0.4, 0), (0.4, 1.2), (0, 1.2)], close=True)
+    ins = msp.add_blockref("N", (4, 2.5), dxfattribs={"layer": "NOTCH", "xscale": 1.25, "yscale": 1.75})
+    doc.saveas(path)
+    if scale is not None:
+        axis, value = scale.split("=")
+        text = path.read_text()
+        old = " 41\n1.25\n 42\n1.75\n"
+        assert text.count(old) == 1
+        path.write_text(text.replace(old, old.replace("1.25" if axis == "x" else "1.75", value)))
+    return ins.dxf.handle
+
+
+@pytest.mark.parametrize("scale,words", [("x=0.0", ("by 0 along X (xscale)", "flattens it")),
+                                         ("y=0", ("by 0 along Y (yscale)", "flattens it")),
+                                         ("x=1e-300", ("by 1e-300 along X", "too small to cut"))])
+def test_an_insert_of_zero_scale_is_refused_naming_it(tmp_path, scale, words):
+    """An INSERT with xscale or yscale 0 (or 1e-300) was a ZeroDivisionError traceback from ezdxf's placing of it."""
+    drawing = tmp_path / "d.dxf"
+    handle = _drawing_with_a_block(drawing, scale=scale)
+    r = camtube("toolpath", str(drawing), "-q", "-o", str(tmp_path / "o"))
+    assert_refused(r, f"{drawing}: INSERT #{handle} on layer NOTCH: scales block 'N'", *words,
+                   "fix: set the INSERT's X and Y scale")
+    assert listing(tmp_path) == ["d.dxf"]
+
+
+def test_a_layer_that_entities_are_on_but_the_layer_table_lacks_can_be_given_a_role(tmp_path):
+    """A drawing (from a script or an old program) with entities on layer CUTS but no CUTS in its layer table:
+    ``--layer CUTS=hole`` was refused 'the drawing has no such layer; allowed: 0' (the layers listed were the
+    table's only, not CUTS). A layer in neither is refused listing the drawing's layers."""
+    drawing = tmp_path / "d.dxf"
+    _drawing_with_a_block(drawing, layer_table=False)
+    r = camtube("design", str(drawing), "-q", "--layer", "cuts=hole")
+    assert r.returncode == 0, r.stderr
+    assert "1 / 1" in r.stdout   # the notch of the block and the hole on CUTS
+    r = camtube("design", str(drawing), "-q", "--layer", "CUT=hole")
+    assert_refused(r, f"{drawing}: --layer CUT=hole: the drawing has no such layer", "CUTS, ", "NOTCH, OUTLINE",
+                   "fix: did you mean 'CUTS'?")
+    r = camtube("design", str(drawing), "-q", "--layer", "ZZZ=ignore")
+    assert_refused(r, "--layer ZZZ=ignore", "fix: name one of the drawing's layers")
+
+
 def test_a_drawing_finds_a_shipped_process_and_names_a_missing_one(tmp_path):
     """With a DXF, ``--set process=femto-polyimide.yaml`` (the shipped process a YAML pattern finds anywhere) and
     ``--set process=nothere.yaml`` were both 'file: cannot read pattern: No such file or directory'."""
@@ -545,6 +638,25 @@ def test_a_calibration_with_an_unphysical_value_names_it(tmp_path, params, words
     cal.write_text('{"params": %s}' % params)
     r = camtube("design", TUBE1, "-q", "--stroke", "1", "--calibration", str(cal))
     assert_refused(r, str(cal), *words)
+
+
+@pytest.mark.parametrize("doc,words", [
+    ('{"params": {"E_t": NaN, "L0": 70}}', ("params.E_t: not a finite number (got NaN)",)),
+    ('{"params": {"E_t": {"value": "28"}}}', ("params.E_t.value: not a finite number (got \"28\")",)),
+    ('{"final": {"params": {"E_t": {"value": 28}, "slack.deadband_mm@2": {"value": null}}}}',
+     ("final.params.slack.deadband_mm@2.value: not a finite number (got null)",)),
+    ('{"params": {"arm_scale": Infinity}}', ("params.arm_scale", "(got Infinity)")),
+], ids=["nan", "text", "null-per-sample", "infinity"])
+def test_a_calibration_value_that_is_not_a_number_names_the_key(tmp_path, doc, words):
+    """A NaN, text or null parameter value in a calibration was skipped silently: the joint was computed with the
+    pattern's value instead, exit 0."""
+    cal = tmp_path / "c.json"
+    cal.write_text(doc)
+    for argv in (["design", TUBE1, "-q", "--stroke", "1"],
+                 ["synthesize", str(ROOT / "examples" / "goals" / "01-tube1-uniform-60.yaml"), "-o",
+                  str(tmp_path / "p.yaml")]):
+        assert_refused(camtube(*argv, "--calibration", str(cal)), f"{cal}: ", *words, "fix: write the fitted value")
+    assert listing(tmp_path) == ["c.json"]
 
 
 def test_a_goal_with_an_empty_list_of_shares(tmp_path):

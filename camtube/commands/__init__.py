@@ -9,6 +9,7 @@ imported only inside the handlers that need them.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import os
 import signal
@@ -119,7 +120,33 @@ def _interrupted(exc: BaseException) -> KeyboardInterrupt | None:
     return None
 
 
+@contextlib.contextmanager
+def _libraries_quiet(quiet: bool):
+    """With ``-q``: no Python warning (numpy's RuntimeWarning, scipy's OptimizeWarning) and no library log record
+    below ERROR (ezdxf's 'Found non-unique entity handle') reaches stderr while the command runs. What matters to the
+    user camtube says itself, as a warning line (which ``-q`` drops too) or an error (which it never drops)."""
+    if not quiet:
+        yield
+        return
+    import logging
+    import warnings
+
+    before = logging.root.manager.disable
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        logging.disable(logging.WARNING)
+        try:
+            yield
+        finally:
+            logging.disable(before)
+
+
 def _run(args: argparse.Namespace) -> int:
+    with _libraries_quiet(bool(getattr(args, "quiet", False))):
+        return _run_command(args)
+
+
+def _run_command(args: argparse.Namespace) -> int:
     try:
         return int(args.func(args) or 0)
     except CamtubeError as exc:

@@ -45,8 +45,8 @@ def register(model_sub) -> None:
     d.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
                    help="hold a parameter at a value (E_t GPa, L0 mm); repeatable")
     d.add_argument("--max-rows", type=int, default=4000, metavar="N",
-                   help="rows used by the candidate search, thinned evenly in time (default 4000; at least 25 per "
-                        "cycle, up to 4x this; 0 = all)")
+                   help="rows used by the candidate search, thinned evenly in time (default 4000, at least 100; "
+                        "at least 25 per cycle, up to 4x this; 0 = all)")
     d.add_argument("--max-effects", type=int, default=4, metavar="N", help="most effects recommended (default 4)")
     d.add_argument("--modulus-range", default="1,300", metavar="LO,HI",
                    help="plausible tendon E_t in GPa; a fit outside is not trusted (default 1,300)")
@@ -109,6 +109,27 @@ def fit_command_prefix(args: argparse.Namespace, instruments=None) -> str:
     return shlex.join(parts)
 
 
+def _check_init_names(init: dict, specs: dict, samples=None) -> None:
+    """Refuse an ``--init`` start for no parameter of the model or a candidate (``specs``), or, once the data are
+    read, for a sample they do not have (``NAME@S``): the search would drop it unseen."""
+    import difflib
+
+    from camtube.errors import DataError
+    from camtube.model.core.params import split_name
+
+    for name in init:
+        base, smp = split_name(name)
+        if base not in specs:
+            near = difflib.get_close_matches(base, list(specs), n=1)
+            raise DataError(f"--init {name}: unknown parameter {base!r}" + (f"; did you mean {near[0]!r}?" if near else "")
+                            + f" (the model's and the candidates' parameters: {', '.join(specs)}); fix: use one of "
+                            "these names (an effect's as EFFECT.param), or give the file of its effect with "
+                            "--effect-file")
+        if samples is not None and smp is not None and smp not in samples:
+            raise DataError(f"--init {name}: the data have no sample {smp!r} (samples: {', '.join(samples)}); "
+                            "fix: use NAME@SAMPLE with one of these samples, or NAME for all")
+
+
 def cmd_diagnose(args: argparse.Namespace) -> int:
     from camtube.model.core.threads import one_blas_thread
 
@@ -129,6 +150,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     from camtube.model.data.csvfile import check_force_identifies
     from camtube.model.diagnose import diagnose
     from camtube.model.diagnose.instruments import check_instruments, confirm_lag
+    from camtube.model.diagnose.search import MIN_SEARCH_ROWS
     from camtube.model.report.diagnosis import diagnosis_json, diagnosis_text, report_files
 
     check_suffix(args.json, (".json",), "--json")
@@ -147,9 +169,12 @@ def _diagnose(args: argparse.Namespace) -> int:
             raise DataError(f"--json {args.json}: is or lies in the --report folder {args.report}; fix: write the "
                             "JSON beside the report folder, not inside it")
     check_outputs_apart([("--json", args.json, True), ("--report", args.report, False)])
-    for opt, v, eg in (("--max-rows", args.max_rows, "4000 (0 = all rows)"), ("--max-effects", args.max_effects, "4")):
-        if v < 0:
-            raise DataError(f"{opt} {v}: must be >= 0; fix: e.g. {opt} {eg}")
+    if args.max_rows != 0 and not MIN_SEARCH_ROWS <= args.max_rows:
+        raise DataError(f"--max-rows {args.max_rows}: too few rows for the candidate search (each candidate is fitted "
+                        f"on half the cycles and tested on the others); allowed: 0 (all rows) or {MIN_SEARCH_ROWS} or "
+                        "more; fix: e.g. --max-rows 4000 (the default), or 0 for all rows")
+    if args.max_effects < 0:
+        raise DataError(f"--max-effects {args.max_effects}: must be >= 0; fix: e.g. --max-effects 4")
     try:
         lo, hi = (float(v) for v in args.modulus_range.split(","))
     except ValueError:
@@ -164,11 +189,13 @@ def _diagnose(args: argparse.Namespace) -> int:
     # every parameter the model or a candidate has (its range), checked before the data are read
     specs = {**{f"{e.name}.{q.name}": q for e in reg.values() for q in e.params}, **model.param_specs}
     init = parse_in_range(args.init, "--init", specs)
+    _check_init_names(init, specs)
     meas = read_measurements(args.data, strict=args.strict)
     rows = select_cycles(meas.data, args.cycles)
     ins = check_instruments(rows, lag_ms=args.lag_ms, dropped=meas.summary(),
                             n_dropped=int(meas.missing_lines.size + meas.backward_lines.size), rezero=args.rezero)
     check_fittable(ins.data, _rows_left(args, meas, ins))
+    _check_init_names(init, specs, ins.data.samples)
     fit_names, held = fitted_and_held(model, args.fit_params, args.fix, with_effects=False)
     check_force_identifies(ins.data, args.data, fit_names)
     fixed = pattern_values(pattern)

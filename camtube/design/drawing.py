@@ -187,7 +187,7 @@ def load_drawing(path: str | os.PathLike, overrides: Iterable[str], options) -> 
 
     doc = _read_document(path, file)
     factor, unit = _units(doc, options.units, file)
-    layer_names = {layer.dxf.name.upper(): layer.dxf.name for layer in doc.layers}
+    layer_names = _layer_names(doc)
     roles = _layer_roles(options.layers, layer_names, file)
     hidden = {layer.dxf.name.upper() for layer in doc.layers if layer.is_off() or layer.is_frozen()}
     rd = _Reading(file, factor, unit, roles, hidden)
@@ -319,6 +319,19 @@ def _units(doc, given: str | None, file: str) -> tuple[float, str]:
                               "save the drawing in mm or inch, or pass --units", file)])
 
 
+def _layer_names(doc) -> dict[str, str]:
+    """Upper-case name -> name of every layer of the drawing: those of its layer table and those its entities are
+    on (model space and blocks), which a DXF written by a script or an old program need not list in the table."""
+    names = {layer.dxf.name.upper(): layer.dxf.name for layer in doc.layers}
+    for block in doc.blocks:
+        if block.name.upper().startswith("*PAPER_SPACE"):
+            continue
+        for e in block:
+            name = e.dxf.get("layer", "0")
+            names.setdefault(str(name).upper(), str(name))
+    return names
+
+
 def _layer_roles(pairs, layer_names: dict[str, str], file: str) -> dict[str, str]:
     out: dict[str, str] = {}
     issues = []
@@ -331,9 +344,10 @@ def _layer_roles(pairs, layer_names: dict[str, str], file: str) -> dict[str, str
             import difflib
 
             near = difflib.get_close_matches(name, list(layer_names.values()), n=1, cutoff=0.5)
-            issues.append(Issue(f"--layer {name}={role}", "the drawing has no such layer", name,
-                                ", ".join(sorted(layer_names.values())),
-                                f"did you mean '{near[0]}'?" if near else "check the layer name", file))
+            issues.append(Issue(f"--layer {name}={role}", "the drawing has no such layer (not in its layer "
+                                "table, no entity on it)", name, "its layers " + ", ".join(sorted(layer_names.values())),
+                                f"did you mean '{near[0]}'?" if near else "name one of the drawing's layers (case "
+                                "does not matter), or drop this --layer", file))
             continue
         out[name.upper()] = role
     if issues:
@@ -346,6 +360,10 @@ def _layer_roles(pairs, layer_names: dict[str, str], file: str) -> dict[str, str
 MAX_INSERT_COPIES = 100_000
 #: Deepest nesting of blocks in blocks followed (CAD programs nest a few levels).
 MAX_BLOCK_DEPTH = 64
+#: Scales an INSERT may give its block along X and Y (magnitude; negative mirrors): a block drawn in um or m and
+#: placed in a mm drawing is scaled 1e-3 or 1e3, a unit square scaled to a cut by the cut's size; 0 flattens the
+#: block to a line or a point (and ezdxf's placing of it divides by zero).
+INSERT_SCALE_RANGE = (1e-9, 1e9)
 
 
 def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, ...] = ()) -> None:
@@ -386,6 +404,21 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
             rd.refuse(ent.describe(), f"places block {name!r} {entity.mcount} times (an array of "
                       f"{entity.dxf.get('row_count', 1)} x {entity.dxf.get('column_count', 1)})",
                       "check the array's row and column counts", f"at most {MAX_INSERT_COPIES} copies", entities=[ent])
+            return
+        lo, hi = INSERT_SCALE_RANGE
+        bad = [(axis, float(entity.dxf.get(f"{axis}scale", 1.0))) for axis in "xy"]
+        bad = [(axis, v) for axis, v in bad if not (math.isfinite(v) and lo <= abs(v) <= hi)]
+        if bad:
+            ent = unplaced()
+            if rd.role(layer) == "ignore":
+                ent.status = "aside:ignored layer"
+            else:
+                axis, v = bad[0]
+                why = ("flattens it to a line or a point" if v == 0 else "is not a finite number" if not math.isfinite(v)
+                       else "makes it too small to cut" if abs(v) < lo else "makes it too large for any tube")
+                rd.refuse(ent.describe(), f"scales block {name!r} by {v:g} along {axis.upper()} ({axis}scale), which "
+                          f"{why}", "set the INSERT's X and Y scale to the block's size in the drawing (e.g. 1) in "
+                          "CAD, or delete the INSERT", f"|scale| {lo:g} to {hi:g}", entities=[ent])
             return
         copies = list(entity.multi_insert()) if entity.mcount > 1 else [entity]
         for k, ins in enumerate(copies):

@@ -213,7 +213,7 @@ class Mechanics:
         except (json.JSONDecodeError, UnicodeDecodeError) as exc:
             raise CamtubeError(f"{p}: the calibration is not JSON ({exc}); fix: pass the file written by "
                                "'camtube model fit --json' or 'camtube model diagnose --json'") from None
-        params = _fit_params(doc)
+        params = _fit_params(doc, p)
         if not params:
             raise CamtubeError(f"{p}: no fitted parameters found (expected 'params' or 'final.params' of a "
                                "camtube.fit/1 or camtube.diagnose/1 file); fix: pass the JSON of 'camtube model "
@@ -240,20 +240,32 @@ class Mechanics:
         return cls(**values, source=str(p), ignored=tuple(sorted(ignored)))
 
 
-def _fit_params(doc) -> dict[str, float]:
-    """``{name: value}`` of a fit or diagnose JSON, per-sample copies averaged."""
+def _fit_params(doc, path: Path) -> dict[str, float]:
+    """``{name: value}`` of a fit or diagnose JSON, per-sample copies averaged.
+
+    Raises
+    ------
+    CamtubeError
+        A parameter whose value is not a finite number (NaN, Infinity, null, text, true/false), naming ``path``
+        and the key: it was skipped, so the joint was computed with the pattern's value instead.
+    """
     if not isinstance(doc, dict):
         return {}
-    block = doc.get("params")
+    where, block = "params", doc.get("params")
     if not isinstance(block, dict) and isinstance(doc.get("final"), dict):
-        block = doc["final"].get("params")
+        where, block = "final.params", doc["final"].get("params")
     if not isinstance(block, dict):
         return {}
     sums: dict[str, list[float]] = {}
     for name, entry in block.items():
+        key = f"{where}.{name}" + (".value" if isinstance(entry, dict) else "")
         v = entry.get("value") if isinstance(entry, dict) else entry
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            continue
+            got = ("no value" if isinstance(entry, dict) and "value" not in entry
+                   else "got " + json.dumps(v, allow_nan=True)[:40])
+            raise CamtubeError(f"{path}: {key}: not a finite number ({got}); fix: write the fitted value there, or "
+                               "pass the JSON of 'camtube model fit --json' or 'camtube model diagnose --json' as "
+                               "written")
         sums.setdefault(str(name).split("@")[0], []).append(float(v))
     return {k: sum(v) / len(v) for k, v in sums.items()}
 

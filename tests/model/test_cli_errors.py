@@ -278,6 +278,17 @@ def test_synth_suffix_mistake_says_the_fix(tmp_path, capsys):
     assert not list(tmp_path.iterdir())
 
 
+@pytest.mark.parametrize("value", ["1", "99", "-3"])
+def test_diagnose_refuses_a_row_limit_too_small_to_search(data_csv, tmp_path, capsys, value):
+    """``--max-rows 1`` ran: the search thinned the rows to 4, then failed with '4 data rows cannot fit 4 parameters;
+    fix: give more rows (--cycles all ...)', which does not name the option; 5 ran a 'search' on 20 rows."""
+    js = tmp_path / "d.json"
+    line = _one_line_with_fix(["model", "diagnose", str(data_csv), "--pattern", TUBE2, "-q", "--max-rows", value,
+                               "--json", str(js)], capsys, f"--max-rows {value}: too few rows",
+                              "allowed: 0 (all rows) or 100 or more", "fix: e.g. --max-rows 4000")
+    assert "Traceback" not in line and not js.exists()
+
+
 @pytest.mark.parametrize("tail,words", [
     ([], ["--from DIAG.json"]), (["--from", "{tmp}/nosuch.json"], ["nosuch.json", "no such diagnosis file"]),
     (["--from", "{tmp}/bad.json"], ["bad.json", "not a diagnosis JSON"]),
@@ -344,6 +355,21 @@ def test_an_init_value_outside_its_parameter_range_is_refused(data_csv, tmp_path
     js = tmp_path / "o.json"
     _one_line_with_fix(["model", cmd, str(data_csv), "--pattern", TUBE2, "-q", *tail, "--json", str(js)],
                        capsys, *words)
+    assert not js.exists()
+
+
+@pytest.mark.parametrize("item,words", [
+    ("nosuch.x=1", ["--init nosuch.x: unknown parameter 'nosuch.x'", "creep.tau_s, ", "fix: use one of these names"]),
+    ("creep.tau=3", ["--init creep.tau: unknown parameter", "did you mean 'creep.tau_s'?"]),
+    ("E_t@S9=30", ["--init E_t@S9: the data have no sample 'S9'", "samples: 1, 2"]),
+])
+def test_diagnose_refuses_an_init_for_no_parameter_it_has(data_csv, tmp_path, capsys, item, words):
+    """``model diagnose --init nosuch.x=1`` (or a misspelt candidate parameter, or an unknown sample) ran the whole
+    search without it and said nothing, while ``model fit`` refuses the same name."""
+    js = tmp_path / "o.json"
+    line = _one_line_with_fix(["model", "diagnose", str(data_csv), "--pattern", TUBE2, "-q", "--init", item,
+                               "--json", str(js)], capsys, *words)
+    assert str(data_csv) not in line   # about the option, not the measurement file
     assert not js.exists()
 
 

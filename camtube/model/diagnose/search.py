@@ -597,6 +597,9 @@ def noise_floor_se(data: Dataset, residual_deg: np.ndarray, blocks: np.ndarray) 
 
 #: The search keeps at least this many rows per cycle (it may then exceed ``max_rows``, up to 4x).
 MIN_ROWS_PER_CYCLE = 25
+#: Fewest rows ``max_rows`` may ask for (0 asks for all): each candidate is fitted on half of the blocks of
+#: cycles and tested on the other half, with several parameters; a handful of rows is no test at all.
+MIN_SEARCH_ROWS = 100
 
 
 def thin(data: Dataset, max_rows: int) -> Dataset:
