@@ -203,3 +203,69 @@ def test_a_param_written_wrong_is_one_line_naming_it(tmp_path, capsys, data_csv,
     assert "eff.py" in err and "fix:" in err, err
     for w in words:
         assert w in err, (w, err)
+
+
+# bug 08 (fuzzing): a BaseException that is no Exception (a class of the user's own, GeneratorExit) raised by an
+# effect file was a traceback with exit 1, at import and in its functions; Ctrl-C stays an interrupt (130)
+OWN = "class Stop(BaseException):\n    pass\n\n\n"
+
+
+@pytest.mark.parametrize("where,raise_,words", [
+    ("import", 'raise Stop("halt")', ["cannot load the effect file: Stop: halt", "fix: correct the file"]),
+    ("import", "raise GeneratorExit", ["cannot load the effect file: GeneratorExit", "fix: correct the file"]),
+    ("import", "raise SystemExit(3)", ["it called sys.exit()", "fix: correct the file"]),
+    ("apply", 'raise Stop("halt")', ["'broken'", "stage stroke: Stop: halt", "fix: correct the effect's function"]),
+    ("apply", "raise GeneratorExit", ["'broken'", "GeneratorExit", "fix: correct the effect's function"]),
+    ("init", 'raise Stop("halt")', ["broken.gain", "its init function raised Stop: halt", "fix:"]),
+])
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+def test_a_base_exception_of_an_effect_file_is_one_line_naming_file_and_line(tmp_path, capsys, data_csv, where,
+                                                                             raise_, words, cmd):
+    src = OWN + HEAD + ("    " + raise_ + "\n" if where == "apply" else "") + "    return x * p['gain']\n\n\n"
+    if where == "init":
+        src += "def _init(data, ctx):\n    " + raise_ + "\n\n\n"
+    src += TAIL.lstrip("\n").replace("1.0, \"gain\"", "_init, \"gain\"" if where == "init" else "1.0, \"gain\"")
+    if where == "import":
+        src += raise_ + "\n"
+    f = tmp_path / "eff.py"
+    f.write_text(src, encoding="utf-8")
+    argv = ["model", cmd, str(data_csv), "--pattern", TUBE2, "-q", "--effect-file", str(f)]
+    argv += ["--effects", "broken"] if cmd == "fit" else ["--candidates", "broken"]
+    code = main(argv)
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert "Traceback" not in err and len(err.splitlines()) == 1, err
+    line = max(i for i, ln in enumerate(src.splitlines(), 1) if ln.strip() == raise_)
+    assert f"{f}:{line}" in err, err
+    for w in words:
+        assert w in err, err
+
+
+def test_a_base_exception_of_a_check_is_one_line():
+    import numpy as np
+
+    from camtube.model.api import Effect, FitError, Param
+    from camtube.model.core.model import form_problem
+
+    class Stop(BaseException):
+        pass
+
+    def check(d, pred):
+        raise Stop("halt")
+
+    eff = Effect(name="odd", stage="angle", params=(Param("b_deg", "deg", -5.0, 5.0, 0.1, "offset"),),
+                 apply=lambda c, a, p: a + p["b_deg"], check=check, source="odd.py")
+    with pytest.raises(FitError, match=r"effect 'odd' \(odd\.py\), check: Stop: halt; fix: correct the check"):
+        form_problem(eff, None, np.zeros(3))
+
+
+@pytest.mark.parametrize("where", ["import", "apply"])
+def test_a_keyboard_interrupt_in_an_effect_file_is_still_an_interrupt(tmp_path, capsys, data_csv, where):
+    src = HEAD + ("    raise KeyboardInterrupt\n" if where == "apply" else "") + "    return x" + TAIL
+    if where == "import":
+        src += "raise KeyboardInterrupt\n"
+    f = tmp_path / "eff.py"
+    f.write_text(src, encoding="utf-8")
+    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--effect-file", str(f),
+                 "--effects", "broken"]) == 130
+    assert "interrupted" in capsys.readouterr().err

@@ -301,6 +301,24 @@ def _user_line(effect: Effect, stage: str, exc: BaseException | None = None) -> 
     return f":{code.co_firstlineno}" if code is not None else ""
 
 
+def user_raised(exc: BaseException) -> str:
+    """What a user's code raised, for a one-line message: ``called sys.exit()`` for a ``SystemExit``, else
+    ``TYPE: MESSAGE`` (any ``BaseException`` but ``KeyboardInterrupt``, which the caller lets through as an
+    interrupt), its message on one line."""
+    if isinstance(exc, SystemExit):
+        return "called sys.exit()"
+    text = " ".join(str(exc).split())
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def _user_line_of(source: str, exc: BaseException) -> str:
+    """``:LINE`` of the deepest frame of ``exc``'s traceback in the effect file ``source`` ("" when none is there)."""
+    import traceback
+
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if source and f.filename == source]
+    return f":{frames[-1].lineno}" if frames else ""
+
+
 def _call(effect: Effect, stage: str, ctx: Context, signal: np.ndarray, p: dict) -> np.ndarray:
     """Run one effect's stage function; a broken effect gets a message naming it, its file, the line and the problem."""
     def where(exc: BaseException | None = None) -> str:
@@ -314,12 +332,12 @@ def _call(effect: Effect, stage: str, ctx: Context, signal: np.ndarray, p: dict)
         raise FitError(f"{where(exc)}, stage {stage}: asked for parameter {exc.args[0]!r}, but its params are "
                        f"{', '.join(repr(q.name) for q in effect.params) or 'none'}; fix: use one of those names "
                        "or add a Param of that name") from None
-    except FitError:
+    except (FitError, KeyboardInterrupt):  # (Ctrl-C and SIGTERM stay an interrupt, wherever they arrive)
         raise
-    except (Exception, SystemExit) as exc:  # noqa: BLE001 - a user's effect may raise anything: report it with its line
+    except BaseException as exc:  # noqa: BLE001 - a user's effect may raise anything: report it with its line
         if not effect.source:
             raise
-        what = "called sys.exit()" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}"
+        what = user_raised(exc)
         raise FitError(f"{where(exc)}, stage {stage}: {what}; fix: correct the effect's function at that "
                        "line") from None
     shape_fix = f"fix: return one number per row (an array shaped like the {stage} signal it was given)"
@@ -364,10 +382,13 @@ def form_problem(effect: Effect, data, predicted_deg: np.ndarray, effects: Seque
     try:
         reason = effect.check(data, predicted_deg, effects=tuple(effects)) if takes else \
             effect.check(data, predicted_deg)
-    except Exception as exc:  # noqa: BLE001 - a user's check may raise anything: report it with its file
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:  # noqa: BLE001 - a user's check may raise anything: report it with its file
         if not effect.source:
             raise
-        raise FitError(f"effect {effect.name!r} ({effect.source}), check: {type(exc).__name__}: {exc}") from None
+        raise FitError(f"effect {effect.name!r} ({effect.source}{_user_line_of(effect.source, exc)}), check: "
+                       f"{user_raised(exc)}; fix: correct the check function at that line") from None
     if reason is not None and not isinstance(reason, str):
         raise FitError(f"effect {effect.name!r}{f' ({effect.source})' if effect.source else ''}, check: returned "
                        f"{type(reason).__name__}, expected a string (empty when the form holds)")
@@ -452,10 +473,13 @@ class JointModel:
 
         try:
             v = spec.initial(data, ctx)
-        except Exception as exc:  # noqa: BLE001 - a user's init function may raise anything: report it with its file
+        except KeyboardInterrupt:
+            raise
+        except BaseException as exc:  # noqa: BLE001 - a user's init function may raise anything: report it with its file
             if not source():
                 raise
-            raise FitError(f"parameter {name!r} ({source()}): its init function raised {type(exc).__name__}: {exc}; "
+            raise FitError(f"parameter {name!r} ({source()}{_user_line_of(source(), exc)}): its init function "
+                           f"raised {user_raised(exc)}; "
                            "fix: correct the function, or give a number") from None
         if not math.isfinite(v):
             src = source()

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Iterable, Iterator, Mapping
 
 from camtube.errors import CamtubeError
-from camtube.model.core.model import Effect
+from camtube.model.core.model import Effect, user_raised
 
 
 class EffectError(CamtubeError, ValueError):
@@ -130,7 +130,9 @@ def load_effect_file(path: str | Path) -> tuple[Effect, ...]:
                               "(UTF-8 text; see docs/diagnose.md)") from None
         raise EffectError(f"{path}:{exc.lineno}: cannot load the effect file: {exc.msg}; fix: correct the Python "
                           "at that line") from None
-    except (Exception, SystemExit) as exc:  # noqa: BLE001 - a user's file may raise anything; report it with its line
+    except KeyboardInterrupt:  # Ctrl-C (or SIGTERM) while importing: an interrupt, not a broken file
+        raise
+    except BaseException as exc:  # noqa: BLE001 - a user's file may raise anything; report it with its line
         import traceback
 
         here = path.resolve()
@@ -139,7 +141,7 @@ def load_effect_file(path: str | Path) -> tuple[Effect, ...]:
             raise EffectError(f"{path}: cannot load the effect file: {exc}; fix: give a Python source file "
                               "(UTF-8 text; see docs/diagnose.md)") from None
         line = f":{tb[-1].lineno}" if tb else ""
-        what = "it called sys.exit()" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}"
+        what = "it called sys.exit()" if isinstance(exc, SystemExit) else user_raised(exc)
         fix = "" if "; fix:" in str(exc) else "; fix: correct the file at that line (importing it must only define effects)"
         raise EffectError(f"{path}{line}: cannot load the effect file: {what}{fix}") from None
     finally:
