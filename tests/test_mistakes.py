@@ -803,3 +803,22 @@ def test_output_folder_given_as_a_link_gets_the_files_and_stays_a_link(tmp_path,
     assert listing(tmp_path) == ["current", "jobs", "jobs/v2", "jobs/v2/tube1.job.json", "jobs/v2/tube1.nc",
                                  "jobs/v2/tube1.ngc", "jobs/v2/tube1.toolpath.dxf"]
     assert (tmp_path / "jobs" / "v2" / "tube1.ngc").read_text() != "old"
+
+
+@pytest.mark.parametrize("override,key", [("process.repeats=1000", "process.repeats"),
+                                          ("process.repeat_rule.0={max_depth: 3, repeats: 500}",
+                                           "process.repeat_rule[0].repeats")])
+def test_repeats_beyond_any_tube_are_refused_at_once_with_the_bound(tmp_path, override, key):
+    """Bug 12 (fuzzing): 1000 repeats were accepted and planned (a curved drawing on linuxcnc-surface: minutes and
+    gigabytes); the paper cuts with 4, 6 and 8. Refused before any work, naming the key and the bound."""
+    r = camtube("toolpath", "tube1", "--machine", "linuxcnc-surface", "--set", override, "-o", str(tmp_path / "o"),
+                "-q")
+    assert_refused(r, key, "<= 100", "fix: use a value <= 100")
+    assert listing(tmp_path) == []
+
+
+def test_the_largest_repeats_is_accepted():
+    from camtube.design.loader import load
+    from camtube.design.schema import MAX_REPEATS
+
+    assert load(PATTERNS / "tube1.yaml", [f"process.repeats={MAX_REPEATS}"]).pattern.process.repeats == MAX_REPEATS
