@@ -7,7 +7,7 @@ import time
 from pathlib import Path
 
 from camtube.commands.common import path_value, refuse_output_over_input
-from camtube.errors import CamtubeError
+from camtube.errors import CamtubeError, PatternError
 
 
 def register(sub) -> None:
@@ -49,7 +49,14 @@ def cmd_synthesize(args: argparse.Namespace) -> int:
     design = synthesize(goal, calib)
     seconds = time.perf_counter() - t0
     text = pattern_yaml(design)
-    loaded = load_text(text, out)  # camtube's own rules, before anything is written
+    try:
+        loaded = load_text(text, out)  # camtube's own rules, before anything is written
+    except PatternError as exc:  # (named after the output file, which is not written: the goal's problem)
+        first = exc.issues[0]
+        more = f" (and {len(exc.issues) - 1} more)" if len(exc.issues) > 1 else ""
+        raise CamtubeError(f"{args.goal}: the pattern designed for this goal breaks camtube's pattern rules: "
+                           f"{first.key}: {first.message}{more}; fix: relax the goal's lengths or limits behind "
+                           f"{first.key} (nothing was written)") from None
     checks = check_design(design, loaded.pattern)
     path = write_atomic(out, text)
     print(summary_text(design, checks, seconds, loaded.pattern))

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Iterable
 
@@ -191,7 +191,13 @@ class _Reader:
             if not isinstance(v, (list, tuple)):
                 self.issue(key, "expected a list", v, f.allowed(), "write e.g. [0, 90, 180, 270]")
                 return ()
-            return tuple(self.number(x, f, f"{key}[{i}]") for i, x in enumerate(v))
+            before = len(self.issues)
+            out = tuple(self.number(x, f, f"{key}[{i}]") for i, x in enumerate(v))
+            if len(self.issues) > before + 1:  # one line for the list ([0, 0, 0]: one mistake, not three lines)
+                first, more = self.issues[before], len(self.issues) - before - 1
+                self.issues[before:] = [replace(first, message=f"{first.message} (and {more} more entr"
+                                                f"{'y' if more == 1 else 'ies'} of {key})")]
+            return out
         if f.kind == "rows":
             if not isinstance(v, list):
                 self.issue(key, "expected a list of mappings", v, f.allowed(), "write one '- key: value' entry per item")

@@ -70,7 +70,8 @@ GOAL_SCHEMA: dict = {
                         "other (the first bend nearest the tip)", "alternate", choices=("alternate", "sequential")),
         "max_notch_bend_deg": Field("float", "deg", "largest bend of one notch ('auto' notch count)", 6.0, 0.0,
                                     45.0, True),
-        "web": Field("float", "mm", "web between notches (edge to edge)", 0.3, **POS),
+        # (>= 1 um: the pattern is written to 0.1 um, and a web of 1e-12 mm was written as a spacing of 0)
+        "web": Field("float", "mm", "web between notches (edge to edge)", 0.3, 0.001),
         "first_offset": Field("float", "mm", "tip to the first notch (room for the anchor holes)", 1.5, **POS),
         "base_length": Field("float", "mm", "plain tube kept beyond the last notch", 1.5, 0.0),
     },
@@ -188,13 +189,21 @@ class Goal:
 
 
 def _sections(r: Reader, raw: dict, name: str) -> dict:
+    """One section's values; a section that is not a mapping, or a missing one with required keys: one issue
+    for the section, not one per key (its keys are then not reported one by one)."""
+    spec = GOAL_SCHEMA[name]
     body = raw.get(name)
+    required = [k for k, f in spec.items() if f.default is ...]
+    if body is None and required:
+        r.issue(name, "required section is missing", None, "a mapping with " + ", ".join(required),
+                f"add e.g. '{name}: {{" + ", ".join(f"{k}: <value>" for k in required) + "}'")
+        r.broken.add(name)
     if body is None:
         body = {}
     if not isinstance(body, dict):
         r.issue(name, "expected a mapping", body, "key: value pairs", f"indent the keys under '{name}:'")
+        r.broken.add(name)
         body = {}
-    spec = GOAL_SCHEMA[name]
     r.check_keys(body, spec, name)
     out = {}
     for k, f in spec.items():
@@ -279,6 +288,14 @@ def build_goal(raw: dict, file: str | None = None, lines: dict[str, int] | None 
         if isinstance(dist, tuple) or dist != "uniform":
             r.issue("goal.distribution", "the curve sets the distribution", dist, "uniform (or leave it out)",
                     "remove goal.distribution")
+    if goal["notches"] in (None, "auto") and not isinstance(dist, tuple):  # ceil(bend / max_notch_bend_deg) notches
+        most = max((b["bend_deg"] for b in bends), default=0.0)
+        hi = GOAL_SCHEMA["goal"]["notches"].hi
+        if most / goal["max_notch_bend_deg"] > hi:
+            r.issue("goal.max_notch_bend_deg", f"asks for {most / goal['max_notch_bend_deg']:.4g} notches for a bend "
+                    f"of {most:g} deg, more than the {hi:g} a direction may have", goal["max_notch_bend_deg"],
+                    f">= {most / hi:.4g} deg", f"raise it to {math.ceil(most / hi * 1e4) / 1e4:g} deg or more, or "
+                    "give goal.notches")
     if lim["min_web"] > goal["web"]:
         r.issue("goal.web", "is thinner than limits.min_web", goal["web"], f">= {lim['min_web']:g} mm",
                 "raise goal.web")
@@ -327,8 +344,10 @@ def load_goal(path: str | os.PathLike) -> Goal:
     """Read and validate a goal YAML file (every failure: a :class:`PatternError` naming file, line and key)."""
     raw, text = read_yaml_file(path, "goal", "check the path of the goal YAML")
     file = str(path)
-    if raw is None:
-        raw = {}
+    if raw is None:  # an empty file (or only comments): one line, not one per missing key
+        raise PatternError([Issue("<top>", "the goal file is empty", None, "sections " + ", ".join(GOAL_SCHEMA),
+                                  "write at least 'tube:' and 'goal:' (e.g. start from "
+                                  "examples/goals/01-tube1-uniform-60.yaml)", file, 1)])
     if not isinstance(raw, dict):
         raise PatternError([Issue("<top>", "a goal file must be a mapping of sections", None,
                                   "sections " + ", ".join(GOAL_SCHEMA), "start the file with 'tube:'", file, 1)])

@@ -32,6 +32,7 @@ import numpy as np
 
 from camtube.design.geometry import joint_geometry
 from camtube.design.pattern import Pattern, Process, Rules, Tube, hole, sort_cuts
+from camtube.design.schema import SCHEMA as PATTERN_SCHEMA
 from camtube.errors import CamtubeError
 from camtube.joint.forward import Mechanics, hinge_root_mm, hinge_side_factor, notch_set
 from camtube.synthesis.goal import BendTarget, Goal, shares_from_tip
@@ -55,6 +56,12 @@ class InfeasibleGoal(CamtubeError):
     def __init__(self, message: str, limit: str, nearest: str):
         self.limit, self.nearest = limit, nearest
         super().__init__(message)
+
+
+def _len(x: float, decimals: int = 2) -> str:
+    """A length (or force) for a message: fixed decimals, or 4 digits when it is huge (a goal of 1e300 mm printed
+    300 digits)."""
+    return f"{x:.{decimals}f}" if abs(x) < 1e6 else f"{x:.4g}"
 
 
 @dataclass(frozen=True)
@@ -267,7 +274,7 @@ def _solve_count_at(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget
             continue
         if g >= 0.0:
             if prev is None:
-                return _Fail("goal.bends[].stroke_mm", f"the bend needs {g + stroke + mech.slack_mm:.3f} mm of tendon "
+                return _Fail("goal.bends[].stroke_mm", f"the bend needs {_len(g + stroke + mech.slack_mm, 3)} mm of tendon "
                              f"travel even without stretching the tendon, more than the stroke "
                              f"{target.stroke_mm:g} mm", "bend")
             bracket = (prev, float(f))
@@ -327,14 +334,14 @@ def _solve_count_at(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget
         pitch = goal.curve_length_mm / n
         need = max((w_tip[i] + w_tip[i + 1]) / 2.0 for i in range(n - 1)) + lim.min_web_mm if n > 1 else 0.0
         if pitch < need:
-            return _Fail("goal.curve_length", f"{n} notches of up to {max(w_tip):.3f} mm do not fit in "
+            return _Fail("goal.curve_length", f"{n} notches of up to {_len(max(w_tip), 3)} mm do not fit in "
                          f"goal.curve_length = {goal.curve_length_mm:g} mm with webs of limits.min_web", "bend")
         length = pitch * (n - 1) + (w_tip[0] + w_tip[-1]) / 2.0
     else:
         length = sum(w_tip) + goal.web_mm * (n - 1)
     if length > budget_mm + 1e-9:
-        return _Fail("limits.max_length", f"the joint would be {length:.2f} mm long (notches {sum(w_tip):.2f} mm "
-                     f"+ webs), more than {budget_mm:.2f} mm", "bend")
+        return _Fail("limits.max_length", f"the joint would be {_len(length)} mm long (notches {_len(sum(w_tip))} mm "
+                     f"+ webs), more than {_len(budget_mm)} mm", "bend")
     return DirectionDesign(target, w_tip, a_tip, tuple(float(s) for s in shares), force, pitch)
 
 
@@ -476,7 +483,7 @@ def _solve_all(goal: Goal, mech: Mechanics, grid: _Grid,
             break
     total = _layout_length(goal, out)
     if total > goal.limits.max_length_mm + 1e-9:
-        return 0, _Fail("limits.max_length", f"the {len(out)} directions together make a joint of {total:.2f} mm, "
+        return 0, _Fail("limits.max_length", f"the {len(out)} directions together make a joint of {_len(total)} mm, "
                         f"more than {goal.limits.max_length_mm:g} mm", "bend")
     if goal.centerline:
         rows = _layout_rows(goal, out)
@@ -540,6 +547,12 @@ def _assemble(goal: Goal, dirs: tuple[DirectionDesign, ...], mech: Mechanics, pr
         "spacings": webs, "angles_deg": [float(round(r[2], 6)) for r in rows],
     }
     length = goal.first_offset_mm + sum(section["widths"]) + sum(webs) + goal.base_length_mm
+    longest = PATTERN_SCHEMA["tube"]["length"].hi
+    if round(length, 4) > longest:  # (a huge first_offset or base_length: the pattern would be refused, unwritten)
+        raise InfeasibleGoal(f"{goal.source + ': ' if goal.source else ''}goal.first_offset = {goal.first_offset_mm:.4g} "
+                             f"mm, the joint and goal.base_length = {goal.base_length_mm:.4g} mm make a tube of "
+                             f"{length:.4g} mm, longer than a pattern's tube.length may be ({longest:g} mm); fix: "
+                             "shorten goal.first_offset or goal.base_length", "goal.base_length", "none")
     from camtube.design.generate import notch_row
 
     cuts = list(notch_row(len(rows), 0.0, 0.0, 0.0, goal.first_offset_mm, widths_mm=section["widths"],

@@ -221,3 +221,61 @@ def test_a_backbone_arc_that_leaves_no_notch_is_refused_with_one_line(tmp_path):
     out = tmp_path / "p.yaml"
     assert_refused(camtube("synthesize", str(goal), "-o", str(out)), "limits.min_backbone_arc", "reach the lumen")
     assert not out.exists()
+
+
+# bugs 17-19 (fuzzing): a bad goal file was several lines for one mistake (a section that is not a mapping, a
+# missing tube section, an empty file, a list of zero shares), 'out of memory' naming nothing (a tiny
+# max_notch_bend_deg), or a message about the unwritten output pattern's keys (a web of 1e-12 mm written as a
+# spacing of 0, a first_offset or base_length of 1e300 mm); a huge length printed 300 digits
+@pytest.mark.parametrize("text,words", [
+    ("", [":1:", "the goal file is empty", "fix: write at least 'tube:' and 'goal:'"]),
+    ("# only a comment\n", ["the goal file is empty"]),
+    (GOOD.replace("tube: {outer_radius: 0.75, inner_radius: 0.45}\n", ""),
+     ["tube: required section is missing", "outer_radius, inner_radius", "fix: add e.g. 'tube: {"]),
+    (GOOD.replace("{outer_radius: 0.75, inner_radius: 0.45}", "[0.75, 0.45]"),
+     [":1:", "tube: expected a mapping", "fix: indent the keys under 'tube:'"]),
+    (GOOD.replace("limits: {max_strain: 0.04}", "limits: 3"), ["limits: expected a mapping"]),
+    (GOOD.replace("goal:", "goal:\n  distribution: [0, 0, 0]"),
+     ["goal.distribution[0]", "(and 2 more entries of goal.distribution)", "fix: use a positive value"]),
+    (GOOD.replace("goal:", "goal:\n  max_notch_bend_deg: 1e-9"),
+     ["goal.max_notch_bend_deg", "more than the 200 a direction may have", ">= 0.2 deg", "fix: raise it to 0.2"]),
+    (GOOD.replace("goal:", "goal:\n  web: 1e-12").replace("max_strain: 0.04", "max_strain: 0.04, min_web: 0"),
+     [":3:", "goal.web", ">= 0.001 mm"]),
+    (GOOD.replace("goal:", "goal:\n  first_offset: 1e300"),
+     ["goal.first_offset = 1e+300 mm", "longer than a pattern's tube.length may be (2000 mm)",
+      "fix: shorten goal.first_offset or goal.base_length"]),
+    (GOOD.replace("goal:", "goal:\n  base_length: 1e300"), ["goal.base_length = 1e+300 mm", "fix: shorten"]),
+    (GOOD.replace("inner_radius: 0.45}", "inner_radius: 0.45, modulus_gpa: 1e300}"),
+     ["limits.max_length", "e+299 mm long", "infeasible"]),
+])
+def test_bad_goal_files_are_one_line_naming_the_key_with_a_fix(tmp_path, capsys, text, words):
+    from camtube.commands import main
+
+    g = tmp_path / "g.yaml"
+    g.write_text(text)
+    code = main(["synthesize", str(g), "-o", str(tmp_path / "p.yaml")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert "Traceback" not in err and len(err.splitlines()) == 1 and "fix:" in err and str(g) in err, err
+    assert not re.search(r"\d{20}", err), err
+    for w in words:
+        assert w in err, err
+    assert listing(tmp_path) == ["g.yaml"]
+
+
+def test_a_designed_pattern_the_rules_refuse_names_the_goal_not_the_unwritten_output(tmp_path, capsys, monkeypatch):
+    """The last guard: camtube's rules refusing the designed pattern were one line per issue, each naming the output
+    file, which is not written."""
+    import camtube.synthesis.report as report
+    from camtube.commands import main
+
+    real = report.pattern_yaml
+    monkeypatch.setattr(report, "pattern_yaml", lambda d: re.sub(r"spacings: \[[^\]]*\]",
+                                                                   "spacings: [" + ", ".join(["0"] * 20) + "]", real(d)))
+    g = tmp_path / "g.yaml"
+    g.write_text(GOOD)
+    assert main(["synthesize", str(g), "-o", str(tmp_path / "p.yaml")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "p.yaml" not in err and str(g) in err, err
+    assert "notch.spacings" in err and "more)" in err and "fix: relax the goal's" in err, err
+    assert listing(tmp_path) == ["g.yaml"]
