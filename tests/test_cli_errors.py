@@ -273,3 +273,25 @@ def test_quiet_keeps_library_warnings_off_stderr(tmp_path):
     drawing.write_text("".join(text))
     r = camtube("design", str(drawing), "-q")
     assert r.returncode == 0 and r.stderr == "", r.stderr
+
+
+def test_forces_too_small_to_weigh_give_their_line_and_no_warning_without_quiet(tmp_path):
+    """Forces of 1e-200 N: the deadband search weighed the force by one over its noise squared, which underflows to
+    0, and numpy's 'invalid value encountered in divide' reached stderr beside the one error line (without ``-q``)."""
+    import csv
+
+    data = tmp_path / "d.csv"
+    assert camtube("model", "synth", "--pattern", "tube2", "-o", str(data), "--cycles", "2", "-q").returncode == 0
+    with open(data, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    for row in rows:
+        row["force_N"] = repr(float(row["force_N"]) * 1e-200)
+    tiny = tmp_path / "tiny.csv"
+    with open(tiny, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    r = camtube("model", "fit", str(tiny), "--pattern", "tube2")
+    lines = [x for x in r.stderr.splitlines() if x.strip()]
+    assert r.returncode == 2 and len(lines) == 1 and "fix:" in lines[0], r.stderr
+    assert "Warning" not in r.stderr

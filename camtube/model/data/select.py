@@ -168,6 +168,8 @@ def _cycle_slack(stroke: np.ndarray, angle: np.ndarray, force: np.ndarray,
                  threshold_deg: float | None) -> Slack:
     """Slack of one loading branch (rows in time order)."""
     sig_a, sig_f = _noise(angle), _noise(force)
+    if not sig_f * sig_f > 0.0:   # (forces of 1e-200 N: a noise whose square underflows cannot weigh the force)
+        sig_f = 0.0
     order = np.argsort(stroke, kind="stable")
     s, a, f = stroke[order], angle[order], force[order]
     s_min, s_max = float(s[0]), float(s[-1])
