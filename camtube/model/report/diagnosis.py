@@ -26,7 +26,8 @@ report directory with an index is complete).
                                                              # parameter the rows kept barely depend on
      "final": {"effects", "rmse_deg", "params"}, "stop_reason", "command",
      "unexplained": null | {"share", "follows", "periodic": [{"variable", "period", "unit", "amplitude_deg"}],
-                            "shape", "samples", ...}}   # camtube.model.unexplained
+                            "shape", "samples", "rows": null | {"share", "n", "fraction", "max_deg", "samples",
+                            "time_s"}, ...}}   # camtube.model.unexplained
 
 Non-finite numbers are written as ``null``.
 """
@@ -375,9 +376,12 @@ def answer_lines(d: Diagnosis) -> list[str]:
                    f"({steps[0].rmse_deg:.3f} vs {floor:.3f} deg)")
     u = unexplained_report.of_diagnosis(d)
     if u is not None and (d.recommended or d.partial or steps[0].rmse_deg > REACH_RATIO * floor):
-        follows = ", ".join(u["follows"][:2]) if u.get("follows") else "nothing in particular (noise-like)"
-        out.append(f"  left: {100 * u['share']:.0f} % of the final error is above the noise floor; it follows "
-                   f"{follows}; carried by sample(s) {', '.join(u.get('samples') or []) or 'alike'}")
+        rows = u.get("rows")
+        follows = ("it follows " + ", ".join(u["follows"][:2]) if u.get("follows") else
+                   f"it follows no variable: {100 * rows['share']:.0f} % of it sits in {rows['n']} isolated rows"
+                   if rows else "it follows nothing in particular (noise-like)")
+        out.append(f"  left: {100 * u['share']:.0f} % of the final error is above the noise floor; {follows}; "
+                   f"carried by sample(s) {', '.join(u.get('samples') or []) or 'alike'}")
     elif d.recommended:
         out.append("  left: nothing structured (the error is at the noise floor)")
     ins = d.instruments
