@@ -317,6 +317,9 @@ HELDOUT35_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 HELDOUT36_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
                    "lag", ("creep", "toe"), ("backbone3", "lost motion"), ("slack", "backbone3"), "sharp friction",
                    "tracker drift"]
+HELDOUT37_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
+                   "lag", ("sharp friction", "lost motion"), ("backbone3", "toe"), ("friction", "creep"),
+                   "sharp friction", "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -405,13 +408,17 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            # drawn once a tracker's fixed value beside a long burst was left out of its reading and what is left was
            # read against the model's bend angle (bench-heldout35's tracker drift traced; the tracker-drift files of
            # bench-heldout11 .. 35 rerun); run once
-           "bench-heldout36": (20281209, HELDOUT36_KINDS)}
+           "bench-heldout36": (20281209, HELDOUT36_KINDS),
+           # drawn once a release the stroke had not logged under a cell at its limit was set aside, with a burst over
+           # the guide's switch (bench-heldout36's sharp guide traced; the instruments' check of bench-sharp and
+           # bench-heldout17 .. 36 compared); run once
+           "bench-heldout37": (20281210, HELDOUT37_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
            "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
            "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36",
-           "bench-sharp"}
+           "bench-heldout37", "bench-sharp"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -420,7 +427,8 @@ ROUGH = {"bench-heldout15", "bench-heldout16"}
 ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21",
            "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26",
            "bench-heldout27", "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
-           "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36"}
+           "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36",
+           "bench-heldout37"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
