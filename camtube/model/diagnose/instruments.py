@@ -1144,43 +1144,9 @@ def shift_angle(data: Dataset, lag_ms: float | Mapping[str, float]) -> tuple[Dat
     out = applied if each else float(np.mean(list(applied.values())))
     return data.with_angle(ang).take(keep), keep, out, past_end
 
-def check_instruments(data: Dataset, lag_ms: float | Mapping[str, float] | None = None, dropped: str = "",
-                      n_dropped: int = 0, rezero: bool = True) -> Instruments:
-    """Find the instruments' artefacts, set them aside, estimate (or apply) the angle's lag.
-
-    Parameters
-    ----------
-    data : Dataset
-        The rows as read (``n`` rows).
-    lag_ms : float or dict, optional
-        The angle channel's lag (ms) to correct, one for every sample or ``{sample: lag_ms}`` (a sample not named:
-        none); ``None``: estimate it (per sample where the samples differ, :func:`estimate_lags`) and correct it
-        where it is resolved.
-    dropped, n_dropped : str, int
-        The reader's line on dropped rows and their count (stated in the findings).
-    rezero : bool
-        Re-zero the force at the rests where the load cell's zero drifts (:func:`rezero_force`); False: read it only.
-
-    Returns
-    -------
-    Instruments
-    """
-    given = {} if lag_ms is None else dict(lag_ms) if isinstance(lag_ms, Mapping) else {"": lag_ms}
-    for smp, ms in given.items():
-        what = f"--lag-ms {smp}={ms:g}" if smp else f"--lag-ms {ms:g}"
-        if not math.isfinite(ms):
-            raise DataError(f"{what}: the angle channel's lag must be a finite number of ms; fix: give e.g. "
-                            "--lag-ms 20, or 0 for none")
-        if abs(ms) > MAX_GIVEN_LAG_MS:
-            raise DataError(f"{what}: a lag of more than {MAX_GIVEN_LAG_MS:g} ms between the tracker and the "
-                            "load cell is not an instrument's delay but clocks that were not aligned; fix: give the "
-                            "tracker's delay in ms (e.g. --lag-ms 20, 0 for none), and align the logs' clocks first "
-                            "(camtube model ingest)")
-    unknown = sorted(smp for smp in given if smp and smp not in set(data.samples))
-    if unknown:
-        raise DataError(f"--lag-ms {unknown[0]}=...: no sample {unknown[0]!r} in the data (samples: "
-                        f"{', '.join(map(str, data.samples))}); fix: name a sample of the file, or give one lag for all")
-    slices = data.sample_slices()
+def _artefacts(data: Dataset, slices: list) -> tuple[dict, np.ndarray, np.ndarray, dict]:
+    """The instruments' artefacts of ``data`` (rows as read): ``(aside {why: rows}, kept (n,) bool, repeated stamps
+    (n,) bool, the load cells' limits {sample: (reading N, rows)})``; see :func:`check_instruments`."""
     aside: dict[str, np.ndarray] = {}
     rep = np.zeros(len(data), bool)
     for _, sl in slices:
@@ -1219,6 +1185,47 @@ def check_instruments(data: Dataset, lag_ms: float | Mapping[str, float] | None 
         if rows.any():   # (the findings name only the kinds found)
             aside[why] = np.flatnonzero(rows)
     kept = ~(rep | sa | sf | fz | ba | bf | sat | ahead)
+    return aside, kept, rep, limits
+
+
+def check_instruments(data: Dataset, lag_ms: float | Mapping[str, float] | None = None, dropped: str = "",
+                      n_dropped: int = 0, rezero: bool = True) -> Instruments:
+    """Find the instruments' artefacts, set them aside, estimate (or apply) the angle's lag.
+
+    Parameters
+    ----------
+    data : Dataset
+        The rows as read (``n`` rows).
+    lag_ms : float or dict, optional
+        The angle channel's lag (ms) to correct, one for every sample or ``{sample: lag_ms}`` (a sample not named:
+        none); ``None``: estimate it (per sample where the samples differ, :func:`estimate_lags`) and correct it
+        where it is resolved.
+    dropped, n_dropped : str, int
+        The reader's line on dropped rows and their count (stated in the findings).
+    rezero : bool
+        Re-zero the force at the rests where the load cell's zero drifts (:func:`rezero_force`); False: read it only.
+
+    Returns
+    -------
+    Instruments
+    """
+    given = {} if lag_ms is None else dict(lag_ms) if isinstance(lag_ms, Mapping) else {"": lag_ms}
+    for smp, ms in given.items():
+        what = f"--lag-ms {smp}={ms:g}" if smp else f"--lag-ms {ms:g}"
+        if not math.isfinite(ms):
+            raise DataError(f"{what}: the angle channel's lag must be a finite number of ms; fix: give e.g. "
+                            "--lag-ms 20, or 0 for none")
+        if abs(ms) > MAX_GIVEN_LAG_MS:
+            raise DataError(f"{what}: a lag of more than {MAX_GIVEN_LAG_MS:g} ms between the tracker and the "
+                            "load cell is not an instrument's delay but clocks that were not aligned; fix: give the "
+                            "tracker's delay in ms (e.g. --lag-ms 20, 0 for none), and align the logs' clocks first "
+                            "(camtube model ingest)")
+    unknown = sorted(smp for smp in given if smp and smp not in set(data.samples))
+    if unknown:
+        raise DataError(f"--lag-ms {unknown[0]}=...: no sample {unknown[0]!r} in the data (samples: "
+                        f"{', '.join(map(str, data.samples))}); fix: name a sample of the file, or give one lag for all")
+    slices = data.sample_slices()
+    aside, kept, rep, limits = _artefacts(data, slices)
     clean = data.take(kept)
     if (~kept & ~rep).any() and SPEED_COLUMN not in data.extra:
         # the drive's speed at each row kept is read on every row whose stamp is sound: a load cell at its limit
