@@ -243,24 +243,29 @@ def test_a_command_without_its_subcommand_is_a_usage_mistake(argv):
     assert len(r.stderr.strip().splitlines()) == 1 and "fix: give one of the" in r.stderr
 
 
-def test_quiet_keeps_library_warnings_off_stderr(tmp_path):
-    """With ``-q``, numpy's RuntimeWarning ('invalid value encountered in divide', two lines each: the warning and
-    the source line) reached stderr around the one error line; and ezdxf's log record 'Found non-unique entity
-    handle' was printed for a drawing that imports fine."""
+def _fit_tiny_forces(tmp_path, *flags: str) -> subprocess.CompletedProcess:
+    """``model fit`` on a synthetic record whose forces are 1e-200 N (refused: the force cannot identify E_t)."""
     import csv
 
     data = tmp_path / "d.csv"
     assert camtube("model", "synth", "--pattern", "tube2", "-o", str(data), "--cycles", "2", "-q").returncode == 0
     with open(data, newline="") as fh:
         rows = list(csv.DictReader(fh))
-    for row in rows:   # forces of 1e-200 N: the deadband search divides by a noise level that underflows to 0
+    for row in rows:
         row["force_N"] = repr(float(row["force_N"]) * 1e-200)
     tiny = tmp_path / "tiny.csv"
     with open(tiny, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    r = camtube("model", "fit", str(tiny), "--pattern", "tube2", "-q")
+    return camtube("model", "fit", str(tiny), "--pattern", "tube2", *flags)
+
+
+def test_quiet_keeps_library_warnings_off_stderr(tmp_path):
+    """With ``-q``, numpy's RuntimeWarning ('invalid value encountered in divide', two lines each: the warning and
+    the source line) reached stderr around the one error line; and ezdxf's log record 'Found non-unique entity
+    handle' was printed for a drawing that imports fine."""
+    r = _fit_tiny_forces(tmp_path, "-q")
     lines = [x for x in r.stderr.splitlines() if x.strip()]
     assert r.returncode == 2 and len(lines) == 1 and "fix:" in lines[0], r.stderr
     assert "Warning" not in r.stderr
@@ -278,20 +283,7 @@ def test_quiet_keeps_library_warnings_off_stderr(tmp_path):
 def test_forces_too_small_to_weigh_give_their_line_and_no_warning_without_quiet(tmp_path):
     """Forces of 1e-200 N: the deadband search weighed the force by one over its noise squared, which underflows to
     0, and numpy's 'invalid value encountered in divide' reached stderr beside the one error line (without ``-q``)."""
-    import csv
-
-    data = tmp_path / "d.csv"
-    assert camtube("model", "synth", "--pattern", "tube2", "-o", str(data), "--cycles", "2", "-q").returncode == 0
-    with open(data, newline="") as fh:
-        rows = list(csv.DictReader(fh))
-    for row in rows:
-        row["force_N"] = repr(float(row["force_N"]) * 1e-200)
-    tiny = tmp_path / "tiny.csv"
-    with open(tiny, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    r = camtube("model", "fit", str(tiny), "--pattern", "tube2")
+    r = _fit_tiny_forces(tmp_path)
     lines = [x for x in r.stderr.splitlines() if x.strip()]
     assert r.returncode == 2 and len(lines) == 1 and "fix:" in lines[0], r.stderr
     assert "Warning" not in r.stderr

@@ -114,13 +114,19 @@ def test_rest_moment_is_a_per_sample_offset():
     assert "samples differ" in u["sentence"]
 
 
+def _triangle_variables(t: np.ndarray) -> dict:
+    """Plain variables of one sample driven by a triangle stroke (0-2 mm, 8 s a cycle) at the times ``t``."""
+    stroke = 2.0 - np.abs(2.0 - (0.5 * t) % 4.0)
+    return {"stroke": stroke, "angle": 10 * stroke, "force": stroke,
+            "direction": np.where(np.gradient(stroke) >= 0, 1, -1), "cycle": (t // 8).astype(int) + 1, "time": t,
+            "sample": np.full(t.size, "A")}
+
+
 def test_plain_arrays_and_floor_rule():
     rng = np.random.default_rng(0)
     n = 4000
     t = np.arange(n) * 0.05
-    stroke = 2.0 - np.abs(2.0 - (0.5 * t) % 4.0)
-    v = {"stroke": stroke, "angle": 10 * stroke, "force": stroke, "direction": np.where(np.gradient(stroke) >= 0, 1, -1),
-         "cycle": (t // 8).astype(int) + 1, "time": t, "sample": np.full(n, "A")}
+    v = _triangle_variables(t)
     noise = rng.normal(0, 0.3, n)
     assert analyse(noise, v, 0.3) is None                      # at the floor: nothing left
     u = analyse(noise + 0.8 * (v["direction"] > 0), v, 0.3)    # a step with the direction of motion
@@ -157,9 +163,7 @@ def test_a_misfit_in_a_few_isolated_rows_is_named_as_such_not_as_noise():
     rng = np.random.default_rng(36)
     n = 20000
     t = np.arange(n) * 0.05
-    stroke = 2.0 - np.abs(2.0 - (0.5 * t) % 4.0)
-    v = {"stroke": stroke, "angle": 10 * stroke, "force": stroke, "direction": np.where(np.gradient(stroke) >= 0, 1, -1),
-         "cycle": (t // 8).astype(int) + 1, "time": t, "sample": np.full(n, "A")}
+    v = _triangle_variables(t)
     r = rng.normal(0, 0.2, n)
     hit = rng.choice(n, 12, replace=False)
     r[hit] -= 20.0
