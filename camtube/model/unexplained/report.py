@@ -73,7 +73,11 @@ def text_lines(d, json_path: str = "DIAG.json") -> list[str]:
                      f"for the physics above: try the starter effect without them")
     if getattr(d, "partial", ()):
         lines.append(f"  this is the misfit left with the partial effects ({', '.join(d.partial)}), which lower the "
-                     "error without explaining it: write the effect (start below) and diagnose again with it")
+                     "error without explaining it: "
+                     + ("write the effect (start below) and diagnose again with it" if u.get("leading") else
+                        "look at the rows named above before writing an effect (set aside what the instruments' "
+                        "check missed, and diagnose again)" if u.get("rows") else
+                        "look at the residual plots before writing an effect"))
     if u.get("leading"):
         lines.append(f"  start an effect for it: camtube model effect new {suggested_name(u)} --from {json_path}"
                      f"  (the diagnosis's --json file)")
