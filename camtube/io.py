@@ -413,19 +413,30 @@ def _followed(out: Path) -> Path:
     return Path(os.path.realpath(out)) if out.is_symlink() else out
 
 
+def output_clash(where: list[Path], is_file: list[bool]) -> tuple[int, int] | None:
+    """The first ``(i, j)`` of outputs at paths ``where`` (normalised by the caller) where output ``i`` is at the path
+    of output ``j``, or inside it, and ``j`` is written as a file (so writing one destroys the other); None if none.
+    Shared by :func:`write_together` and the command line's check before any work."""
+    for i, a in enumerate(where):
+        for j, b in enumerate(where):
+            if i != j and is_file[j] and (a == b or b in a.parents):
+                return i, j
+    return None
+
+
 def _check_apart(targets: list[Path], is_set: list[bool]) -> None:
     """Refuse two outputs at one path, or an output inside another output that is a file."""
     where = [Path(os.path.normpath(t.absolute())) for t in targets]
-    for i, a in enumerate(where):
-        for j, b in enumerate(where):
-            if i == j:
-                continue
-            if a == b and i < j:
-                raise OutputError(targets[j], f"it is also the path of another output ({targets[i]})",
-                                  "give each output a path of its own")
-            if not is_set[j] and b in a.parents:
-                raise OutputError(targets[i], f"it lies inside {targets[j]}, which is written as a file",
-                                  f"give it a path outside {targets[j]}")
+    clash = output_clash(where, [not s for s in is_set])
+    if clash is None:
+        return
+    i, j = clash
+    if where[i] == where[j]:
+        first, later = sorted(clash)
+        raise OutputError(targets[later], f"it is also the path of another output ({targets[first]})",
+                          "give each output a path of its own")
+    raise OutputError(targets[i], f"it lies inside {targets[j]}, which is written as a file",
+                      f"give it a path outside {targets[j]}")
 
 
 def write_together(outputs) -> list:

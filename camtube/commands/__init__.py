@@ -9,7 +9,6 @@ imported only inside the handlers that need them.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import importlib
 import os
 import signal
@@ -120,7 +119,7 @@ def _interrupted(exc: BaseException) -> KeyboardInterrupt | None:
     return None
 
 
-@contextlib.contextmanager
+@contextmanager
 def _libraries_quiet(quiet: bool):
     """With ``-q``: no Python warning (numpy's RuntimeWarning, scipy's OptimizeWarning) and no library log record
     below ERROR (ezdxf's 'Found non-unique entity handle') reaches stderr while the command runs. What matters to the

@@ -193,13 +193,15 @@ def check_outputs_apart(outputs) -> None:
     """
     from pathlib import Path
 
+    from camtube.io import output_clash
+
     given = [(opt, path, Path(path).resolve(), is_file) for opt, path, is_file in outputs if path]
-    for i, (opt, path, where, _) in enumerate(given):
-        for j, (other, other_path, other_where, other_is_file) in enumerate(given):
-            if i != j and other_is_file and (where == other_where or other_where in where.parents):
-                raise CamtubeError(f"{opt} {path}: {'is' if where == other_where else 'lies inside'} the {other} "
-                                   f"file {other_path}, so writing one would destroy the other; fix: give {opt} a "
-                                   f"path of its own, outside {other_path}")
+    clash = output_clash([g[2] for g in given], [g[3] for g in given])
+    if clash is not None:
+        (opt, path, where, _), (other, other_path, other_where, _) = given[clash[0]], given[clash[1]]
+        raise CamtubeError(f"{opt} {path}: {'is' if where == other_where else 'lies inside'} the {other} "
+                           f"file {other_path}, so writing one would destroy the other; fix: give {opt} a "
+                           f"path of its own, outside {other_path}")
 
 
 def check_output_file(path: str, option: str) -> None:

@@ -291,14 +291,8 @@ def _user_line(effect: Effect, stage: str, exc: BaseException | None = None) -> 
     """``:LINE`` in the effect's own file: the deepest traceback frame there, else the stage function's ``def``."""
     fn = effect.function(stage)
     code = getattr(fn, "__code__", None)
-    files = {effect.source, getattr(code, "co_filename", None)} - {None, ""}
-    if exc is not None:
-        import traceback
-
-        frames = [f for f in traceback.extract_tb(exc.__traceback__) if f.filename in files]
-        if frames:
-            return f":{frames[-1].lineno}"
-    return f":{code.co_firstlineno}" if code is not None else ""
+    line = _user_line_of({effect.source, getattr(code, "co_filename", None)}, exc) if exc is not None else ""
+    return line or (f":{code.co_firstlineno}" if code is not None else "")
 
 
 def user_raised(exc: BaseException) -> str:
@@ -311,11 +305,13 @@ def user_raised(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
-def _user_line_of(source: str, exc: BaseException) -> str:
-    """``:LINE`` of the deepest frame of ``exc``'s traceback in the effect file ``source`` ("" when none is there)."""
+def _user_line_of(files: str | set, exc: BaseException) -> str:
+    """``:LINE`` of the deepest frame of ``exc``'s traceback in the effect's file (``files``: its name, or the names
+    it may go by) ("" when none is there)."""
     import traceback
 
-    frames = [f for f in traceback.extract_tb(exc.__traceback__) if source and f.filename == source]
+    names = ({files} if isinstance(files, str) else set(files)) - {None, ""}
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if f.filename in names]
     return f":{frames[-1].lineno}" if frames else ""
 
 
