@@ -577,10 +577,11 @@ def _far_rows(r: np.ndarray, v: dict, floor: float) -> dict | None:
         return None
     sample = v["sample"]
     t = v["time"]
-    t0 = {s: float(t[sample == s].min()) for s in _unique_in_order(sample[far])}
+    where = _unique_in_order(sample[far])
+    t0 = {s: float(t[sample == s].min()) for s in where}
     big = far[np.argsort(-a2[far], kind="stable")[:5]]
     return {"share": min(share, 1.0), "n": int(far.size), "fraction": far.size / n,
-            "max_deg": float(np.abs(r[far]).max()), "samples": [str(x) for x in _unique_in_order(sample[far])],
+            "max_deg": float(np.abs(r[far]).max()), "samples": [str(x) for x in where],
             "time_s": [[str(sample[i]), float(t[i]) - t0[sample[i]]] for i in sorted(big)]}
 
 
