@@ -194,3 +194,31 @@ def test_near_zero_force_the_law_is_averaged_over_the_tensions_posterior(tube2):
         want = np.trapezoid(law * w, grid) / np.trapezoid(w, grid)
         assert extra[i] == pytest.approx(want, rel=0.03), (i, mu)
     assert checked > 10
+
+
+def test_the_compiled_rows_give_the_numpy_expressions_numbers_to_the_bit():
+    # speed: toe_rows replaced about ten NumPy passes over the rows; the numbers must be those passes', bit for bit
+    # (a fit's path depends on them), at every row: low forces, zero forces, the largest force, a table's last cell
+    from camtube.model.effects.builtin import TOE_GRID, _toe_table
+    from camtube.model.effects.kernels import toe_rows
+
+    rng = np.random.default_rng(11)
+    q = np.arange(TOE_GRID + 1) / TOE_GRID
+    for trial in range(40):
+        n = int(rng.integers(1, 20_000))
+        f = np.maximum(rng.normal(0.3, 1.0, n), 0.0) * rng.uniform(0.01, 5.0)
+        f[rng.integers(0, n, size=max(n // 10, 1))] = 0.0
+        c, shape, lam = rng.uniform(1e-3, 0.3), rng.uniform(0.5, 10.0), rng.uniform(1e-3, 3.0)
+        tau = c * f / lam
+        t_max = float(tau.max(initial=0.0))
+        if t_max <= 0.0:
+            continue
+        assert c * float(f.max()) / lam == t_max   # what the law computes instead of tau.max()
+        xg, tg = _toe_table(shape, t_max + 2.0)
+        xj = np.interp(t_max * q**2, tg, xg)
+        pos = np.sqrt(tau * (1.0 / t_max)) * TOE_GRID
+        i = np.minimum(pos.astype(np.intp), TOE_GRID - 1)
+        lo = xj.take(i)
+        want = lam * (lo + (pos - i) * (xj.take(i + 1) - lo) - tau)
+        got = toe_rows(f, c, lam, t_max, xj)
+        assert np.array_equal(got.view(np.int64), want.view(np.int64)), trial

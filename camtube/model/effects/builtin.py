@@ -54,6 +54,7 @@ from camtube.model.data.dataset import Dataset, recently_used, rests_of
 from camtube.model.effects.history import (  # noqa: F401
     carriage_hold, first_order_lag, monotone_segments, play_operator,
 )
+from camtube.model.effects.kernels import toe_rows
 
 # ----------------------------------------------------------------------------- helpers
 
@@ -668,20 +669,17 @@ def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
     lam = mean / m                          # Weibull scale (mm)
 
     def extra(f: np.ndarray) -> np.ndarray:
-        tau = c * f / lam                   # normalised tension (the linear tendon's elongation / lam)
-        # tabulate tau(x) once, invert by interpolation; tau(x) >= x - m, so x_max covers every row
-        t_max = float(tau.max(initial=0.0))
+        # normalised tension tau = c f / lam (the linear tendon's elongation / lam); its largest value is that of the
+        # largest force (rounding keeps the order)
+        t_max = c * max(float(f.max(initial=0.0)), 0.0) / lam
         if t_max <= 0.0:
-            return np.zeros_like(tau)
+            return np.zeros(f.shape)
+        # tabulate tau(x) once, invert by interpolation; tau(x) >= x - m, so x_max covers every row
         q = np.arange(TOE_GRID + 1) / TOE_GRID
         xg, tg = _toe_table(k, t_max + m + 1.0)
-        # speed: x on a grid uniform in sqrt(tau) (one small interp), then rows by direct indexing
+        # speed: x on a grid uniform in sqrt(tau) (one small interp), then the rows in one compiled pass
         xj = np.interp(t_max * q**2, tg, xg)
-        pos = np.sqrt(tau * (1.0 / t_max)) * TOE_GRID
-        i = pos.astype(np.intp)
-        np.minimum(i, TOE_GRID - 1, out=i)
-        lo = xj.take(i)
-        return lam * (lo + (pos - i) * (xj.take(i + 1) - lo) - tau)  # 0 .. offset_mm
+        return toe_rows(np.asarray(f, float), c, lam, t_max, xj)  # 0 .. offset_mm
 
     return toe_elongation(ctx, elong, extra, key=("toe_shape", c, mean, k))
 
