@@ -43,6 +43,11 @@ class Tolerances:
         chords adds its blending tolerance (``G64 P0.001`` on ``linuxcnc-path``):
         the beam stays within 2 um of the drawing, a tenth of a 20 um kerf
         (``MachineProfile.path_tolerance_mm``).
+    rule : float
+        A length at a design rule's limit within this (1 nm) is at the limit, not past it: the design rules
+        (:mod:`camtube.design.rules`), the CAD verification (:mod:`camtube.cad.verify`) and the synthesis
+        compare a web with ``rules.min_web`` with this one slack, so a web at the limit (or a float's
+        rounding from it, e.g. a spacing of 0.0999999999 mm for 0.1) gets one verdict from all of them.
     corner_deg : float
         A vertex where the path turns by more than this (deg) is a true corner:
         the time-optimal bound stops there (:mod:`camtube.machine.bound`); below it
@@ -56,6 +61,7 @@ class Tolerances:
     gap: float = 1e-3
     outline: float = 1e-3
     path: float = 1e-3
+    rule: float = 1e-9
     corner_deg: float = 5.0
 
 

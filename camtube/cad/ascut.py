@@ -38,8 +38,10 @@ from typing import Sequence
 
 import numpy as np
 
+from camtube.design.pattern import ASSUMED_KERF_MM
+
 #: Beam kerf (mm) assumed by the simulation when the process has none (kerf_mm = 0).
-DEFAULT_SIM_KERF_MM = 0.02
+DEFAULT_SIM_KERF_MM = ASSUMED_KERF_MM
 #: Slack (mm) on the overcut/undercut depth allowances.
 DEPTH_TOL_MM = 0.002
 #: Pieces smaller than this (mm^2) are numerical dust, not reported.
@@ -153,6 +155,9 @@ class AsCut:
         For each cut, its narrowest web to another cut (pairs listed once).
     allow_overcut_mm, allow_undercut_mm : float
         Depth allowances (see the module docstring).
+    expected_overcut_mm : float
+        Overcut expected on every edge: ``kerf / 2`` for a job planned without kerf compensation (its first
+        pass runs on the design line), 0 for a compensated one. Every web is that much thinner on each side.
     """
 
     kerf_mm: float
@@ -168,6 +173,7 @@ class AsCut:
     webs: tuple[Web, ...]
     allow_overcut_mm: float
     allow_undercut_mm: float
+    expected_overcut_mm: float = 0.0
 
     @property
     def circumference_mm(self) -> float:
@@ -267,7 +273,10 @@ def _cut_segments(job, moves) -> dict[int, np.ndarray]:
     rev = (seg[:, 0] > seg[:, 2]) | ((seg[:, 0] == seg[:, 2]) & (seg[:, 1] > seg[:, 3]))
     seg[rev] = seg[rev][:, [2, 3, 0, 1]]
     key = np.column_stack([cid, np.round(seg, 9)])
-    uniq = np.unique(key, axis=0)
+    # one of each (rounded) segment, with its own coordinates: rounded ones would move a cut's edge by up to
+    # 0.5 nm, more than the min_web check's slack (TOL.rule) allows a web at the limit
+    _, first = np.unique(key, axis=0, return_index=True)
+    uniq = np.column_stack([cid, seg])[first]
     out: dict[int, np.ndarray] = {}
     for c in np.unique(uniq[:, 0]).astype(int).tolist():
         out[c] = uniq[uniq[:, 0] == c][:, 1:]
@@ -298,7 +307,8 @@ def simulate(job, moves=None, kerf_mm: float | None = None) -> AsCut:
     if not kerf > 0:
         raise ValueError(f"kerf_mm must be > 0 for the simulation, got {kerf}")
     compensated = job.process.kerf_mm > 0
-    allow_over = (0.0 if compensated else kerf / 2.0) + DEPTH_TOL_MM
+    expected_over = 0.0 if compensated else kerf / 2.0
+    allow_over = expected_over + DEPTH_TOL_MM
     allow_under = (math.sqrt(2.0) - 1.0) * kerf / 2.0 + DEPTH_TOL_MM
     ro, circ = float(job.outer_radius_mm), 2.0 * math.pi * float(job.outer_radius_mm)
     n = len(job.design)
@@ -380,7 +390,7 @@ def simulate(job, moves=None, kerf_mm: float | None = None) -> AsCut:
 
     webs = _webs(removed_by_cut, design, circ)
     return AsCut(kerf, from_process, ro, float(job.length_mm), removed, removed_by_cut, design, tuple(cuts),
-                 over, under, webs, allow_over, allow_under)
+                 over, under, webs, allow_over, allow_under, expected_over)
 
 
 def _webs(removed: Sequence, design: Sequence, circ: float) -> tuple[Web, ...]:

@@ -18,7 +18,9 @@ Checks (each pass/fail with measured value, expected value and tolerance):
   volume minus the removed sheet area mapped radially (area / r_o * (r_o^2 - r_i^2) / 2);
 - ``notch[i].phi.as_cut``: the as-cut mesh's backbone angle within 1 % of the
   design plus the expected kerf overcut (2 allowance / r_o);
-- ``min_web``: the narrowest as-cut bridge between two cuts >= ``rules.min_web``.
+- ``min_web``: the narrowest as-cut bridge between two cuts >= ``rules.min_web``, within ``TOL.rule`` as the
+  design rules. A job without kerf compensation thins every web by the kerf (half on each side): a web designed
+  at the limit fails, and the check says so and what to change (the design rules warn of it first).
 
 The report is plain data (:class:`Report`); :func:`report_text` and
 :func:`report_json` render it deterministically.
@@ -33,6 +35,7 @@ import numpy as np
 
 from camtube.design.geometry import backbone_angle_rad
 from camtube.design.pattern import Pattern
+from camtube.tol import TOL
 
 STL_VOLUME_RTOL = 0.005
 STEP_VOLUME_RTOL = 0.002
@@ -233,10 +236,16 @@ def _ascut_checks(pattern: Pattern, a, checks: list[Check], summary: dict) -> No
     if w is not None:
         summary["min_web_mm"] = w.as_cut_mm
         summary["min_web_design_mm"] = w.design_mm
+        # rules.min_web is the bridge the part needs, as cut: a job without kerf compensation cuts each side of a web
+        # half a kerf wide, so a web designed at the limit fails here, and says why (the design rules warn of it)
         need = pattern.rules.min_web_mm
-        checks.append(Check("min_web", w.as_cut_mm >= need - 1e-9, w.as_cut_mm, need, ">= rules.min_web", "mm",
+        thinned = a.expected_overcut_mm > 0 and w.design_mm >= need - TOL.rule > w.as_cut_mm
+        why = (f"; thinned by the kerf ({2.0 * a.expected_overcut_mm:g} mm simulated): process.kerf = 0 (no kerf "
+               f"compensation); fix: set process.kerf to the beam's kerf, or design the web "
+               f">= {need + 2.0 * a.expected_overcut_mm:g} mm" if thinned else "")
+        checks.append(Check("min_web", w.as_cut_mm >= need - TOL.rule, w.as_cut_mm, need, ">= rules.min_web", "mm",
                             f"between cut[{w.a}] and cut[{w.b}] at x {w.where[0]:.3f} mm, y {w.where[1]:.3f} mm "
-                            f"(design {w.design_mm:.4f} mm)"))
+                            f"(design {w.design_mm:.4f} mm){why}"))
 
 
 def _ascut_mesh_checks(pattern, a, mesh, notch_idx, seg, checks: list[Check], summary: dict) -> None:

@@ -149,6 +149,12 @@ class RepeatRule:
     repeats: int
 
 
+#: A beam's kerf (mm) assumed where the process gives none (``process.kerf = 0``, no kerf compensation): the CAD
+#: simulation cuts with it, the design rules warn of webs it would thin below ``rules.min_web``, the synthesis draws
+#: notches that much narrower.
+ASSUMED_KERF_MM = 0.02
+
+
 @dataclass(frozen=True)
 class Process:
     """Femtosecond laser process (the paper's Table II plus the pass structure).

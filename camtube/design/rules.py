@@ -15,8 +15,9 @@ import re
 from typing import Sequence
 
 from camtube.design.geometry import DirectionBend, bends_at_stroke
-from camtube.design.pattern import Cut, Pattern
+from camtube.design.pattern import ASSUMED_KERF_MM, Cut, Pattern
 from camtube.errors import Issue
+from camtube.tol import TOL
 
 
 def _circular_gap(a0: float, a1: float, b0: float, b1: float, c: float) -> float:
@@ -245,13 +246,14 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
 
     # pairwise overlap / web: sweep in x so long patterns stay near-linear
     order = sorted(range(len(pattern.cuts)), key=lambda i: pattern.cuts[i].x_start_mm)
+    thinned_by_kerf = not pattern.process.kerf_mm > 0
     cuts = pattern.cuts
     reported = 0
     for a_pos, i in enumerate(order):
         a = cuts[i]
         for j in order[a_pos + 1:]:
             b = cuts[j]
-            if b.x_start_mm > a.x_end_mm + rules.min_web_mm:
+            if b.x_start_mm > a.x_end_mm + rules.min_web_mm + (ASSUMED_KERF_MM if thinned_by_kerf else 0.0):
                 break
             hole_pair = "hole" in (a.kind, b.kind)
             key = _pair_key(origins[i], origins[j], a, b)
@@ -264,11 +266,20 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
                     "move the hole along x or around the tube" if hole_pair else "increase notch.spacing or move the cut")
             else:
                 d = cut_distance_mm(a, b, ro)
-                if d < rules.min_web_mm - 1e-12:
+                if d < rules.min_web_mm - TOL.rule:  # (the CAD verification's min_web: the same slack)
                     what = "is too close to" if not hole_pair else "collides with (web too thin)"
                     err(key, f"{_describe(b)} {what} {_describe(a)}: web {d:.4g} mm", round(d, 9),
                         f">= rules.min_web = {rules.min_web_mm:g} mm",
                         "move the hole away from the notches" if hole_pair else "increase notch.spacing")
+                elif thinned_by_kerf and d < rules.min_web_mm + ASSUMED_KERF_MM - TOL.rule:
+                    # without kerf compensation each side of the web is cut half a kerf wider than drawn: as cut it is
+                    # thinner than the limit, and the CAD verification (which cuts it so) fails it
+                    warn(key, f"the web between {_describe(a)} and {_describe(b)} is {d:.4g} mm as drawn; with "
+                         f"process.kerf = 0 (no kerf compensation) a {ASSUMED_KERF_MM:g} mm kerf leaves "
+                         f"{d - ASSUMED_KERF_MM:.4g} mm as cut", round(d, 9),
+                         f">= rules.min_web + kerf = {rules.min_web_mm + ASSUMED_KERF_MM:g} mm as drawn",
+                         "set process.kerf to the beam's kerf (kerf compensation), or "
+                         + ("move the hole away from the notches" if hole_pair else "increase notch.spacing"))
             reported += 1
         if len(errors) > 50:
             break

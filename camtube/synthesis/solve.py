@@ -31,11 +31,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from camtube.design.geometry import joint_geometry
-from camtube.design.pattern import Pattern, Process, Rules, Tube, hole, sort_cuts
+from camtube.design.pattern import ASSUMED_KERF_MM, Pattern, Process, Rules, Tube, hole, sort_cuts
 from camtube.design.schema import SCHEMA as PATTERN_SCHEMA
 from camtube.errors import CamtubeError
 from camtube.joint.forward import Mechanics, hinge_root_mm, hinge_side_factor, notch_set
 from camtube.synthesis.goal import BendTarget, Goal, shares_from_tip
+from camtube.tol import TOL
 
 #: Backbone strain aimed at, as a fraction of ``limits.max_strain`` (room for the laser's tolerance).
 STRAIN_DESIGN = 0.85
@@ -132,15 +133,13 @@ def expected_overcut_mm(process, calibration: Mechanics | None = None) -> float:
 
     A process with kerf compensation (``process.kerf > 0``) cuts the drawing; without it the first pass
     runs on the design line and the cut is one kerf wider: the calibration's fitted ``kerf.kerf_mm`` when
-    given, else the kerf the CAD verification assumes (:data:`camtube.cad.ascut.DEFAULT_SIM_KERF_MM`).
+    given, else the kerf the CAD verification assumes (:data:`camtube.design.pattern.ASSUMED_KERF_MM`).
     """
     if process is not None and process.kerf_mm > 0:
         return 0.0
     if calibration is not None and calibration.kerf_mm:
         return max(calibration.kerf_mm, 0.0)
-    from camtube.cad.ascut import DEFAULT_SIM_KERF_MM
-
-    return DEFAULT_SIM_KERF_MM
+    return ASSUMED_KERF_MM
 
 
 def goal_mechanics(goal: Goal, calibration: Mechanics | None = None, process=None) -> Mechanics:
@@ -489,7 +488,7 @@ def _solve_all(goal: Goal, mech: Mechanics, grid: _Grid,
         rows = _layout_rows(goal, out)
         for j in range(len(rows) - 1):
             web = (rows[j][3] + rows[j + 1][3]) / 2.0 - (rows[j][0] + rows[j + 1][0]) / 2.0
-            if web < goal.limits.min_web_mm - 1e-9:
+            if web < goal.limits.min_web_mm - TOL.rule:
                 return 0, _Fail("limits.min_web", f"two pieces of the centre line meet with a web of {web:.3f} mm, "
                                 f"thinner than limits.min_web = {goal.limits.min_web_mm:g} mm", "bend")
     return tuple(out)

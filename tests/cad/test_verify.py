@@ -5,12 +5,14 @@ import dataclasses
 import json
 
 import numpy as np
+import pytest
 
 from camtube.cad.ascut import simulate
 from camtube.cad.mesh import tube_mesh
 from camtube.cad.verify import analytic_volume_mm3, report_json, report_text, verify
 from camtube.design.contour import Contour
 from tests.cad.conftest import analytic_volume, job_of, mesh_of, preset
+from tests.conftest import PATTERNS
 
 
 def _full(name, job=None, moves=None):
@@ -79,3 +81,45 @@ def test_gap_caught_slug_not_freed():
     assert "cut[7].undercut" in failed
     assert "x 7.5" in failed["cut[7].slug"].detail  # names where the cut is
     assert not any(n.startswith("cut[") and not n.startswith("cut[7]") for n in failed)
+
+
+def _web_verdicts(web: float, kerf: str):
+    """(design-rule errors, warnings, the CAD verification's min_web check) of tube1 with its notches ``web`` mm apart
+    and ``rules.min_web`` 0.1 mm, planned with ``process.kerf = kerf``."""
+    from camtube.design.loader import load
+    from camtube.design.rules import check
+    from camtube.plan import plan_job
+
+    p = load(PATTERNS / "tube1.yaml", [f"notch.spacing={web!r}", "rules.min_web=0", f"process.kerf={kerf}"]).pattern
+    p = dataclasses.replace(p, rules=dataclasses.replace(p.rules, min_web_mm=0.1))
+    errors, warnings = check(p)
+    cad = next(c for c in verify(p, ascut=simulate(plan_job(p))).checks if c.name == "min_web")
+    return [i for i in errors if "rules.min_web" in i.allowed], warnings, cad
+
+
+@pytest.mark.parametrize("web,ok", [(0.1, True), (0.1 - 5e-10, True), (0.1 + 5e-10, True), (0.1 - 1e-6, False),
+                                    (0.1 + 1e-6, True), (0.099, False)])
+def test_min_web_one_verdict_from_the_rules_and_the_cad_verification(web, ok):
+    """Bug 26 (fuzzing): at rules.min_web, within a float's rounding of it, the design rules and the CAD check used
+    different slacks (1e-12 and 1e-9, and the simulation's 1 nm rounding of the cut's segments). A compensated job
+    (process.kerf > 0) cuts the drawing: one verdict."""
+    errors, _, cad = _web_verdicts(web, "0.02")
+    assert (not errors, cad.passed) == (ok, ok), (errors, cad)
+
+
+def test_a_web_designed_at_the_limit_without_kerf_compensation_is_warned_of_and_fails_as_cut_saying_why():
+    """Bug 26: without kerf compensation the beam cuts each side of a web half a kerf wider than drawn, so a web
+    designed at rules.min_web is thinner as cut. The CAD check reads the part as cut (min_web is the bridge the part
+    needs) and fails it naming the kerf and the fix; the design rules warn of it first; a web a kerf wider passes."""
+    from camtube.design.pattern import ASSUMED_KERF_MM
+
+    errors, warnings, cad = _web_verdicts(0.1, "0.0")
+    assert not errors
+    warned = [w for w in warnings if "no kerf compensation" in w.message]
+    assert warned and "process.kerf" in warned[0].fix and warned[0].value == pytest.approx(0.1)
+    assert not cad.passed and cad.measured == pytest.approx(0.1 - ASSUMED_KERF_MM, abs=2e-3)
+    assert "thinned by the kerf" in cad.detail and "set process.kerf" in cad.detail
+    errors, warnings, cad = _web_verdicts(0.1 + ASSUMED_KERF_MM + 1e-4, "0.0")
+    assert not errors and not [w for w in warnings if "kerf" in w.message] and cad.passed, cad
+    errors, warnings, cad = _web_verdicts(0.099, "0.0")   # too thin as drawn: an error, and no word of the kerf
+    assert errors and not cad.passed and "thinned by the kerf" not in cad.detail
