@@ -8,12 +8,13 @@ spawns there) or with one core, the pieces run in this process.
 """
 from __future__ import annotations
 
-import multiprocessing
 import os
+import pickle
+import select
 import signal
+import struct
 import sys
-from concurrent.futures import ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
+import threading
 from typing import Callable, TypeVar
 
 T = TypeVar("T")
@@ -31,51 +32,188 @@ def cores() -> int:
     return max(1, min(n, int(cap))) if cap.isdigit() else n
 
 
-def _worker_start() -> None:
-    """In a new worker: SIGTERM ends it at once, as before the command line made SIGTERM an interrupt in the
-    process the worker was forked from (a killed worker is a broken pool, whose pieces then run in the parent)."""
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-
-
-def _stop_workers(ex: ProcessPoolExecutor, futures) -> None:
-    """Ctrl-C or SIGTERM in the parent: cancel the pieces not started and end the workers now (leaving the
-    executor would otherwise wait for every piece to finish)."""
-    for f in futures:
-        f.cancel()
-    for proc in list((getattr(ex, "_processes", None) or {}).values()):
-        try:
-            proc.kill()
-        except (OSError, ValueError, AttributeError):
-            pass
-
-
-def _run(i: int):
-    from camtube.model.core.threads import one_blas_thread
-
-    with one_blas_thread():
-        return _JOB(i)
+#: Bytes of a piece's index in the queue of pieces (a pipe every process takes the next index from).
+_INDEX = struct.Struct("<I")
+#: Bytes of the length of a result message.
+_LENGTH = struct.Struct("<Q")
 
 
 def map_forked(fn: Callable[[int], T], n: int) -> list[T]:
-    """``[fn(0), ..., fn(n - 1)]``, on up to :func:`cores` forked processes; in this process off Linux, with one
-    core or one piece. An exception in a piece is raised here, as it would be in a loop
-    (the first piece's first)."""
+    """``[fn(0), ..., fn(n - 1)]``, on up to :func:`cores` processes: this one and workers forked now; in this process
+    alone off Linux, with one core or one piece. An exception in a piece is raised here, as it would be in a loop
+    (the first piece's first).
+
+    Each process takes the next piece from one queue until none is left (dynamic: a long piece does not hold the
+    others up), with BLAS on one thread (:func:`~camtube.model.core.threads.one_blas_thread`), so the numbers are
+    those of the sequential run. A worker's results cross back pickled; this process's stay as they are. A worker
+    that dies (killed, out of memory) leaves its unfinished pieces to this process. Ctrl-C or SIGTERM here ends the
+    workers at once. Never nested: within a piece, a further ``map_forked`` runs its pieces in turn.
+
+    speed: a diagnosis calls this 30-90 times; a pool of forked workers cost 45-55 ms a call (the fork of a
+    several-hundred-MB process twice, the executor's queues and threads), one forked worker beside this process about
+    12 ms, and this process works instead of waiting.
+    """
     global _JOB
     workers = min(n, cores())
-    if workers < 2 or not sys.platform.startswith("linux") or _JOB is not None:
-        return [fn(i) for i in range(n)]   # (and never nested: a worker runs its pieces in turn)
+    if workers < 2 or not sys.platform.startswith("linux") or _JOB is not None or n * _INDEX.size > select.PIPE_BUF * 8:
+        return [fn(i) for i in range(n)]
     _JOB = fn
     try:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
-                                 initializer=_worker_start) as ex:
-            futures = [ex.submit(_run, i) for i in range(n)]
-            try:
-                return [f.result() for f in futures]
-            except KeyboardInterrupt:
-                _stop_workers(ex, futures)
-                raise
-    except BrokenProcessPool:  # a worker died (killed, out of memory): the pieces again, here
-        pass
+        return _shared_queue(fn, n, workers)
     finally:
         _JOB = None
-    return [fn(i) for i in range(n)]
+
+
+def _shared_queue(fn: Callable[[int], T], n: int, workers: int) -> list[T]:
+    """:func:`map_forked`'s pieces on this process and ``workers - 1`` forked ones."""
+    from camtube.model.core.threads import one_blas_thread
+
+    queue_r, queue_w = os.pipe()
+    os.write(queue_w, b"".join(_INDEX.pack(i) for i in range(n)))   # (n x 4 bytes: within the pipe's buffer)
+    os.close(queue_w)
+    done: dict[int, tuple[bool, object]] = {}
+    children: list[tuple[int, int]] = []
+    readers = []
+    try:
+        for _ in range(workers - 1):
+            res_r, res_w = os.pipe()
+            sys.stdout.flush()
+            sys.stderr.flush()
+            pid = os.fork()
+            if pid == 0:   # the worker: pieces from the queue until it is empty, each result sent back
+                os.close(res_r)
+                _worker(fn, queue_r, res_w)
+            os.close(res_w)
+            children.append((pid, res_r))
+        # (the threads start once every worker is forked: a fork copies this thread alone)
+        readers = [threading.Thread(target=_collect, args=(res_r, done), daemon=True) for _, res_r in children]
+        for reader in readers:
+            reader.start()
+        with one_blas_thread():
+            while True:
+                i = _next_index(queue_r)
+                if i is None:
+                    break
+                done[i] = _piece(fn, i)
+            for reader in readers:
+                reader.join()
+            for i in range(n):
+                if i not in done:   # a worker died in it: here
+                    done[i] = _piece(fn, i)
+    except BaseException:   # Ctrl-C, SIGTERM (camtube.io.Terminated): the workers end now
+        for pid, _ in children:
+            _kill(pid)
+        raise
+    finally:
+        for pid, _ in children:
+            _reap(pid)
+        for reader in readers:
+            reader.join()
+        for _, res_r in children:
+            os.close(res_r)
+        os.close(queue_r)
+    for i in range(n):
+        ok, value = done[i]
+        if not ok:
+            raise value
+    return [done[i][1] for i in range(n)]
+
+
+def _piece(fn: Callable[[int], T], i: int) -> tuple[bool, object]:
+    """``(True, fn(i))``, or ``(False, the exception)`` (raised later, in the pieces' order, as in a loop)."""
+    try:
+        return True, fn(i)
+    except Exception as exc:
+        return False, exc
+
+
+def _next_index(queue_r: int) -> int | None:
+    """The next piece's index from the queue, or None when it is empty (each read takes one whole index: the pipe
+    gives a read all of the bytes asked for that are there, and every index was written before the first read)."""
+    got = os.read(queue_r, _INDEX.size)
+    return _INDEX.unpack(got)[0] if len(got) == _INDEX.size else None
+
+
+def _worker(fn: Callable[[int], T], queue_r: int, res_w: int) -> None:
+    """A forked worker's life: SIGTERM ends it at once (as before the command line made SIGTERM an interrupt in the
+    process it was forked from); each piece's ``(index, ok, result or exception)`` sent pickled; then it exits."""
+    code = 0
+    try:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        from camtube.model.core.threads import one_blas_thread
+
+        with one_blas_thread():
+            while True:
+                i = _next_index(queue_r)
+                if i is None:
+                    break
+                ok, value = _piece(fn, i)
+                if ok:
+                    try:
+                        msg = pickle.dumps((i, True, value), protocol=pickle.HIGHEST_PROTOCOL)
+                    except Exception as exc:
+                        msg = _error_message(i, exc)
+                else:
+                    msg = _error_message(i, value)
+                _send(res_w, msg)
+    except BaseException:   # interrupted: the process this one was forked from sees the pieces it did not send
+        code = 1
+    finally:
+        try:
+            sys.stdout.flush()
+            sys.stderr.flush()
+        finally:
+            os._exit(code)
+
+
+def _error_message(i: int, exc: Exception) -> bytes:
+    """The piece's exception, pickled; as a RuntimeError naming it when it does not pickle."""
+    try:
+        return pickle.dumps((i, False, exc), protocol=pickle.HIGHEST_PROTOCOL)
+    except Exception:
+        return pickle.dumps((i, False, RuntimeError(f"{type(exc).__name__}: {exc}")))
+
+
+def _send(fd: int, msg: bytes) -> None:
+    view = memoryview(_LENGTH.pack(len(msg)) + msg)
+    while view:
+        view = view[os.write(fd, view):]
+
+
+def _read_exactly(fd: int, size: int) -> bytes | None:
+    parts, left = [], size
+    while left:
+        got = os.read(fd, min(left, 1 << 20))
+        if not got:
+            return None
+        parts.append(got)
+        left -= len(got)
+    return b"".join(parts)
+
+
+def _collect(res_r: int, done: dict) -> None:
+    """A worker's results into ``done`` (``index -> (ok, value)``) until its pipe closes (a thread: the reads wait
+    without holding the interpreter, and the worker never blocks on a full pipe)."""
+    while True:
+        head = _read_exactly(res_r, _LENGTH.size)
+        if head is None:
+            return
+        body = _read_exactly(res_r, _LENGTH.unpack(head)[0])
+        if body is None:
+            return   # the worker died mid-message: its piece runs here
+        i, ok, value = pickle.loads(body)
+        done[i] = (ok, value)
+
+
+def _kill(pid: int) -> None:
+    try:
+        os.kill(pid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
+
+
+def _reap(pid: int) -> None:
+    try:
+        os.waitpid(pid, 0)
+    except ChildProcessError:
+        pass
