@@ -154,8 +154,14 @@ def _check_file_target(path: Path) -> None:
 
 @contextmanager
 def _staged(path: Path, prefix: str, suffix: str):
-    """Yield ``(fd, tmp)`` of a temporary file beside ``path``; publish it on success, remove it on failure."""
+    """Yield ``(fd, tmp)`` of a temporary file beside ``path``; publish it on success, remove it on failure.
+
+    A ``path`` that is a symbolic link is written through: the file it points to is replaced (staged beside that
+    file) and the link is kept, as a shell's ``>`` or an editor's save leaves it."""
     _check_file_target(path)
+    if path.is_symlink():
+        path = Path(os.path.realpath(path))
+        _check_file_target(path)
     tmp = None
     try:
         path.parent.mkdir(parents=True, exist_ok=True)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from camtube.io import write_atomic, write_atomic_with
+from camtube.io import OutputError, write_atomic, write_atomic_with
 
 
 def test_write_atomic_text_bytes_and_permissions(tmp_path):
@@ -135,3 +135,25 @@ def test_write_set_into_a_link_to_a_folder_writes_into_the_folder_and_keeps_the_
     (tmp_path / "next").symlink_to(tmp_path / "jobs" / "v3")
     write_set(tmp_path / "next", {"j.ngc": "G0 X3\n"})
     assert (tmp_path / "next").is_symlink() and (tmp_path / "jobs" / "v3" / "j.ngc").read_text() == "G0 X3\n"
+
+
+def test_write_atomic_through_a_link_to_a_file_replaces_the_file_and_keeps_the_link(tmp_path):
+    """A ``-o report.html`` that is a link (report.html -> runs/7/report.html) lost its link: the staged file was
+    renamed onto the link itself, and the file it pointed to kept the old contents."""
+    (tmp_path / "runs" / "7").mkdir(parents=True)
+    target = tmp_path / "runs" / "7" / "report.html"
+    target.write_text("old\n")
+    link = tmp_path / "report.html"
+    link.symlink_to(Path("runs") / "7" / "report.html")
+    assert write_atomic(link, "new\n") == link
+    assert link.is_symlink() and os.readlink(link) == str(Path("runs") / "7" / "report.html")
+    assert target.read_text() == "new\n"
+    assert sorted(os.listdir(tmp_path)) == ["report.html", "runs"] and os.listdir(target.parent) == ["report.html"]
+    # a link to a file not made yet (dangling): the file is made where it points
+    (tmp_path / "next.html").symlink_to(tmp_path / "runs" / "8.html")
+    write_atomic(tmp_path / "next.html", "x")
+    assert (tmp_path / "runs" / "8.html").read_text() == "x" and (tmp_path / "next.html").is_symlink()
+    # a link to a folder is still refused as a file's target
+    (tmp_path / "dir.html").symlink_to(tmp_path / "runs")
+    with pytest.raises(OutputError, match="directory"):
+        write_atomic(tmp_path / "dir.html", "x")
