@@ -320,6 +320,9 @@ HELDOUT36_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 HELDOUT37_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
                    "lag", ("sharp friction", "lost motion"), ("backbone3", "toe"), ("friction", "creep"),
                    "sharp friction", "tracker drift"]
+HELDOUT38_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
+                   "lag", ("lost motion", "creep"), ("friction", "toe"), ("backbone", "slack"), "sharp friction",
+                   "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -412,13 +415,17 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            # drawn once a release the stroke had not logged under a cell at its limit was set aside, with a burst over
            # the guide's switch (bench-heldout36's sharp guide traced; the instruments' check of bench-sharp and
            # bench-heldout17 .. 36 compared); run once
-           "bench-heldout37": (20281210, HELDOUT37_KINDS)}
+           "bench-heldout37": (20281210, HELDOUT37_KINDS),
+           # drawn once the diagnosis's speed steps were settled (the same answers, bit for bit, on bench-heldout33 and
+           # 34: the sample-wise union's orders sharing their steps, toe_shape's compiled rows, this process working
+           # beside one forked worker); run once
+           "bench-heldout38": (20281211, HELDOUT38_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
            "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
            "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36",
-           "bench-heldout37", "bench-sharp"}
+           "bench-heldout37", "bench-heldout38", "bench-sharp"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -428,7 +435,7 @@ ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19
            "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26",
            "bench-heldout27", "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
            "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36",
-           "bench-heldout37"}
+           "bench-heldout37", "bench-heldout38"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
