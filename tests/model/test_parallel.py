@@ -100,3 +100,28 @@ def test_sigterm_in_the_parent_stops_the_workers_at_once(tmp_path):
     for pid in workers:  # the workers are gone
         with pytest.raises(ProcessLookupError):
             os.kill(pid, 0)
+
+
+def test_a_result_or_an_error_that_does_not_pickle_comes_back_as_in_a_loop():
+    # a worker's result crosses back pickled; one that cannot (a closure, an error of a class made inside a function)
+    # is not lost or turned into another error: the piece runs again in this process
+    import time
+
+    class Local(Exception):
+        pass
+
+    def closure(i: int):
+        time.sleep(0.05)   # (every process takes some)
+        return lambda: i * i
+
+    got = parallel.map_forked(closure, 6)
+    assert [f() for f in got] == [0, 1, 4, 9, 16, 25]
+
+    def piece(i: int):
+        time.sleep(0.05)
+        if i % 2:
+            raise Local(f"piece {i}")
+        return i
+
+    with pytest.raises(Local, match="piece 1"):   # the first piece's error, as in a loop
+        parallel.map_forked(piece, 6)

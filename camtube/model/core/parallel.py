@@ -1,10 +1,10 @@
 """Independent pieces of work on the machine's cores, with results identical to running them one after another.
 
-:func:`map_forked` runs ``fn(0) .. fn(n - 1)`` in forked worker processes (each inherits the parent's memory,
-so ``fn`` may close over models, data and a user's effect files; only its result crosses back, pickled). Each
-worker runs BLAS on one thread, as the parent's fits do, so the numbers are those of the sequential run. Off
-Linux (Windows has no fork; on macOS a forked process may crash in the system's libraries, which is why Python
-spawns there) or with one core, the pieces run in this process.
+:func:`map_forked` runs ``fn(0) .. fn(n - 1)`` in this process and in worker processes forked for the call (each
+inherits this process's memory, so ``fn`` may close over models, data and a user's effect files; only a worker's
+result crosses back, pickled). Every process runs BLAS on one thread, as the fits do, so the numbers are those of the
+sequential run. Off Linux (Windows has no fork; on macOS a forked process may crash in the system's libraries, which
+is why Python spawns there) or with one core, the pieces run in this process alone.
 """
 from __future__ import annotations
 
@@ -136,7 +136,8 @@ def _next_index(queue_r: int) -> int | None:
 
 def _worker(fn: Callable[[int], T], queue_r: int, res_w: int) -> None:
     """A forked worker's life: SIGTERM ends it at once (as before the command line made SIGTERM an interrupt in the
-    process it was forked from); each piece's ``(index, ok, result or exception)`` sent pickled; then it exits."""
+    process it was forked from); each piece's ``(index, ok, result or exception)`` sent pickled (one that does not
+    pickle is not sent: the process it was forked from runs that piece itself); then it exits."""
     code = 0
     try:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
@@ -147,14 +148,10 @@ def _worker(fn: Callable[[int], T], queue_r: int, res_w: int) -> None:
                 i = _next_index(queue_r)
                 if i is None:
                     break
-                ok, value = _piece(fn, i)
-                if ok:
-                    try:
-                        msg = pickle.dumps((i, True, value), protocol=pickle.HIGHEST_PROTOCOL)
-                    except Exception as exc:
-                        msg = _error_message(i, exc)
-                else:
-                    msg = _error_message(i, value)
+                try:
+                    msg = pickle.dumps((i,) + _piece(fn, i), protocol=pickle.HIGHEST_PROTOCOL)
+                except Exception:   # a result (or an error) that does not pickle: the piece runs again there
+                    continue
                 _send(res_w, msg)
     except BaseException:   # interrupted: the process this one was forked from sees the pieces it did not send
         code = 1
@@ -164,14 +161,6 @@ def _worker(fn: Callable[[int], T], queue_r: int, res_w: int) -> None:
             sys.stderr.flush()
         finally:
             os._exit(code)
-
-
-def _error_message(i: int, exc: Exception) -> bytes:
-    """The piece's exception, pickled; as a RuntimeError naming it when it does not pickle."""
-    try:
-        return pickle.dumps((i, False, exc), protocol=pickle.HIGHEST_PROTOCOL)
-    except Exception:
-        return pickle.dumps((i, False, RuntimeError(f"{type(exc).__name__}: {exc}")))
 
 
 def _send(fd: int, msg: bytes) -> None:
@@ -201,7 +190,10 @@ def _collect(res_r: int, done: dict) -> None:
         body = _read_exactly(res_r, _LENGTH.unpack(head)[0])
         if body is None:
             return   # the worker died mid-message: its piece runs here
-        i, ok, value = pickle.loads(body)
+        try:
+            i, ok, value = pickle.loads(body)
+        except Exception:   # (a result that does not unpickle here: its piece runs here instead)
+            continue
         done[i] = (ok, value)
 
 
