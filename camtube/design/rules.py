@@ -274,9 +274,11 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
                 elif thinned_by_kerf and d < rules.min_web_mm + ASSUMED_KERF_MM - TOL.rule:
                     # without kerf compensation each side of the web is cut half a kerf wider than drawn: as cut it is
                     # thinner than the limit, and the CAD verification (which cuts it so) fails it
+                    left = (f"{d - ASSUMED_KERF_MM:.4g} mm as cut" if d > ASSUMED_KERF_MM
+                            else "none: the two cuts merge as cut")
                     warn(key, f"the web between {_describe(a)} and {_describe(b)} is {d:.4g} mm as drawn; with "
-                         f"process.kerf = 0 (no kerf compensation) a {ASSUMED_KERF_MM:g} mm kerf leaves "
-                         f"{d - ASSUMED_KERF_MM:.4g} mm as cut", round(d, 9),
+                         f"process.kerf = 0 (no kerf compensation) a {ASSUMED_KERF_MM:g} mm kerf leaves {left}",
+                         round(d, 9),
                          f">= rules.min_web + kerf = {rules.min_web_mm + ASSUMED_KERF_MM:g} mm as drawn",
                          "set process.kerf to the beam's kerf (kerf compensation), or "
                          + ("move the hole away from the notches" if hole_pair else "increase notch.spacing"))

@@ -123,3 +123,10 @@ def test_a_web_designed_at_the_limit_without_kerf_compensation_is_warned_of_and_
     assert not errors and not [w for w in warnings if "kerf" in w.message] and cad.passed, cad
     errors, warnings, cad = _web_verdicts(0.099, "0.0")   # too thin as drawn: an error, and no word of the kerf
     assert errors and not cad.passed and "thinned by the kerf" not in cad.detail
+    # no limit (rules.min_web = 0) and a web thinner than the kerf: the cuts merge as cut, and the rules say so
+    from camtube.design.loader import load
+    from camtube.design.rules import check
+
+    p = load(PATTERNS / "tube1.yaml", ["notch.spacing=0.01", "rules.min_web=0", "process.kerf=0.0"]).pattern
+    errors, warnings = check(p)
+    assert not errors and any("the two cuts merge as cut" in w.message for w in warnings)
