@@ -125,3 +125,22 @@ def test_a_result_or_an_error_that_does_not_pickle_comes_back_as_in_a_loop():
 
     with pytest.raises(Local, match="piece 1"):   # the first piece's error, as in a loop
         parallel.map_forked(piece, 6)
+
+
+def test_a_standard_stream_that_cannot_be_written_does_not_stop_the_pieces(monkeypatch):
+    # `camtube model diagnose ... --report R | head`: once head has gone, flushing stdout raises; the fits must go on
+    # (the report is written; the command's own printing meets the broken pipe, as before workers flushed it)
+    import io
+    import time
+
+    class Gone(io.StringIO):
+        def flush(self):
+            raise BrokenPipeError(32, "Broken pipe")
+
+    monkeypatch.setattr("sys.stdout", Gone())
+
+    def piece(i: int):
+        time.sleep(0.02)
+        return i * 3
+
+    assert parallel.map_forked(piece, 4) == [0, 3, 6, 9]

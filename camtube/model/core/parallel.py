@@ -77,8 +77,7 @@ def _shared_queue(fn: Callable[[int], T], n: int, workers: int) -> list[T]:
     try:
         for _ in range(workers - 1):
             res_r, res_w = os.pipe()
-            sys.stdout.flush()
-            sys.stderr.flush()
+            _flush()   # (what this process has buffered is not written twice, by the worker too)
             pid = os.fork()
             if pid == 0:   # the worker: pieces from the queue until it is empty, each result sent back
                 os.close(res_r)
@@ -156,11 +155,18 @@ def _worker(fn: Callable[[int], T], queue_r: int, res_w: int) -> None:
     except BaseException:   # interrupted: the process this one was forked from sees the pieces it did not send
         code = 1
     finally:
+        _flush()
+        os._exit(code)
+
+
+def _flush() -> None:
+    """Flush the standard streams; one that cannot be written (a reader that went away: ``| head``) is left as it is,
+    for the command's own output to meet."""
+    for stream in (sys.stdout, sys.stderr):
         try:
-            sys.stdout.flush()
-            sys.stderr.flush()
-        finally:
-            os._exit(code)
+            stream.flush()
+        except (OSError, ValueError, AttributeError):
+            pass
 
 
 def _send(fd: int, msg: bytes) -> None:
