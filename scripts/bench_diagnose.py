@@ -30,7 +30,7 @@ measured sampling followed). ``heldout11``: drawn again after that (seed 2026120
 then looked at (drops and swaps before the --max-effects stop followed). ``heldout12``: drawn again after
 that (seed 20261203, seeds 27000-).
 ``speed``: 10,000 and 200,000 rows (targets 5 s and 20 s).
-``bench``, ``bench-heldout``, ``bench-heldout2`` .. ``bench-heldout16``: whole-bench files of issue 19 (:mod:`camtube.model.sim.bench`, about 60,000 rows each,
+``bench``, ``bench-sharp``, ``bench-heldout``, ``bench-heldout2`` .. ``bench-heldout38``: whole-bench files of issue 19 (:mod:`camtube.model.sim.bench`, about 60,000 rows each,
 instrument artefacts, several mechanisms at once), see ``scripts/bench_real.py``; prints the seconds per
 60,000-row file.
 """
