@@ -156,17 +156,23 @@ def test_a_tracker_drifting_in_time_is_not_read_as_following_the_angle(seed):
     assert u["leading"] in ("time", "cycle") and {"time", "cycle"} <= set(u["follows"]), u["follows"]
 
 
+def _twelve_rows_off(seed: int):
+    """20,000 rows of a triangle stroke at 20 Hz, white noise of 0.2 deg and 12 rows 20 deg off: ``(the generator,
+    the times, the variables, the residual, the rows off)``."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(20000) * 0.05
+    r = rng.normal(0, 0.2, t.size)
+    hit = rng.choice(t.size, 12, replace=False)
+    r[hit] -= 20.0
+    return rng, t, _triangle_variables(t), r, hit
+
+
 def test_a_misfit_in_a_few_isolated_rows_is_named_as_such_not_as_noise():
     # bench-heldout36's sharp guide: 92 % of the error above the floor sat in 34 of 50,000 rows (the last row of each
     # dwell after a load cell at its limit, 20 deg off; a burst the check missed). Bins average them away, so it
     # "followed none of" the variables, read as noise-like; now the rows are named, with their count and times
-    rng = np.random.default_rng(36)
-    n = 20000
-    t = np.arange(n) * 0.05
-    v = _triangle_variables(t)
-    r = rng.normal(0, 0.2, n)
-    hit = rng.choice(n, 12, replace=False)
-    r[hit] -= 20.0
+    rng, t, v, r, hit = _twelve_rows_off(36)
+    n = t.size
     u = analyse(r, v, 0.2)
     assert u is not None and u["rows"] is not None
     assert u["rows"]["n"] == 12 and u["rows"]["share"] > 0.9 and u["rows"]["samples"] == ["A"]
@@ -186,11 +192,8 @@ def test_isolated_rows_left_by_partial_effects_point_to_the_rows_not_to_a_starte
 
     from camtube.model.unexplained import report
 
-    rng = np.random.default_rng(37)
-    t = np.arange(20000) * 0.05
-    r = rng.normal(0, 0.2, t.size)
-    r[rng.choice(t.size, 12, replace=False)] -= 20.0
-    u = analyse(r, _triangle_variables(t), 0.2)
+    _, _, v, r, _ = _twelve_rows_off(37)
+    u = analyse(r, v, 0.2)
     assert u is not None and u["rows"] is not None and not u["leading"]
     d = SimpleNamespace(cache={"unexplained": u}, recommended=(), partial=("capstan",), noise_floor_deg=0.2)
     text = "\n".join(report.text_lines(d))

@@ -855,10 +855,11 @@ def _force_ahead(force: np.ndarray, stroke: np.ndarray, t: np.ndarray, slices: l
         s_in, s_out, f_in, f_out = step[:-1], step[1:], df[:-1], df[1:]
         # (the force may reach the new state over two rows: a row read halfway through the switch is ahead too)
         start = (s_out != 0.0) & (np.abs(s_in) <= AHEAD_STEP * np.abs(s_out))
-        ahead = start & (np.abs(f_in) > SPIKE_Z * scale) & (np.sign(f_in) == np.sign(s_out)) & even[:-1] & even[1:]
+        # a change into the row the size of a jump, or any change off the cell's limit (the row before read it)
+        moved = np.abs(f_in) > SPIKE_Z * scale
         if limit is not None:
-            lim = limit[sl]
-            ahead |= start & lim[:-2] & ~lim[1:-1] & (np.sign(f_in) == np.sign(s_out)) & even[:-1] & even[1:]
+            moved |= limit[sl][:-2] & ~limit[sl][1:-1]
+        ahead = start & moved & (np.sign(f_in) == np.sign(s_out)) & even[:-1] & even[1:]
         # behind: row k at rest after a step into row k-1, the jump into row k+1 (f_out) against that step
         s_before = np.concatenate(([0.0], step[:-2]))
         f_next = np.concatenate((df[2:], [0.0]))

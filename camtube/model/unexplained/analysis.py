@@ -561,11 +561,12 @@ def analyse(residual_deg, variables: Mapping[str, np.ndarray], noise_floor_deg: 
 
 def _far_rows(r: np.ndarray, v: dict, floor: float) -> dict | None:
     """Rows more than :data:`FAR_FLOORS` noise floors off, when they are few (at most :data:`FAR_ROWS` of the rows)
-    and hold at least :data:`FAR_SHARE` of the error above the floor: ``{share, n, fraction, max_deg, samples, time_s}`` (``time_s``: of the largest five, since each
-    sample's start), else None. A misfit that sits in a few isolated rows follows no variable (the cross-validated
-    bins average it away), and is named here instead: an artefact the instruments' check missed, or rows where the
-    model is asked for what the rows kept never show (``bench-heldout36``'s sharp guide: 92 % of it in 50 of 50,000
-    rows, the last row of each dwell after a load cell at its limit set the top of the pull aside, 20 deg off)."""
+    and hold at least :data:`FAR_SHARE` of the error above the floor: ``{share, n, fraction, max_deg, samples,
+    time_s}`` (``time_s``: of the largest five, since each sample's start), else None. A misfit that sits in a few
+    isolated rows follows no variable (the cross-validated bins average it away), and is named here instead: an
+    artefact the instruments' check missed, or rows where the model is asked for what the rows kept never show
+    (``bench-heldout36``'s sharp guide: 92 % of it in 34 of 50,199 rows, among them the last row of each dwell after
+    a load cell at its limit set the top of the pull aside, 20 deg off)."""
     n = r.size
     a2 = r * r
     excess = float(a2.sum()) - n * floor**2
