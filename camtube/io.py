@@ -159,9 +159,8 @@ def _staged(path: Path, prefix: str, suffix: str):
     A ``path`` that is a symbolic link is written through: the file it points to is replaced (staged beside that
     file) and the link is kept, as a shell's ``>`` or an editor's save leaves it."""
     _check_file_target(path)
-    if path.is_symlink():
-        path = Path(os.path.realpath(path))
-        _check_file_target(path)
+    path = _followed(path)
+    _check_file_target(path)
     tmp = None
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -411,10 +410,11 @@ def _keep_old(path: Path) -> Path | None:
 
 
 def _followed(out: Path) -> Path:
-    """The folder a set given as ``out`` goes into: ``out``, or the folder it links to when it is a symbolic link.
+    """Where an output given as ``out`` is written: ``out``, or what it links to when it is a symbolic link.
 
-    A link to the output folder is the user's way of naming it (``-o current -> jobs/2024-05``): the set is written
-    into the folder the link names, and the link is kept (the swap would otherwise replace the link itself).
+    A link is the user's way of naming the output (``-o current -> jobs/2024-05``, ``report.html ->
+    runs/7/report.html``): the set or the file is written where the link points, and the link is kept (the swap or
+    the rename would otherwise replace the link itself). Used for sets (:func:`write_set`) and files (:func:`_staged`).
     """
     return Path(os.path.realpath(out)) if out.is_symlink() else out
 
