@@ -266,11 +266,11 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
                     "move the hole along x or around the tube" if hole_pair else "increase notch.spacing or move the cut")
             else:
                 d = cut_distance_mm(a, b, ro)
+                widen = "move the hole away from the notches" if hole_pair else "increase notch.spacing"
                 if d < rules.min_web_mm - TOL.rule:  # (the CAD verification's min_web: the same slack)
                     what = "is too close to" if not hole_pair else "collides with (web too thin)"
                     err(key, f"{_describe(b)} {what} {_describe(a)}: web {d:.4g} mm", round(d, 9),
-                        f">= rules.min_web = {rules.min_web_mm:g} mm",
-                        "move the hole away from the notches" if hole_pair else "increase notch.spacing")
+                        f">= rules.min_web = {rules.min_web_mm:g} mm", widen)
                 elif thinned_by_kerf and d < rules.min_web_mm + ASSUMED_KERF_MM - TOL.rule:
                     # without kerf compensation each side of the web is cut half a kerf wider than drawn: as cut it is
                     # thinner than the limit, and the CAD verification (which cuts it so) fails it
@@ -280,8 +280,7 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
                          f"process.kerf = 0 (no kerf compensation) a {ASSUMED_KERF_MM:g} mm kerf leaves {left}",
                          round(d, 9),
                          f">= rules.min_web + kerf = {rules.min_web_mm + ASSUMED_KERF_MM:g} mm as drawn",
-                         "set process.kerf to the beam's kerf (kerf compensation), or "
-                         + ("move the hole away from the notches" if hole_pair else "increase notch.spacing"))
+                         f"set process.kerf to the beam's kerf (kerf compensation), or {widen}")
             reported += 1
         if len(errors) > 50:
             break
