@@ -222,3 +222,21 @@ def test_the_compiled_rows_give_the_numpy_expressions_numbers_to_the_bit():
         want = lam * (lo + (pos - i) * (xj.take(i + 1) - lo) - tau)
         got = toe_rows(f, c, lam, t_max, xj)
         assert np.array_equal(got.view(np.int64), want.view(np.int64)), trial
+
+
+def test_toe_law_on_a_load_cell_read_in_coarse_steps(tube2):
+    """A load cell logged in 0.1 N steps, its noise 2 mN and its zero 0.06 N low: most rows repeat the last reading,
+    and the rests read -0.1 N. The toe law's posterior near zero force takes the steps' own error as the noise left
+    (it read none: a division by zero, a warning on the user's terminal)."""
+    import warnings
+
+    from camtube.model.sim.synth import synthesize
+
+    data = synthesize(tube2, n_samples=1, n_cycles=5, noise_force_N=0.002, seed=4)
+    read = data.with_force(np.round((data.force_N - 0.06) / 0.1) * 0.1)
+    m = model_for_pattern(tube2, ["toe_shape"])
+    vals = m.initial_values(read, pattern_values(tube2)) | {"toe_shape.offset_mm": 0.2, "toe_shape.shape": 1.5}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = m.predict(read, vals)
+    assert np.all(np.isfinite(out))
