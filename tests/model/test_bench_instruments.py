@@ -367,6 +367,22 @@ def test_a_change_of_the_logging_rate_is_reported():
     assert any("sampling rate of sample A changes: 25 Hz from t = 40" in line for line in ins.lines())
 
 
+def test_time_stamps_that_look_like_ms_are_asked_about():
+    from camtube.model.data import Dataset
+
+    t = np.arange(0.0, 40.0, 0.02)
+    x = 1.0 - np.cos(2 * np.pi * t / 8.0)
+    n = t.size
+
+    def lines(time_col):
+        d = Dataset(np.full(n, "A", dtype=object), (t // 8).astype(int) + 1, time_col, x, 2.0 * x, 20.0 * x)
+        return check_instruments(d).lines()
+
+    asked = [line for line in lines(1000.0 * t) if "in ms" in line]
+    assert len(asked) == 1 and "A a row every 20 s" in asked[0] and "divided by 1000" in asked[0]
+    assert not any("in ms" in line for line in lines(t))   # 50 Hz: nothing asked
+
+
 def test_a_relaxing_backbone_is_recommended_in_the_place_of_the_rest_angle(tube2):
     """A backbone with a Maxwell arm (the bench simulator's joint, no set): the unloaded joint stands at
     k1 / (k + k1) of the arm's relaxed angle and creeps back. The baseline's constant rest angle takes some of it;

@@ -125,6 +125,9 @@ MODEL_LAG_MAX_RATIO = 3.0
 #: Window (s) of the filter that reads the angle's rate for :func:`lag_misfit_deg`: several rows at 25-100 Hz, short
 #: against a ramp.
 LAG_RATE_WINDOW_S = 0.25
+#: A sample logged more slowly than this (Hz) gets a line that asks whether its time stamps are in ms (a bench logs at
+#: 25-100 Hz; time in ms read as s is 0.025-0.1 Hz).
+SLOW_RATE_HZ = 1.0
 #: A sampling interval this far off the sample's median is a rate change.
 RATE_CHANGE = 0.2
 
@@ -418,6 +421,11 @@ class Instruments:
                        "model of the rows' stamps fits them, so they are set aside; a stroke logged at a finer "
                        "resolution, or at the load cell's instant, measures them")
         out.append("sampling: " + ", ".join(f"{s} {r:.4g} Hz" for s, r in self.rates_hz.items()))
+        slow = {smp: r for smp, r in self.rates_hz.items() if 0.0 < r < SLOW_RATE_HZ}
+        if slow:
+            out.append("sampling: " + ", ".join(f"{smp} a row every {1.0 / r:.3g} s" for smp, r in slow.items())
+                       + f", slower than {SLOW_RATE_HZ:g} Hz; if the time column is in ms, give it in s (time_s, "
+                         "divided by 1000): the model's time constants (creep, relaxation, a lag) are read in s")
         out.extend(self.rate_changes)
         out.extend(zero_lines(self.zeros, self.rezero))
         lg = self.lag

@@ -295,11 +295,25 @@ def _detrend(x: np.ndarray, r: np.ndarray, sid: np.ndarray, degree: int) -> np.n
     return out
 
 
+#: Most entries (rows times frequencies) of one Lomb-Scargle call: scipy's holds several arrays of that size at once
+#: (8000 rows by 3000 frequencies took 1.4 GB); more frequencies are taken in turn, each as it would be alone.
+LOMB_ENTRIES = 10_000_000
+
+
+def _lomb(x: np.ndarray, y: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """scipy's Lomb-Scargle power (floating mean) of ``y`` at ``x`` for angular frequencies ``w``, in parts of at most
+    :data:`LOMB_ENTRIES` entries."""
+    from scipy.signal import lombscargle
+
+    per = max(1, LOMB_ENTRIES // max(x.size, 1))
+    if w.size <= per:
+        return lombscargle(x, y, w, floating_mean=True)
+    return np.concatenate([lombscargle(x, y, w[i:i + per], floating_mean=True) for i in range(0, w.size, per)])
+
+
 def _periodogram(x: np.ndarray, r: np.ndarray, sid: np.ndarray, pmin: float, pmax: float,
                  floor: float) -> tuple[float, float, float, int] | None:
     """Best period of ``r`` against ``x`` within ``[pmin, pmax]``: (period, power, false-alarm prob., n freqs)."""
-    from scipy.signal import lombscargle
-
     if not (pmax > pmin > 0):
         return None
     span = max(float(np.ptp(x[sid == k])) for k in range(int(sid.max()) + 1))
@@ -313,7 +327,7 @@ def _periodogram(x: np.ndarray, r: np.ndarray, sid: np.ndarray, pmin: float, pma
         m = sid == k
         if m.sum() < 20:
             continue
-        power += lombscargle(x[m], r[m] - r[m].mean(), 2 * math.pi * f, floating_mean=True)
+        power += _lomb(x[m], r[m] - r[m].mean(), 2 * math.pi * f)
         n += int(m.sum())
     i = int(np.argmax(power))
     lo, hi = f[max(i - 1, 0)], f[min(i + 1, f.size - 1)]
@@ -323,7 +337,7 @@ def _periodogram(x: np.ndarray, r: np.ndarray, sid: np.ndarray, pmin: float, pma
         m = sid == k
         if m.sum() < 20:
             continue
-        pf += lombscargle(x[m], r[m] - r[m].mean(), 2 * math.pi * fine, floating_mean=True)
+        pf += _lomb(x[m], r[m] - r[m].mean(), 2 * math.pi * fine)
     j = int(np.argmax(pf))
     # unnormalised power ~ A^2 N / 4 ~ (SSE drop) / 2; under white noise of variance s^2, 2 P / s^2 ~ chi2(2)
     z = float(pf[j]) / floor**2
@@ -348,6 +362,15 @@ def _bin_means(x: np.ndarray, r: np.ndarray, sid: np.ndarray, width: float):
     return xb, np.concatenate(br), np.concatenate(bs), x.size / max(xb.size, 1)
 
 
+#: Width (s) of the bins of time a periodic misfit is looked for in (their means: the noise averaged) ...
+TIME_BIN_S = 0.25
+#: ... and the most bins a sample's record is cut into: a longer record gets wider bins, and its shortest period looked
+#: for (8 bins) grows with them. The periodogram's work grows with the bins times the periods tried (three per
+#: 1/record of frequency): a 12-hour record in 0.25 s bins asked for 90 GB, a record whose time was logged in ms read
+#: as s for 159 GB.
+TIME_BINS = 8000
+
+
 def _periodic(r: np.ndarray, v: dict, sid: np.ndarray, floor: float, excess: float,
               stroke_smooth: np.ndarray) -> list[dict]:
     out = []
@@ -367,15 +390,17 @@ def _periodic(r: np.ndarray, v: dict, sid: np.ndarray, floor: float, excess: flo
             if fap < 1e-3 and drop >= MIN_SCORE * excess:
                 out.append({"variable": "stroke", "period": period, "unit": "mm", "amplitude_deg": amp,
                             "phase_rad": phase, "explained": drop / excess})
-    # against time: what repeats with the stroke cycle removed; bin means of 0.25 s; >= 3 periods per record
+    # against time: what repeats with the stroke cycle removed; bin means of 0.25 s (longer in a record of more than
+    # TIME_BINS of them); periods of 8 bins (2 s) to a third of the record
     t = v["time"]
     rt = r - stroke_smooth
     t0 = np.array([t[sid == k].min() for k in range(int(sid.max()) + 1)])
-    tb, rb, sb, rows_per_bin = _bin_means(t - t0[sid], rt, sid, 0.25)
+    width = max(TIME_BIN_S, max(float(np.ptp(t[sid == k])) for k in range(int(sid.max()) + 1)) / TIME_BINS)
+    tb, rb, sb, rows_per_bin = _bin_means(t - t0[sid], rt, sid, width)
     tspan = float(tb.max()) if tb.size else 0.0
     if tspan > 0 and tb.size > 20:
         rb_d = _detrend(tb, rb, sb, 2)
-        hit = _periodogram(tb, rb_d, sb, 2.0, tspan / 3.0, floor / math.sqrt(rows_per_bin))
+        hit = _periodogram(tb, rb_d, sb, 8.0 * width, tspan / 3.0, floor / math.sqrt(rows_per_bin))
         if hit is not None:
             period, _, fap, _ = hit
             amp, phase, _ = _sinusoid(tb, rb_d, sb, 2 * math.pi / period)
