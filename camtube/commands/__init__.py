@@ -158,8 +158,10 @@ def _run_command(args: argparse.Namespace) -> int:
         print(f"camtube {args.command}: error: {msg}", file=sys.stderr)
         return 2
     except MemoryError:
-        print(f"camtube {args.command}: error: out of memory; fix: make the job smaller (fewer notches or "
-              "repeats) or use a machine with more memory", file=sys.stderr)
+        smaller = ("give fewer rows (--cycles SPEC)" if args.command == "model" else
+                   "make the job smaller (fewer notches or repeats)")
+        print(f"camtube {args.command}: error: out of memory; fix: {smaller} or use a machine with more memory",
+              file=sys.stderr)
         return 2
     except OSError as exc:
         if isinstance(exc, BrokenPipeError):

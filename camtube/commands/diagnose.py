@@ -147,7 +147,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     from camtube.model.core.build import build_registry, check_suffix, fitted_and_held, parse_in_range, split_names
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import check_fittable, read_measurements, select_cycles
-    from camtube.model.data.csvfile import check_force_identifies
+    from camtube.model.data.csvfile import check_force_identifies, check_signs
     from camtube.model.diagnose import diagnose
     from camtube.model.diagnose.instruments import check_instruments, confirm_lag
     from camtube.model.diagnose.search import MIN_SEARCH_ROWS
@@ -195,6 +195,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     ins = check_instruments(rows, lag_ms=args.lag_ms, dropped=meas.summary(),
                             n_dropped=int(meas.missing_lines.size + meas.backward_lines.size), rezero=args.rezero)
     check_fittable(ins.data, _rows_left(args, meas, ins))
+    check_signs(ins.data, args.data)
     _check_init_names(init, specs, ins.data.samples)
     fit_names, held = fitted_and_held(model, args.fit_params, args.fix, with_effects=False)
     check_force_identifies(ins.data, args.data, fit_names)

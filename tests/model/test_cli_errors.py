@@ -103,6 +103,31 @@ def test_constant_or_zero_stroke_data_is_refused(data_csv, tmp_path, capsys, cmd
                        "'stroke_mm' never changes")
 
 
+def _negated(src, dst, *cols):
+    with open(src, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    with open(dst, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        for r in rows:
+            r.update({c: repr(-float(r[c])) for c in cols})
+            w.writerow(r)
+    return dst
+
+
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+@pytest.mark.parametrize("cols", [("stroke_mm",), ("angle_deg",), ("force_N",), ("stroke_mm", "angle_deg")])
+def test_a_column_of_the_opposite_sign_is_named_with_its_fix(data_csv, tmp_path, capsys, cmd, cols):
+    # a motor that counts the other way, a tracker whose bend reads negative, a load cell that reads tension
+    # negative: the model cannot fit them (the diagnosis found nothing at 330 x the floor), so the column is named
+    f = _negated(data_csv, tmp_path / "v.csv", *cols)
+    out = tmp_path / "fit.json"
+    err = _fails_cleanly(["model", cmd, str(f), "--pattern", TUBE2, "-q", "--json", str(out)], capsys,
+                         f"fix: negate {' and '.join(cols)}", *(f"column {c!r}" for c in cols))
+    assert err.count("\n") == 1 and not out.exists()
+    assert main(["model", cmd, str(data_csv), "--pattern", TUBE2, "-q", "--json", str(out)]) == 0   # as logged
+
+
 def test_fit_of_an_unidentifiable_parameter_exits_2_and_names_it(data_csv, tmp_path, capsys):
     # force all zero: E_t has no effect on the model (its stderr is infinite) -> not a success
     f = _variant(data_csv, tmp_path / "noforce.csv", force_N="0.0")
@@ -476,3 +501,17 @@ def test_an_output_inside_another_output_file_is_refused_before_the_work(data_cs
     _one_line_with_fix(_two_outputs(cmd, data_csv, tmp_path, first, second), capsys,
                        f"{option} {tmp_path / second}: lies inside", str(tmp_path / first))
     assert not list(tmp_path.iterdir())
+
+
+def test_out_of_memory_in_a_model_command_names_the_rows_not_the_notches(data_csv, capsys, monkeypatch):
+    # (a record of days in 0.25 s bins once asked the unexplained analysis for 159 GB; what a user can make smaller
+    # in a model command is the rows it reads, not a pattern's notches or repeats)
+    import camtube.model.data as model_data
+
+    def too_big(*args, **kwargs):
+        raise MemoryError
+
+    monkeypatch.setattr(model_data, "read_measurements", too_big)
+    err = _fails_cleanly(["model", "diagnose", str(data_csv), "--pattern", TUBE2, "-q"], capsys,
+                         "out of memory; fix: give fewer rows (--cycles SPEC)")
+    assert "notches" not in err

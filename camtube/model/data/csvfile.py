@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import difflib
 import io
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,6 +27,12 @@ MAX_VALUE = {"time_s": 1e9, "stroke_mm": 1e6, "force_N": 1e6, "angle_deg": 1e6}
 
 
 # ----------------------------------------------------------------------------- loading
+
+#: Most rows whose time stamp goes backwards that a reading drops as a logger's glitches: this many, or this share of
+#: the rows where that is more; more are refused, naming the first.
+BACKWARD_GLITCHES = 10
+BACKWARD_SHARE = 0.01
+
 
 def _err(source: str, line: int | None, msg: str, fix: str = "") -> DataError:
     where = f"{source}:{line}" if line is not None else source
@@ -239,15 +246,29 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
         num = {c: v[order] for c, v in num.items()}
         extra = {c: v[order] for c, v in extra.items()}
     backward_lines = np.zeros(0, np.int64)
+    t = num["time_s"]
+    starts = np.flatnonzero(np.concatenate(([True], sample[1:] != sample[:-1])))
+    ends = np.concatenate((starts[1:], [t.size]))
+    for a, b in zip(starts, ends):
+        # a time that starts again with each cycle is not a logger's glitch (dropping the rows behind the first
+        # cycle's last stamp kept 770 of 59,949 rows), nor rows to sort
+        restart = np.flatnonzero((t[a + 1:b] < t[a:b - 1]) & (cyc_f[a + 1:b] > cyc_f[a:b - 1])) + a + 1
+        if restart.size >= 2:
+            k = int(restart[0])
+            raise _err(source, int(ln[k]), f"column 'time_s' starts again with each cycle in sample {sample[k]!r} "
+                       f"({restart.size} times; here cycle {cyc_f[k]:g} starts at {t[k]:g} s after {t[k - 1]:g})",
+                       "give the time since the sample's record began (add each cycle's start time to its rows)")
     if not strict:
         # a stamp below the latest one before it (same sample) is set aside; the rest stays in order
-        t = num["time_s"]
         back = np.zeros(t.size, bool)
-        starts = np.flatnonzero(np.concatenate(([True], sample[1:] != sample[:-1])))
-        ends = np.concatenate((starts[1:], [t.size]))
         for a, b in zip(starts, ends):
             seg = t[a:b]
             back[a + 1:b] = seg[1:] < np.maximum.accumulate(seg)[:-1]
+        if back.sum() > max(BACKWARD_GLITCHES, BACKWARD_SHARE * t.size):
+            k = int(np.flatnonzero(back)[0])
+            raise _err(source, int(ln[k]), f"{int(back.sum())} of {t.size} rows have a time stamp below one before "
+                       f"them in their sample (here {t[k]:g} s in sample {sample[k]!r}): more than a logger's glitches",
+                       "sort each sample's rows by time (or check the time_s column)")
         if back.any():
             keep = ~back
             backward_lines = ln[back]
@@ -323,6 +344,64 @@ def check_fittable(data: Dataset, what: str = "the selected rows") -> None:
             raise DataError(f"{what}: column {col!r} never changes (every value is {float(v[0]):g} {unit}): "
                             "the model's parameters cannot be identified; fix: give rows where the joint "
                             "is actuated (check the file and the --cycles selection)")
+
+
+#: A column whose correlation with the tendon's tension is below this (in a sample) runs the opposite way to the
+#: model's convention (on the bench records every sample's stroke and angle correlate with the force by 0.74 or more).
+SIGN_CORRELATION = -0.3
+
+
+def reversed_columns(data: Dataset) -> dict[str, list[tuple[str, float]]]:
+    """The columns that run the opposite way to the model's convention, per column: ``[(sample, evidence), ...]``.
+
+    The model takes the stroke as the tendon drawn in (rising as the joint bends), the force as its tension (positive)
+    and the angle as the bend (positive). A load cell that reads tension negative shows its largest readings below
+    zero (``evidence``: its most negative reading over its most positive); a stroke or an angle that runs the other
+    way falls as that tension rises (``evidence``: their correlation, below :data:`SIGN_CORRELATION`)."""
+    out: dict[str, list[tuple[str, float]]] = {}
+    for smp, sl in data.sample_slices():
+        s, f, a = (np.asarray(getattr(data, c)[sl], float) for c in ("stroke_mm", "force_N", "angle_deg"))
+        ok = np.isfinite(s) & np.isfinite(f) & np.isfinite(a)
+        s, f, a = s[ok], f[ok], a[ok]
+        if s.size < 20 or not np.ptp(f) > 0:
+            continue
+        lo, hi = float(np.min(f)), float(np.max(f))
+        if -lo > 2.0 * max(hi, 0.0):
+            out.setdefault("force_N", []).append((str(smp), lo / hi if hi > 0 else -math.inf))
+            f = -f
+        for col, v in (("stroke_mm", s), ("angle_deg", a)):
+            if np.ptp(v) > 0:
+                with np.errstate(all="ignore"):   # (readings so small that their spread underflows: no evidence)
+                    r = float(np.corrcoef(v, f)[0, 1])
+                if r < SIGN_CORRELATION:
+                    out.setdefault(col, []).append((str(smp), r))
+    return out
+
+
+def check_signs(data: Dataset, what: str) -> None:
+    """Refuse rows whose stroke, force or angle runs the opposite way to the model's convention
+    (:func:`reversed_columns`), naming each column, its samples and the evidence; the fix is to negate it.
+
+    Raises
+    ------
+    DataError
+    """
+    bad = reversed_columns(data)
+    if not bad:
+        return
+    parts = []
+    for col, hits in bad.items():
+        smp = ", ".join(s for s, _ in hits)
+        if col == "force_N":
+            parts.append(f"column 'force_N' reads the tension below zero in {smp} (its most negative reading is "
+                         f"{-hits[0][1]:.3g} x its most positive)" if math.isfinite(hits[0][1]) else
+                         f"column 'force_N' reads the tension below zero in {smp} (never above zero)")
+        else:
+            parts.append(f"column {col!r} falls as the tension rises in {smp} (correlation {hits[0][1]:+.2f})")
+    cols = " and ".join(bad)
+    raise DataError(f"{what}: {'; '.join(parts)}: the model takes the stroke as the tendon drawn in, the force as "
+                    f"its tension and the angle as the bend, each rising as the joint bends; fix: negate {cols} "
+                    "(multiply the column by -1)")
 
 
 def check_time_varies(data: Dataset, what: str) -> None:
