@@ -1469,3 +1469,12 @@ def test_a_sample_the_regression_s_split_left_uncorrected_is_tested_against_the_
         assert any("S2 35 +- 1.6 ms, corrected: read" in line for line in out.lines())
     else:
         assert out is ins and out.lag.applied_for("S2") == 0.0
+
+
+def test_stamps_jittering_back_at_new_cycles_are_glitches_not_a_restarting_time(tmp_path):
+    # a logger's jitter that stamps the first row of each new cycle a few ms before the last of the cycle before
+    times = [0.1 * i for i in range(100)]
+    for i in range(20, 100, 20):
+        times[i] = times[i - 1] - 0.004
+    meas = read_measurements(_rows_csv(tmp_path / "t.csv", times, [1 + i // 20 for i in range(100)]))
+    assert list(meas.backward_lines) == [22, 42, 62, 82] and len(meas.data) == 96

@@ -252,8 +252,11 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
     ends = np.concatenate((starts[1:], [t.size]))
     for a, b in zip(starts, ends):
         # a time that starts again with each cycle is not a logger's glitch (dropping the rows behind the first
-        # cycle's last stamp kept 770 of 59,949 rows), nor rows to sort
-        restart = np.flatnonzero((t[a + 1:b] < t[a:b - 1]) & (cyc_f[a + 1:b] > cyc_f[a:b - 1])) + a + 1
+        # cycle's last stamp kept 770 of 59,949 rows), nor rows to sort: a new cycle stamped no later than the cycle
+        # before began (a stamp's jitter at a new cycle goes back by ms only)
+        new_cycle = np.flatnonzero(cyc_f[a + 1:b] > cyc_f[a:b - 1]) + a + 1
+        began = np.concatenate(([a], new_cycle[:-1]))
+        restart = new_cycle[t[new_cycle] <= t[began]]
         if restart.size >= 2:
             k = int(restart[0])
             raise _err(source, int(ln[k]), f"column 'time_s' starts again with each cycle in sample {sample[k]!r} "
