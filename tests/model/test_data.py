@@ -286,3 +286,20 @@ def test_each_samples_median_step_with_and_without_repeated_stamps():
                               np.array([0.0, 0.0, 0.0, 0.1, 0.1, 0.1]), np.zeros(6), np.zeros(6), np.zeros(6))
     assert mostly_repeated.median_steps_s() == (0.0,)
     assert mostly_repeated.median_steps_s(positive=True) == pytest.approx((0.1,))
+
+
+def test_reversed_columns_names_each_column_that_runs_the_other_way_and_not_a_zero_far_off():
+    from camtube.model.data.csvfile import reversed_columns
+    from camtube.model.data.dataset import Dataset
+
+    t = np.arange(0.0, 40.0, 0.02)
+    x = 1.0 - np.cos(2 * np.pi * t / 8.0)
+
+    def record(stroke, force, angle):
+        return Dataset(np.full(t.size, "A", dtype=object), (t // 8).astype(int) + 1, t, stroke, force, angle)
+
+    assert reversed_columns(record(x, 2 * x - 10.0, 20 * x)) == {}     # a load cell's zero 10 N low: no sign turned
+    assert set(reversed_columns(record(-x, -2 * x, 20 * x))) == {"force_N", "stroke_mm"}
+    assert set(reversed_columns(record(x, -2 * x, 20 * x))) == {"force_N"}
+    assert set(reversed_columns(record(x, 2 * x, -20 * x))) == {"angle_deg"}
+    assert reversed_columns(record(x, 2 * x, 20 * x)) == {}

@@ -360,8 +360,9 @@ def reversed_columns(data: Dataset) -> dict[str, list[tuple[str, float]]]:
 
     The model takes the stroke as the tendon drawn in (rising as the joint bends), the force as its tension (positive)
     and the angle as the bend (positive). A load cell that reads tension negative shows its largest readings below
-    zero (``evidence``: its most negative reading over its most positive); a stroke or an angle that runs the other
-    way falls as that tension rises (``evidence``: their correlation, below :data:`SIGN_CORRELATION`)."""
+    zero, and the stroke or the angle falls as they grow (``evidence``: its most negative reading over its most
+    positive); a stroke or an angle that runs the other way falls as that tension rises (``evidence``: their
+    correlation with it, below :data:`SIGN_CORRELATION`)."""
     out: dict[str, list[tuple[str, float]]] = {}
     for smp, sl in data.sample_slices():
         s, f, a = (np.asarray(getattr(data, c)[sl], float) for c in ("stroke_mm", "force_N", "angle_deg"))
@@ -369,16 +370,22 @@ def reversed_columns(data: Dataset) -> dict[str, list[tuple[str, float]]]:
         s, f, a = s[ok], f[ok], a[ok]
         if s.size < 20 or not np.ptp(f) > 0:
             continue
+        def corr(v: np.ndarray, w: np.ndarray) -> float:
+            if not np.ptp(v) > 0:
+                return math.nan
+            with np.errstate(all="ignore"):   # (readings so small that their spread underflows: no evidence)
+                return float(np.corrcoef(v, w)[0, 1])
+
         lo, hi = float(np.min(f)), float(np.max(f))
-        if -lo > 2.0 * max(hi, 0.0):
+        # a load cell that reads tension negative: its largest readings below zero, and the stroke or the angle falls
+        # as they grow (a zero far off alone does not turn the correlations)
+        if -lo > 2.0 * max(hi, 0.0) and min(corr(s, f), corr(a, f)) < SIGN_CORRELATION:
             out.setdefault("force_N", []).append((str(smp), lo / hi if hi > 0 else -math.inf))
             f = -f
         for col, v in (("stroke_mm", s), ("angle_deg", a)):
-            if np.ptp(v) > 0:
-                with np.errstate(all="ignore"):   # (readings so small that their spread underflows: no evidence)
-                    r = float(np.corrcoef(v, f)[0, 1])
-                if r < SIGN_CORRELATION:
-                    out.setdefault(col, []).append((str(smp), r))
+            r = corr(v, f)
+            if r < SIGN_CORRELATION:
+                out.setdefault(col, []).append((str(smp), r))
     return out
 
 
