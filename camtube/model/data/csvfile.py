@@ -256,7 +256,7 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
         # before began (a stamp's jitter at a new cycle goes back by ms only)
         new_cycle = np.flatnonzero(cyc_f[a + 1:b] > cyc_f[a:b - 1]) + a + 1
         began = np.concatenate(([a], new_cycle[:-1]))
-        restart = new_cycle[t[new_cycle] <= t[began]]
+        restart = new_cycle[(t[new_cycle] < t[new_cycle - 1]) & (t[new_cycle] <= t[began])]
         if restart.size >= 2:
             k = int(restart[0])
             raise _err(source, int(ln[k]), f"column 'time_s' starts again with each cycle in sample {sample[k]!r} "
