@@ -149,7 +149,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     from camtube.model.data import check_fittable, read_measurements, select_cycles
     from camtube.model.data.csvfile import check_force_identifies, check_signs
     from camtube.model.diagnose import diagnose
-    from camtube.model.diagnose.instruments import check_instruments, confirm_lag
+    from camtube.model.diagnose.instruments import check_instruments, confirm_lag, unit_mistake
     from camtube.model.diagnose.search import MIN_SEARCH_ROWS
     from camtube.model.report.diagnosis import diagnosis_json, diagnosis_text, report_files
 
@@ -201,6 +201,9 @@ def _diagnose(args: argparse.Namespace) -> int:
     check_force_identifies(ins.data, args.data, fit_names)
     fixed = pattern_values(pattern)
     fixed.update(held)
+    wrong = unit_mistake(model_for_pattern(pattern), ins.data, fixed, [n for n in fit_names if n == "E_t"], (lo, hi))
+    if wrong:
+        raise DataError(f"{args.data}: {wrong}")
     ins = confirm_lag(ins, model, fixed, fit_names)
     rows = ins.data
     cands = [reg.get_effect(c) for c in split_names(args.candidates, "--candidates")] or None

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import csv
+import math
 import os
 from pathlib import Path
 import re
@@ -501,6 +502,35 @@ def test_an_output_inside_another_output_file_is_refused_before_the_work(data_cs
     _one_line_with_fix(_two_outputs(cmd, data_csv, tmp_path, first, second), capsys,
                        f"{option} {tmp_path / second}: lies inside", str(tmp_path / first))
     assert not list(tmp_path.iterdir())
+
+
+def _scaled_csv(src, dst, col, factor):
+    with open(src, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    with open(dst, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        for r in rows:
+            r[col] = repr(float(r[col]) * factor)
+            w.writerow(r)
+    return dst
+
+
+@pytest.mark.parametrize("col,factor,unit,fix", [
+    ("stroke_mm", 1000.0, "um", "divide it by 1000"),
+    ("force_N", 1000.0, "mN", "divide it by 1000"),
+    ("force_N", 1.0 / 9.80665e-3, "grams-force", "multiply it by 0.00980665"),
+    ("angle_deg", math.pi / 180.0, "radians", "multiply it by 57.30"),
+])
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+def test_a_column_in_another_unit_is_named_with_its_fix(data_csv, tmp_path, capsys, col, factor, unit, fix, cmd):
+    # a motor logged in um, a load cell in mN or grams-force, a tracker in radians: the diagnosis searched them and
+    # said 'nothing the library has explains the misfit' (a stroke in um: 1540 x the floor); the fit put E_t on a bound
+    f = _scaled_csv(data_csv, tmp_path / "v.csv", col, factor)
+    out = tmp_path / "d.json"
+    err = _fails_cleanly(["model", cmd, str(f), "--pattern", TUBE2, "-q", "--json", str(out)], capsys,
+                         f"column {col!r} reads like {unit}", f"fix: give {col} in", fix)
+    assert err.count("\n") == 1 and not out.exists()
 
 
 def test_out_of_memory_in_a_model_command_names_the_rows_not_the_notches(data_csv, capsys, monkeypatch):

@@ -75,6 +75,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from camtube.errors import DataError
+from camtube.model.core.params import DEFAULT_E_T_GPA
 from camtube.model.core.threads import one_blas_thread
 from camtube.model.data.dataset import SPEED_COLUMN, Dataset, Rests, rests_of
 
@@ -1459,3 +1460,97 @@ def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Ins
     return Instruments(new.data, new.raw, new.aside, new.kept, new.rates_hz, new.rate_changes,
                        Lag(lg.lag_ms, lg.se_ms, False, new.lag.applied_ms, lg.fall, (got[0], got[1]), own=lg.own),
                        new.dropped, new.n_dropped, new.zeros, new.rezero, new.limits)
+
+
+#: Units a column is often logged in by mistake: ``(column, factor to the model's unit, the unit, the conversion)``.
+#: A motor logged in um (or m, cm, inches), a load cell in mN (or grams-, kilograms-, pounds-force), a tracker in
+#: radians.
+UNIT_MISTAKES = (
+    ("stroke_mm", 1e-3, "um", "divide it by 1000"),
+    ("stroke_mm", 1e3, "m", "multiply it by 1000"),
+    ("stroke_mm", 10.0, "cm", "multiply it by 10"),
+    ("stroke_mm", 25.4, "inches", "multiply it by 25.4"),
+    ("force_N", 1e-3, "mN", "divide it by 1000"),
+    ("force_N", 9.80665e-3, "grams-force", "multiply it by 0.00980665"),
+    ("force_N", 9.80665, "kilograms-force", "multiply it by 9.80665"),
+    ("force_N", 4.4482216, "pounds-force", "multiply it by 4.448"),
+    ("angle_deg", 180.0 / math.pi, "radians", "multiply it by 57.30"),
+)
+#: A unit read instead must lower the paper model's RMSE to this share of the RMSE as logged, at least.
+UNIT_FALL = 0.2
+#: Rows the units' check fits on (evenly thinned in time).
+UNIT_ROWS = 2000
+#: The units are tried where the tendon's fitted modulus is implausible, or where the angle spans less than this share
+#: of what the paper model gives at the pattern's values (a tracker in radians: 1/57).
+UNIT_ANGLE_SPAN = 0.1
+#: Units that fit within this share of the best RMSE fit as well.
+UNIT_TIE = 0.02
+
+
+def _scaled(data: Dataset, column: str, factor: float) -> Dataset:
+    cols = {c: getattr(data, c) for c in ("stroke_mm", "force_N", "angle_deg")}
+    cols[column] = np.asarray(cols[column], float) * factor
+    return Dataset(data.sample, data.cycle, data.time_s, cols["stroke_mm"], cols["force_N"], cols["angle_deg"],
+                   data.extra)
+
+
+def unit_mistake(model, data: Dataset, fixed: Mapping[str, float], fit_names: Sequence[str],
+                 modulus_range_gpa: tuple[float, float] = (1.0, 300.0)) -> str | None:
+    """A column whose unit looks wrong, said with the evidence and the fix; None when the units look right.
+
+    Where the tendon's modulus is fitted and the paper model fitted to ``data`` as logged puts it outside the plausible
+    ``modulus_range_gpa`` (a stroke in um, a force in grams-force: no modulus makes the model's scale), or where the
+    angle spans less than :data:`UNIT_ANGLE_SPAN` of what the paper model gives at the pattern's values (a tracker in
+    radians), each unit of :data:`UNIT_MISTAKES` is tried in turn, one column at a time: one that brings the modulus
+    into the range and lowers the RMSE over the angle's standard deviation to :data:`UNIT_FALL` of that as logged or
+    less is named (of those within
+    :data:`UNIT_TIE` of the best RMSE, the one whose modulus is nearest the pattern's: a force's unit is a factor the
+    modulus takes up). A well-logged record costs one fit and one evaluation on :data:`UNIT_ROWS` rows."""
+    from camtube.model.core.fit import FitError, fit
+    from camtube.model.diagnose.search import thin
+
+    if "E_t" not in fit_names or len(data) < 50:
+        return None
+    rows = thin(data, UNIT_ROWS)
+    lo, hi = modulus_range_gpa
+
+    def paper(d: Dataset):
+        try:
+            r = fit(model, d, list(fit_names), fixed)
+        except FitError:
+            return None
+        return r if math.isfinite(r.rmse) else None
+
+    with one_blas_thread():
+        r0 = paper(rows)
+        if r0 is None:
+            return None
+        # the angle's span against the paper model's at the pattern's values (E_t does not make up a tracker's unit)
+        expected = float(np.ptp(model.predict(rows, model.initial_values(rows, fixed))))
+        small = expected > 0 and float(np.ptp(rows.angle_deg)) < UNIT_ANGLE_SPAN * expected
+        if lo <= r0.params["E_t"] <= hi and not small:
+            return None
+        # the misfit against the angle's own spread (a tracker's unit scales both)
+        miss0 = r0.rmse / (float(np.std(rows.angle_deg)) or 1.0)
+        tried = []
+        for col, factor, unit, conversion in UNIT_MISTAKES:
+            d = _scaled(rows, col, factor)
+            r = paper(d)
+            if r is not None and lo <= r.params["E_t"] <= hi and (
+                    r.rmse / (float(np.std(d.angle_deg)) or 1.0) <= UNIT_FALL * miss0):
+                tried.append((r, col, unit, conversion))
+    if not tried:
+        return None
+    # a force's unit is a factor E_t takes up (the same RMSE in mN and in grams-force): of the units that fit as well
+    # as the best, the one whose modulus is nearest the pattern's
+    e_t = float(fixed.get("E_t", DEFAULT_E_T_GPA))
+    top = min(r.rmse for r, *_ in tried)
+    r, col, unit, conversion = min((t for t in tried if t[0].rmse <= (1.0 + UNIT_TIE) * top),
+                                   key=lambda t: abs(math.log(t[0].params["E_t"] / e_t)))
+    model_unit = {"stroke_mm": "mm", "force_N": "N", "angle_deg": "deg"}[col]
+    e0 = r0.params["E_t"]
+    logged = (f"E_t = {e0:.3g} GPa, outside {lo:g}-{hi:g}" if not lo <= e0 <= hi else
+              f"the angle spans {float(np.ptp(rows.angle_deg)):.3g} against the {expected:.3g} deg the model gives")
+    return (f"column {col!r} reads like {unit}, not {model_unit}: as logged the paper model misses by {r0.rmse:.4g} "
+            f"deg RMS ({logged}); read as {unit} it misses by {r.rmse:.4g} deg with E_t = {r.params['E_t']:.3g} GPa; "
+            f"fix: give {col} in {model_unit} ({conversion})")
