@@ -34,3 +34,8 @@ def test_a_signal_read_in_steps_coarser_than_its_noise_has_the_steps_noise(step)
 def test_a_smooth_signal_without_noise_reads_none():
     assert white_noise_sd(np.linspace(0.0, 3.0, 500)) < 1e-12   # (the float rounding of the ramp's steps)
     assert white_noise_sd(np.full(500, 0.25)) == 0.0
+
+
+def test_a_signal_without_noise_that_holds_and_steps_reads_none():
+    # a load cell's noise-free reading that holds 0.2 N at a rest, then 0: one step, no steps of a resolution
+    assert white_noise_sd(np.concatenate((np.full(100, 0.2), np.zeros(100)))) == 0.0
