@@ -355,6 +355,15 @@ def check_fittable(data: Dataset, what: str = "the selected rows") -> None:
 SIGN_CORRELATION = -0.3
 
 
+def _corr(v: np.ndarray, w: np.ndarray) -> float:
+    """Pearson's correlation of ``v`` and ``w``; nan where ``v`` is constant or the readings are so small that their
+    spread underflows (no evidence either way)."""
+    if not np.ptp(v) > 0:
+        return math.nan
+    with np.errstate(all="ignore"):
+        return float(np.corrcoef(v, w)[0, 1])
+
+
 def reversed_columns(data: Dataset) -> dict[str, list[tuple[str, float]]]:
     """The columns that run the opposite way to the model's convention, per column: ``[(sample, evidence), ...]``.
 
@@ -370,20 +379,14 @@ def reversed_columns(data: Dataset) -> dict[str, list[tuple[str, float]]]:
         s, f, a = s[ok], f[ok], a[ok]
         if s.size < 20 or not np.ptp(f) > 0:
             continue
-        def corr(v: np.ndarray, w: np.ndarray) -> float:
-            if not np.ptp(v) > 0:
-                return math.nan
-            with np.errstate(all="ignore"):   # (readings so small that their spread underflows: no evidence)
-                return float(np.corrcoef(v, w)[0, 1])
-
         lo, hi = float(np.min(f)), float(np.max(f))
         # a load cell that reads tension negative: its largest readings below zero, and the stroke or the angle falls
         # as they grow (a zero far off alone does not turn the correlations)
-        if -lo > 2.0 * max(hi, 0.0) and min(corr(s, f), corr(a, f)) < SIGN_CORRELATION:
+        if -lo > 2.0 * max(hi, 0.0) and min(_corr(s, f), _corr(a, f)) < SIGN_CORRELATION:
             out.setdefault("force_N", []).append((str(smp), lo / hi if hi > 0 else -math.inf))
             f = -f
         for col, v in (("stroke_mm", s), ("angle_deg", a)):
-            r = corr(v, f)
+            r = _corr(v, f)
             if r < SIGN_CORRELATION:
                 out.setdefault(col, []).append((str(smp), r))
     return out

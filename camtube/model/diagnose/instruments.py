@@ -1476,7 +1476,8 @@ UNIT_MISTAKES = (
     ("force_N", 4.4482216, "pounds-force", "multiply it by 4.448"),
     ("angle_deg", 180.0 / math.pi, "radians", "multiply it by 57.30"),
 )
-#: A unit read instead must lower the paper model's RMSE to this share of the RMSE as logged, at least.
+#: A unit read instead must lower the paper model's RMSE over the angle's standard deviation (in that unit) to this
+#: share of the same as logged, at least.
 UNIT_FALL = 0.2
 #: Rows the units' check fits on (evenly thinned in time).
 UNIT_ROWS = 2000
@@ -1503,9 +1504,9 @@ def unit_mistake(model, data: Dataset, fixed: Mapping[str, float], fit_names: Se
     angle spans less than :data:`UNIT_ANGLE_SPAN` of what the paper model gives at the pattern's values (a tracker in
     radians), each unit of :data:`UNIT_MISTAKES` is tried in turn, one column at a time: one that brings the modulus
     into the range and lowers the RMSE over the angle's standard deviation to :data:`UNIT_FALL` of that as logged or
-    less is named (of those within
-    :data:`UNIT_TIE` of the best RMSE, the one whose modulus is nearest the pattern's: a force's unit is a factor the
-    modulus takes up). A well-logged record costs one fit and one evaluation on :data:`UNIT_ROWS` rows."""
+    less is named (of those within :data:`UNIT_TIE` of the best RMSE, the one whose modulus is nearest the pattern's:
+    a force's unit is a factor the modulus takes up). A well-logged record costs one fit and one evaluation on
+    :data:`UNIT_ROWS` rows."""
     from camtube.model.core.fit import FitError, fit
     from camtube.model.diagnose.search import thin
 
