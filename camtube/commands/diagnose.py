@@ -52,6 +52,10 @@ def register(model_sub) -> None:
                    help="plausible tendon E_t in GPa; a fit outside is not trusted (default 1,300)")
     d.add_argument("--no-stop-rule", dest="stop_rule", action="store_false",
                    help="do not stop at 1.15 x the noise floor (the significance tests alone decide)")
+    d.add_argument("--per-sample", dest="given_per_sample", default="", metavar="P1,P2",
+                   help="parameters of --effects (full names, or effect names for all their parameters) fitted with "
+                        "one value per sample from the start, as model fit's --per-sample: an effect an earlier "
+                        "diagnosis recommended per sample")
     d.add_argument("--no-per-sample", dest="per_sample", action="store_false",
                    help="do not test per-sample parameters of the recommended effects")
     d.add_argument("--init", action="append", default=[], metavar="NAME=VALUE",
@@ -138,6 +142,22 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
         return _diagnose(args)
 
 
+def _per_sample_names(model, names) -> list:
+    """``--per-sample`` as full names of ``model``'s parameters (an effect's name stands for all its parameters); an
+    unknown name is refused with the model's names (a candidate's parameters are tested per sample by the search)."""
+    from camtube.model.core.model import unknown_parameter
+
+    out = []
+    for nm in names:
+        if nm in model.param_specs:
+            out.append(nm)
+        elif nm in model.effect_names():
+            out += [f"{nm}.{p.name}" for e in model.effects if e.name == nm for p in e.params]
+        else:
+            raise unknown_parameter(nm, list(model.param_specs) + list(model.effect_names()), "--per-sample")
+    return list(dict.fromkeys(out))
+
+
 def _diagnose(args: argparse.Namespace) -> int:
     from camtube.commands.common import (
         check_output_dir, check_output_file, check_outputs_apart, load_joint_pattern, refuse_output_over_input,
@@ -190,6 +210,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     specs = {**{f"{e.name}.{q.name}": q for e in reg.values() for q in e.params}, **model.param_specs}
     init = parse_in_range(args.init, "--init", specs)
     _check_init_names(init, specs)
+    given_ps = _per_sample_names(model, split_names(args.given_per_sample, "--per-sample"))
     meas = read_measurements(args.data, strict=args.strict)
     rows = select_cycles(meas.data, args.cycles)
     ins = check_instruments(rows, lag_ms=args.lag_ms, dropped=meas.summary(),
@@ -207,7 +228,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     ins = confirm_lag(ins, model, fixed, fit_names)
     rows = ins.data
     cands = [reg.get_effect(c) for c in split_names(args.candidates, "--candidates")] or None
-    d = diagnose(model, rows, fit_names, fixed, candidates=cands,
+    d = diagnose(model, rows, fit_names, fixed, candidates=cands, given_per_sample=given_ps,
                  max_rows=args.max_rows, max_effects=args.max_effects, registry=reg,
                  stop_ratio=1.15 if args.stop_rule else None, modulus_range_gpa=(lo, hi),
                  per_sample=args.per_sample, init=init,

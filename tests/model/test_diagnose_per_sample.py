@@ -349,3 +349,48 @@ def test_an_effect_one_sample_refuses_is_fitted_in_the_others():
     assert any(c.significant for c in relax)
     assert d.recommended[0] in {"carriage_gap", "carriage_hold"} and set(d.recommended) & {"relaxation", "relaxation2"}
     assert d.final.rmse_deg <= 1.15 * rec.floor_deg, (d.final.rmse_deg, rec.floor_deg)
+
+
+def test_a_copy_held_in_a_sample_of_a_parameter_held_whole_is_the_whole_s():
+    # the search held relaxation2.slow_ratio@S2 off (the sample does not show the effect) and then slow_ratio whole (the
+    # rows barely depend on it); the fit of both refused the copy of a parameter not fitted per sample, and
+    # `model diagnose --effects slack` on a bench file stopped with a fix the user could not apply
+    from camtube.model.diagnose.search import _whole_held
+
+    held = {"relaxation2.slow_ratio": 10.0, "relaxation2.slow_ratio@S2": 10.0, "relaxation2.fraction@S2": 0.0}
+    assert _whole_held(held) == {"relaxation2.slow_ratio": 10.0, "relaxation2.fraction@S2": 0.0}
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    model = model_for_pattern(p).with_effects(["relaxation2"], builtin_registry())
+    rec = simulate_bench(p, (SampleBench(tracker=Tracker(n_spikes=0, n_dropouts=0)),) * 2,
+                         Protocol(n_cycles=3, ramp_s=2.0, dwell_s=1.0, rest_s=1.0, first_dwell_s=1.0),
+                         Clock(rate_hz=25.0), seed=1)
+    fixed = {**pattern_values(p), **_whole_held(held)}
+    params = model.make_params(rec.data, ["E_t", "relaxation2.fraction", "relaxation2.tau_s"], fixed,
+                               per_sample=["relaxation2.fraction"])
+    assert not params["relaxation2.fraction@S2"].vary and params["relaxation2.fraction@S1"].vary
+    assert params["relaxation2.slow_ratio"].value == 10.0 and "relaxation2.slow_ratio@S2" not in params
+    with pytest.raises(Exception, match="is held for one sample"):
+        model.make_params(rec.data, ["E_t", "relaxation2.fraction", "relaxation2.tau_s"], {**pattern_values(p), **held},
+                          per_sample=["relaxation2.fraction"])
+
+
+def test_diagnose_fits_the_given_effect_per_sample_with_per_sample(tmp_path, capsys):
+    # the loop 'add the effect, diagnose again': slack recommended per sample (0.04 and 0.12 mm), then given with
+    # --effects slack; shared, it leaves the samples' difference to be read as something missing
+    from camtube.commands import main
+    from camtube.model.data import format_csv
+
+    p, rec, _ = _two_samples(Tendon(slack_mm=0.04), Tendon(slack_mm=0.12))
+    path = tmp_path / "d.csv"
+    path.write_text(format_csv(rec.data))
+    base = ["model", "diagnose", str(path), "--pattern", str(PATTERNS / "tube2.yaml"), "-q", "--effects", "slack"]
+    assert main(base) == 0
+    shared = capsys.readouterr().out
+    assert main(base + ["--per-sample", "slack"]) == 0
+    own = capsys.readouterr().out
+
+    assert shared.splitlines()[1].startswith("answer: add ")            # (viscoelastic, then force_zero)
+    assert own.splitlines()[1].startswith("answer: nothing to add")
+    assert "current model (effects: slack; per sample: slack.deadband_mm)" in own
+    assert main(base + ["--per-sample", "slak"]) == 2
+    assert "--per-sample slak: unknown model parameter 'slak'; did you mean 'slack'?" in capsys.readouterr().err

@@ -861,6 +861,7 @@ class SearchSettings:
     modulus_range_gpa: tuple = (1.0, 300.0)
     per_sample: bool = True
     init: dict = field(default_factory=dict)
+    given_per_sample: tuple = ()
 
 
 @dataclass
@@ -899,6 +900,7 @@ def diagnose(
     per_sample: bool = True,
     init: Mapping[str, float] | None = None,
     baseline: Sequence[str | Effect] | None = None,
+    given_per_sample: Sequence[str] = (),
 ) -> Diagnosis:
     """Find the effects missing from ``model`` (see the module docstring): ``Search(...).run()``.
 
@@ -937,6 +939,9 @@ def diagnose(
     init : dict, optional
         Extra start values ``{full name: value}`` for candidates' parameters (``--init``): each candidate
         is also fitted from them (useful for multimodal parameters such as a period).
+    given_per_sample : sequence of str
+        Parameters of ``model`` (its effects' full names) fitted per sample from the start (``--per-sample``): an
+        effect added after an earlier diagnosis whose samples differ in it.
     baseline : sequence, optional
         Effects (or names in ``registry``) taken into the baseline, not recommended, when the data show them
         (default :data:`BASELINE`; ``()``: none, they are then ordinary candidates). Before every round
@@ -948,7 +953,8 @@ def diagnose(
     Diagnosis
     """
     settings = SearchSettings(tuple(fit_params), dict(fixed or {}), max_rows, max_effects, bic_threshold, min_gain,
-                              min_excess, stop_ratio, z, grid, tuple(modulus_range_gpa), per_sample, dict(init or {}))
+                              min_excess, stop_ratio, z, grid, tuple(modulus_range_gpa), per_sample, dict(init or {}),
+                              tuple(given_per_sample))
     with one_blas_thread():  # speed: tall, thin linear algebra (see camtube.model.core.threads)
         return Search(model, data, settings, candidates=candidates, registry=registry, baseline=baseline).run()
 
@@ -988,6 +994,8 @@ class Search:
         self.all_pool = list(self.pool)
         check_fittable(data)
         self.chain: _Chain | None = None
+        #: the given model's parameters fitted per sample from the start (``SearchSettings.given_per_sample``)
+        self.given_ps: tuple = ()
         self.rounds: list[tuple[Candidate, ...]] = []
         self.recommended: list[str] = []
         self.rejected: list[tuple[Candidate, str]] = []  # (candidate, why it failed the all-rows check)
@@ -1012,7 +1020,7 @@ class Search:
         (the chain's and ``held``) of the effects ``model`` has."""
         specs = model.param_specs
         out = dict(self.fixed)
-        for src in (self.held, held or {}):
+        for src in (self.held, _whole_held(held or {})):
             out.update({k: v for k, v in src.items() if k.split("@")[0] in specs})
         return out
 
@@ -1021,7 +1029,9 @@ class Search:
         """Fit the model as given on every row, estimate the noise floor, thin the search rows, cut the blocks."""
         s, data = self.settings, self.data
         names = _names_for(self.given_model, s.fit_params)
-        base_full = refit_all_rows(self.given_model, data, names, self.fixed, {}, s.grid)
+        ps = [n for n in s.given_per_sample if n in names] if len(data.samples) > 1 else []
+        self.given_ps = tuple(ps)
+        base_full = refit_all_rows(self.given_model, data, names, self.fixed, {}, s.grid, per_sample=ps)
         self.block_all, _ = cycle_blocks(data)
         spaced = _spaced_residual(data, base_full.residuals)
         self.floor_rms, self.floor, self.floor_lags = noise_reading(data, base_full.residuals, spaced)
@@ -1031,11 +1041,12 @@ class Search:
         self.search = thin(data, s.max_rows)
         self.block, self.fold = cycle_blocks(self.search)
         self.strata = block_strata(self.search, self.block)
-        cur = _search_fit(self.given_model, self.search, names, base_full.params, self.fixed)
-        cur_ho, cur_mse = _cv(self.given_model, self.search, names, cur.params, self.fixed, self.fold, self.block)
+        cur = _search_fit(self.given_model, self.search, names, base_full.params, self.fixed, per_sample=ps)
+        cur_ho, cur_mse = _cv(self.given_model, self.search, names, cur.params, self.fixed, self.fold, self.block,
+                              per_sample=ps)
         self.base_rmse, self.base_ho = cur.rmse, cur_ho
-        self.given = _step(base_full)
-        self.chain = _Chain(self.given_model, self.given_model, names, [], cur, cur_ho, cur_mse, base_full,
+        self.given = _step(base_full, ps)
+        self.chain = _Chain(self.given_model, self.given_model, names, list(ps), cur, cur_ho, cur_mse, base_full,
                             [self.given], [])
         return self
 
@@ -1463,7 +1474,7 @@ class Search:
             # on every row too, a parameter of the candidate the rows barely depend on is held, not a reason to refuse
             # the effect (bench-heldout21's friction beside a backbone: the guide's hold on its bound in the sample
             # where the guide barely acts, and nothing recommended at 6.6x the floor)
-            c = replace(c, held={**c.held, **unresolved})
+            c = replace(c, held=_whole_held({**c.held, **unresolved}))
             names, ps = _drop_names(names, c.held), list(_drop_names(ps, c.held))
             init = {k: v for k, v in init.items() if k not in c.held}
             r = refit_all_rows(m, data, names, self._fx(m, c.held), init, s.grid, per_sample=ps,
@@ -1733,7 +1744,7 @@ class Search:
         """Each sample diagnosed alone (one per core): ``(recommended, baseline effects in force, final parameters,
         what each effect explains)`` each by sample, or None when a sample cannot be fitted or is left partial
         (stand-ins that leave it unexplained: no answer to combine)."""
-        data, sub_settings = self.data, replace(self.settings, per_sample=False)
+        data, sub_settings = self.data, replace(self.settings, per_sample=False, given_per_sample=())
 
         def alone(i: int):
             """Sample ``i`` diagnosed alone: ``None`` when it cannot be fitted, else (partial, recommended, the
@@ -1876,7 +1887,8 @@ class Search:
         base_model = ch.model.with_effects(list(ch.model.effects) + base_new) if base_new else ch.model
         m = base_model.with_effects(list(base_model.effects) + effects)
         names = _names_for(m, s.fit_params)
-        ps = [n for e in base_split + base_new + effects for n in e.full_names()]
+        ps = [n for n in self.chain.per_sample if n in self.given_ps] + \
+            [n for e in base_split + base_new + effects for n in e.full_names()]
         start = m.initial_values(data)
         shows = {smp: set(chains[smp]) | set(bases[smp]) for smp in samples}
         held = {}
@@ -2223,6 +2235,14 @@ def _chain_form_problems(m: JointModel, data: Dataset, predicted_deg: np.ndarray
         if reason:
             out.append(f"{e.name}: {reason}")
     return out
+
+
+def _whole_held(held: Mapping[str, float]) -> dict:
+    """``held`` without the per-sample copies (``name@S``) of a parameter it also holds whole (``name``): the whole
+    holds every sample's value. (A copy held off in the sample that does not show the effect, and then the parameter
+    held whole because every row barely depends on it, made a fit refuse the copy of a parameter not fitted per
+    sample: ``model diagnose --effects slack`` on a bench file stopped with a fix the user could not apply.)"""
+    return {k: v for k, v in held.items() if not ("@" in k and k.split("@")[0] in held)}
 
 
 def _drop_names(names: Sequence[str], held: Mapping[str, float]) -> tuple:

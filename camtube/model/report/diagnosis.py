@@ -414,6 +414,8 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
     lines.append("")
     given = d.given or base
     cur = ", ".join(given.effects) or "none"
+    if given.per_sample:
+        cur += f"; per sample: {', '.join(given.per_sample)}"
     parts = d.noise_floor_parts_deg
     what = ("white noise in the residual" if d.noise_lag_rows <= 1 else
             f"the noise in the residual, correlated from row to row: read from rows {d.noise_lag_rows} apart"
