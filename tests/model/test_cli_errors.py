@@ -25,7 +25,8 @@ def data_csv(tmp_path_factory):
     return path
 
 
-def _variant(src, dst, **cols):
+def _variant(src, dst, scale=None, **cols):
+    """``src`` written to ``dst`` with the columns ``cols`` set to a value and those of ``scale`` multiplied."""
     with open(src, newline="") as fh:
         rows = list(csv.DictReader(fh))
     with open(dst, "w", newline="") as fh:
@@ -33,6 +34,7 @@ def _variant(src, dst, **cols):
         w.writeheader()
         for r in rows:
             r.update(cols)
+            r.update({c: repr(float(r[c]) * k) for c, k in (scale or {}).items()})
             w.writerow(r)
     return dst
 
@@ -104,24 +106,12 @@ def test_constant_or_zero_stroke_data_is_refused(data_csv, tmp_path, capsys, cmd
                        "'stroke_mm' never changes")
 
 
-def _negated(src, dst, *cols):
-    with open(src, newline="") as fh:
-        rows = list(csv.DictReader(fh))
-    with open(dst, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        for r in rows:
-            r.update({c: repr(-float(r[c])) for c in cols})
-            w.writerow(r)
-    return dst
-
-
 @pytest.mark.parametrize("cmd", ["fit", "diagnose"])
 @pytest.mark.parametrize("cols", [("stroke_mm",), ("angle_deg",), ("force_N",), ("stroke_mm", "angle_deg")])
 def test_a_column_of_the_opposite_sign_is_named_with_its_fix(data_csv, tmp_path, capsys, cmd, cols):
     # a motor that counts the other way, a tracker whose bend reads negative, a load cell that reads tension
     # negative: the model cannot fit them (the diagnosis found nothing at 330 x the floor), so the column is named
-    f = _negated(data_csv, tmp_path / "v.csv", *cols)
+    f = _variant(data_csv, tmp_path / "v.csv", scale={c: -1.0 for c in cols})
     out = tmp_path / "fit.json"
     err = _fails_cleanly(["model", cmd, str(f), "--pattern", TUBE2, "-q", "--json", str(out)], capsys,
                          f"fix: negate {' and '.join(cols)}", *(f"column {c!r}" for c in cols))
@@ -504,18 +494,6 @@ def test_an_output_inside_another_output_file_is_refused_before_the_work(data_cs
     assert not list(tmp_path.iterdir())
 
 
-def _scaled_csv(src, dst, col, factor):
-    with open(src, newline="") as fh:
-        rows = list(csv.DictReader(fh))
-    with open(dst, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        for r in rows:
-            r[col] = repr(float(r[col]) * factor)
-            w.writerow(r)
-    return dst
-
-
 @pytest.mark.parametrize("col,factor,unit,fix", [
     ("stroke_mm", 1000.0, "um", "divide it by 1000"),
     ("force_N", 1000.0, "mN", "divide it by 1000"),
@@ -526,7 +504,7 @@ def _scaled_csv(src, dst, col, factor):
 def test_a_column_in_another_unit_is_named_with_its_fix(data_csv, tmp_path, capsys, col, factor, unit, fix, cmd):
     # a motor logged in um, a load cell in mN or grams-force, a tracker in radians: the diagnosis searched them and
     # said 'nothing the library has explains the misfit' (a stroke in um: 1540 x the floor); the fit put E_t on a bound
-    f = _scaled_csv(data_csv, tmp_path / "v.csv", col, factor)
+    f = _variant(data_csv, tmp_path / "v.csv", scale={col: factor})
     out = tmp_path / "d.json"
     err = _fails_cleanly(["model", cmd, str(f), "--pattern", TUBE2, "-q", "--json", str(out)], capsys,
                          f"column {col!r} reads like {unit}", f"fix: give {col} in", fix)
