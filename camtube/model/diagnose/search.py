@@ -940,8 +940,8 @@ def diagnose(
         Extra start values ``{full name: value}`` for candidates' parameters (``--init``): each candidate
         is also fitted from them (useful for multimodal parameters such as a period).
     given_per_sample : sequence of str
-        Parameters of ``model`` (its effects' full names) fitted per sample from the start (``--per-sample``): an
-        effect added after an earlier diagnosis whose samples differ in it.
+        Parameters of ``model`` (full names: its effects', or a base parameter's) fitted per sample from the start
+        (``--per-sample``): an effect added after an earlier diagnosis whose samples differ in it.
     baseline : sequence, optional
         Effects (or names in ``registry``) taken into the baseline, not recommended, when the data show them
         (default :data:`BASELINE`; ``()``: none, they are then ordinary candidates). Before every round
