@@ -167,7 +167,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     from camtube.model.core.build import build_registry, check_suffix, fitted_and_held, parse_in_range, split_names
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import check_fittable, read_measurements, select_cycles
-    from camtube.model.data.csvfile import check_force_identifies, check_signs
+    from camtube.model.data.csvfile import check_force_identifies, check_signs, check_zeros
     from camtube.model.diagnose import diagnose
     from camtube.model.diagnose.instruments import check_instruments, confirm_lag, unit_mistake
     from camtube.model.diagnose.search import MIN_SEARCH_ROWS
@@ -217,6 +217,7 @@ def _diagnose(args: argparse.Namespace) -> int:
                             n_dropped=int(meas.missing_lines.size + meas.backward_lines.size), rezero=args.rezero)
     check_fittable(ins.data, _rows_left(args, meas, ins))
     check_signs(ins.data, args.data)
+    check_zeros(ins.data, args.data)
     _check_init_names(init, specs, ins.data.samples)
     fit_names, held = fitted_and_held(model, args.fit_params, args.fix, with_effects=False)
     check_force_identifies(ins.data, args.data, fit_names)

@@ -145,7 +145,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from camtube.model.core.fit import FitError, fit
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import check_fittable, find_slack, load_csv, prepare, remove_deadband, select_cycles
-    from camtube.model.data.csvfile import check_signs, check_time_varies
+    from camtube.model.data.csvfile import check_signs, check_time_varies, check_zeros
     from camtube.model.diagnose.instruments import unit_mistake
     from camtube.errors import DataError
     from camtube.model.report.fit import fit_json, fit_text
@@ -195,6 +195,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
         rows = prepare(raw, args.cycles, args.branch, args.deadband, args.deadband_threshold)
     check_fittable(rows, f"{args.data} (cycles {args.cycles}, {args.branch} branch)")
     check_signs(rows, args.data)
+    check_zeros(raw, args.data)   # (every row: the slack deadband's removal shifts the stroke by its own zero)
     names, held = fitted_and_held(model, args.fit_params, args.fix)
     fixed = pattern_values(pattern)
     fixed.update(held)

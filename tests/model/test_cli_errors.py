@@ -511,6 +511,27 @@ def test_a_column_in_another_unit_is_named_with_its_fix(data_csv, tmp_path, caps
     assert err.count("\n") == 1 and not out.exists()
 
 
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+@pytest.mark.parametrize("col,offset", [("stroke_mm", 100.0), ("stroke_mm", -250.0), ("angle_deg", 90.0)])
+def test_a_column_whose_zero_is_not_the_straight_joint_is_named_with_its_fix(data_csv, tmp_path, capsys, cmd, col,
+                                                                             offset):
+    # a motor that logs its absolute position, a tracker whose straight joint reads 90 deg: the diagnosis read them as
+    # 'nothing the library has explains the misfit' (577 x the floor); model fit took 100 mm of stroke as slack
+    with open(data_csv, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    f = tmp_path / "v.csv"
+    with open(f, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        for r in rows:
+            w.writerow({**r, col: repr(float(r[col]) + offset)})
+    out = tmp_path / "d.json"
+    err = _fails_cleanly(["model", cmd, str(f), "--pattern", TUBE2, "-q", "--json", str(out)], capsys,
+                         f"column {col!r} reads", "with the joint at rest",
+                         f"fix: subtract each sample's value at rest from {col}")
+    assert err.count("\n") == 1 and not out.exists()
+
+
 def test_out_of_memory_in_a_model_command_names_the_rows_not_the_notches(data_csv, capsys, monkeypatch):
     # (a record of days in 0.25 s bins once asked the unexplained analysis for 159 GB; what a user can make smaller
     # in a model command is the rows it reads, not a pattern's notches or repeats)

@@ -303,3 +303,22 @@ def test_reversed_columns_names_each_column_that_runs_the_other_way_and_not_a_ze
     assert set(reversed_columns(record(x, -2 * x, 20 * x))) == {"force_N"}
     assert set(reversed_columns(record(x, 2 * x, -20 * x))) == {"angle_deg"}
     assert reversed_columns(record(x, 2 * x, 20 * x)) == {}
+
+
+def test_far_zeros_names_an_absolute_stroke_or_a_tracker_s_offset_not_a_joint_resting_bent():
+    from camtube.model.data.csvfile import far_zeros
+    from camtube.model.data.dataset import Dataset
+
+    t = np.arange(0.0, 40.0, 0.02)
+    x = 1.0 - np.cos(2 * np.pi * t / 8.0)
+
+    def record(stroke, angle):
+        return Dataset(np.full(t.size, "A", dtype=object), (t // 8).astype(int) + 1, t, stroke, 2 * x, angle)
+
+    assert far_zeros(record(x, 20 * x + 3.0)) == {}                      # a permanent set of 3 deg beside 40 deg
+    assert far_zeros(record(x - 0.1, 20 * x)) == {}                      # a rest a little below the start
+    assert list(far_zeros(record(x + 100.0, 20 * x))) == ["stroke_mm"]   # the motor's absolute position
+    assert list(far_zeros(record(x, 20 * x + 90.0))) == ["angle_deg"]    # a tracker's straight joint at 90 deg
+    spiky = 20 * x + 3.0
+    spiky[::400] += 60.0                                                 # spikes do not widen the angle's span
+    assert far_zeros(record(x, spiky)) == {}
