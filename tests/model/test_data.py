@@ -84,10 +84,14 @@ def test_bad_csv_names_file_and_line(tmp_path, lines, line, words):
     (HEADER.replace("angle_deg", "angle_rad"), ["convert 'angle_rad' from rad to deg", "'angle_deg'"]),
     (HEADER.replace("force_N", "force_mN"), ["convert 'force_mN' from mN to N"]),
     (HEADER.replace("stroke_mm", "Stroke (mm)"), ["rename 'Stroke (mm)' -> 'stroke_mm'"]),
+    # a logger that does not count the pulls: how to number them (by hand, or by camtube model ingest)
+    (HEADER.replace("cycle,", ""), ["number each sample's pulls in a column 'cycle'", "camtube model ingest"]),
+    (HEADER.replace("cycle,", "cycles,"), ["rename 'cycles' -> 'cycle'"]),
 ])
 def test_missing_column_fix_converts_other_units_and_renames_near_names(header, words):
+    rows = GOOD[1:] if "cycle" in header else [r.replace("A,1,", "A,").replace("A,2,", "A,") for r in GOOD[1:]]
     with pytest.raises(DataError) as err:
-        parse_csv(_csv([header] + GOOD[1:]), source="m.csv")
+        parse_csv(_csv([header] + rows), source="m.csv")
     msg = str(err.value)
     for w in words:
         assert w in msg, msg
