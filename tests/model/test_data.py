@@ -87,9 +87,14 @@ def test_bad_csv_names_file_and_line(tmp_path, lines, line, words):
     # a logger that does not count the pulls: how to number them (by hand, or by camtube model ingest)
     (HEADER.replace("cycle,", ""), ["number each sample's pulls in a column 'cycle'", "camtube model ingest"]),
     (HEADER.replace("cycle,", "cycles,"), ["rename 'cycles' -> 'cycle'"]),
+    (HEADER.replace("sample,", ""), ["name the tube each row was measured on in a column 'sample'"]),
 ])
 def test_missing_column_fix_converts_other_units_and_renames_near_names(header, words):
-    rows = GOOD[1:] if "cycle" in header else [r.replace("A,1,", "A,").replace("A,2,", "A,") for r in GOOD[1:]]
+    rows = GOOD[1:]
+    if "cycle" not in header:
+        rows = [r.replace("A,1,", "A,").replace("A,2,", "A,") for r in rows]
+    if "sample" not in header:
+        rows = [r.split(",", 1)[1] for r in rows]
     with pytest.raises(DataError) as err:
         parse_csv(_csv([header] + rows), source="m.csv")
     msg = str(err.value)

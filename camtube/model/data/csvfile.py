@@ -183,6 +183,9 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
             m = difflib.get_close_matches(c, header, n=1, cutoff=0.5)
             if m:
                 hints.append(f"rename {m[0]!r} -> {c!r}")
+        if "sample" in missing and not any("'sample'" in h for h in hints):
+            hints.append("name the tube each row was measured on in a column 'sample' (S1 for every row of a file "
+                         "of one tube)")
         if "cycle" in missing and not any(h.startswith("rename") and "'cycle'" in h for h in hints):
             hints.append("number each sample's pulls in a column 'cycle' (1, 2, 3, ...), or write the file from the "
                          "instruments' logs with camtube model ingest, which numbers them from the stroke")
