@@ -142,22 +142,6 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
         return _diagnose(args)
 
 
-def _per_sample_names(model, names) -> list:
-    """``--per-sample`` as full names of ``model``'s parameters (an effect's name stands for all its parameters); an
-    unknown name is refused with the model's names (a candidate's parameters are tested per sample by the search)."""
-    from camtube.model.core.model import unknown_parameter
-
-    out = []
-    for nm in names:
-        if nm in model.param_specs:
-            out.append(nm)
-        elif nm in model.effect_names():
-            out += [f"{nm}.{p.name}" for e in model.effects if e.name == nm for p in e.params]
-        else:
-            raise unknown_parameter(nm, list(model.param_specs) + list(model.effect_names()), "--per-sample")
-    return list(dict.fromkeys(out))
-
-
 def _diagnose(args: argparse.Namespace) -> int:
     from camtube.commands.common import (
         check_output_dir, check_output_file, check_outputs_apart, load_joint_pattern, refuse_output_over_input,
@@ -169,7 +153,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     from camtube.model.data import check_fittable, read_measurements, select_cycles
     from camtube.model.data.csvfile import check_force_identifies, check_signs, check_zeros
     from camtube.model.diagnose import diagnose
-    from camtube.model.diagnose.instruments import check_instruments, confirm_lag, unit_mistake
+    from camtube.model.diagnose.instruments import check_instruments, check_units, confirm_lag
     from camtube.model.diagnose.search import MIN_SEARCH_ROWS
     from camtube.model.report.diagnosis import diagnosis_json, diagnosis_text, report_files
 
@@ -210,7 +194,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     specs = {**{f"{e.name}.{q.name}": q for e in reg.values() for q in e.params}, **model.param_specs}
     init = parse_in_range(args.init, "--init", specs)
     _check_init_names(init, specs)
-    given_ps = _per_sample_names(model, split_names(args.given_per_sample, "--per-sample"))
+    given_ps = list(dict.fromkeys(model.per_sample_names(split_names(args.given_per_sample, "--per-sample"))))
     meas = read_measurements(args.data, strict=args.strict)
     rows = select_cycles(meas.data, args.cycles)
     ins = check_instruments(rows, lag_ms=args.lag_ms, dropped=meas.summary(),
@@ -223,9 +207,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     check_force_identifies(ins.data, args.data, fit_names)
     fixed = pattern_values(pattern)
     fixed.update(held)
-    wrong = unit_mistake(model_for_pattern(pattern), ins.data, fixed, [n for n in fit_names if n == "E_t"], (lo, hi))
-    if wrong:
-        raise DataError(f"{args.data}: {wrong}")
+    check_units(model_for_pattern(pattern), ins.data, fixed, fit_names, args.data, (lo, hi))
     ins = confirm_lag(ins, model, fixed, fit_names)
     rows = ins.data
     cands = [reg.get_effect(c) for c in split_names(args.candidates, "--candidates")] or None

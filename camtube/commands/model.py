@@ -146,7 +146,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import check_fittable, find_slack, load_csv, prepare, remove_deadband, select_cycles
     from camtube.model.data.csvfile import check_signs, check_time_varies, check_zeros
-    from camtube.model.diagnose.instruments import unit_mistake
+    from camtube.model.diagnose.instruments import check_units
     from camtube.errors import DataError
     from camtube.model.report.fit import fit_json, fit_text
 
@@ -199,9 +199,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     names, held = fitted_and_held(model, args.fit_params, args.fix)
     fixed = pattern_values(pattern)
     fixed.update(held)
-    wrong = unit_mistake(model_for_pattern(pattern), rows, fixed, [n for n in names if n == "E_t"])
-    if wrong:
-        raise DataError(f"{args.data}: {wrong}")
+    check_units(model_for_pattern(pattern), rows, fixed, names, args.data)
     init = parse_in_range(args.init, "--init", model.param_specs)
     params = model.make_params(rows, names, fixed, initial=init, per_sample=split_names(args.per_sample, "--per-sample"))
     warn = history_warning(model, args.branch, min((len(set(rows.cycle[sl].tolist()))

@@ -483,6 +483,26 @@ class JointModel:
                            "number; fix: make init give a value between lo and hi") from None
         return v
 
+    def per_sample_names(self, names: Sequence[str]) -> list[str]:
+        """``names`` (``--per-sample``) as full parameter names: a full name as it is, an effect's name for all its
+        parameters, in order.
+
+        Raises
+        ------
+        FitError
+            For a name that is neither (with a "did you mean" hint).
+        """
+        specs = self.param_specs
+        out = []
+        for nm in names:
+            if nm in specs:
+                out.append(nm)
+            elif nm in self.effect_names():
+                out += [f"{nm}.{p.name}" for p in next(e for e in self.effects if e.name == nm).params]
+            else:
+                raise unknown_parameter(nm, list(specs) + list(self.effect_names()), "--per-sample")
+        return out
+
     def make_params(
         self,
         data: Dataset,
@@ -520,14 +540,7 @@ class JointModel:
         fixed = dict(fixed or {})
         initial = dict(initial or {})
         bounds = dict(bounds or {})
-        ps = []
-        for nm in per_sample:
-            if nm in specs:
-                ps.append(nm)
-            elif nm in self.effect_names():
-                ps += [f"{nm}.{p.name}" for p in next(e for e in self.effects if e.name == nm).params]
-            else:
-                raise unknown_parameter(nm, known + list(self.effect_names()), "--per-sample")
+        ps = self.per_sample_names(per_sample)
         samples = data.samples
         for option, names in (("--fit", fit), ("--fix", fixed), ("--init", initial), ("bounds", bounds)):
             for nm in names:

@@ -1488,13 +1488,6 @@ UNIT_ANGLE_SPAN = 0.1
 UNIT_TIE = 0.02
 
 
-def _scaled(data: Dataset, column: str, factor: float) -> Dataset:
-    cols = {c: getattr(data, c) for c in ("stroke_mm", "force_N", "angle_deg")}
-    cols[column] = np.asarray(cols[column], float) * factor
-    return Dataset(data.sample, data.cycle, data.time_s, cols["stroke_mm"], cols["force_N"], cols["angle_deg"],
-                   data.extra)
-
-
 def unit_mistake(model, data: Dataset, fixed: Mapping[str, float], fit_names: Sequence[str],
                  modulus_range_gpa: tuple[float, float] = (1.0, 300.0)) -> str | None:
     """A column whose unit looks wrong, said with the evidence and the fix; None when the units look right.
@@ -1535,7 +1528,7 @@ def unit_mistake(model, data: Dataset, fixed: Mapping[str, float], fit_names: Se
         miss0 = r0.rmse / (float(np.std(rows.angle_deg)) or 1.0)
         tried = []
         for col, factor, unit, conversion in UNIT_MISTAKES:
-            d = _scaled(rows, col, factor)
+            d = replace(rows, **{col: np.asarray(getattr(rows, col), float) * factor})
             r = paper(d)
             if r is not None and lo <= r.params["E_t"] <= hi and (
                     r.rmse / (float(np.std(d.angle_deg)) or 1.0) <= UNIT_FALL * miss0):
@@ -1555,3 +1548,17 @@ def unit_mistake(model, data: Dataset, fixed: Mapping[str, float], fit_names: Se
     return (f"column {col!r} reads like {unit}, not {model_unit}: as logged the paper model misses by {r0.rmse:.4g} "
             f"deg RMS ({logged}); read as {unit} it misses by {r.rmse:.4g} deg with E_t = {r.params['E_t']:.3g} GPa; "
             f"fix: give {col} in {model_unit} ({conversion})")
+
+
+def check_units(model, data: Dataset, fixed: Mapping[str, float], fit_names: Sequence[str], what: str,
+                modulus_range_gpa: tuple[float, float] = (1.0, 300.0)) -> None:
+    """Refuse ``data`` with a column whose unit looks wrong (:func:`unit_mistake`, the paper ``model``; tried where
+    ``E_t`` is among ``fit_names``), naming ``what`` (the file), the column, the evidence and the conversion.
+
+    Raises
+    ------
+    DataError
+    """
+    wrong = unit_mistake(model, data, fixed, [n for n in fit_names if n == "E_t"], modulus_range_gpa)
+    if wrong:
+        raise DataError(f"{what}: {wrong}")
