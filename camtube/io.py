@@ -158,9 +158,8 @@ def _staged(path: Path, prefix: str, suffix: str):
 
     A ``path`` that is a symbolic link is written through: the file it points to is replaced (staged beside that
     file) and the link is kept, as a shell's ``>`` or an editor's save leaves it."""
-    _check_file_target(path)
+    _check_file_target(path)   # (is_dir follows a link: a link to a folder is refused here, named as given)
     path = _followed(path)
-    _check_file_target(path)
     tmp = None
     try:
         path.parent.mkdir(parents=True, exist_ok=True)

@@ -386,13 +386,13 @@ def reversed_columns(data: Dataset) -> dict[str, list[tuple[str, float]]]:
         if s.size < 20 or not np.ptp(f) > 0:
             continue
         lo, hi = float(np.min(f)), float(np.max(f))
+        r_s, r_a = _corr(s, f), _corr(a, f)
         # a load cell that reads tension negative: its largest readings below zero, and the stroke or the angle falls
-        # as they grow (a zero far off alone does not turn the correlations)
-        if -lo > 2.0 * max(hi, 0.0) and min(_corr(s, f), _corr(a, f)) < SIGN_CORRELATION:
+        # as they grow (a zero far off alone does not turn the correlations); against the tension, theirs turn
+        if -lo > 2.0 * max(hi, 0.0) and min(r_s, r_a) < SIGN_CORRELATION:
             out.setdefault("force_N", []).append((str(smp), lo / hi if hi > 0 else -math.inf))
-            f = -f
-        for col, v in (("stroke_mm", s), ("angle_deg", a)):
-            r = _corr(v, f)
+            r_s, r_a = -r_s, -r_a
+        for col, r in (("stroke_mm", r_s), ("angle_deg", r_a)):
             if r < SIGN_CORRELATION:
                 out.setdefault(col, []).append((str(smp), r))
     return out

@@ -994,8 +994,6 @@ class Search:
         self.all_pool = list(self.pool)
         check_fittable(data)
         self.chain: _Chain | None = None
-        #: the given model's parameters fitted per sample from the start (``SearchSettings.given_per_sample``)
-        self.given_ps: tuple = ()
         self.rounds: list[tuple[Candidate, ...]] = []
         self.recommended: list[str] = []
         self.rejected: list[tuple[Candidate, str]] = []  # (candidate, why it failed the all-rows check)
@@ -1030,7 +1028,6 @@ class Search:
         s, data = self.settings, self.data
         names = _names_for(self.given_model, s.fit_params)
         ps = [n for n in s.given_per_sample if n in names] if len(data.samples) > 1 else []
-        self.given_ps = tuple(ps)
         base_full = refit_all_rows(self.given_model, data, names, self.fixed, {}, s.grid, per_sample=ps)
         self.block_all, _ = cycle_blocks(data)
         spaced = _spaced_residual(data, base_full.residuals)
@@ -1887,7 +1884,7 @@ class Search:
         base_model = ch.model.with_effects(list(ch.model.effects) + base_new) if base_new else ch.model
         m = base_model.with_effects(list(base_model.effects) + effects)
         names = _names_for(m, s.fit_params)
-        ps = [n for n in self.chain.per_sample if n in self.given_ps] + \
+        ps = [n for n in self.chain.per_sample if n in s.given_per_sample] + \
             [n for e in base_split + base_new + effects for n in e.full_names()]
         start = m.initial_values(data)
         shows = {smp: set(chains[smp]) | set(bases[smp]) for smp in samples}
