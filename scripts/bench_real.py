@@ -329,6 +329,11 @@ HELDOUT38_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 HELDOUT39_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
                    "lag", ("slack", "toe"), ("lag", "backbone3"), ("friction", "slack"), "sharp friction",
                    "tracker drift"]
+#: The fortieth fresh held-out batch (issue 19, after a lag under a load cell at its limit is read against the stroke):
+#: a lag beside a relaxing backbone, creep beside a toe, slack beside lost motion, a smooth guide alone.
+HELDOUT40_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
+                   "lag", ("lag", "backbone"), ("creep", "toe"), ("slack", "lost motion"), "friction",
+                   "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -428,13 +433,16 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            "bench-heldout38": (20281211, HELDOUT38_KINDS),
            # drawn once the measurement files' checks were settled (the search as for bench-heldout38: a measure of the
            # settled method on pairs not drawn before); run once
-           "bench-heldout39": (20281212, HELDOUT39_KINDS)}
+           "bench-heldout39": (20281212, HELDOUT39_KINDS),
+           # drawn once a lag under a load cell at its limit was read against the stroke (bench-heldout39 looked at);
+           # run once
+           "bench-heldout40": (20281213, HELDOUT40_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
            "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
            "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36",
-           "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-sharp"}
+           "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-sharp"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -444,7 +452,7 @@ ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19
            "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26",
            "bench-heldout27", "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
            "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36",
-           "bench-heldout37", "bench-heldout38", "bench-heldout39"}
+           "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
