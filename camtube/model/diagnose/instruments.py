@@ -1449,8 +1449,8 @@ def _confirm_per_sample(ins: Instruments, model, fixed: dict, fit_names) -> Inst
     corrected."""
     lg = ins.lag
     rows_ms = {smp: 1e3 / hz for smp, hz in ins.rates_hz.items() if hz > 0}
-    if len(lg.own) < 2 or not all(smp in rows_ms for smp, *_ in lg.own) or not (lg.per_sample or _lags_differ(
-            [(ms, se, rows_ms[smp]) for smp, ms, se, _ in lg.own], LAG_SPLIT_MODEL_Z)):
+    if len(lg.own) < 2 or not all(smp in rows_ms for smp, *_ in lg.own) or not (lg.per_sample or
+                                                                               _own_lags_differ(ins)):
         return None
     sample = np.asarray(ins.data.sample)
     # the regression's own corrections stand (a split: each resolved and lowering its residual by MIN_FALL)
