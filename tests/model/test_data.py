@@ -331,3 +331,27 @@ def test_far_zeros_names_an_absolute_stroke_or_a_tracker_s_offset_not_a_joint_re
     spiky = 20 * x + 3.0
     spiky[::400] += 60.0                                                 # spikes do not widen the angle's span
     assert far_zeros(record(x, spiky)) == {}
+
+
+def test_a_clock_that_counts_from_elsewhere_reads_as_the_same_record(tube2, tmp_path):
+    # a logger counting Unix seconds, or a second sample logged 1000 s after the first: the physics reads the time since
+    # each sample's first row. Before, a file in Unix seconds was refused ("beyond 1e9 ... no bench measures that"),
+    # and creep read the clock's time: a second sample 1000 s later had crept for 1000 s before its first pull
+    from camtube.model.api import get_effect
+    from camtube.model.core.predict import model_for_pattern, pattern_values
+    from camtube.model.data import read_measurements
+    from camtube.model.data.dataset import Dataset
+
+    data = synthesize(tube2, n_samples=2, n_cycles=4, rate_hz=20.0, seed=3)
+    later = np.where(data.sample == data.samples[1], 1000.0, 0.0)
+    for offset in (later, 1.7e9):
+        moved = Dataset(data.sample, data.cycle, data.time_s + offset, data.stroke_mm, data.force_N, data.angle_deg)
+        assert np.allclose(moved.elapsed_s, data.elapsed_s, atol=1e-6)
+        m = model_for_pattern(tube2, [get_effect("creep")])
+        values = {**pattern_values(tube2), "creep.creep_mm": 0.2, "creep.tau_s": 30.0}
+        assert np.allclose(m.predict(moved, values), m.predict(data, values), atol=1e-6)
+    path = tmp_path / "unix.csv"
+    path.write_text(format_csv(Dataset(data.sample, data.cycle, data.time_s + 1.7e9, data.stroke_mm, data.force_N,
+                                       data.angle_deg)))
+    read = read_measurements(path).data
+    assert read.time_s[0] == pytest.approx(1.7e9) and np.allclose(read.elapsed_s, data.elapsed_s, atol=1e-3)

@@ -23,7 +23,9 @@ _FORMATS = {"time_s": "%.4f", "stroke_mm": "%.6f", "force_N": "%.6f", "angle_deg
 MAX_CYCLE = 1e9
 #: Largest magnitude read in a measured column (time in s, stroke in mm, force in N, angle in deg): beyond it a
 #: value is a unit or export mistake, and the arithmetic of a fit would overflow.
-MAX_VALUE = {"time_s": 1e9, "stroke_mm": 1e6, "force_N": 1e6, "angle_deg": 1e6}
+#: Largest magnitude a column may hold. The time's covers a clock that counts Unix seconds (1.7e9 in 2023; the physics
+#: reads the time since each sample's first row, ``Dataset.elapsed_s``); a clock in ms since 1970 is beyond it.
+MAX_VALUE = {"time_s": 1e10, "stroke_mm": 1e6, "force_N": 1e6, "angle_deg": 1e6}
 
 
 # ----------------------------------------------------------------------------- loading

@@ -232,6 +232,22 @@ class Dataset:
         out.setflags(write=False)
         return self.cache.set("dataset.stroke_speed", out)
 
+    @property
+    def elapsed_s(self) -> np.ndarray:
+        """(n,) float: the time since each sample's first row (s), computed once per Dataset. The clock's origin is no
+        part of the physics: a logger counting from when it was switched on, Unix time, a second sample logged after
+        the first. A sample whose first row is at 0 s reads its ``time_s`` unchanged."""
+        hit = self.cache.get("dataset.elapsed")
+        if hit is None:
+            t = np.asarray(self.time_s, float)
+            out = t.copy()
+            for _, sl in self.sample_slices():
+                if t[sl.start] != 0.0:
+                    out[sl] = t[sl] - t[sl.start]
+            out.setflags(write=False)
+            hit = self.cache.set("dataset.elapsed", out)
+        return hit
+
     def median_steps_s(self, positive: bool = False) -> tuple[float, ...]:
         """Each sample's median time step (s), in the order of :meth:`sample_slices` (0.0 for a sample of fewer than
         two rows, or with no positive step when ``positive``). ``positive``: over the steps above zero only (a

@@ -268,7 +268,7 @@ CARRIAGE_GAP = Effect(
 
 
 def _creep(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
-    t = np.asarray(ctx.data.time_s, float)
+    t = ctx.data.elapsed_s   # since the sample's record began, whatever the logger's clock counts from
     # a tendon longer than the stroke is slack: the joint stays straight
     return np.maximum(stroke - p["creep_mm"] * -np.expm1(-t / max(p["tau_s"], 1e-9)), 0.0)
 

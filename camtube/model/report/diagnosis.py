@@ -571,17 +571,17 @@ def artefacts_png(d: Diagnosis, max_samples: int = 4) -> bytes | None:
              "force burst row": ("+", "tab:pink"), "frozen angle row": ("s", "tab:cyan"),
              "load cell limit row": (".", "tab:olive"), "force ahead of the stroke row": ("D", "tab:blue")}
     for ax, (smp, s) in zip(axes, sl):
-        t = raw.time_s[s]
+        t = raw.elapsed_s[s]
         ax.plot(t, raw.angle_deg[s], "-", lw=0.4, color="0.55", label="angle as read", rasterized=True)
         for why, rows in ins.aside.items():
             r = rows[(rows >= s.start) & (rows < s.stop)]
             if r.size:
                 m, c = marks.get(why, ("o", "black"))
-                ax.plot(raw.time_s[r], raw.angle_deg[r], m, ms=6, color=c, label=f"{why} ({r.size}), set aside")
+                ax.plot(raw.elapsed_s[r], raw.angle_deg[r], m, ms=6, color=c, label=f"{why} ({r.size}), set aside")
         ax.set_ylabel(f"{smp}: angle (deg)")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="upper right")
-    axes[-1].set_xlabel("time (s)")
+    axes[-1].set_xlabel("time since the sample's first row (s)")
     lag = ins.lag
     axes[0].set_title(f"rows read {len(raw)}; set aside {ins.n_aside}; dropped before (missing values, backward "
                       f"stamps) {ins.n_dropped}; angle lag corrected "

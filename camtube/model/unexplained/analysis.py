@@ -120,7 +120,7 @@ def variables_of(data, residual_deg=None) -> dict[str, np.ndarray]:
         angle = angle - np.asarray(residual_deg, float)
     return {"stroke": np.asarray(data.stroke_mm, float), "angle": angle,
             "force": np.asarray(data.force_N, float), "direction": np.asarray(data.direction, int),
-            "cycle": np.asarray(data.cycle, int), "time": np.asarray(data.time_s, float),
+            "cycle": np.asarray(data.cycle, int), "time": np.asarray(data.elapsed_s, float),
             "sample": np.asarray(data.sample).astype(str)}
 
 
