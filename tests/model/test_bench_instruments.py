@@ -639,6 +639,55 @@ def test_a_force_that_stays_at_rest_is_not_taken_for_the_zero(tube2):
     assert any("not corrected, the cell does not read zero at the first rests" in line for line in ins.lines())
 
 
+def test_a_load_cell_reading_below_zero_at_every_rest_is_re_zeroed(tube2):
+    """S1's load cell reads 0.4 N low (not zeroed before the test), S2's is zeroed: at S1's rests the force reads
+    below zero, which no tension does (a tendon cannot push), so it is the cell's zero: re-zeroed at every rest in
+    S1, said, and the diagnosis is the zeroed record's (nothing to add; before, angle_bias stood in for it). A cell
+    reading above zero at rest stays as read (a tendon held taut would do it too: the test above)."""
+    from camtube.model.diagnose import diagnose
+
+    rec = _drifting_zero(tube2, 0.0, offset_N=-0.4)
+    ins = check_instruments(rec.data)
+    z1, z2 = ins.zeros["S1"], ins.zeros["S2"]
+    assert z1.below_zero and z1.applied and not z2.below_zero and not z2.applied
+    rest = (ins.data.sample == "S1") & (ins.data.stroke_mm == 0.0)
+    assert abs(float(np.median(ins.data.force_N[rest]))) < 0.01
+    s2 = ins.data.sample == "S2"
+    assert np.array_equal(ins.data.force_N[s2], rec.data.force_N[ins.kept][s2])
+    assert any(line.startswith("load cell zero: at S1's rests (motor at zero, tendon slack) the force reads -0.4")
+               and "a tendon cannot push" in line for line in ins.lines()), ins.lines()
+    d = diagnose(model_for_pattern(tube2), ins.data, ["E_t"], pattern_values(tube2))
+    assert not d.recommended and not d.partial
+    assert d.final.rmse_deg < 1.1 * rec.floor_deg
+
+
+def test_a_load_cell_reading_above_zero_at_rest_with_the_joint_straight_is_re_zeroed(tube2):
+    """S1's tendon is 0.15 mm slack and its load cell reads 1.5 N high (not zeroed before the test). At the rests the
+    force reads 1.5 N while the joint is straight, though 1.5 N bends it by about 12 deg on the pulls: no tension
+    holds it, so it is the cell's zero: re-zeroed, said, and slack is recommended (before, nothing was: relaxation and
+    slack partial at 85x the floor). A tendon a carriage holds taut at rest bends the joint as its tension does, and
+    stays as read (the test above)."""
+    from dataclasses import replace
+
+    from camtube.model.diagnose import diagnose
+
+    slow = Protocol(n_cycles=12, ramp_s=6.0, dwell_s=2.0, rest_s=3.0, first_dwell_s=4.0)
+    rec = simulate_bench(tube2, (SampleBench(tendon=Tendon(slack_mm=0.15), tracker=QUIET), SampleBench(tracker=QUIET)),
+                         slow, Clock(rate_hz=25.0, n_repeats=0), seed=7)
+    rec = replace(rec, data=rec.data.with_force(rec.data.force_N + 1.5 * (rec.data.sample == "S1")))
+    ins = check_instruments(rec.data)
+    z1, z2 = ins.zeros["S1"], ins.zeros["S2"]
+    assert z1.unloaded_offset and z1.applied and not z2.applied
+    assert abs(z1.rest_deg) < 1.0 and z1.implied_deg > 8.0
+    rest = (ins.data.sample == "S1") & (ins.data.stroke_mm == 0.0)
+    assert abs(float(np.median(ins.data.force_N[rest]))) < 0.01
+    assert any(line.startswith("load cell zero: at S1's rests (motor at zero) the force reads 1.5 N while the joint "
+                               "there is straight") for line in ins.lines()), ins.lines()
+    d = diagnose(model_for_pattern(tube2), ins.data, ["E_t"], pattern_values(tube2))
+    assert d.recommended[:1] == ("slack",) and "force_zero" not in d.recommended
+    assert d.final.rmse_deg < 1.15 * rec.floor_deg
+
+
 def test_a_carriage_held_within_a_gap_that_binds_is_lost_motion_in_the_drive(tube2):
     """A nut's gap narrower than the stroke at which the rail holds the carriage: the far flank pushes the held
     carriage down with the motor, so the joint rests bent by what the gap keeps, the tendon taut (sample 1, 0.11 mm

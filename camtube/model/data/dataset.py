@@ -122,7 +122,7 @@ class Dataset:
     cycle : (n,) int
         Actuation cycle number (1-based).
     time_s : (n,) float
-        Time since the start of the sample's record (s), non-decreasing per sample.
+        Time (s), non-decreasing per sample, from any origin (:attr:`elapsed_s`: since the sample's first row).
     stroke_mm : (n,) float
         Tendon stroke (motor side), mm.
     force_N : (n,) float

@@ -211,6 +211,14 @@ ZERO_JUMP = 0.4
 ZERO_START = 0.25
 #: Fewest rests (runs of rows at the bottom of the stroke) a sample needs for its zero to be read.
 MIN_RESTS = 6
+#: The rests read below zero when their median is below zero by this many of the cell's row-to-row noise at rest: no
+#: tension (a tendon cannot push), so the cell's own zero (:attr:`Zero.below_zero`).
+BELOW_ZERO_NOISE = 5.0
+#: A force above zero at every rest is the cell's zero, not a tendon held taut, where the joint there is straight: bent
+#: by less than this share of what that force bends it by as tension (its angle against the force on the pulls) ...
+STRAIGHT_SHARE = 0.25
+#: ... and that bend is this many times the tracker's noise at rest (else the two cannot be told apart).
+STRAIGHT_NOISE = 10.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -228,6 +236,9 @@ class Zero:
         The rests' scatter about that line.
     jump_N : float
         The largest step from one rest's reading to the next (each the median of it and its neighbours).
+    rest_deg, implied_deg, angle_noise_deg : float
+        The joint's angle at the rests; the bend the rests' reading gives as tension (the angle's slope against the
+        force on the pulls times that reading); the tracker's row-to-row noise at rest.
     row_noise_N : float
         The load cell's noise from row to row at rest.
     applied : bool
@@ -246,6 +257,9 @@ class Zero:
     jump_N: float = 0.0
     applied: bool = False
     rests: Rests | None = None
+    rest_deg: float = 0.0
+    implied_deg: float = 0.0
+    angle_noise_deg: float = 0.0
 
     @property
     def drifts(self) -> bool:
@@ -259,6 +273,23 @@ class Zero:
     @property
     def zeroed(self) -> bool:
         return abs(self.start_N) <= ZERO_START * abs(self.change_N) + 2.0 * self.scatter_N
+
+    @property
+    def below_zero(self) -> bool:
+        """The rests read below zero beyond the cell's noise (:data:`BELOW_ZERO_NOISE`): a tendon cannot push, so no
+        tension reads so; the cell was not zeroed (or its zero drifted down), and the rests measure its zero."""
+        if self.rests is None or not self.rests.force_N.size:
+            return False
+        return float(np.median(self.rests.force_N)) < -BELOW_ZERO_NOISE * self.row_noise_N
+
+    @property
+    def unloaded_offset(self) -> bool:
+        """The rests read above zero, steadily, while the joint there is straight (:data:`STRAIGHT_SHARE` of the bend
+        that force gives as tension, which is :data:`STRAIGHT_NOISE` x the tracker's noise): no tension bends it, so
+        the reading is the cell's zero (not zeroed before the test). A tendon a carriage holds taut at rest bends the
+        joint as that tension does."""
+        return (self.held and self.start_N > 0.0 and self.implied_deg > STRAIGHT_NOISE * self.angle_noise_deg
+                and abs(self.rest_deg) < STRAIGHT_SHARE * self.implied_deg)
 
     @property
     def held(self) -> bool:
@@ -289,20 +320,41 @@ def read_zero(data: Dataset) -> dict:
         span = float(t[-1] - t[0])
         jump = float(np.max(np.abs(np.diff(_rest_medians(z))))) if z.size > 1 else 0.0
         out[smp] = Zero(z.size, float(np.median(z[:3])), float(np.median(z[-3:])), b * span,
-                        scatter / math.sqrt(sxx) * span, scatter, rests.row_noise_N, jump, rests=rests)
+                        scatter / math.sqrt(sxx) * span, scatter, rests.row_noise_N, jump, rests=rests,
+                        **_bend_at_rest(data, sl, rests))
     return out
+
+
+def _bend_at_rest(data: Dataset, sl: slice, rests: Rests) -> dict:
+    """``rest_deg`` (the joint's median angle at the rests), ``implied_deg`` (the bend the rests' median reading gives
+    as tension: the slope of the angle against the force on the pulls, between 20 and 80 % of the force's rise above
+    that reading, times the reading) and ``angle_noise_deg`` (the tracker's row-to-row noise at rest) of one sample."""
+    rows = np.concatenate(rests.runs)
+    a, f = np.asarray(data.angle_deg[sl], float), np.asarray(data.force_N[sl], float)
+    ar = np.asarray(data.angle_deg, float)[rows]
+    steps = np.concatenate([np.diff(np.asarray(data.angle_deg, float)[r]) for r in rests.runs])
+    noise = float(1.4826 * np.median(np.abs(steps - np.median(steps))) / math.sqrt(2.0)) if steps.size else 0.0
+    level = float(np.median(rests.force_N))
+    top = float(np.percentile(f, 99))
+    pull = (np.asarray(data.direction[sl]) > 0) & (f > level + 0.2 * (top - level)) & (f < level + 0.8 * (top - level))
+    implied = 0.0
+    if pull.sum() >= 20 and top > level:
+        slope = float(np.polyfit(f[pull], a[pull], 1)[0])
+        implied = max(slope, 0.0) * max(level, 0.0)
+    return {"rest_deg": float(np.median(ar)), "implied_deg": implied, "angle_noise_deg": noise}
 
 
 def rezero_force(data: Dataset, zeros: dict) -> tuple[Dataset, dict]:
     """``data`` with the force re-zeroed at every rest in the samples whose zero drifts (smoothly, from a cell
-    zeroed before the test: :class:`Zero`), and ``zeros`` with ``applied`` set. The zero between two rests is
-    interpolated in time (each rest's reading the median of it and its neighbours'), held before the first and after
-    the last."""
+    zeroed before the test: :class:`Zero`) or whose rests read below zero (:attr:`Zero.below_zero`: a cell not
+    zeroed; a force above zero at rest may be a tendon held taut, and stays), and ``zeros`` with ``applied`` set. The
+    zero between two rests is interpolated in time (each rest's reading the median of it and its neighbours'), held
+    before the first and after the last."""
     force = data.force_N.copy()
     out = dict(zeros)
     for smp, sl in data.sample_slices():
         zr = zeros.get(smp)
-        if zr is None or not (zr.drifts and zr.smooth and zr.zeroed):
+        if zr is None or not ((zr.drifts and zr.smooth and zr.zeroed) or zr.below_zero or zr.unloaded_offset):
             continue
         force[sl] = data.force_N[sl] - np.interp(data.time_s[sl], zr.rests.time_s, _rest_medians(zr.rests.force_N))
         out[smp] = replace(zr, applied=True)
@@ -319,6 +371,19 @@ def zero_lines(zeros: dict, enabled: bool, option: str = "--no-rezero to keep it
     out = []
     fixed = {s: z for s, z in zeros.items() if z.applied}
     for smp, z in fixed.items():
+        if z.unloaded_offset:
+            out.append(f"load cell zero: at {smp}'s rests (motor at zero) the force reads {z.start_N:.3g} N while the "
+                       f"joint there is straight ({z.rest_deg:.2g} deg; that force bends it by {z.implied_deg:.2g} deg "
+                       f"on the pulls): no tension holds it, so that is the cell's zero (not zeroed before the test); "
+                       f"corrected, the force re-zeroed at every rest ({option})")
+            continue
+        if not (z.drifts and z.smooth and z.zeroed):   # re-zeroed for reading below zero at the rests
+            out.append(f"load cell zero: at {smp}'s rests (motor at zero, tendon slack) the force reads "
+                       f"{z.start_N:.3g} N at the start and {z.end_N:.3g} N at the end, below zero by more than "
+                       f"{BELOW_ZERO_NOISE:g}x its noise ({z.row_noise_N:.2g} N): a tendon cannot push, so that is "
+                       f"the cell's zero (not zeroed before the test, or drifting); corrected, the force re-zeroed "
+                       f"at every rest ({option})")
+            continue
         out.append(f"load cell zero: at {smp}'s rests (motor at zero, tendon slack) the force moves from "
                    f"{z.start_N:.3g} to {z.end_N:.3g} N, a drift of {z.change_N:+.3g} N over the record "
                    f"({abs(z.change_N) / max(z.se_N, 1e-300):.0f} standard errors): the load cell's zero drifts (an "
