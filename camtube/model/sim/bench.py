@@ -73,14 +73,16 @@ class Drive:
 
 @dataclass(frozen=True)
 class LoadCell:
-    """Load cell on the carriage: ``zero(t) = drift_N_per_h t / 3600 + random walk``; noise ``noise_N``;
+    """Load cell on the carriage: ``zero(t) = offset_N + drift_N_per_h t / 3600 + random walk``; noise ``noise_N``;
     ``range_N``: the largest reading its amplifier gives (the reading is clipped there: a cell too small for the
-    tension); ``inf``: none reached."""
+    tension); ``inf``: none reached. ``offset_N``: its reading at zero tension from the start (a cell not zeroed
+    before the test)."""
 
     noise_N: float = 0.005
     drift_N_per_h: float = 0.0
     walk_N_per_sqrt_h: float = 0.0
     range_N: float = math.inf
+    offset_N: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -480,6 +482,8 @@ def simulate_bench(pattern: Pattern, samples: tuple[SampleBench, SampleBench] | 
         else:
             raise ValueError(f"Tracker.dropout {tr.dropout!r}: one of 'nan', 'zero', 'hold'")
         zero = lc.drift_N_per_h * t_true / 3600.0
+        if lc.offset_N:
+            zero = zero + lc.offset_N
         if lc.walk_N_per_sqrt_h > 0:
             zero = zero + np.cumsum(rng.normal(0.0, lc.walk_N_per_sqrt_h * math.sqrt(1.0 / clock.rate_hz / 3600.0), n))
         force = np.minimum(cell + zero + rng.normal(0.0, lc.noise_N, n), lc.range_N)
