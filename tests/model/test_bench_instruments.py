@@ -632,17 +632,6 @@ def test_a_force_that_stays_at_rest_is_not_taken_for_the_zero(tube2):
     assert ins.zeros["S1"].held and ins.zeros["S1"].start_N > 0.1
     assert any(line.startswith("load cell at rest: S1's force stays at") and "lost motion in the drive" in line
                for line in ins.lines()), ins.lines()
-    # the same carriage with a cell 0.5 N high: the joint is bent at rest by what the held tension does, not by what
-    # its reading would: the rest of the reading is the cell's zero, and only that is taken off (before: all of it stayed)
-    from dataclasses import replace
-
-    high = replace(held, data=held.data.with_force(held.data.force_N + 0.5 * (held.data.sample == "S1")))
-    ins_h = check_instruments(high.data)
-    z = ins_h.zeros["S1"]
-    assert z.unloaded_offset and z.applied and not ins_h.zeros["S2"].applied
-    level = float(np.median(z.rests.force_N))
-    assert level - z.rest_tension_N == pytest.approx(0.5, abs=0.05)
-    assert z.rest_tension_N == pytest.approx(ins.zeros["S1"].start_N, rel=0.3)
     off = _drifting_zero(tube2, 2.0, offset_N=0.08)
     ins = check_instruments(off.data)
     assert ins.zeros["S1"].drifts and not ins.zeros["S1"].zeroed and not ins.zeros["S1"].applied
@@ -692,11 +681,20 @@ def test_a_load_cell_reading_above_zero_at_rest_with_the_joint_straight_is_re_ze
     assert abs(z1.rest_deg) < 1.0 and z1.implied_deg > 8.0
     rest = (ins.data.sample == "S1") & (ins.data.stroke_mm == 0.0)
     assert abs(float(np.median(ins.data.force_N[rest]))) < 0.01
-    assert any(line.startswith("load cell zero: at S1's rests (motor at zero) the force reads 1.5 N while the joint "
-                               "there is bent") and "is the cell's zero" for line in ins.lines()), ins.lines()
+    assert any(line.startswith("load cell zero: at S1's rests (motor at zero) the force reads 1.5 N at the start")
+               and "while the joint there is nearly straight" in line and "that is the cell's zero" in line
+               for line in ins.lines()), ins.lines()
     d = diagnose(model_for_pattern(tube2), ins.data, ["E_t"], pattern_values(tube2))
     assert d.recommended[:1] == ("slack",) and "force_zero" not in d.recommended
     assert d.final.rmse_deg < 1.15 * rec.floor_deg
+    # a zero that drifts from a cell not zeroed (1 N high): the drift's rule needs a cell zeroed before the test and
+    # left it; the joint straight at the rests says the readings there are the zero, and it is taken off at every rest
+    drift = _drifting_zero(tube2, 2.0, offset_N=1.0)
+    ins = check_instruments(drift.data)
+    z1 = ins.zeros["S1"]
+    assert z1.drifts and not z1.zeroed and z1.unloaded_offset and z1.applied
+    at_rest = (ins.data.sample == "S1") & (ins.data.stroke_mm == 0.0)
+    assert abs(float(np.median(ins.data.force_N[at_rest]))) < 0.01
 
 
 def test_a_carriage_held_within_a_gap_that_binds_is_lost_motion_in_the_drive(tube2):
