@@ -351,6 +351,12 @@ HELDOUT40_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 #: (:data:`UNTARED`), three lag files, slack and a toe beside lost motion and creep.
 HELDOUT41_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag", "lag",
                    ("lag", "creep"), ("slack", "lost motion"), ("toe", "creep"), "friction", "tracker drift"]
+#: The forty-second fresh held-out batch (issue 19, after the cell's zero is read whole where the joint at rest is
+#: nearly straight; bench-heldout41 looked at): cells not zeroed in half the samples, slack beside creep, lost motion
+#: beside a toe, a backbone beside slack.
+HELDOUT42_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
+                   "lag", ("slack", "creep"), ("lost motion", "toe"), ("backbone", "slack"), "friction",
+                   "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -455,14 +461,16 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            # run once
            "bench-heldout40": (20281213, HELDOUT40_KINDS),
            # drawn once a cell not zeroed was re-zeroed where the rests say so (bench-heldout40 looked at); run once
-           "bench-heldout41": (20281214, HELDOUT41_KINDS)}
+           "bench-heldout41": (20281214, HELDOUT41_KINDS),
+           # drawn once the cell's zero was read whole where the joint at rest is nearly straight; run once
+           "bench-heldout42": (20281215, HELDOUT42_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
            "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
            "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36",
            "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-heldout41",
-           "bench-sharp"}
+           "bench-heldout42", "bench-sharp"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -472,9 +480,10 @@ ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19
            "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26",
            "bench-heldout27", "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
            "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36",
-           "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-heldout41"}
+           "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-heldout41",
+           "bench-heldout42"}
 #: Batches whose load cells may not be zeroed before the test (:func:`untared`).
-UNTARED = {"bench-heldout41"}
+UNTARED = {"bench-heldout41", "bench-heldout42"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
