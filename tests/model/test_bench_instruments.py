@@ -1213,6 +1213,13 @@ def test_a_load_cell_at_the_end_of_its_range_is_set_aside_and_said(tube2):
     quantised = Dataset(d.sample, d.cycle, d.time_s, d.stroke_mm, np.round(d.force_N / 0.01) * 0.01, d.angle_deg)
     q = check_instruments(quantised)
     assert "load cell limit row" not in q.aside and not q.limits
+    # a cell at its limit in most rows (its median is the limit: a cell too small, or not zeroed): the same (it was
+    # taken for a force that never rises, and nothing was set aside)
+    low = 0.3 * float(d.force_N.max())
+    most = Dataset(d.sample, d.cycle, d.time_s, d.stroke_mm, np.minimum(d.force_N, low), d.angle_deg)
+    assert np.median(most.force_N[most.sample == "S1"]) == low
+    m = check_instruments(most)
+    assert set(m.aside["load cell limit row"]) == set(np.flatnonzero(most.force_N == low))
 
 
 def test_a_lag_is_read_by_time_across_the_rows_a_load_cell_at_its_limit_set_aside(tube2):
