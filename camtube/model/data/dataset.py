@@ -87,14 +87,19 @@ class Rests:
     row_noise_N: float
 
 
+def rest_noise(x: np.ndarray, runs: list) -> float:
+    """A signal's row-to-row noise over the rests' rows: ``1.4826 MAD(diff x) / sqrt 2`` of the changes within each
+    run of ``runs`` (0 without rows). ``x`` (n,): the whole record's values (``runs`` index it)."""
+    steps = np.concatenate([np.diff(x[r]) for r in runs]) if runs else np.zeros(0)
+    return float(1.4826 * np.median(np.abs(steps - np.median(steps))) / math.sqrt(2.0)) if steps.size else 0.0
+
+
 def rests_of(data: "Dataset", sl: slice) -> Rests:
     """:class:`Rests` of one sample (``sl``) of ``data``."""
     runs = rest_runs(data, sl)
     f, t = np.asarray(data.force_N, float), np.asarray(data.time_s, float)
-    steps = np.concatenate([np.diff(f[r]) for r in runs]) if runs else np.zeros(0)
-    noise = float(1.4826 * np.median(np.abs(steps - np.median(steps))) / math.sqrt(2.0)) if steps.size else 0.0
     return Rests(runs, np.array([float(np.median(t[r])) for r in runs]),
-                 np.array([float(np.median(f[r])) for r in runs]), noise)
+                 np.array([float(np.median(f[r])) for r in runs]), rest_noise(f, runs))
 
 
 def recently_used(store: dict, key: Any, compute: Callable[[], Any], limit: int) -> Any:

@@ -81,7 +81,7 @@ import numpy as np
 from camtube.errors import DataError
 from camtube.model.core.params import DEFAULT_E_T_GPA
 from camtube.model.core.threads import one_blas_thread
-from camtube.model.data.dataset import SPEED_COLUMN, Dataset, Rests, rests_of
+from camtube.model.data.dataset import SPEED_COLUMN, Dataset, Rests, rest_noise, rests_of
 
 #: A row this many robust scales from its running median is a spike.
 SPIKE_Z = 8.0
@@ -278,12 +278,26 @@ class Zero:
         return abs(self.start_N) <= ZERO_START * abs(self.change_N) + 2.0 * self.scatter_N
 
     @property
+    def level_N(self) -> float:
+        """The rests' median reading (0 without rests)."""
+        return float(np.median(self.rests.force_N)) if self.rests is not None and self.rests.force_N.size else 0.0
+
+    @property
+    def drift_corrected(self) -> bool:
+        """A drift of a cell zeroed before the test, smooth: corrected (:func:`rezero_force`)."""
+        return self.drifts and self.smooth and self.zeroed
+
+    @property
+    def rezeroes(self) -> bool:
+        """The rests are the cell's zero and it is taken off (:func:`rezero_force`): a drift corrected, rests below
+        zero, or a nearly straight joint at rests that read above zero."""
+        return self.drift_corrected or self.below_zero or self.unloaded_offset
+
+    @property
     def below_zero(self) -> bool:
         """The rests read below zero beyond the cell's noise (:data:`BELOW_ZERO_NOISE`): a tendon cannot push, so no
         tension reads so; the cell was not zeroed (or its zero drifted down), and the rests measure its zero."""
-        if self.rests is None or not self.rests.force_N.size:
-            return False
-        return float(np.median(self.rests.force_N)) < -BELOW_ZERO_NOISE * self.row_noise_N
+        return self.level_N < -BELOW_ZERO_NOISE * self.row_noise_N
 
     @property
     def unloaded_offset(self) -> bool:
@@ -293,9 +307,7 @@ class Zero:
         zeroed before the test; drifting or not). A tendon a carriage holds taut at rest bends the joint as its
         tension does: its reading stays. Beside a cell not zeroed, a held tension under a quarter of the reading is
         taken for the zero too (the limit: the reading at rest cannot be split between them)."""
-        if self.rests is None or not self.rests.force_N.size:
-            return False
-        return (float(np.median(self.rests.force_N)) > BELOW_ZERO_NOISE * self.row_noise_N
+        return (self.level_N > BELOW_ZERO_NOISE * self.row_noise_N
                 and self.implied_deg > STRAIGHT_NOISE * self.angle_noise_deg
                 and self.rest_deg < STRAIGHT_SHARE * self.implied_deg)
 
@@ -337,11 +349,8 @@ def _bend_at_rest(data: Dataset, sl: slice, rests: Rests) -> dict:
     """``rest_deg`` (the joint's median angle at the rests), ``implied_deg`` (the bend the rests' median reading gives
     as tension: the slope of the angle against the force on the pulls, between 20 and 80 % of the force's rise above
     that reading, times the reading) and ``angle_noise_deg`` (the tracker's row-to-row noise at rest) of one sample."""
-    rows = np.concatenate(rests.runs)
-    a, f = np.asarray(data.angle_deg[sl], float), np.asarray(data.force_N[sl], float)
-    ar = np.asarray(data.angle_deg, float)[rows]
-    steps = np.concatenate([np.diff(np.asarray(data.angle_deg, float)[r]) for r in rests.runs])
-    noise = float(1.4826 * np.median(np.abs(steps - np.median(steps))) / math.sqrt(2.0)) if steps.size else 0.0
+    angle = np.asarray(data.angle_deg, float)
+    a, f = angle[sl], np.asarray(data.force_N[sl], float)
     level = float(np.median(rests.force_N))
     top = float(np.percentile(f, 99))
     pull = (np.asarray(data.direction[sl]) > 0) & (f > level + 0.2 * (top - level)) & (f < level + 0.8 * (top - level))
@@ -349,7 +358,8 @@ def _bend_at_rest(data: Dataset, sl: slice, rests: Rests) -> dict:
     if pull.sum() >= 20 and top > level:
         slope = float(np.polyfit(f[pull], a[pull], 1)[0])
         implied = max(slope, 0.0) * max(level, 0.0)
-    return {"rest_deg": float(np.median(ar)), "implied_deg": implied, "angle_noise_deg": noise}
+    return {"rest_deg": float(np.median(angle[np.concatenate(rests.runs)])), "implied_deg": implied,
+            "angle_noise_deg": rest_noise(angle, rests.runs)}
 
 
 def rezero_force(data: Dataset, zeros: dict) -> tuple[Dataset, dict]:
@@ -362,7 +372,7 @@ def rezero_force(data: Dataset, zeros: dict) -> tuple[Dataset, dict]:
     out = dict(zeros)
     for smp, sl in data.sample_slices():
         zr = zeros.get(smp)
-        if zr is None or not ((zr.drifts and zr.smooth and zr.zeroed) or zr.below_zero or zr.unloaded_offset):
+        if zr is None or not zr.rezeroes:
             continue
         force[sl] = data.force_N[sl] - np.interp(data.time_s[sl], zr.rests.time_s, _rest_medians(zr.rests.force_N))
         out[smp] = replace(zr, applied=True)
@@ -379,14 +389,14 @@ def zero_lines(zeros: dict, enabled: bool, option: str = "--no-rezero to keep it
     out = []
     fixed = {s: z for s, z in zeros.items() if z.applied}
     for smp, z in fixed.items():
-        if z.unloaded_offset and not (z.drifts and z.smooth and z.zeroed) and not z.below_zero:
+        if z.unloaded_offset and not z.drift_corrected and not z.below_zero:
             out.append(f"load cell zero: at {smp}'s rests (motor at zero) the force reads {z.start_N:.3g} N at the "
                        f"start and {z.end_N:.3g} N at the end while the joint there is nearly straight "
                        f"({z.rest_deg:.2g} deg; that force bends it by {z.implied_deg:.2g} deg on the pulls): no tension "
                        f"holds it, so that is the cell's zero (not zeroed before the test); corrected, the force "
                        f"re-zeroed at every rest ({option})")
             continue
-        if not (z.drifts and z.smooth and z.zeroed):   # re-zeroed for reading below zero at the rests
+        if not z.drift_corrected:   # re-zeroed for reading below zero at the rests
             out.append(f"load cell zero: at {smp}'s rests (motor at zero, tendon slack) the force reads "
                        f"{z.start_N:.3g} N at the start and {z.end_N:.3g} N at the end, below zero by more than "
                        f"{BELOW_ZERO_NOISE:g}x its noise ({z.row_noise_N:.2g} N): a tendon cannot push, so that is "
