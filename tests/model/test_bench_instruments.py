@@ -313,6 +313,23 @@ def test_samples_own_lags_apart_are_tested_on_their_own_rows_though_one_lag_was_
     assert np.array_equal(got.data.angle_deg[s2], rec.data.angle_deg[raw2 & got.kept])
 
 
+def test_the_lag_regressions_normal_equations_match_the_svd_and_give_way_where_columns_are_dependent():
+    """The lag scan's least squares (normal equations, for speed) against the SVD's: the same residual where the
+    columns are independent; where one is all zeros (a sample that never rests) or two are copies, the SVD's
+    minimum-norm answer."""
+    from camtube.model.diagnose.instruments import _least_squares
+
+    rng = np.random.default_rng(7)
+    x = rng.normal(size=(3000, 12)) * np.logspace(-3, 3, 12)
+    a = x @ rng.normal(size=12) + rng.normal(size=3000)
+    want = np.linalg.lstsq(x, a, rcond=None)[0]
+    r_fast, r_svd = a - x @ _least_squares(x, a), a - x @ want
+    assert abs(r_fast @ r_fast / (r_svd @ r_svd) - 1.0) < 1e-10
+    for bad in (np.zeros(3000), x[:, 3].copy()):
+        xb = np.column_stack([x, bad])
+        np.testing.assert_allclose(_least_squares(xb, a), np.linalg.lstsq(xb, a, rcond=None)[0], rtol=1e-9, atol=1e-12)
+
+
 def test_missing_values_are_dropped_and_counted_or_refused_with_the_line(tube2, tmp_path, capsys):
     tr = Tracker(noise_deg=0.15, n_spikes=4, n_dropouts=3, dropout_rows=(2, 5))
     slow = Protocol(n_cycles=4, ramp_s=6.0, dwell_s=2.0, rest_s=2.0, first_dwell_s=4.0)  # the bench files' pace

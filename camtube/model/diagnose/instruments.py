@@ -77,6 +77,7 @@ from dataclasses import dataclass, field, replace
 from typing import Mapping, Sequence
 
 import numpy as np
+import scipy.linalg
 
 from camtube.errors import DataError
 from camtube.model.core.params import DEFAULT_E_T_GPA
@@ -1087,10 +1088,38 @@ def _lag_sse(data: Dataset, design: list, shift: int, rows: np.ndarray) -> float
             continue
         a = data.angle_deg[idx]
         x = basis[idx - shift - sl.start]
-        coef, *_ = np.linalg.lstsq(x, a, rcond=None)
-        r = a - x @ coef
+        r = a - x @ _least_squares(x, a)
         sse += float(r @ r)
     return sse
+
+
+#: The normal equations solve a lag's regression (:func:`_least_squares`) where the columns, scaled to unit length,
+#: are this far from dependent (the Cholesky factor's smallest diagonal over its largest; the square root of the
+#: reciprocal of the Gram matrix's condition number: 1e-6 keeps that number below 1e12, and the residual to about
+#: 1e-4 of the noise); else the SVD's least squares.
+GRAM_RCOND = 1e-6
+
+
+def _least_squares(x: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """The coefficients minimising ``|a - x c|``: by the normal equations (Cholesky) with the columns scaled to unit
+    length, where they are well conditioned (:data:`GRAM_RCOND`); else (a column of zeros: no rest in a sample) by
+    the SVD's least squares, the minimum-norm solution.
+
+    speed: a lag's scan solves some 400 regressions of 6,000-12,000 rows and 21 columns; the SVD took 1.4 ms each
+    on one core, the normal equations 0.3 ms, with residual sums of squares equal to 1e-14 (relative)."""
+    norm = np.sqrt(np.einsum("ij,ij->j", x, x))
+    if np.all(norm > 0.0) and np.all(np.isfinite(norm)):
+        xs = x / norm
+        gram = xs.T @ xs
+        try:
+            chol = scipy.linalg.cholesky(gram, lower=True, check_finite=False)
+        except np.linalg.LinAlgError:
+            chol = None
+        if chol is not None:
+            d = np.abs(np.diag(chol))
+            if d.min() > GRAM_RCOND * d.max():
+                return scipy.linalg.cho_solve((chol, True), xs.T @ a, check_finite=False) / norm
+    return np.linalg.lstsq(x, a, rcond=None)[0]
 
 
 @np.errstate(over="ignore", invalid="ignore")  # an absurd value (angle 1e300) overflows: inf, and no warning
