@@ -357,6 +357,12 @@ HELDOUT41_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 HELDOUT42_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
                    "lag", ("slack", "creep"), ("lost motion", "toe"), ("backbone", "slack"), "friction",
                    "tracker drift"]
+#: The forty-third fresh held-out batch (issue 19, after the lag scan's regressions were solved by the normal equations;
+#: bench-heldout40 .. 42 looked at): cells not zeroed in half the samples, a guide whose friction switches within a row,
+#: a lag beside slack, friction beside creep, a three-arm backbone beside a toe.
+HELDOUT43_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
+                   "lag", ("lag", "slack"), ("friction", "creep"), ("backbone3", "toe"), "sharp friction",
+                   "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -463,14 +469,16 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            # drawn once a cell not zeroed was re-zeroed where the rests say so (bench-heldout40 looked at); run once
            "bench-heldout41": (20281214, HELDOUT41_KINDS),
            # drawn once the cell's zero was read whole where the joint at rest is nearly straight; run once
-           "bench-heldout42": (20281215, HELDOUT42_KINDS)}
+           "bench-heldout42": (20281215, HELDOUT42_KINDS),
+           # drawn once the lag scan's normal equations were settled (bench-heldout40 .. 42 looked at); run once
+           "bench-heldout43": (20281216, HELDOUT43_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
            "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
            "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36",
            "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-heldout41",
-           "bench-heldout42", "bench-sharp"}
+           "bench-heldout42", "bench-heldout43", "bench-sharp"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -481,9 +489,9 @@ ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19
            "bench-heldout27", "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
            "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36",
            "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-heldout41",
-           "bench-heldout42"}
+           "bench-heldout42", "bench-heldout43"}
 #: Batches whose load cells may not be zeroed before the test (:func:`untared`).
-UNTARED = {"bench-heldout41", "bench-heldout42"}
+UNTARED = {"bench-heldout41", "bench-heldout42", "bench-heldout43"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
