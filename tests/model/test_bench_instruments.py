@@ -592,6 +592,15 @@ def _drifting_zero(tube2, drift_N_per_h: float, offset_N: float = 0.0, seed: int
     return rec
 
 
+def _from_first_pull(data: Dataset) -> Dataset:
+    """``data`` without each sample's rows before its stroke first moves (a record started with the first pull)."""
+    keep = np.ones(len(data), bool)
+    for _, sl in data.sample_slices():
+        s = data.stroke_mm[sl]
+        keep[sl.start:sl.start + int(np.flatnonzero(s > s.min() + 1e-3 * np.ptp(s))[0])] = False
+    return data.take(np.flatnonzero(keep))
+
+
 def test_a_drifting_load_cell_zero_is_read_at_the_rests_and_corrected(tube2, tmp_path, capsys):
     """The tendon is slack at every rest, so the force there is the load cell's zero: a drift of the zero is found
     (within 20 % of the truth), corrected at every rest in that sample only, said, and carried into the fit
@@ -671,8 +680,15 @@ def test_a_load_cell_reading_below_zero_at_every_rest_is_re_zeroed(tube2):
     assert abs(float(np.median(ins.data.force_N[rest]))) < 0.01
     s2 = ins.data.sample == "S2"
     assert np.array_equal(ins.data.force_N[s2], rec.data.force_N[ins.kept][s2])
+    assert any(line.startswith("load cell zero: before S1's first pull (motor at zero, the joint never loaded) the "
+                               f"force reads {z1.first_N:.3g} N") and "a tendon cannot push" in line
+               and "re-zeroed at every rest" in line and z1.first_N == pytest.approx(-0.4, abs=0.01)
+               for line in ins.lines()), ins.lines()
+    # a record that starts with the first pull (no reading before it): the rests alone say so
+    cut = check_instruments(_from_first_pull(rec.data))
+    assert cut.zeros["S1"].first_rows == 0 and cut.zeros["S1"].below_zero and cut.zeros["S1"].applied
     assert any(line.startswith("load cell zero: at S1's rests (motor at zero, tendon slack) the force reads -0.4")
-               and "a tendon cannot push" in line for line in ins.lines()), ins.lines()
+               and "a tendon cannot push" in line for line in cut.lines()), cut.lines()
     d = diagnose(model_for_pattern(tube2), ins.data, ["E_t"], pattern_values(tube2))
     assert not d.recommended and not d.partial
     assert d.final.rmse_deg < 1.1 * rec.floor_deg
@@ -698,9 +714,15 @@ def test_a_load_cell_reading_above_zero_at_rest_with_the_joint_straight_is_re_ze
     assert abs(z1.rest_deg) < 1.0 and z1.implied_deg > 8.0
     rest = (ins.data.sample == "S1") & (ins.data.stroke_mm == 0.0)
     assert abs(float(np.median(ins.data.force_N[rest]))) < 0.01
+    assert any(line.startswith("load cell zero: before S1's first pull (motor at zero, the joint never loaded) the "
+                               "force reads 1.5 N") and "with the joint straight" in line and "the cell's zero" in line
+               for line in ins.lines()), ins.lines()
+    # a record that starts with the first pull (no reading before it): the rests alone say so
+    cut = check_instruments(_from_first_pull(rec.data))
+    assert cut.zeros["S1"].first_rows == 0 and cut.zeros["S1"].unloaded_offset and cut.zeros["S1"].applied
     assert any(line.startswith("load cell zero: at S1's rests (motor at zero) the force reads 1.5 N at the start")
                and "while the joint there is nearly straight" in line and "that is the cell's zero" in line
-               for line in ins.lines()), ins.lines()
+               for line in cut.lines()), cut.lines()
     d = diagnose(model_for_pattern(tube2), ins.data, ["E_t"], pattern_values(tube2))
     assert d.recommended[:1] == ("slack",) and "force_zero" not in d.recommended
     assert d.final.rmse_deg < 1.15 * rec.floor_deg
@@ -712,6 +734,82 @@ def test_a_load_cell_reading_above_zero_at_rest_with_the_joint_straight_is_re_ze
     assert z1.drifts and not z1.zeroed and z1.unloaded_offset and z1.applied
     at_rest = (ins.data.sample == "S1") & (ins.data.stroke_mm == 0.0)
     assert abs(float(np.median(ins.data.force_N[at_rest]))) < 0.01
+
+
+def test_a_cell_not_zeroed_beside_a_backbone_that_rests_bent_is_read_before_the_first_pull(tube2):
+    """S1's backbone relaxes and sets, so its joint rests bent (about 10 deg), and its load cell reads 0.9 N high. At
+    the rests the reading cannot be told from a tension holding the joint bent, and was left (bench-heldout43's
+    backbone file: nothing recommended at 41x the floor). Before the first pull the joint has never been loaded and
+    is straight though 0.9 N bends it by several degrees: that reading is the cell's zero. Re-zeroed at every rest,
+    said; S2 (zeroed) as read."""
+    from camtube.model.sim.bench import Backbone
+
+    pace = Protocol(n_cycles=12, ramp_s=4.0, dwell_s=2.0, rest_s=3.0, first_dwell_s=3.0)
+    bent = SampleBench(backbone=Backbone(relax=((0.3, 2.0), (0.2, 25.0)), yield_nmm=3.5, set_rate_per_s=0.045),
+                       load_cell=LoadCell(offset_N=0.9), tracker=QUIET)
+    rec = simulate_bench(tube2, (bent, SampleBench(tracker=QUIET)), pace, Clock(rate_hz=25.0, n_repeats=0), seed=5)
+    ins = check_instruments(rec.data)
+    z1, z2 = ins.zeros["S1"], ins.zeros["S2"]
+    # the rests alone: the joint there is bent by more than a quarter of what 0.9 N bends it by (the old rules leave it)
+    assert z1.rest_deg > 0.25 * z1.implied_deg and not z1.unloaded_offset and not z1.below_zero
+    assert z1.first_rows >= 3 and z1.first_N == pytest.approx(0.9, abs=0.02) and abs(z1.first_deg) < 1.0
+    assert z1.offset_at_start and not z1.held_beside_offset and z1.applied and not z2.applied
+    rest = (ins.data.sample == "S1") & (ins.data.stroke_mm == 0.0)
+    assert abs(float(np.median(ins.data.force_N[rest]))) < 0.01
+    s2 = ins.data.sample == "S2"
+    assert np.array_equal(ins.data.force_N[s2], rec.data.force_N[ins.kept][s2])
+    assert any(line.startswith("load cell zero: before S1's first pull (motor at zero, the joint never loaded) the "
+                               "force reads 0.9") and "with the joint straight" in line and "re-zeroed at every rest"
+               in line for line in ins.lines()), ins.lines()
+
+
+@pytest.mark.parametrize("offset_N", [0.5, -0.3])
+def test_a_tension_held_at_rest_beside_a_cell_not_zeroed_is_kept(tube2, offset_N):
+    """A carriage its rail holds keeps the tendon taut at rest (about 0.15 N), and the cell reads ``offset_N`` off.
+    Taking the rests' reading for the zero took the held tension off with it (bench-heldout41's and 42's lost motion:
+    the drive's effects then had nothing to fit). The reading before the first pull, with nothing held yet, is the
+    zero: taken off throughout, the held tension stays as in the same record read by a zeroed cell."""
+    from camtube.model.sim.bench import Backbone
+
+    pace = Protocol(n_cycles=12, ramp_s=4.0, dwell_s=2.0, rest_s=3.0, first_dwell_s=3.0)
+
+    def record(off):
+        held = SampleBench(drive=Drive(backlash_mm=0.16, rail_friction_N=0.16, settle=True),
+                           backbone=Backbone(relax=((0.09, 3.0),)), load_cell=LoadCell(offset_N=off), tracker=QUIET)
+        return simulate_bench(tube2, (held,), pace, Clock(rate_hz=25.0, n_repeats=0), seed=3)
+
+    zeroed, rec = check_instruments(record(0.0).data), check_instruments(record(offset_N).data)
+    z = rec.zeros["S1"]
+    held_N = zeroed.zeros["S1"].start_N
+    assert held_N > 0.1 and not zeroed.zeros["S1"].applied
+    assert z.offset_at_start and z.held_beside_offset and z.applied
+    assert z.first_N == pytest.approx(offset_N, abs=0.01)
+    rest = rec.data.stroke_mm == 0.0
+    assert float(np.median(rec.data.force_N[rest])) == pytest.approx(
+        float(np.median(zeroed.data.force_N[zeroed.data.stroke_mm == 0.0])), abs=0.01)
+    assert any(line.startswith("load cell zero: before S1's first pull") and "taken off throughout" in line
+               and "a tension held at rest" in line for line in rec.lines()), rec.lines()
+
+
+def test_a_reading_before_the_first_pull_that_bends_the_joint_is_a_preload_not_an_offset():
+    """Before the first pull the cell reads 0.3 N: where the joint is bent by what 0.3 N bends it by on the pulls, that
+    is a tension (a preload) and nothing is taken off; where the joint is straight, it is the cell's zero."""
+    from camtube.model.diagnose.instruments import read_zero
+
+    t = np.arange(0.0, 402.0, 0.05)
+    cycle = (np.maximum(t - 2.0, 0.0) // 10).astype(int)
+    stroke = np.clip(np.sin(2 * np.pi * (t - 2.0) / 10.0), 0.0, None) * 2.0   # 2 s at rest, then 40 cycles
+    rng = np.random.default_rng(2)
+    n = t.size
+    base = dict(sample=np.full(n, "S1", dtype=object), cycle=cycle + 1, time_s=t, stroke_mm=stroke)
+    force = 2.0 * stroke + 0.3 + rng.normal(0.0, 0.003, n)
+    preload = read_zero(Dataset(force_N=force, angle_deg=8.0 * force + rng.normal(0.0, 0.05, n), **base))["S1"]
+    offset = read_zero(Dataset(force_N=force, angle_deg=8.0 * (force - 0.3) + rng.normal(0.0, 0.05, n), **base))["S1"]
+    for z in (preload, offset):
+        assert z.first_rows == 41 and z.first_N == pytest.approx(0.3, abs=0.002)
+        assert z.first_implied_deg == pytest.approx(2.4, rel=0.05)
+    assert not preload.offset_at_start and not preload.rezeroes
+    assert offset.offset_at_start and offset.rezeroes and not offset.held_beside_offset
 
 
 def test_a_carriage_held_within_a_gap_that_binds_is_lost_motion_in_the_drive(tube2):

@@ -223,6 +223,12 @@ BELOW_ZERO_NOISE = 5.0
 STRAIGHT_SHARE = 0.25
 #: ... and that bend is this many times the tracker's noise at rest (else the two cannot be told apart).
 STRAIGHT_NOISE = 10.0
+#: Fewest rows before the first pull (from the sample's first row, the stroke at the bottom of its span) for the cell's
+#: reading there to be read (:attr:`Zero.offset_at_start`).
+MIN_FIRST_ROWS = 3
+#: The first rests read above the reading before the first pull by this many of the cell's row-to-row noise: a tension
+#: held at rest (a carriage its rail holds) beside a cell not zeroed (:attr:`Zero.held_beside_offset`).
+HELD_ABOVE_NOISE = 5.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -243,6 +249,13 @@ class Zero:
     rest_deg, implied_deg, angle_noise_deg : float
         The joint's angle at the rests; the bend the rests' reading gives as tension (the angle's slope against the
         force on the pulls times that reading); the tracker's row-to-row noise at rest.
+    slope_deg_per_N : float
+        That slope (0 where the pulls do not give it).
+    first_rows : int
+        Rows before the first pull (the stroke at the bottom of its span from the sample's first row); 0 where there
+        are fewer than :data:`MIN_FIRST_ROWS` (then ``first_N`` and ``first_deg`` are nan).
+    first_N, first_deg : float
+        The median force and angle there: the joint never loaded yet.
     row_noise_N : float
         The load cell's noise from row to row at rest.
     applied : bool
@@ -264,6 +277,10 @@ class Zero:
     rest_deg: float = 0.0
     implied_deg: float = 0.0
     angle_noise_deg: float = 0.0
+    slope_deg_per_N: float = 0.0
+    first_rows: int = 0
+    first_N: float = math.nan
+    first_deg: float = math.nan
 
     @property
     def drifts(self) -> bool:
@@ -290,9 +307,39 @@ class Zero:
 
     @property
     def rezeroes(self) -> bool:
-        """The rests are the cell's zero and it is taken off (:func:`rezero_force`): a drift corrected, rests below
-        zero, or a nearly straight joint at rests that read above zero."""
-        return self.drift_corrected or self.below_zero or self.unloaded_offset
+        """The cell's zero is taken off (:func:`rezero_force`): read before the first pull (:attr:`offset_at_start`),
+        or at the rests: a drift corrected, rests below zero, or a nearly straight joint at rests that read above
+        zero."""
+        return self.offset_at_start or self.drift_corrected or self.below_zero or self.unloaded_offset
+
+    @property
+    def first_implied_deg(self) -> float:
+        """The bend the reading before the first pull gives as tension (the pulls' slope times it; 0 below zero)."""
+        return self.slope_deg_per_N * max(self.first_N, 0.0) if self.first_rows else 0.0
+
+    @property
+    def offset_at_start(self) -> bool:
+        """Before the first pull the cell reads off zero where no tension can be: below zero beyond
+        :data:`BELOW_ZERO_NOISE` x its noise (a tendon cannot push), or above it with the joint straight there (bent by
+        less than :data:`STRAIGHT_SHARE` of what that reading bends it by as tension, which is :data:`STRAIGHT_NOISE` x
+        the tracker's noise: a preload bends it). The joint has never been loaded there, so neither a backbone's
+        relaxation or set nor a carriage its rail holds can be what the rests show instead: the reading is the
+        cell's zero (not zeroed before the test), also where the joint rests bent later."""
+        if self.first_rows < MIN_FIRST_ROWS:
+            return False
+        noise = BELOW_ZERO_NOISE * self.row_noise_N
+        if self.first_N < -noise:
+            return True
+        return (self.first_N > noise and self.first_implied_deg > STRAIGHT_NOISE * self.angle_noise_deg
+                and abs(self.first_deg) < STRAIGHT_SHARE * self.first_implied_deg)
+
+    @property
+    def held_beside_offset(self) -> bool:
+        """:attr:`offset_at_start`, and the first rests read above that zero by more than :data:`HELD_ABOVE_NOISE` x
+        the cell's noise: a tension held at rest (a carriage its rail holds: lost motion in the drive) beside the
+        cell's offset. The offset read before the first pull is taken off throughout and the held tension stays (the
+        rests are not the zero)."""
+        return self.offset_at_start and self.start_N - self.first_N > HELD_ABOVE_NOISE * self.row_noise_N
 
     @property
     def below_zero(self) -> bool:
@@ -342,8 +389,23 @@ def read_zero(data: Dataset) -> dict:
         jump = float(np.max(np.abs(np.diff(_rest_medians(z))))) if z.size > 1 else 0.0
         out[smp] = Zero(z.size, float(np.median(z[:3])), float(np.median(z[-3:])), b * span,
                         scatter / math.sqrt(sxx) * span, scatter, rests.row_noise_N, jump, rests=rests,
-                        **_bend_at_rest(data, sl, rests))
+                        **_bend_at_rest(data, sl, rests), **_before_first_pull(data, sl))
     return out
+
+
+def _before_first_pull(data: Dataset, sl: slice) -> dict:
+    """``first_rows``, ``first_N``, ``first_deg`` of one sample: the rows from its first while the stroke stays at the
+    bottom of its span (within 0.1 % of it, as a rest's), and the median force and angle there (none: 0 and nan)."""
+    s = np.asarray(data.stroke_mm[sl], float)
+    if s.size < 2:
+        return {}
+    lo, hi = float(np.min(s)), float(np.max(s))
+    moved = np.flatnonzero(s > lo + 1e-3 * (hi - lo) + 1e-12)
+    k = int(moved[0]) if moved.size else 0
+    if k < MIN_FIRST_ROWS:
+        return {}
+    return {"first_rows": k, "first_N": float(np.median(data.force_N[sl][:k])),
+            "first_deg": float(np.median(data.angle_deg[sl][:k]))}
 
 
 def _bend_at_rest(data: Dataset, sl: slice, rests: Rests) -> dict:
@@ -355,27 +417,30 @@ def _bend_at_rest(data: Dataset, sl: slice, rests: Rests) -> dict:
     level = float(np.median(rests.force_N))
     top = float(np.percentile(f, 99))
     pull = (np.asarray(data.direction[sl]) > 0) & (f > level + 0.2 * (top - level)) & (f < level + 0.8 * (top - level))
-    implied = 0.0
+    slope = 0.0
     if pull.sum() >= 20 and top > level:
-        slope = float(np.polyfit(f[pull], a[pull], 1)[0])
-        implied = max(slope, 0.0) * max(level, 0.0)
-    return {"rest_deg": float(np.median(angle[np.concatenate(rests.runs)])), "implied_deg": implied,
-            "angle_noise_deg": rest_noise(angle, rests.runs)}
+        slope = max(float(np.polyfit(f[pull], a[pull], 1)[0]), 0.0)
+    return {"rest_deg": float(np.median(angle[np.concatenate(rests.runs)])), "implied_deg": slope * max(level, 0.0),
+            "angle_noise_deg": rest_noise(angle, rests.runs), "slope_deg_per_N": slope}
 
 
 def rezero_force(data: Dataset, zeros: dict) -> tuple[Dataset, dict]:
-    """``data`` with the force re-zeroed at every rest in the samples whose zero drifts (smoothly, from a cell
-    zeroed before the test: :class:`Zero`) or whose rests read below zero (:attr:`Zero.below_zero`: a cell not
-    zeroed; a force above zero at rest may be a tendon held taut, and stays), and ``zeros`` with ``applied`` set. The
-    zero between two rests is interpolated in time (each rest's reading the median of it and its neighbours'), held
-    before the first and after the last."""
+    """``data`` with the load cell's zero taken off in the samples where :attr:`Zero.rezeroes`, and ``zeros`` with
+    ``applied`` set: re-zeroed at every rest where the rests are the zero (a zero that drifts smoothly from a cell
+    zeroed before the test; rests below zero; rests above zero with the joint nearly straight; a cell that read off
+    zero before the first pull, as the rests do), the zero between two rests interpolated in time (each rest's reading
+    the median of it and its neighbours'), held before the first and after the last; the reading before the first
+    pull taken off throughout where the rests hold a tension above it (:attr:`Zero.held_beside_offset`)."""
     force = data.force_N.copy()
     out = dict(zeros)
     for smp, sl in data.sample_slices():
         zr = zeros.get(smp)
         if zr is None or not zr.rezeroes:
             continue
-        force[sl] = data.force_N[sl] - np.interp(data.time_s[sl], zr.rests.time_s, _rest_medians(zr.rests.force_N))
+        if zr.held_beside_offset:   # the zero read before the first pull; the rests hold a tension above it
+            force[sl] = data.force_N[sl] - zr.first_N
+        else:
+            force[sl] = data.force_N[sl] - np.interp(data.time_s[sl], zr.rests.time_s, _rest_medians(zr.rests.force_N))
         out[smp] = replace(zr, applied=True)
     if not any(z.applied for z in out.values()):
         return data, out
@@ -390,6 +455,22 @@ def zero_lines(zeros: dict, enabled: bool, option: str = "--no-rezero to keep it
     out = []
     fixed = {s: z for s, z in zeros.items() if z.applied}
     for smp, z in fixed.items():
+        if z.offset_at_start:
+            why = (f"below zero by more than {BELOW_ZERO_NOISE:g}x its noise ({z.row_noise_N:.2g} N): a tendon cannot "
+                   "push" if z.first_N < 0.0 else
+                   f"with the joint straight ({z.first_deg:.2g} deg; that force bends it by {z.first_implied_deg:.2g} "
+                   "deg on the pulls): no tension holds it")
+            start = (f"load cell zero: before {smp}'s first pull (motor at zero, the joint never loaded) the force "
+                     f"reads {z.first_N:.3g} N, {why}, so that is the cell's zero (not zeroed before the test); ")
+            if z.held_beside_offset:
+                out.append(start + f"taken off throughout. At the rests it reads {z.start_N:.3g} N at the start and "
+                           f"{z.end_N:.3g} N at the end, {z.start_N - z.first_N:.3g} N above that zero: a tension held "
+                           "at rest (a carriage its rail holds: lost motion in the drive), kept "
+                           f"({option})")
+            else:
+                out.append(start + f"the rests read {z.start_N:.3g} N at the start and {z.end_N:.3g} N at the end, "
+                           f"as it does: corrected, the force re-zeroed at every rest ({option})")
+            continue
         if z.unloaded_offset and not z.drift_corrected and not z.below_zero:
             out.append(f"load cell zero: at {smp}'s rests (motor at zero) the force reads {z.start_N:.3g} N at the "
                        f"start and {z.end_N:.3g} N at the end while the joint there is nearly straight "
