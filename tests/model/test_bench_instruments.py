@@ -625,6 +625,9 @@ def test_a_drifting_load_cell_zero_is_read_at_the_rests_and_corrected(tube2, tmp
     got = json.loads(js.read_text())
     assert got["instruments"]["load_cell_zero"]["S1"]["rezeroed"] is True
     assert got["instruments"]["load_cell_zero"]["S2"]["rezeroed"] is False
+    # the reading before the first pull: a cell zeroed before the test reads 0 there (its drift starts from it)
+    first = got["instruments"]["load_cell_zero"]["S1"]
+    assert abs(first["before_first_pull_N"]) < 0.02 and first["held_at_rest"] is False
     assert not set(got["recommended"]) & {"creep", "creep_load", "viscoelastic", "force_zero"}, got["recommended"]
     assert "--rezero" in fit_command_prefix(argparse.Namespace(data=str(path), pattern=str(TUBE2), overrides=[],
                                                                cycles="all", effect_file=[], fix=[]),
