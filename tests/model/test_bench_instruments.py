@@ -803,6 +803,22 @@ def test_a_tension_held_at_rest_beside_a_cell_not_zeroed_is_kept(tube2, offset_N
                and "a tension held at rest" in line for line in rec.lines()), rec.lines()
 
 
+def test_a_zero_drifting_fast_from_a_cell_not_zeroed_is_not_taken_for_a_held_tension(tube2):
+    """A cell 0.3 N high whose zero drifts 6 N/h: its first three rests read 0.06 N above the reading before the first
+    pull, as a tension held at rest beside the offset would. The rests' line, taken back to the first pull, reads the
+    offset there: the zero drifts from it, and the force is re-zeroed at every rest (nothing held is kept)."""
+    rec = _drifting_zero(tube2, 6.0, offset_N=0.3)
+    ins = check_instruments(rec.data)
+    z = ins.zeros["S1"]
+    assert z.offset_at_start and z.drifts and z.applied
+    assert z.start_N - z.first_N > 0.04   # the first rests alone would say "held"
+    assert abs(z.rests_at_first_N - z.first_N) < 0.01 and not z.held_beside_offset
+    at_rest = (ins.data.sample == "S1") & (ins.data.stroke_mm == 0.0)
+    assert abs(float(np.median(ins.data.force_N[at_rest]))) < 0.01
+    assert any(line.startswith("load cell zero: before S1's first pull") and "re-zeroed at every rest" in line
+               and "the rests' line reads" in line for line in ins.lines()), ins.lines()
+
+
 def test_a_reading_before_the_first_pull_that_bends_the_joint_is_a_preload_not_an_offset():
     """Before the first pull the cell reads 0.3 N: where the joint is bent by what 0.3 N bends it by on the pulls, that
     is a tension (a preload) and nothing is taken off; where the joint is straight, it is the cell's zero."""

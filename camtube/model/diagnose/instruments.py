@@ -257,6 +257,9 @@ class Zero:
         are fewer than :data:`MIN_FIRST_ROWS` (then ``first_N`` and ``first_deg`` are nan).
     first_N, first_deg : float
         The median force and angle there: the joint never loaded yet.
+    rests_at_first_N : float
+        The line through the rests' readings (``change_N``'s) at the time of those rows: where the zero drifts, what
+        the rests read there.
     row_noise_N : float
         The load cell's noise from row to row at rest.
     applied : bool
@@ -282,6 +285,7 @@ class Zero:
     first_rows: int = 0
     first_N: float = math.nan
     first_deg: float = math.nan
+    rests_at_first_N: float = math.nan
 
     @property
     def drifts(self) -> bool:
@@ -339,11 +343,14 @@ class Zero:
 
     @property
     def held_beside_offset(self) -> bool:
-        """:attr:`offset_at_start`, and the first rests read above that zero by more than :data:`HELD_ABOVE_NOISE` x
-        the cell's noise: a tension held at rest (a carriage its rail holds: lost motion in the drive) beside the
-        cell's offset. The offset read before the first pull is taken off throughout and the held tension stays (the
-        rests are not the zero)."""
-        return self.offset_at_start and self.start_N - self.first_N > HELD_ABOVE_NOISE * self.row_noise_N
+        """:attr:`offset_at_start`, and the rests read above that zero by more than :data:`HELD_ABOVE_NOISE` x the
+        cell's noise plus two of their scatters about their line, that line taken back to the rows before the first
+        pull (a zero drifting from the offset reads the offset there: a cell drifting 2 N/h from 0.08 N high read
+        0.017 N above it at its first three rests already): a tension held at rest (a carriage its rail holds: lost
+        motion in the drive) beside the cell's offset. The offset read before the first pull is taken off throughout
+        and the held tension stays (the rests are not the zero)."""
+        return (self.offset_at_start and self.rests_at_first_N - self.first_N
+                > HELD_ABOVE_NOISE * self.row_noise_N + 2.0 * self.scatter_N)
 
     @property
     def below_zero(self) -> bool:
@@ -391,15 +398,19 @@ def read_zero(data: Dataset) -> dict:
         scatter = float(np.sqrt(resid @ resid / max(z.size - 2, 1)))
         span = float(t[-1] - t[0])
         jump = float(np.max(np.abs(np.diff(_rest_medians(z))))) if z.size > 1 else 0.0
+        first = _before_first_pull(data, sl)
+        if first:
+            first["rests_at_first_N"] = float(z.mean() + b * (first.pop("first_time_s") - t.mean()))
         out[smp] = Zero(z.size, float(np.median(z[:3])), float(np.median(z[-3:])), b * span,
                         scatter / math.sqrt(sxx) * span, scatter, rests.row_noise_N, jump, rests=rests,
-                        **_bend_at_rest(data, sl, rests), **_before_first_pull(data, sl))
+                        **_bend_at_rest(data, sl, rests), **first)
     return out
 
 
 def _before_first_pull(data: Dataset, sl: slice) -> dict:
-    """``first_rows``, ``first_N``, ``first_deg`` of one sample: the rows from its first while the stroke stays at the
-    bottom of its span (within 0.1 % of it, as a rest's), and the median force and angle there (none: 0 and nan)."""
+    """``first_rows``, ``first_N``, ``first_deg``, ``first_time_s`` of one sample: the rows from its first while the
+    stroke stays at the bottom of its span (within 0.1 % of it, as a rest's), and the median force, angle and time
+    there (none: an empty dict)."""
     s = np.asarray(data.stroke_mm[sl], float)
     if s.size < 2:
         return {}
@@ -409,7 +420,7 @@ def _before_first_pull(data: Dataset, sl: slice) -> dict:
     if k < MIN_FIRST_ROWS:
         return {}
     return {"first_rows": k, "first_N": float(np.median(data.force_N[sl][:k])),
-            "first_deg": float(np.median(data.angle_deg[sl][:k]))}
+            "first_deg": float(np.median(data.angle_deg[sl][:k])), "first_time_s": float(np.median(data.time_s[sl][:k]))}
 
 
 def _bend_at_rest(data: Dataset, sl: slice, rests: Rests) -> dict:
@@ -468,12 +479,14 @@ def zero_lines(zeros: dict, enabled: bool, option: str = "--no-rezero to keep it
                      f"reads {z.first_N:.3g} N, {why}, so that is the cell's zero (not zeroed before the test); ")
             if z.held_beside_offset:
                 out.append(start + f"taken off throughout. At the rests it reads {z.start_N:.3g} N at the start and "
-                           f"{z.end_N:.3g} N at the end, {z.start_N - z.first_N:.3g} N above that zero: a tension held "
+                           f"{z.end_N:.3g} N at the end, {z.rests_at_first_N - z.first_N:.3g} N above that zero: a "
+                           "tension held "
                            "at rest (a carriage its rail holds: lost motion in the drive), kept "
                            f"({option})")
             else:
-                out.append(start + f"the rests read {z.start_N:.3g} N at the start and {z.end_N:.3g} N at the end, "
-                           f"as it does: corrected, the force re-zeroed at every rest ({option})")
+                out.append(start + f"the rests' line reads {z.rests_at_first_N:.3g} N there ({z.start_N:.3g} N at the "
+                           f"first rests, {z.end_N:.3g} N at the last): corrected, the force re-zeroed at every rest "
+                           f"({option})")
             continue
         if z.unloaded_offset and not z.drift_corrected and not z.below_zero:
             out.append(f"load cell zero: at {smp}'s rests (motor at zero) the force reads {z.start_N:.3g} N at the "
