@@ -313,6 +313,27 @@ def test_samples_own_lags_apart_are_tested_on_their_own_rows_though_one_lag_was_
     assert np.array_equal(got.data.angle_deg[s2], rec.data.angle_deg[raw2 & got.kept])
 
 
+def test_a_load_cell_at_its_limit_in_half_the_rows_does_not_shrink_the_forces_noise_scale():
+    """A cell at its limit reads one value exactly, so half a sample's row-to-row changes are 0: read over them, the
+    force's noise scale came out near 0 and rows of plain noise were set aside as spikes (809 in one file of
+    bench-heldout44). With the limit's rows left out of the scale, no row of noise is a spike, and a real one still is."""
+    from camtube.model.diagnose.instruments import _noise_scale, _spikes
+
+    rng = np.random.default_rng(3)
+    t = np.arange(6000) * 0.02
+    force = 2.0 * np.clip(np.sin(2 * np.pi * t / 12.0), 0.0, None) + rng.normal(0.0, 0.005, t.size)
+    limit = force >= 0.3
+    force[limit] = 0.3                     # the cell's limit: the same reading while the tension goes on
+    force[450] -= 0.2                      # one real spike, at a rest
+    assert not limit[450]
+    slices = [("S1", slice(0, t.size))]
+    assert _noise_scale(force, limit) == pytest.approx(0.005, rel=0.2)   # (the ramps add a little)
+    assert _noise_scale(force) < 0.5 * _noise_scale(force, limit)
+    found = np.flatnonzero(_spikes(force, slices, limit=limit) & ~limit)
+    assert list(found) == [450]
+    assert np.flatnonzero(_spikes(force, slices) & ~limit).size > 10   # at the scale read over the limit's rows
+
+
 def test_the_lag_regressions_normal_equations_match_the_svd_and_give_way_where_columns_are_dependent():
     """The lag scan's least squares (normal equations, for speed) against the SVD's: the same residual where the
     columns are independent; where one is all zeros (a sample that never rests) or two are copies, the SVD's
