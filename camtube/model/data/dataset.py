@@ -62,15 +62,22 @@ class Cache:
         return f"Cache({sorted(self._data)})"
 
 
+def at_bottom(stroke_mm: np.ndarray) -> np.ndarray:
+    """(n,) bool: the rows of one sample's stroke at the bottom of its span (within 0.1 % of it): the motor at rest at
+    zero (a rest, or the rows before the first pull)."""
+    s = np.asarray(stroke_mm, float)
+    lo, hi = float(np.min(s)), float(np.max(s))
+    return s <= lo + 1e-3 * (hi - lo) + 1e-12
+
+
 def rest_runs(data: "Dataset", sl: slice, min_rows: int = 6) -> list[np.ndarray]:
     """Rows (indices into ``data``) of each rest of one sample (``sl``): the later half of each run of at least
-    ``min_rows`` rows at the bottom of the stroke (within 0.1 % of its span), where the tendon has gone slack (or
-    is held) and the guide has let go."""
+    ``min_rows`` rows at the bottom of the stroke (:func:`at_bottom`), where the tendon has gone slack (or is held)
+    and the guide has let go."""
     s = data.stroke_mm[sl]
     if s.size < 2:
         return []
-    lo, hi = float(np.min(s)), float(np.max(s))
-    idx = np.flatnonzero(s <= lo + 1e-3 * (hi - lo) + 1e-12) + sl.start
+    idx = np.flatnonzero(at_bottom(s)) + sl.start
     runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if idx.size else []
     return [r[r.size // 2:] for r in runs if r.size >= min_rows]
 

@@ -82,7 +82,7 @@ import scipy.linalg
 from camtube.errors import DataError
 from camtube.model.core.params import DEFAULT_E_T_GPA
 from camtube.model.core.threads import one_blas_thread
-from camtube.model.data.dataset import SPEED_COLUMN, Dataset, Rests, rest_noise, rests_of
+from camtube.model.data.dataset import SPEED_COLUMN, Dataset, Rests, at_bottom, rest_noise, rests_of
 
 #: A row this many robust scales from its running median is a spike.
 SPIKE_Z = 8.0
@@ -227,8 +227,9 @@ STRAIGHT_NOISE = 10.0
 #: reading there to be read (:attr:`Zero.offset_at_start`; a record that starts with the motor's ramp has two to four
 #: rows before the stroke leaves the bottom 0.1 % of its span on the bench batches).
 MIN_FIRST_ROWS = 2
-#: The first rests read above the reading before the first pull by this many of the cell's row-to-row noise: a tension
-#: held at rest (a carriage its rail holds) beside a cell not zeroed (:attr:`Zero.held_beside_offset`).
+#: The rests' line, taken back to the rows before the first pull, reads above the reading there by this many of the
+#: cell's row-to-row noise (and two of the rests' scatters): a tension held at rest (a carriage its rail holds) beside a
+#: cell not zeroed (:attr:`Zero.held_beside_offset`).
 HELD_ABOVE_NOISE = 5.0
 
 
@@ -409,13 +410,12 @@ def read_zero(data: Dataset) -> dict:
 
 def _before_first_pull(data: Dataset, sl: slice) -> dict:
     """``first_rows``, ``first_N``, ``first_deg``, ``first_time_s`` of one sample: the rows from its first while the
-    stroke stays at the bottom of its span (within 0.1 % of it, as a rest's), and the median force, angle and time
-    there (none: an empty dict)."""
+    stroke stays at the bottom of its span (:func:`~camtube.model.data.dataset.at_bottom`, as a rest's), and the
+    median force, angle and time there (none: an empty dict)."""
     s = np.asarray(data.stroke_mm[sl], float)
     if s.size < 2:
         return {}
-    lo, hi = float(np.min(s)), float(np.max(s))
-    moved = np.flatnonzero(s > lo + 1e-3 * (hi - lo) + 1e-12)
+    moved = np.flatnonzero(~at_bottom(s))
     k = int(moved[0]) if moved.size else 0
     if k < MIN_FIRST_ROWS:
         return {}
@@ -480,9 +480,7 @@ def zero_lines(zeros: dict, enabled: bool, option: str = "--no-rezero to keep it
             if z.held_beside_offset:
                 out.append(start + f"taken off throughout. At the rests it reads {z.start_N:.3g} N at the start and "
                            f"{z.end_N:.3g} N at the end, {z.rests_at_first_N - z.first_N:.3g} N above that zero: a "
-                           "tension held "
-                           "at rest (a carriage its rail holds: lost motion in the drive), kept "
-                           f"({option})")
+                           f"tension held at rest (a carriage its rail holds: lost motion in the drive), kept ({option})")
             else:
                 out.append(start + f"the rests' line reads {z.rests_at_first_N:.3g} N there ({z.start_N:.3g} N at the "
                            f"first rests, {z.end_N:.3g} N at the last): corrected, the force re-zeroed at every rest "
