@@ -375,6 +375,12 @@ HELDOUT44_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 HELDOUT45_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
                    "lag", ("slack", "backbone"), ("lag", "toe"), ("creep", "friction"), "sharp friction",
                    "tracker drift"]
+#: The forty-sixth fresh held-out batch (issue 19, the final method of the session after bench-heldout45, measured
+#: again on a seed not used before; every batch above looked at): cells not zeroed in half the samples, creep beside a
+#: three-arm backbone, a lag beside friction, a toe beside slack.
+HELDOUT46_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
+                   "lag", ("creep", "backbone3"), ("lag", "friction"), ("toe", "slack"), "sharp friction",
+                   "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -487,14 +493,16 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            # drawn once the cell's reading before the first pull was settled (bench-heldout43 looked at); run once
            "bench-heldout44": (20281217, HELDOUT44_KINDS),
            # drawn once the limit's rows were left out of the force's noise scale (bench-heldout44 looked at); run once
-           "bench-heldout45": (20281218, HELDOUT45_KINDS)}
+           "bench-heldout45": (20281218, HELDOUT45_KINDS),
+           # drawn to measure the final method of the session after bench-heldout45 (every batch above looked at); run once
+           "bench-heldout46": (20281219, HELDOUT46_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
            "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
            "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36",
            "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-heldout41",
-           "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45", "bench-sharp"}
+           "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45", "bench-sharp", "bench-heldout46"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -505,9 +513,9 @@ ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19
            "bench-heldout27", "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
            "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36",
            "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-heldout41",
-           "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45"}
+           "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45", "bench-heldout46"}
 #: Batches whose load cells may not be zeroed before the test (:func:`untared`).
-UNTARED = {"bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45"}
+UNTARED = {"bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45", "bench-heldout46"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
