@@ -394,3 +394,43 @@ def test_diagnose_fits_the_given_effect_per_sample_with_per_sample(tmp_path, cap
     assert "current model (effects: slack; per sample: slack.deadband_mm)" in own
     assert main(base + ["--per-sample", "slak"]) == 2
     assert "--per-sample slak: unknown model parameter 'slak'; did you mean 'slack'?" in capsys.readouterr().err
+
+
+def _union_case():
+    """Two samples of the truth simulator (tube 1, 10 Hz): sample 1's tendon has a toe and a viscoelastic part whose
+    time (0.02 s) the rows cannot resolve, sample 2's is slack; a Search on them with its base fitted."""
+    from camtube.model.diagnose.search import Search, SearchSettings
+    from camtube.model.sim.truth import Hidden, simulate
+
+    p = load_pattern(PATTERNS / "tube1.yaml")
+    sim = simulate(p, [Hidden(toe_mm=0.3, visco_ratio=0.05, visco_tau_s=0.02), Hidden(slack_mm=0.3)], n_samples=2,
+                   n_cycles=20, rate_hz=10.0, seed=4244, dwell_s=2.0)
+    return Search(model_for_pattern(p), sim.data, SearchSettings(("E_t",), pattern_values(p))).fit_base()
+
+
+@pytest.mark.parametrize("visco_gain", [1.0, 500.0])
+def test_a_minor_effect_the_samples_together_cannot_resolve_is_left_out_of_their_union(visco_gain):
+    """bench-heldout44's toe beside slack: sample 1 diagnosed alone added toe_shape, relaxation and, last, relaxation2
+    for 0.001 % of what the samples' effects explain; in the union its time ended on its bound and the union (0.96x the
+    true floor) was refused whole: nothing recommended at 34x. Here the samples' answers are given (sample 1: a toe,
+    then viscoelastic for a sliver; sample 2: slack) on data whose viscoelastic time the rows cannot resolve: the union
+    is fitted without that copy and taken. Where the unresolved effect explains a real share (1/5 of the gains), the
+    union is refused as before."""
+    s = _union_case()
+    s1, s2 = s.data.samples
+    answers = ({s1: ["toe", "viscoelastic"], s2: ["slack"]}, {s1: [], s2: []}, {s1: {}, s2: {}},
+               {"toe": 1000.0, "slack": 1000.0, "viscoelastic": visco_gain})
+    s._samples_alone = lambda samples: answers   # the samples' own searches: given (each is tested above)
+    first = s._sample_union([s1, s2], *answers)
+    problems = first[-1]
+    # the case: the union with the copy converges below the chain, but its time is unresolved
+    assert not first[-2] and any(nm == f"viscoelastic.tau_s@{s1}" for nm, _ in problems), problems
+    before = s.chain.all_rows.rmse
+    took = s.try_sample_wise()
+    if visco_gain > 0.01 * 2000.0:
+        assert not took and not s.recommended
+        return
+    assert took and set(s.recommended) == {"toe", "slack"}, s.recommended
+    assert s.chain.all_rows.rmse < before
+    note = next(n for n in s.notes_late if n.startswith("each sample diagnosed alone"))
+    assert f"viscoelastic left out in {s1}" in note and "on its bound" in note, note
