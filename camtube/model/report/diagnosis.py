@@ -377,7 +377,9 @@ def answer_lines(d: Diagnosis) -> list[str]:
         out.append(f"answer: nothing to add: the model is at {_times(steps[0].rmse_deg, floor)} the noise floor "
                    f"({steps[0].rmse_deg:.3f} vs {floor:.3f} deg)")
     u = unexplained_report.of_diagnosis(d)
-    if u is not None and (d.recommended or d.partial or steps[0].rmse_deg > REACH_RATIO * floor):
+    if u is not None and u.get("drift"):
+        out.append(f"  left: {u['sentence']}")
+    elif u is not None and (d.recommended or d.partial or steps[0].rmse_deg > REACH_RATIO * floor):
         rows = u.get("rows")
         follows = ("it follows " + ", ".join(u["follows"][:2]) if u.get("follows") else
                    f"it follows no variable: {100 * rows['share']:.0f} % of it sits in {rows['n']} isolated rows"

@@ -64,7 +64,12 @@ def text_lines(d, json_path: str = "DIAG.json") -> list[str]:
     if u is None:
         return []
     lines = describe(u)
-    if d.recommended and getattr(d, "explanation", "") == "partial":
+    if u.get("drift"):
+        lines.append("  it is below what the diagnosis counts as a misfit (the error within 1.15 x the floor), so "
+                     + (f"the explanation with {', '.join(d.recommended)} stays complete" if d.recommended else
+                        "nothing is recommended for it")
+                     + "; a drift of an instrument is corrected at the instrument, not added to the joint model")
+    elif d.recommended and getattr(d, "explanation", "") == "partial":
         lines.append(f"  this is what is left with the recommended effects ({', '.join(d.recommended)}): they explain "
                      f"most of the misfit, the error stays at {d.final.rmse_deg / d.noise_floor_deg:.2f} x the floor")
     elif d.recommended:  # not reached by the diagnosis (a recommended chain is within 1.15 x the floor)
