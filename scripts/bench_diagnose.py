@@ -53,6 +53,7 @@ from camtube.model.data.csvfile import format_csv
 from camtube.model.diagnose import diagnose
 from camtube.model.report.diagnosis import add_command
 from camtube.model.sim.truth import Hidden, simulate
+from camtube.model.unexplained import report as unexplained_report
 
 SPEED_TARGETS_S = {10_000: 5.0, 200_000: 20.0}
 
@@ -557,8 +558,10 @@ def controls() -> None:
             for fr in (0.0, 0.05, 0.1):
                 sim = simulate(p, Hidden(joint_friction_nmm=fr), n_samples=2, n_cycles=50, rate_hz=10.0, seed=seed)
                 d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p), stop_ratio=None)
+                u = unexplained_report.of_diagnosis(d)
                 print(f"control {tube} seed {seed} friction {fr:g} N mm, stop rule off: recommended "
-                      f"{list(d.recommended) or 'nothing'}, partial {list(d.partial) or 'nothing'}; "
+                      f"{list(d.recommended) or 'nothing'}, partial {list(d.partial) or 'nothing'}, unexplained "
+                      f"{'nothing' if u is None else 'follows ' + (', '.join(u['follows']) or 'nothing named')}; "
                       f"RMSE / true floor {d.final.rmse_deg / sim.sensor_floor_deg:.2f}")
 
 
