@@ -182,10 +182,38 @@ def test_a_slow_drift_is_named_though_the_error_stays_within_the_stop_ratio(seed
     assert u is not None and set(u["drift"]) == {"S1"} and u["samples"] == ["S1"]
     assert u["drift"]["S1"]["change_deg"] == pytest.approx(0.4, abs=0.08)
     assert u["leading"] in ("time", "cycle") and {"time", "cycle"} <= set(u["follows"]), u["follows"]
-    assert "slow drift" in u["sentence"] and f"S1 {u['drift']['S1']['change_deg']:+.2f} deg" in u["sentence"]
+    assert "slow drift" in u["sentence"] and f"sample S1 by {u['drift']['S1']['change_deg']:+.2f} deg" in u["sentence"]
     for small in (0.0, 0.1):
         residual, v = _drifting(seed, small)
         assert analyse(residual, v, 0.245) is None
+
+
+def test_the_diagnosis_says_a_slow_drift_is_left_and_recommends_nothing_for_it():
+    # the paper's physics (truth simulator, tube 2), one sample's tracker zero drifting 0.5 deg over the record: the
+    # error stays within 1.15x the floor, nothing is recommended, and the answer names the drift in that sample
+    from camtube.design.loader import load_pattern
+    from camtube.model.core.predict import model_for_pattern, pattern_values
+    from camtube.model.diagnose import diagnose
+    from camtube.model.report.diagnosis import answer_lines, diagnosis_dict, diagnosis_text
+    from camtube.model.sim.truth import Hidden, simulate
+
+    p = load_pattern(ROOT / "patterns" / "tube2.yaml")
+    sim = simulate(p, Hidden(), n_samples=2, n_cycles=40, rate_hz=10.0, seed=31)
+    d0 = sim.data
+    t = np.asarray(d0.elapsed_s, float)
+    s = np.asarray(d0.sample).astype(str)
+    mine = s == s[0]
+    angle = d0.angle_deg + np.where(mine, 0.5 * (t / t[mine].max() - 0.5), 0.0)
+    d = diagnose(model_for_pattern(p), Dataset(d0.sample, d0.cycle, d0.time_s, d0.stroke_mm, d0.force_N, angle),
+                 ("E_t",), pattern_values(p))
+    assert not d.recommended and not d.partial and d.final.rmse_deg < 1.15 * d.noise_floor_deg
+    drift = diagnosis_dict(d)["unexplained"]["drift"]
+    assert list(drift) == [s[0]] and 0.35 < drift[s[0]]["change_deg"] < 0.6
+    lines = answer_lines(d)
+    assert lines[0].startswith("answer: nothing to add")
+    assert lines[1].startswith("  left: a slow drift in time"), lines[1]
+    assert f"in sample {s[0]} by {drift[s[0]]['change_deg']:+.2f} deg" in lines[1], lines[1]
+    assert "nothing is recommended for it" in diagnosis_text(d)
 
 
 def _twelve_rows_off(seed: int):

@@ -677,8 +677,8 @@ def drift_sentence(u: dict) -> str:
     drift = u.get("drift") or {}
     if not drift:
         return ""
-    each = "; ".join(f"{smp} {d['change_deg']:+.2f} deg from its second cycle to its last (RMS {d['rms_deg']:.3f} deg, "
-                     f"{d['z']:.0f}x the scatter of its cycles' means)" for smp, d in drift.items())
+    each = "; ".join(f"in sample {smp} by {d['change_deg']:+.2f} deg from its second cycle to its last (RMS "
+                     f"{d['rms_deg']:.3f} deg, {d['z']:.0f}x the scatter of its cycles' means)" for smp, d in drift.items())
     return (f"a slow drift in time, steady over the record though the error stays within {u['stop_ratio']:g} x the "
             f"floor ({u['rmse_deg'] / u['noise_floor_deg']:.2f} x): the residual's cycle means move {each}; "
             f"{HINTS[('time', False)][0]}")
