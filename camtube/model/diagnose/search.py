@@ -107,7 +107,7 @@ import itertools
 import math
 import time
 from dataclasses import dataclass, field, replace
-from typing import Mapping, Sequence
+from typing import Mapping, NamedTuple, Sequence
 
 import numpy as np
 
@@ -873,6 +873,22 @@ class SearchSettings:
     per_sample: bool = True
     init: dict = field(default_factory=dict)
     given_per_sample: tuple = ()
+
+
+class _Union(NamedTuple):
+    """The union of the samples' chains fitted on every row (:meth:`Search._sample_union`)."""
+
+    fit: FitResult
+    model: JointModel
+    names: tuple                # fitted names
+    per_sample: list            # of them, those fitted per sample
+    held: dict                  # per-sample copies held off
+    effects: list               # the effects added
+    base_new: list              # baseline effects that joined in some samples alone
+    base_split: list            # baseline effects of the chain split by sample
+    base_model: JointModel      # the model before the effects
+    failed: bool                # not converged, or not below the chain's RMSE and BIC
+    problems: list              # resolution findings, (name, why)
 
 
 @dataclass
@@ -1854,12 +1870,10 @@ class Search:
                     return list(perm), inter
         return None, []
 
-    def _sample_union(self, samples: Sequence[str], chains: dict, bases: dict, inits: dict, explained: dict):
-        """The union of the samples' chains (each diagnosed alone, :meth:`_samples_alone`) fitted on every row:
-        ``(fit, model, fitted names, per-sample names, held, the effects added, the baseline effects added, the
-        baseline effects split by sample, the model before the effects, whether the fit fails the union's tests
-        (converged, lower RMSE and BIC than the chain), its resolution findings)``; None when there is no union
-        to fit (nothing to add, or every sample shows the same)."""
+    def _sample_union(self, samples: Sequence[str], chains: dict, bases: dict, inits: dict,
+                      explained: dict) -> "_Union | None":
+        """The union of the samples' chains (each diagnosed alone, :meth:`_samples_alone`) fitted on every row
+        (:class:`_Union`); None when there is no union to fit (nothing to add, or every sample shows the same)."""
         ch, s, data = self.chain, self.settings, self.data
         # the union in the order of what each effect explains in its samples, most first: the waterfall then says
         # what to add first (with one sample's effects first, a shared parameter, E_t, bent by the other sample's
@@ -1905,7 +1919,7 @@ class Search:
         failed = (r.nfev >= UNION_MAX_NFEV or not r.rmse < ch.all_rows.rmse
                   or not r.bic < ch.all_rows.bic - s.bic_threshold)
         problems = _resolution_findings(m, list(r.fitted), r.params, r.stderr, r.at_bound, data, s.modulus_range_gpa)
-        return r, m, names, ps, held, effects, base_new, base_split, base_model, failed, problems
+        return _Union(r, m, names, ps, held, effects, base_new, base_split, base_model, failed, problems)
 
     @staticmethod
     def _minor_copies(problems: Sequence[tuple[str, str]], effects: Sequence[Effect], explained: dict) -> dict:
@@ -1940,9 +1954,9 @@ class Search:
         built = self._sample_union(samples, chains, bases, inits, explained)
         if built is None:
             return False
-        minor = self._minor_copies(built[-1], built[5], explained)
+        minor = self._minor_copies(built.problems, built.effects, explained)
         left_out = ""
-        if built[-1] and minor and not built[-2]:
+        if built.problems and minor and not built.failed:
             # an effect one sample alone added last for a sliver of its misfit, whose copy there the union cannot
             # resolve: the union is fitted without that copy rather than refused whole (bench-heldout44's toe beside
             # slack: relaxation2 explained 0.001 % of what the samples' effects explain, its time on its bound in
