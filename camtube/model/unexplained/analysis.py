@@ -14,7 +14,9 @@ arrays (it does not depend on how the model was built or fitted):
 Method
 ------
 1. **Nothing left?** If the RMSE is within ``stop_ratio`` (1.15) x the noise
-   floor, the answer is ``None``.
+   floor, the answer is ``None``, unless what is left is a slow drift in time
+   (:func:`slow_drift`: each sample's cycle means on a parabola in time of at
+   least 0.3 floors RMS); then the analysis goes on, with ``drift`` set.
 2. **What it follows.** For each variable a smoother (means in bins) is chosen
    by 5-fold cross-validation among resolutions from coarse to fine, so a
    fine periodic pattern is resolved instead of aliased by fixed bins.
@@ -473,12 +475,14 @@ def analyse(residual_deg, variables: Mapping[str, np.ndarray], noise_floor_deg: 
     Returns
     -------
     dict or None
-        ``None`` when the RMSE <= ``stop_ratio`` x floor; else ``share`` (fraction of the mean-square error
+        ``None`` when the RMSE <= ``stop_ratio`` x floor and no slow drift is left (:func:`slow_drift`); else
+        ``share`` (fraction of the mean-square error
         above the floor), ``rmse_deg``, ``noise_floor_deg``, ``follows`` [names, best first],
         ``explained`` {name: fraction of the excess}, ``periodic`` [{variable, period, unit, amplitude_deg,
         phase_rad, explained}], ``shape``, ``leading``, ``samples`` [ids], ``per_sample_rmse_deg``,
         ``physics``, ``stage``, ``rows`` (None, or the isolated rows far off that hold most of it, see
-        :func:`_far_rows`), ``sentence``.
+        :func:`_far_rows`), ``drift`` (None, or the slow drift per sample below the stop ratio), ``stop_ratio``,
+        ``sentence``.
     """
     r = np.asarray(residual_deg, float)
     n = r.size
