@@ -134,6 +134,16 @@ def test_plain_arrays_and_floor_rule():
     assert first_cycle_mask(np.array(["a", "a", "b", "b"]), np.array([3, 4, 1, 2])).tolist() == [True, False, True, False]
 
 
+def _two_cycling_samples():
+    """Two samples S1, S2 of 50 cycles at 20 Hz (a 3 s ramp to 2 mm, a 2 s dwell, a 3 s ramp back, a 2 s rest):
+    ``(sample, cycle, time s, stroke mm)``."""
+    one = np.concatenate([np.linspace(0, 2, 60), np.full(40, 2.0), np.linspace(2, 0, 60), np.zeros(40)])
+    stroke = np.tile(np.tile(one, 50), 2)
+    n1 = stroke.size // 2
+    return (np.repeat(["S1", "S2"], n1), np.tile(np.repeat(np.arange(1, 51), one.size), 2),
+            np.tile(np.arange(n1) / 20.0, 2), stroke)
+
+
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_a_tracker_drifting_in_time_is_not_read_as_following_the_angle(seed):
     # bench-heldout35's tracker drift: the tracker's zero drifts 0.3 deg over the test. Where the model is flat (the
@@ -141,14 +151,10 @@ def test_a_tracker_drifting_in_time_is_not_read_as_following_the_angle(seed):
     # measured angle sorted the residual by itself (its noise and its drift) and "the bend angle" led. Read against
     # the model's angle, what is left follows the cycle or time, as it is
     rng = np.random.default_rng(seed)
-    one = np.concatenate([np.linspace(0, 2, 60), np.full(40, 2.0), np.linspace(2, 0, 60), np.zeros(40)])
-    stroke = np.tile(np.tile(one, 50), 2)
-    n1 = stroke.size // 2
-    t = np.tile(np.arange(n1) / 20.0, 2)
+    sample, cycle, t, stroke = _two_cycling_samples()
     model = 15.0 * stroke + 1.0
     residual = rng.normal(0.0, 0.2, stroke.size) + 0.3 * t / t.max()
-    data = Dataset(np.repeat(["S1", "S2"], n1), np.tile(np.repeat(np.arange(1, 51), one.size), 2), t, stroke,
-                   1.5 * stroke + rng.normal(0.0, 0.005, stroke.size), model + residual)
+    data = Dataset(sample, cycle, t, stroke, 1.5 * stroke + rng.normal(0.0, 0.005, stroke.size), model + residual)
     measured = analyse(residual, variables_of(data), 0.2)
     assert measured is not None and measured["leading"] == "angle"      # the measured angle: the bias shown
     u = analyse(residual, variables_of(data, residual), 0.2)
@@ -160,13 +166,9 @@ def _drifting(seed: int, drift_deg: float):
     """Two samples of 50 cycles (stroke ramps, dwells, rests; 20 Hz), white noise of 0.25 deg, and in S1 a zero that
     drifts ``drift_deg`` over the record: ``(residual, variables)``."""
     rng = np.random.default_rng(seed)
-    one = np.concatenate([np.linspace(0, 2, 60), np.full(40, 2.0), np.linspace(2, 0, 60), np.zeros(40)])
-    stroke = np.tile(np.tile(one, 50), 2)
-    n1 = stroke.size // 2
-    t = np.tile(np.arange(n1) / 20.0, 2)
-    residual = rng.normal(0.0, 0.25, stroke.size) + np.where(np.arange(stroke.size) < n1, drift_deg * (t / t.max() - 0.5), 0.0)
-    data = Dataset(np.repeat(["S1", "S2"], n1), np.tile(np.repeat(np.arange(1, 51), one.size), 2), t, stroke,
-                   1.5 * stroke, 15.0 * stroke + residual)
+    sample, cycle, t, stroke = _two_cycling_samples()
+    residual = rng.normal(0.0, 0.25, stroke.size) + np.where(sample == "S1", drift_deg * (t / t.max() - 0.5), 0.0)
+    data = Dataset(sample, cycle, t, stroke, 1.5 * stroke, 15.0 * stroke + residual)
     return residual, variables_of(data, residual)
 
 
