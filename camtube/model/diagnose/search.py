@@ -1956,7 +1956,7 @@ class Search:
             return False
         minor = self._minor_copies(built.problems, built.effects, explained)
         left_out = ""
-        if built.problems and minor and not built.failed:
+        if minor and not built.failed:   # (minor copies are among the problems)
             # an effect one sample alone added last for a sliver of its misfit, whose copy there the union cannot
             # resolve: the union is fitted without that copy rather than refused whole (bench-heldout44's toe beside
             # slack: relaxation2 explained 0.001 % of what the samples' effects explain, its time on its bound in
