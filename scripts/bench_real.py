@@ -193,11 +193,14 @@ HELDOUT8_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", 
                   ("slack", "backbone"), ("friction", "creep"), "friction"]
 HELDOUT9_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "zero drift", "lag",
                   ("lost motion", "toe"), ("creep", "lost motion"), "friction"]
+#: The files most batches from here on begin with; each adds its pairs, a guide's friction and (later) a tracker's
+#: drift.
+USUAL_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
+               "lag"]
 #: The tenth fresh held-out batch (issue 19, after `relaxation2` and the samples' effects combined by what they
 #: explain): a backbone with three relaxing arms a decade apart (a form the library does not have: its laws have one
 #: or two arms), and a backbone beside a creeping tendon (the joint's relaxation against the tendon's creep).
-HELDOUT10_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("backbone", "creep"), "friction"]
+HELDOUT10_KINDS = USUAL_KINDS + [("backbone", "creep"), "friction"]
 #: The eleventh fresh held-out batch (issue 19, after the load cell's zero read at the rests, carriage_gap and the
 #: joint's resting effects refused where the force at rest stays): the pairs the last changes were tuned on, drawn
 #: anew, and a tracker whose zero drifts (an instrument's artefact the library has no form for).
@@ -220,8 +223,7 @@ HELDOUT14_KINDS = ["control", "control", "toe", "slack", "lost motion", "lost mo
 #: The fifteenth fresh held-out batch (issue 19, after bursts, a frozen tracker and noise correlated from row to row):
 #: the usual files and two pairs, every tracker's artefacts drawn as well (dropouts written as nan, 0 or the last
 #: reading, bursts, a filter on its noise).
-HELDOUT15_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("toe", "creep"), ("slack", "lost motion"), "friction", "tracker drift"]
+HELDOUT15_KINDS = USUAL_KINDS + [("toe", "creep"), ("slack", "lost motion"), "friction", "tracker drift"]
 #: The sixteenth fresh held-out batch (issue 19, after a stand-in of the baseline's rest angle was credited with its
 #: gain): lost motion three times, beside a relaxing backbone and beside a creeping tendon, the usual files around them,
 #: every tracker's artefacts drawn too.
@@ -290,62 +292,54 @@ HELDOUT26_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 #: The twenty-seventh fresh held-out batch (issue 19, after a long burst's jumps were read on the rows kept and beside
 #: the joint's own jump under a cell at its limit, and a lag the blocks disagree on was left unresolved): both
 #: backbones, guides smooth and sharp beside a toe and a three-arm backbone, a lag beside creep.
-HELDOUT27_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("friction", "toe"), ("backbone3", "sharp friction"), ("lag", "creep"), "tracker drift"]
+HELDOUT27_KINDS = USUAL_KINDS + [("friction", "toe"), ("backbone3", "sharp friction"), ("lag", "creep"),
+                                 "tracker drift"]
 #: The twenty-eighth fresh held-out batch (issue 19, after the angle's lag was read per sample where the samples'
 #: trackers lag differently): a lag in one sample beside a toe, and beside a backbone, in the other; a smooth guide
 #: beside a relaxing backbone; the instruments of bench-heldout17 and every carriage settling.
-HELDOUT28_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("lag", "toe"), ("lag", "backbone"), ("friction", "backbone"), "tracker drift"]
+HELDOUT28_KINDS = USUAL_KINDS + [("lag", "toe"), ("lag", "backbone"), ("friction", "backbone"), "tracker drift"]
 #: The twenty-ninth fresh held-out batch (issue 19, after the samples' own lags a few errors apart were tested against
 #: the current model): a lag in one sample beside slack, and beside lost motion, in the other; a guide that switches
 #: within a row beside creep.
-HELDOUT29_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("lag", "slack"), ("lag", "lost motion"), ("sharp friction", "creep"), "tracker drift"]
+HELDOUT29_KINDS = USUAL_KINDS + [("lag", "slack"), ("lag", "lost motion"), ("sharp friction", "creep"),
+                                 "tracker drift"]
 #: The thirtieth fresh held-out batch (issue 19, after the noise floor's row spacing was tested per sample): a toe
 #: beside creep, lost motion beside a relaxing backbone, a three-arm backbone beside slack.
-HELDOUT30_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("toe", "creep"), ("lost motion", "backbone"), ("backbone3", "slack"), "tracker drift"]
+HELDOUT30_KINDS = USUAL_KINDS + [("toe", "creep"), ("lost motion", "backbone"), ("backbone3", "slack"),
+                                 "tracker drift"]
 #: The thirty-first fresh held-out batch (issue 19, after a better model's reading from rows further apart replaced the
 #: floor): creep beside slack, a relaxing backbone beside a toe, lost motion beside creep.
-HELDOUT31_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("creep", "slack"), ("backbone", "toe"), ("lost motion", "creep"), "tracker drift"]
+HELDOUT31_KINDS = USUAL_KINDS + [("creep", "slack"), ("backbone", "toe"), ("lost motion", "creep"), "tracker drift"]
 #: The thirty-second fresh held-out batch (issue 19, after a swap's replacement took the place of the effect it
 #: replaced): a toe beside a three-arm backbone, slack beside a smooth guide, creep beside a relaxing backbone.
-HELDOUT32_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("toe", "backbone3"), ("slack", "friction"), ("creep", "backbone"), "tracker drift"]
+HELDOUT32_KINDS = USUAL_KINDS + [("toe", "backbone3"), ("slack", "friction"), ("creep", "backbone"), "tracker drift"]
 #: The thirty-third fresh held-out batch (issue 19, after the union of the samples' chains held a copy at its off
 #: value): a toe beside a relaxing backbone, lost motion beside a three-arm backbone, slack beside creep.
-HELDOUT33_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("toe", "backbone"), ("lost motion", "backbone3"), ("slack", "creep"), "tracker drift"]
+HELDOUT33_KINDS = USUAL_KINDS + [("toe", "backbone"), ("lost motion", "backbone3"), ("slack", "creep"),
+                                 "tracker drift"]
 #: The thirty-fourth fresh held-out batch (issue 19, after a gain judged on the log scale too and a lag confirmed in
 #: one sample tested in another): creep beside a three-arm backbone, a backbone beside slack, a toe beside lost motion.
-HELDOUT34_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("creep", "backbone3"), ("backbone", "slack"), ("toe", "lost motion"), "tracker drift"]
+HELDOUT34_KINDS = USUAL_KINDS + [("creep", "backbone3"), ("backbone", "slack"), ("toe", "lost motion"),
+                                 "tracker drift"]
 #: The thirty-fifth fresh held-out batch (issue 19, after an effect one sample refuses was fitted in the others): a
 #: relaxing backbone beside lost motion, a smooth guide beside a three-arm backbone, creep beside a smooth guide.
-HELDOUT35_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("backbone", "lost motion"), ("friction", "backbone3"), ("creep", "friction"), "tracker drift"]
-HELDOUT36_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("creep", "toe"), ("backbone3", "lost motion"), ("slack", "backbone3"), "sharp friction",
-                   "tracker drift"]
-HELDOUT37_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("sharp friction", "lost motion"), ("backbone3", "toe"), ("friction", "creep"),
-                   "sharp friction", "tracker drift"]
-HELDOUT38_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("lost motion", "creep"), ("friction", "toe"), ("backbone", "slack"), "sharp friction",
-                   "tracker drift"]
+HELDOUT35_KINDS = USUAL_KINDS + [("backbone", "lost motion"), ("friction", "backbone3"), ("creep", "friction"),
+                                 "tracker drift"]
+HELDOUT36_KINDS = USUAL_KINDS + [("creep", "toe"), ("backbone3", "lost motion"), ("slack", "backbone3"),
+                                 "sharp friction", "tracker drift"]
+HELDOUT37_KINDS = USUAL_KINDS + [("sharp friction", "lost motion"), ("backbone3", "toe"), ("friction", "creep"),
+                                 "sharp friction", "tracker drift"]
+HELDOUT38_KINDS = USUAL_KINDS + [("lost motion", "creep"), ("friction", "toe"), ("backbone", "slack"),
+                                 "sharp friction", "tracker drift"]
 #: The thirty-ninth fresh held-out batch (issue 19, after the measurement files' sign, unit and time checks; the
 #: diagnosis itself as for bench-heldout38): slack beside a toe, a lag beside a three-arm backbone, a smooth guide
 #: beside slack.
-HELDOUT39_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("slack", "toe"), ("lag", "backbone3"), ("friction", "slack"), "sharp friction",
-                   "tracker drift"]
+HELDOUT39_KINDS = USUAL_KINDS + [("slack", "toe"), ("lag", "backbone3"), ("friction", "slack"), "sharp friction",
+                                 "tracker drift"]
 #: The fortieth fresh held-out batch (issue 19, after a lag under a load cell at its limit is read against the stroke):
 #: a lag beside a relaxing backbone, creep beside a toe, slack beside lost motion, a smooth guide alone.
-HELDOUT40_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("lag", "backbone"), ("creep", "toe"), ("slack", "lost motion"), "friction",
-                   "tracker drift"]
+HELDOUT40_KINDS = USUAL_KINDS + [("lag", "backbone"), ("creep", "toe"), ("slack", "lost motion"), "friction",
+                                 "tracker drift"]
 #: The forty-first fresh held-out batch (issue 19, after a load cell not zeroed is re-zeroed where the rests say so, and
 #: a lag under a cell at its limit is read against the stroke): in half the samples a cell not zeroed before the test
 #: (:data:`UNTARED`), three lag files, slack and a toe beside lost motion and creep.
@@ -354,40 +348,34 @@ HELDOUT41_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep",
 #: The forty-second fresh held-out batch (issue 19, after the cell's zero is read whole where the joint at rest is
 #: nearly straight; bench-heldout41 looked at): cells not zeroed in half the samples, slack beside creep, lost motion
 #: beside a toe, a backbone beside slack.
-HELDOUT42_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("slack", "creep"), ("lost motion", "toe"), ("backbone", "slack"), "friction",
-                   "tracker drift"]
+HELDOUT42_KINDS = USUAL_KINDS + [("slack", "creep"), ("lost motion", "toe"), ("backbone", "slack"), "friction",
+                                 "tracker drift"]
 #: The forty-third fresh held-out batch (issue 19, after the lag scan's regressions were solved by the normal equations;
 #: bench-heldout40 .. 42 looked at): cells not zeroed in half the samples, a guide whose friction switches within a row,
 #: a lag beside slack, friction beside creep, a three-arm backbone beside a toe.
-HELDOUT43_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("lag", "slack"), ("friction", "creep"), ("backbone3", "toe"), "sharp friction",
-                   "tracker drift"]
+HELDOUT43_KINDS = USUAL_KINDS + [("lag", "slack"), ("friction", "creep"), ("backbone3", "toe"), "sharp friction",
+                                 "tracker drift"]
 #: The forty-fourth fresh held-out batch (issue 19, after the cell's reading before the first pull was read as its zero;
 #: bench-heldout43 looked at): cells not zeroed in half the samples, lost motion beside a backbone and beside creep, a toe
 #: beside slack.
-HELDOUT44_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("lost motion", "backbone"), ("toe", "slack"), ("creep", "lost motion"), "friction",
-                   "tracker drift"]
+HELDOUT44_KINDS = USUAL_KINDS + [("lost motion", "backbone"), ("toe", "slack"), ("creep", "lost motion"), "friction",
+                                 "tracker drift"]
 #: The forty-fifth fresh held-out batch (issue 19, after a cell's rows at its limit were left out of the force's noise
 #: scale and the reading before the first pull was read from 2 rows; bench-heldout44 looked at): cells not zeroed in
 #: half the samples, slack beside a backbone, a lag beside a toe, creep beside friction.
-HELDOUT45_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("slack", "backbone"), ("lag", "toe"), ("creep", "friction"), "sharp friction",
-                   "tracker drift"]
+HELDOUT45_KINDS = USUAL_KINDS + [("slack", "backbone"), ("lag", "toe"), ("creep", "friction"), "sharp friction",
+                                 "tracker drift"]
 #: The forty-sixth fresh held-out batch (issue 19, the final method of the session after bench-heldout45, measured
 #: again on a seed not used before; every batch above looked at): cells not zeroed in half the samples, creep beside a
 #: three-arm backbone, a lag beside friction, a toe beside slack.
-HELDOUT46_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("creep", "backbone3"), ("lag", "friction"), ("toe", "slack"), "sharp friction",
-                   "tracker drift"]
+HELDOUT46_KINDS = USUAL_KINDS + [("creep", "backbone3"), ("lag", "friction"), ("toe", "slack"), "sharp friction",
+                                 "tracker drift"]
 #: The forty-seventh fresh held-out batch (issue 19, after the union fitted without a minor copy it cannot resolve,
 #: overlapping bursts read by the sum of their jumps and a slow drift named below the stop ratio; bench-heldout44 and
 #: 46 looked at): cells not zeroed in half the samples, a backbone beside a toe, friction beside slack, lost motion
 #: beside creep.
-HELDOUT47_KINDS = ["control", "control", "toe", "slack", "lost motion", "creep", "backbone", "backbone3", "zero drift",
-                   "lag", ("backbone", "toe"), ("friction", "slack"), ("lost motion", "creep"), "sharp friction",
-                   "tracker drift"]
+HELDOUT47_KINDS = USUAL_KINDS + [("backbone", "toe"), ("friction", "slack"), ("lost motion", "creep"),
+                                 "sharp friction", "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -501,30 +489,35 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            "bench-heldout44": (20281217, HELDOUT44_KINDS),
            # drawn once the limit's rows were left out of the force's noise scale (bench-heldout44 looked at); run once
            "bench-heldout45": (20281218, HELDOUT45_KINDS),
-           # drawn to measure the final method of the session after bench-heldout45 (every batch above looked at); run once
+           # drawn to measure the final method of the session after bench-heldout45 (every batch above looked at);
+           # run once
            "bench-heldout46": (20281219, HELDOUT46_KINDS),
-           # drawn once the session's changes after bench-heldout46 were settled (bench-heldout44 and 46 looked at); run once
+           # drawn once the session's changes after bench-heldout46 were settled (bench-heldout44 and 46 looked at);
+           # run once
            "bench-heldout47": (20281220, HELDOUT47_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
-           "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
-           "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36",
-           "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-heldout41",
-           "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45", "bench-sharp", "bench-heldout46", "bench-heldout47"}
+           "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31", "bench-heldout32",
+           "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36", "bench-heldout37",
+           "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-heldout41", "bench-heldout42",
+           "bench-heldout43", "bench-heldout44", "bench-heldout45", "bench-sharp", "bench-heldout46",
+           "bench-heldout47"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
 #: Batches with those, interference lasting seconds and load cells that reach their range
 #: (:func:`rougher_instruments`).
-ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20", "bench-heldout21",
-           "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26",
-           "bench-heldout27", "bench-heldout28", "bench-heldout29", "bench-heldout30", "bench-heldout31",
-           "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36",
-           "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-heldout41",
-           "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45", "bench-heldout46", "bench-heldout47"}
+ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19", "bench-heldout20",
+           "bench-heldout21", "bench-heldout22", "bench-heldout23", "bench-heldout24", "bench-heldout25",
+           "bench-heldout26", "bench-heldout27", "bench-heldout28", "bench-heldout29", "bench-heldout30",
+           "bench-heldout31", "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35",
+           "bench-heldout36", "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40",
+           "bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45",
+           "bench-heldout46", "bench-heldout47"}
 #: Batches whose load cells may not be zeroed before the test (:func:`untared`).
-UNTARED = {"bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45", "bench-heldout46", "bench-heldout47"}
+UNTARED = {"bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45",
+           "bench-heldout46", "bench-heldout47"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:

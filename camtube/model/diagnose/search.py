@@ -1962,9 +1962,10 @@ class Search:
             # slack: relaxation2 explained 0.001 % of what the samples' effects explain, its time on its bound in
             # the union, and the union at 0.96x the true floor was refused, nothing recommended at 34x)
             chains = {smp: [e for e in chains[smp] if (e, smp) not in minor] for smp in samples}
-            left_out = "; ".join(f"{e} left out in {smp} (it explains {100 * explained[e] / sum(explained.values()):.2g} % "
-                                 f"of what the samples' effects explain, and the samples fitted together do not "
-                                 f"resolve it: {why})" for (e, smp), why in minor.items())
+            total = sum(explained.values())
+            left_out = "; ".join(f"{e} left out in {smp} (it explains {100 * explained[e] / total:.2g} % of what the "
+                                 f"samples' effects explain, and the samples fitted together do not resolve it: {why})"
+                                 for (e, smp), why in minor.items())
             built = self._sample_union(samples, chains, bases, inits, explained)
             if built is None:
                 return False

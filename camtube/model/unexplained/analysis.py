@@ -613,8 +613,8 @@ DRIFT_ROWS = 10
 def slow_drift(r: np.ndarray, v: dict, floor: float) -> dict | None:
     """A slow drift in time that a residual within the stop ratio of the floor still carries: ``{sample: {rms_deg,
     change_deg, z}}`` for the samples whose cycle means (the first cycle left out) follow a parabola in time with an
-    RMS of at least :data:`DRIFT_FLOORS` floors and :data:`DRIFT_Z` times what their scatter about it gives (``change_deg``:
-    the parabola's change from the first cycle kept to the last), or None. A tracker whose zero drifts 0.4 deg over
+    RMS of at least :data:`DRIFT_FLOORS` floors and :data:`DRIFT_Z` times what their scatter about it gives
+    (``change_deg``: the parabola's change from the first cycle kept to the last), or None. A tracker whose zero drifts 0.4 deg over
     five minutes leaves the error at 1.1x the floor, below the ratio, and the drift was not named
     (``bench-heldout44`` and ``46``)."""
     out = {}
@@ -682,7 +682,8 @@ def drift_sentence(u: dict) -> str:
     if not drift:
         return ""
     each = "; ".join(f"in sample {smp} by {d['change_deg']:+.2f} deg from its second cycle to its last (RMS "
-                     f"{d['rms_deg']:.3f} deg, {d['z']:.0f}x the scatter of its cycles' means)" for smp, d in drift.items())
+                     f"{d['rms_deg']:.3f} deg, {d['z']:.0f}x the scatter of its cycles' means)"
+                     for smp, d in drift.items())
     return (f"a slow drift in time, steady over the record though the error stays within {u['stop_ratio']:g} x the "
             f"floor ({u['rmse_deg'] / u['noise_floor_deg']:.2f} x): the residual's cycle means move {each}; "
             f"{HINTS[('time', False)][0]}")

@@ -65,7 +65,8 @@ def text_lines(d, json_path: str = "DIAG.json") -> list[str]:
         return []
     lines = describe(u)
     if u.get("drift"):
-        lines.append("  it is below what the diagnosis counts as a misfit (the error within 1.15 x the floor), so "
+        lines.append(f"  it is below what the diagnosis counts as a misfit (the error within {u['stop_ratio']:g} x the "
+                     "floor), so "
                      + (f"the explanation with {', '.join(d.recommended)} stays complete" if d.recommended else
                         "nothing is recommended for it")
                      + "; a drift of an instrument is corrected at the instrument, not added to the joint model")
