@@ -20,6 +20,7 @@ from camtube.model.core.fit import fit
 from camtube.model.core.predict import model_for_pattern, pattern_values
 from camtube.model.data import format_csv, read_measurements
 from camtube.model.data.dataset import Dataset
+from camtube.model.data.select import select_cycles
 from camtube.model.diagnose.instruments import check_instruments, with_aside
 from camtube.model.diagnose.search import explanation_label, explained_share
 from camtube.model.sim.bench import (
@@ -756,6 +757,14 @@ def test_a_load_cell_reading_above_zero_at_rest_with_the_joint_straight_is_re_ze
     assert any(line.startswith("load cell zero: at S1's rests (motor at zero) the force reads 1.5 N at the start")
                and "while the joint there is nearly straight" in line and "that is the cell's zero" in line
                for line in cut.lines()), cut.lines()
+    # rows that begin after the first cycle (--cycles 5-12): the rest before their first pull reads the zero as well,
+    # but the joint was loaded in the cycles before, and the words say so (they said "the joint never loaded")
+    later = check_instruments(select_cycles(rec.data, "5-12"))
+    assert later.zeros["S1"].first_cycle == 5 and later.zeros["S1"].applied
+    lines = [line for line in later.lines() if line.startswith("load cell zero: before S1's first pull")]
+    assert len(lines) == 1 and "never loaded" not in lines[0], later.lines()
+    assert lines[0].startswith("load cell zero: before S1's first pull in these rows (they begin with cycle 5: the "
+                               "joint was loaded in the cycles before; motor at zero) the force reads 1.5 N"), lines
     d = diagnose(model_for_pattern(tube2), ins.data, ["E_t"], pattern_values(tube2))
     assert d.recommended[:1] == ("slack",) and "force_zero" not in d.recommended
     assert d.final.rmse_deg < 1.15 * rec.floor_deg

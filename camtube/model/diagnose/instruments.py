@@ -261,6 +261,9 @@ class Zero:
     rests_at_first_N : float
         The line through the rests' readings (``change_N``'s) at the time of those rows: where the zero drifts, what
         the rests read there.
+    first_cycle : int
+        The cycle the sample's rows begin with: past 1 (a ``--cycles`` selection, a log that starts late), the joint
+        was loaded before those rows, and the words say so.
     row_noise_N : float
         The load cell's noise from row to row at rest.
     applied : bool
@@ -287,6 +290,7 @@ class Zero:
     first_N: float = math.nan
     first_deg: float = math.nan
     rests_at_first_N: float = math.nan
+    first_cycle: int = 1
 
     @property
     def drifts(self) -> bool:
@@ -420,7 +424,8 @@ def _before_first_pull(data: Dataset, sl: slice) -> dict:
     if k < MIN_FIRST_ROWS:
         return {}
     return {"first_rows": k, "first_N": float(np.median(data.force_N[sl][:k])),
-            "first_deg": float(np.median(data.angle_deg[sl][:k])), "first_time_s": float(np.median(data.time_s[sl][:k]))}
+            "first_deg": float(np.median(data.angle_deg[sl][:k])), "first_time_s": float(np.median(data.time_s[sl][:k])),
+            "first_cycle": int(data.cycle[sl][0])}
 
 
 def _bend_at_rest(data: Dataset, sl: slice, rests: Rests) -> dict:
@@ -476,7 +481,10 @@ def zero_lines(zeros: dict, enabled: bool, option: str = "--no-rezero to keep it
                    f"with the joint straight ({z.first_deg:.2g} deg; that force bends it by {z.first_implied_deg:.2g} "
                    "deg on the pulls): no tension holds it")
             start = (f"load cell zero: before {smp}'s first pull (motor at zero, the joint never loaded) the force "
-                     f"reads {z.first_N:.3g} N, {why}, so that is the cell's zero (not zeroed before the test); ")
+                     if z.first_cycle <= 1 else
+                     f"load cell zero: before {smp}'s first pull in these rows (they begin with cycle {z.first_cycle}: "
+                     "the joint was loaded in the cycles before; motor at zero) the force ")
+            start += f"reads {z.first_N:.3g} N, {why}, so that is the cell's zero (not zeroed before the test); "
             if z.held_beside_offset:
                 out.append(start + f"taken off throughout. At the rests it reads {z.start_N:.3g} N at the start and "
                            f"{z.end_N:.3g} N at the end, {z.rests_at_first_N - z.first_N:.3g} N above that zero: a "

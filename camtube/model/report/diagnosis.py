@@ -183,6 +183,7 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
                                      "change_N": _num(z.change_N), "change_se_N": _num(z.se_N),
                                      "scatter_N": _num(z.scatter_N), "rezeroed": bool(z.applied),
                                      "before_first_pull_N": _num(z.first_N) if z.first_rows else None,
+                                     "first_cycle": int(z.first_cycle),
                                      "held_at_rest": bool(z.held_beside_offset)}
                                for smp, z in ins.zeros.items()},
             "load_cell_limit_N": {smp: {"reading_N": _num(v), "rows": int(k)} for smp, (v, k) in ins.limits.items()}}
