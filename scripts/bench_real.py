@@ -381,6 +381,11 @@ HELDOUT47_KINDS = USUAL_KINDS + [("backbone", "toe"), ("friction", "slack"), ("l
 #: samples, creep beside a three-arm backbone, a lag beside slack, friction beside a toe.
 HELDOUT48_KINDS = USUAL_KINDS + [("backbone3", "creep"), ("lag", "slack"), ("friction", "toe"), "sharp friction",
                                  "tracker drift"]
+#: The forty-ninth fresh held-out batch (issue 19, after a small drift alike at rest and under load was named as the
+#: tracker's; every batch above looked at): cells not zeroed in half the samples, a toe beside a three-arm backbone,
+#: creep beside slack, a lag beside lost motion.
+HELDOUT49_KINDS = USUAL_KINDS + [("toe", "backbone3"), ("creep", "slack"), ("lag", "lost motion"), "friction",
+                                 "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -501,7 +506,9 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            # run once
            "bench-heldout47": (20281220, HELDOUT47_KINDS),
            # drawn to measure the method settled after bench-heldout47 (every batch above looked at); run once
-           "bench-heldout48": (20281221, HELDOUT48_KINDS)}
+           "bench-heldout48": (20281221, HELDOUT48_KINDS),
+           # drawn once a small drift alike at rest and under load was named (every batch above looked at); run once
+           "bench-heldout49": (20281222, HELDOUT49_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
@@ -509,7 +516,7 @@ SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldo
            "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36", "bench-heldout37",
            "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-heldout41", "bench-heldout42",
            "bench-heldout43", "bench-heldout44", "bench-heldout45", "bench-sharp", "bench-heldout46",
-           "bench-heldout47", "bench-heldout48"}
+           "bench-heldout47", "bench-heldout48", "bench-heldout49"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -521,10 +528,10 @@ ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19
            "bench-heldout31", "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35",
            "bench-heldout36", "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40",
            "bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45",
-           "bench-heldout46", "bench-heldout47", "bench-heldout48"}
+           "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49"}
 #: Batches whose load cells may not be zeroed before the test (:func:`untared`).
 UNTARED = {"bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45",
-           "bench-heldout46", "bench-heldout47", "bench-heldout48"}
+           "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
