@@ -1614,7 +1614,35 @@ def check_instruments(data: Dataset, lag_ms: float | Mapping[str, float] | None 
         aside["end of record after the lag shift"] = idx[ends]
     if (~k2 & ~ends).any():
         aside["row before a gap after the lag shift"] = idx[~k2 & ~ends]
+    shifted = _on_history(shifted, data, kept, aside, rep, zeros if rezero else {})
     return Instruments(shifted, data, aside, kept, rates, notes, lag, dropped, n_dropped, zeros, rezero, limits)
+
+
+#: Rows set aside for what the angle read alone: their stroke, force and time are sound, and the drive's history runs
+#: through them (:func:`_on_history`).
+ANGLE_ONLY = ("angle spike", "angle burst row", "frozen angle row")
+
+
+def _on_history(rows: Dataset, data: Dataset, kept: np.ndarray, aside: dict, rep: np.ndarray, zeros: dict) -> Dataset:
+    """``rows`` (the rows ``kept`` of ``data``) taken from the record of the drive's history: every row of ``data`` but
+    those whose stamp repeats or whose force was set aside, the force re-zeroed as ``rows``' was (``zeros``), so that a
+    law computed on the whole record (:meth:`Dataset.rows_of_record`: a carriage its rail holds) runs through the rows
+    set aside for the angle alone. An interference burst of 2 s over the end of an unloading hid the row where the
+    force fell to the rail's hold: the carriage's law, read across the gap, let it go at once, and the rest after it
+    read 8 deg off (``bench-heldout49``'s lost motion: nothing recommended, at 16x the floor)."""
+    history = kept.copy()
+    for why in ANGLE_ONLY:
+        history[aside.get(why, np.zeros(0, int))] = True
+    history &= ~rep
+    at = np.flatnonzero(history)
+    taken = data.take(at)
+    record = Dataset(taken.sample, taken.cycle, taken.time_s, taken.stroke_mm, taken.force_N, taken.angle_deg,
+                     taken.extra)   # (a record of its own: its rows_of_record is itself)
+    if zeros:
+        record, _ = rezero_force(record, zeros)
+    out = Dataset(rows.sample, rows.cycle, rows.time_s, rows.stroke_mm, rows.force_N, rows.angle_deg, rows.extra)
+    object.__setattr__(out, "taken_from", (record, np.searchsorted(at, np.flatnonzero(kept))))
+    return out
 
 
 @np.errstate(over="ignore", invalid="ignore")  # an absurd value (angle 1e300) overflows: inf, and no warning
