@@ -386,6 +386,11 @@ HELDOUT48_KINDS = USUAL_KINDS + [("backbone3", "creep"), ("lag", "slack"), ("fri
 #: creep beside slack, a lag beside lost motion.
 HELDOUT49_KINDS = USUAL_KINDS + [("toe", "backbone3"), ("creep", "slack"), ("lag", "lost motion"), "friction",
                                  "tracker drift"]
+#: The fiftieth fresh held-out batch (issue 19, after the drive's history ran through the rows set aside for the
+#: angle alone; every batch above looked at): cells not zeroed in half the samples, lost motion beside a toe, a backbone
+#: beside creep, a lag beside a three-arm backbone.
+HELDOUT50_KINDS = USUAL_KINDS + [("lost motion", "toe"), ("backbone", "creep"), ("lag", "backbone3"),
+                                 "sharp friction", "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -508,7 +513,10 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            # drawn to measure the method settled after bench-heldout47 (every batch above looked at); run once
            "bench-heldout48": (20281221, HELDOUT48_KINDS),
            # drawn once a small drift alike at rest and under load was named (every batch above looked at); run once
-           "bench-heldout49": (20281222, HELDOUT49_KINDS)}
+           "bench-heldout49": (20281222, HELDOUT49_KINDS),
+           # drawn once the drive's history ran through the rows set aside for the angle alone (every batch above
+           # looked at); run once
+           "bench-heldout50": (20281223, HELDOUT50_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
@@ -516,7 +524,7 @@ SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldo
            "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36", "bench-heldout37",
            "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-heldout41", "bench-heldout42",
            "bench-heldout43", "bench-heldout44", "bench-heldout45", "bench-sharp", "bench-heldout46",
-           "bench-heldout47", "bench-heldout48", "bench-heldout49"}
+           "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -528,10 +536,10 @@ ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19
            "bench-heldout31", "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35",
            "bench-heldout36", "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40",
            "bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45",
-           "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49"}
+           "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50"}
 #: Batches whose load cells may not be zeroed before the test (:func:`untared`).
 UNTARED = {"bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45",
-           "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49"}
+           "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
