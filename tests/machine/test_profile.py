@@ -59,3 +59,12 @@ def test_a_profile_number_out_of_its_range_is_one_line_naming_file_line_and_key(
     assert_refused(r, f"{m}:{line}: ", *words)
     assert listing(tmp_path) == ["m.yaml"]
 
+
+def test_a_spindle_value_that_rounds_to_zero_is_refused(tmp_path):
+    """S = 0.3 W x 1 S/W is written S0: the GRBL beam never comes on, yet the job was written with exit 0."""
+    m = tmp_path / "m.yaml"
+    m.write_text(GRBL.replace("s_per_watt: 100 ", "s_per_watt: 1 "))
+    r = camtube("toolpath", TUBE1, "-q", "-o", str(tmp_path / "o"), "--machine", str(m),
+                "--set", "process.power_w=0.3")
+    assert_refused(r, "process.power_w", "'M4 S0'", "machine.laser.s_per_watt")
+    assert listing(tmp_path) == ["m.yaml"]
