@@ -17,6 +17,19 @@ def one_line(text: str) -> str:
     return str(text).translate(ONE_LINE)
 
 
+def fixed(x: float, digits: int = 6) -> str:
+    """``x`` in fixed-point notation with ``digits`` significant digits and no trailing zeros: what ``f"{x:g}"``
+    writes, but never an exponent (rs274ngc, LinuxCNC's G-code reader, reads no exponents: ``G64 P1e-09`` would
+    be P1 and an E word). Every number a G-code program holds is written so (or with a fixed ``.Nf``).
+
+    >>> fixed(0.001), fixed(1e-9), fixed(1e9), fixed(2.0)
+    ('0.001', '0.000000001', '1000000000', '2')
+    """
+    import numpy as np
+
+    return np.format_float_positional(float(x), precision=digits, unique=False, fractional=False, trim="-")
+
+
 def hms(seconds: float) -> str:
     """``h:mm:ss`` of ``seconds`` (rounded to the nearest second; hours are not wrapped at 24).
 

@@ -133,10 +133,11 @@ def outputs(loaded: Loaded, request: Request, progress: Progress = NO_PROGRESS):
 
             files[f"{job.name}.design.dxf"] = design_dxf(pattern)
         dialects = tuple(request.dialects) if request.dialects else tuple(DIALECTS.values())
-        from camtube.machine.kinematics import check_feeds
+        from camtube.machine.kinematics import check_feeds, check_laser_values
 
-        for d in dialects:  # a feed the G-code cannot carry makes the job meaningless: refused before writing
-            check_feeds(job, d)
+        for d in dialects:  # a feed or laser value the G-code cannot carry makes the job meaningless: refused
+            check_feeds(job, d)  # before writing
+            check_laser_values(job, d)
         # the estimate on the first dialect's machine, computed once here: the G-code header and the
         # job file of that machine read the same one from the job's cache
         est = job_estimate(job, dialects[0])

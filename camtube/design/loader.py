@@ -235,7 +235,7 @@ class _Reader:
         if lo_bad or hi_bad:
             fix = ("use a positive value" if lo_bad and f.lo == 0 and f.lo_open
                    else f"use a value {'<' if f.hi_open else '<='} {f.hi:g}" if hi_bad
-                   else "bring it inside the allowed range")
+                   else f"use a value {'>' if f.lo_open else '>='} {f.lo:g}")
             self.issue(key, "out of range", v, f.allowed(), fix)
             return None
         return int(x) if integer else x

@@ -203,6 +203,12 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
         err("tube.inner_radius", "inner radius must be smaller than the outer radius",
             ri, f"< tube.outer_radius = {ro:g} mm", "check r_i and r_o (radii, not diameters)")
         return errors, warnings  # everything below depends on a valid section
+    defocus = pattern.process.defocus_mm
+    if defocus > 2.0 * ro:  # Z = -defocus: a focus beyond the far side of the tube cuts nothing of it
+        err("process.defocus", f"puts the second focus {defocus:g} mm into the material, beyond the far side of the "
+            f"tube (outer diameter 2 r_o = {2.0 * ro:g} mm), where it cuts nothing", defocus,
+            f">= 0 and <= 2 r_o = {2.0 * ro:g} mm", "set process.defocus to the depth of the second focus level "
+            "(0.1 mm in the paper's process)")
     rt = pattern.tendon.radius_mm
     if not rt < ri:
         err("tendon.radius", "the tendon is thicker than the tube's lumen (it runs inside the tube)", rt,

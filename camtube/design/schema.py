@@ -72,7 +72,8 @@ _CUT_ROW = (
 MAX_REPEATS = 100
 
 _RULE_ROW = (
-    ("max_depth", Field("float", "mm", "largest beam depth this row covers", ..., **POS)),
+    # (a beam crosses at most the diameter of the largest tube, 2 x 50 mm)
+    ("max_depth", Field("float", "mm", "largest beam depth this row covers", ..., 0.0, 100.0, True)),
     ("repeats", Field("int", "", "repeats of the focus+defocus group", ..., 1, MAX_REPEATS)),
 )
 
@@ -119,23 +120,39 @@ SCHEMA: dict[str, dict[str, Field]] | dict = {
         "friction": Field("float", "", "capstan friction coefficient of the tendon on the notch edges "
                           "(forward model)", 0.0, 0.0, 2.0),
     },
+    # Process bounds (issue: fuzz E2): the range a femtosecond micromachining lab works in (the paper's process:
+    # 2.0 W, 60 kHz, 25 mm/s, drill offset 0.005 mm, defocus 0.1 mm), so that no value writes a meaningless or
+    # unsafe job. The lower bounds of power and frequency keep their G-code values (M68 Q.. with 3 decimals)
+    # within 1 % of the value, as camtube.machine.kinematics.FEED_ROUNDING asks of the feeds, and the dose
+    # (M68 Q<1000 frequency / speed> pulses per mm) away from Q0.000000; a too slow scan speed is refused per
+    # machine (camtube.machine.kinematics.check_feeds), a defocus below the tube per tube (design.rules).
     "process": {
-        "power_w": Field("float", "W", "average laser power", 2.0, **POS),
-        "frequency_khz": Field("float", "kHz", "pulse repetition frequency", 60.0, **POS),
-        "scan_speed_mm_s": Field("float", "mm/s", "cutting speed on the outer surface", 25.0, **POS),
-        "wavelength_nm": Field("float", "nm", "laser wavelength", 1030.0, **POS),
-        "drill_offset": Field("float", "mm", "step between the cuts of a drill group", 0.005, 0.0),
+        # 50 mW (a tight focus on polyimide) to 100 W (the strongest femtosecond machining lasers)
+        "power_w": Field("float", "W", "average laser power", 2.0, 0.05, 100.0),
+        # 100 Hz (high-energy amplifiers) to 100 MHz (oscillator rates)
+        "frequency_khz": Field("float", "kHz", "pulse repetition frequency", 60.0, 0.1, 100000.0),
+        # up to 2 m/s, beyond any stage pair a tube is cut on (a linear motor's top speed)
+        "scan_speed_mm_s": Field("float", "mm/s", "cutting speed on the outer surface", 25.0, 0.0, 2000.0, True),
+        # deep UV (the 5th harmonic, 206 nm) to mid-infrared OPAs
+        "wavelength_nm": Field("float", "nm", "laser wavelength", 1030.0, 100.0, 20000.0),
+        # 0 (every cut of a group on one line) to 0.1 mm, twenty times the paper's step and several kerfs
+        "drill_offset": Field("float", "mm", "step between the cuts of a drill group", 0.005, 0.0, 0.1),
         "drill_passes": Field("int", "", "cuts per drill group", 4, 1, 100),
-        "defocus": Field("float", "mm", "second focus level, into the material", 0.1, 0.0),
+        # at most the diameter of the largest tube (2 x 50 mm); design.rules refuses a focus below the tube itself
+        "defocus": Field("float", "mm", "second focus level, into the material (at most the tube's outer "
+                          "diameter 2 r_o)", 0.1, 0.0, 100.0),
         "repeats": Field("int_or_auto", "", "repeats of the focus+defocus group; auto uses repeat_rule",
                          "auto", 1, MAX_REPEATS),
         "repeat_rule": Field("rows", "", "beam depth -> repeats; first row with depth <= max_depth wins",
                              ({"max_depth": 1.0, "repeats": 4}, {"max_depth": 1.3, "repeats": 6},
                               {"max_depth": 2.0, "repeats": 8}), row=_RULE_ROW),
-        "kerf": Field("float", "mm", "kerf width for compensation (0 = off)", 0.0, 0.0),
-        "rapid_speed_mm_s": Field("float", "mm/s", "laser-off traverse speed (time estimate)", 50.0, **POS),
-        "focus_speed_mm_s": Field("float", "mm/s", "Z focus move speed (time estimate)", 5.0, **POS),
-        "max_time_h": Field("float", "h", "warn when the estimated laser time of a job exceeds this", 8.0, **POS),
+        # a kerf wider than 1 mm is no laser's; design.rules also keeps it below half the narrowest cut
+        "kerf": Field("float", "mm", "kerf width for compensation (0 = off)", 0.0, 0.0, 1.0),
+        "rapid_speed_mm_s": Field("float", "mm/s", "laser-off traverse speed (time estimate)", 50.0, 0.1, 10000.0),
+        "focus_speed_mm_s": Field("float", "mm/s", "Z focus move speed (time estimate)", 5.0, 0.01, 1000.0),
+        # 36 s to six weeks
+        "max_time_h": Field("float", "h", "warn when the estimated laser time of a job exceeds this", 8.0, 0.01,
+                            1000.0),
     },
     "rules": {
         "min_backbone_arc": Field("float", "mm", "smallest backbone arc 2 pi r_o - s allowed", 0.3, 0.0),

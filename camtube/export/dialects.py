@@ -148,7 +148,15 @@ def blending_line(profile) -> str | None:
         return "G61"
     if profile.blending == "controller":
         return None
-    return f"G64 P{profile.blending:g}"
+    return tolerance_line(profile)
+
+
+def tolerance_line(profile) -> str:
+    """``G64 P<profile.blending>`` in fixed-point notation (``G64 P0.001``; rs274ngc reads no exponent, so
+    ``{:g}``'s ``P1e-09`` would not be a tolerance of 1 nm)."""
+    from camtube.fmt import fixed
+
+    return f"G64 P{fixed(profile.blending)}"
 
 
 def dialect_from_profile(profile) -> Dialect:
@@ -169,7 +177,7 @@ def dialect_from_profile(profile) -> Dialect:
                                                 (profile.radius_output, "M68 E{} Q{{outer_radius_mm:.6f}}"))
                          if out is not None for line in [line.format(out)])
         pre = ("G21 G90 G17 G40 G49 G80",) + ((blend,) if blend else ()) + (f"M65 P{g}", "G93", f"G0 {az}0")
-        blend = (f"G64 P{profile.blending:g}", "G61") if profile.corner_strategy == "blend" else (None, None)
+        blend = (tolerance_line(profile), "G61") if profile.corner_strategy == "blend" else (None, None)
         return Dialect(preamble=pre, postamble=(f"M65 P{g}", "G94", "M2"), laser_on=f"M62 P{g}",
                        laser_off=f"M63 P{g}", settings=settings, blend_on=blend[0], blend_off=blend[1], **common)
     pre = ("G21 G90 G17 G94",) + ((blend,) if blend else ()) + ("M5", f"G0 {az}0")

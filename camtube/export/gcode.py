@@ -31,7 +31,7 @@ import numpy as np
 
 from camtube import __version__
 from camtube.export.dialects import LINUXCNC, Dialect
-from camtube.fmt import format_duration_s
+from camtube.fmt import fixed, format_duration_s
 from camtube.machine.kinematics import MachineMoves, machine_moves
 from camtube.machine.motion_time import job_estimate, slow_job_warning
 from camtube.plan.moves import FOCUS, LINK, RAPID, Moves, iter_moves, time_warning
@@ -48,13 +48,14 @@ def _header(job, dialect: Dialect, est) -> list[str]:
     pr = job.process
     c = dialect.comment_line
     ax, ay, az = dialect.axes
-    wrap = (f"{ay} = degrees(y / r_o) deg, r_o = {job.outer_radius_mm:g} mm" if dialect.rotary
+    wrap = (f"{ay} = degrees(y / r_o) deg, r_o = {fixed(job.outer_radius_mm)} mm" if dialect.rotary
             else f"{ay} = y mm (unrolled sheet)")
     lines = [
         c(f"camtube {__version__} job {job.name}, dialect {dialect.name}: {dialect.description}"),
         c(f"frame: {ax} = x mm from the tip, {wrap}, {az} = -focus offset into the material mm"),
-        c(f"process: {pr.power_w:g} W, {pr.frequency_khz:g} kHz, {pr.scan_speed_mm_s:g} mm/s on the outer surface, "
-          f"{pr.drill_passes} drill cuts {pr.drill_offset_mm:g} mm apart, defocus {pr.defocus_mm:g} mm, "
+        c(f"process: {fixed(pr.power_w)} W, {fixed(pr.frequency_khz)} kHz, {fixed(pr.scan_speed_mm_s)} mm/s on the "
+          f"outer surface, {pr.drill_passes} drill cuts {fixed(pr.drill_offset_mm)} mm apart, defocus "
+          f"{fixed(pr.defocus_mm)} mm, "
           f"{job.repeats} repeats, ordering {job.ordering}"),
         c(f"{est.cuts} cuts, {est.passes} passes, cut length {est.cut_length_mm:.3f} mm, estimated "
           f"{format_duration_s(est.total_s)}" + (f" on machine {est.machine}" if est.machine else "")
@@ -80,8 +81,15 @@ class _Emitter:
         self.feed = f"G1 {ax}{f} {ay}{f} F{ff}".format
         # the pass comment holds no parentheses, so it needs no escaping in either comment style
         lead, tail = ("(", ")") if d.comment == "paren" else ("; ", "")
-        self.comment = (lead + "pass {}: cut {} {}, repeat {}, focus {} at {:g} mm, drill {} offset {:.4f} mm"
-                        + tail).format
+        comment = (lead + "pass {}: cut {} {}, repeat {}, focus {} at {} mm, drill {} offset {:.4f} mm" + tail).format
+        z_text: dict[float, str] = {}  # the focus depth as fixed(z) (never an exponent); two values per job
+
+        def pass_comment(p, cut, kind, rep, foc, z, dri, off):
+            t = z_text.get(z)
+            if t is None:
+                t = z_text[z] = fixed(z)
+            return comment(p, cut, kind, rep, foc, t, dri, off)
+        self.comment = pass_comment
         self.gates: dict[tuple[float, float, float], tuple[str, str]] = {}
         self.prev_key: tuple[float, float, float] | None = None
         self.blocks: dict[tuple[int, float], tuple[str, str, bool, bool]] = {}

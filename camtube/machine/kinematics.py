@@ -151,3 +151,55 @@ def check_feeds(job, machine) -> None:
         f"written {printed} with {profile.feed_decimals} decimals (off by more than {100 * FEED_ROUNDING:g} %); "
         "the job would be meaningless", f"{v:g} mm/s", f">= {v_min:.3g} mm/s on this machine",
         f"set process.scan_speed_mm_s to at least {v_min:.3g}")])
+
+
+#: Process key (and what else sets it) of each value a dialect's laser lines write.
+_LASER_FIELDS = {
+    "power_w": ("process.power_w", "the laser power (W)"),
+    "spindle": ("process.power_w", "the spindle value S = power x machine.laser.s_per_watt"),
+    "frequency_khz": ("process.frequency_khz", "the pulse rate (kHz)"),
+    "pulses_per_mm": ("process.frequency_khz", "the dose 1000 x frequency / scan speed (pulses per mm)"),
+    "outer_radius_mm": ("tube.outer_radius", "the outer radius (mm)"),
+}
+
+
+def check_laser_values(job, machine) -> None:
+    """Refuse a job whose laser lines (``M68 E.. Q..``, ``M4 S..``) would write a positive value as zero.
+
+    Each value is printed with its line's fixed format (``Q{power_w:.3f}``, ``S{spindle:.0f}``); one that prints
+    as 0 (a GRBL ``S0``: no beam; ``Q0.000``: no pulses) makes the job meaningless, as a feed that rounds to zero
+    does (:func:`check_feeds`).
+
+    Raises
+    ------
+    PatternError
+        One issue naming the process key, the line as it would be written, and the smallest value that works.
+    """
+    import string
+
+    from camtube.errors import Issue, PatternError
+    from camtube.fmt import fixed
+
+    dialect = machine
+    templates = tuple(getattr(dialect, "settings", ())) + ((dialect.laser_on,) if hasattr(dialect, "laser_on") else ())
+    specs = [(name, spec, t) for t in templates for _, name, spec, _ in string.Formatter().parse(t)
+             if name in _LASER_FIELDS]
+    pk = job.packed
+    if not specs or pk.n_pass == 0:
+        return
+    keys = sorted({(float(p), float(f), float(v)) for p, f, v in zip(pk.pass_power.tolist(), pk.pass_freq.tolist(),
+                                                                      pk.pass_speed.tolist())})
+    for key in keys:
+        fields = dialect.fields(*key, job.outer_radius_mm)
+        for name, spec, template in specs:
+            value = fields[name]
+            if value > 0 and float(format(value, spec)) == 0.0:
+                what, words = _LASER_FIELDS[name]
+                line = template.format(**fields)
+                profile = getattr(dialect, "profile", None)
+                where = f" for machine {profile.name}" if profile is not None else ""
+                dec = int(spec.rstrip("f").lstrip(".") or 0)
+                raise PatternError([Issue(
+                    what, f"{words} is {value:.3g}, written '{line}'{where}: zero, so the job would be meaningless",
+                    None, f">= {fixed(0.5 * 10.0 ** -dec)} (written with {dec} decimals)",
+                    f"raise {what}" + (" or machine.laser.s_per_watt" if name == "spindle" else ""))])

@@ -441,7 +441,7 @@ def slow_job_warning(job, est, profile, short: bool = False) -> str | None:
     ``short``: one line of at most ~200 characters for a G-code comment (LinuxCNC's interpreter
     refuses lines over 255). Returns None when the estimate is within the factor (or no profile).
     """
-    from camtube.fmt import format_duration_s
+    from camtube.fmt import fixed, format_duration_s
 
     if profile is None or not est.lower_bound_s > 0:
         return None
@@ -472,7 +472,7 @@ def slow_job_warning(job, est, profile, short: bool = False) -> str | None:
     shown = [k for k in order if parts[k] > 0.005 * est.total_s]
     if short:
         return (f"estimate {est.total_s / est.lower_bound_s:.2f} x the lower bound (machine.warn_time_factor "
-                f"{factor:g}); above it: " + ", ".join(f"{k} {parts[k]:.1f} s" for k in shown)
+                f"{fixed(factor)}); above it: " + ", ".join(f"{k} {parts[k]:.1f} s" for k in shown)
                 + f"; time-optimal {opt.total_s:.1f} s")
     causes = ", ".join(f"{k} {parts[k]:.1f} s ({what[k]})" for k in shown)
     return (f"the estimated laser time {format_duration_s(est.total_s)} on machine {profile.name} is "

@@ -214,9 +214,40 @@ _KEYS = ("description", "dialect", "suffix", "rotary", "axes", "limits", "blendi
 _REQUIRED = ("dialect", "axes", "limits")
 
 
+#: Ranges of the profile's numbers (fuzz report E3): what real stages, controllers and G-code readers do, so
+#: that no value writes a doubtful program or a meaningless estimate. ``(lo, hi)``, both included.
+#: Velocities: 0.01 mm/s (or deg/s) to 100000 (a 16,000 rpm spindle); accelerations: 0.1 to 10^7 mm/s^2 or
+#: deg/s^2 (10 g is 98,000 mm/s^2); 1e-300 gave a time estimate of 150 digits.
+VELOCITY_RANGE = (0.01, 100_000.0)
+ACCELERATION_RANGE = (0.1, 10_000_000.0)
+#: The path tolerance of ``G64 P`` (mm): 1 nm (the 6-decimal coordinates' resolution) to 10 um (a femtosecond
+#: kerf: a larger tolerance lets the beam stray from the drawn path by more than the width it cuts).
+BLENDING_RANGE_MM = (0.000001, 0.01)
+#: Digits after the point of coordinates and feeds: 9 is 1 pm, far below any stage's resolution, and still
+#: exact in double precision for a 2000 mm coordinate (decimals: 50 wrote 50-digit coordinates).
+MAX_DECIMALS = 9
+#: Servo period (s): 1 us to 10 ms (LinuxCNC's usual 1 ms, 25 us for a fast gate).
+SERVO_PERIOD_RANGE_S = (0.000001, 0.01)
+#: GRBL S per watt: S1000 = 1000 W to S1000 = 10 mW (laser power = S / s_per_watt).
+S_PER_WATT_RANGE = (1.0, 100_000.0)
+#: LinuxCNC's motion module has at most 64 digital and 64 analog I/O (num_dio, num_aio).
+MAX_OUTPUT = 63
+#: warn_time_factor: 1 (warn whenever the estimate exceeds the lower bound) to 1000.
+WARN_FACTOR_RANGE = (1.0, 1000.0)
+#: The rotary axis' travel (deg): 100 turns either way at most (a continuous axis: leave rotary_range_deg out).
+ROTARY_RANGE_LIMIT_DEG = 36000.0
+
+
 def _hint(word: str, options) -> str:
     m = closest(word, options)
     return f"did you mean '{m}'?" if m else f"remove it (known: {', '.join(options)})"
+
+
+def _num(x: float) -> str:
+    """A bound for a message: plain digits (0.000001, 10000000), as a profile would give it."""
+    from camtube.fmt import fixed
+
+    return fixed(x)
 
 
 class _Checker:
@@ -233,7 +264,7 @@ class _Checker:
             if k not in allowed:
                 self.add(f"{prefix}{k}", "unknown key", None, ", ".join(allowed), _hint(k, allowed))
 
-    def number(self, v, key, lo=0.0, strict=True, integer=False):
+    def number(self, v, key, lo=0.0, strict=True, integer=False, hi=math.inf, unit=""):
         ok = isinstance(v, (int, float)) and not isinstance(v, bool)
         try:
             ok = ok and math.isfinite(v)
@@ -243,9 +274,12 @@ class _Checker:
             ok = False
         if ok and (v <= lo if strict else v < lo):
             ok = False
+        if ok and v > hi:
+            ok = False
         if not ok:
             what = "a whole number" if integer else "a finite number"
-            rng = f"{what} {'>' if strict else '>='} {lo:g}"
+            rng = f"{what} {'>' if strict else '>='} {_num(lo)}" + (f" and <= {_num(hi)}" if hi < math.inf else "")
+            rng += f" {unit}" if unit else ""
             self.add(key, f"must be {rng}", v, rng, f"set {key} to {rng}")
             return None
         return int(v) if integer else float(v)
@@ -309,14 +343,18 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
             ck.add(key, "must be a mapping", v, "max_velocity, max_acceleration", "e.g. {max_velocity: 50, ...}")
             continue
         ck.unknown(v, _LIMIT_KEYS, key + ".")
-        vals = [ck.number(v.get(k), f"{key}.{k}") for k in _LIMIT_KEYS]
+        unit = "deg" if (letter == axes[1] and rotary is True) else "mm"
+        vals = [ck.number(v.get(k), f"{key}.{k}", lo, strict=False, hi=hi, unit=unit + per)
+                for k, (lo, hi), per in zip(_LIMIT_KEYS, (VELOCITY_RANGE, ACCELERATION_RANGE), ("/s", "/s^2"))]
         if None not in vals:
             limits.append((letter, AxisLimits(*vals)))
     blending = m.get("blending", "exact_stop")
+    lo_b, hi_b = BLENDING_RANGE_MM
     if not (blending in ("exact_stop", "controller")
             or (isinstance(blending, (int, float)) and not isinstance(blending, bool) and math.isfinite(blending)
-                and blending >= 0)):
-        ck.add("blending", "not an allowed value", blending, "exact_stop | controller | a tolerance >= 0 mm",
+                and lo_b <= blending <= hi_b)):
+        ck.add("blending", "not an allowed value", blending,
+               f"exact_stop | controller | a path tolerance >= {_num(lo_b)} and <= {_num(hi_b)} mm",
                "write blending: exact_stop, or a path tolerance such as 0.001")
     elif not isinstance(blending, str):
         blending = float(blending)
@@ -331,7 +369,8 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
         ck.add("corner_strategy", "blend needs a LinuxCNC profile with a path tolerance (blending: 0.001) on linear "
                "axes (LinuxCNC blends moves with rotary motion parabolically, at half the acceleration)", corner,
                "none | overtravel", "write corner_strategy: none, or drive the rotary axis in surface mm (Y)")
-    servo = ck.number(m.get("servo_period_s", 0.001), "servo_period_s")
+    servo = ck.number(m.get("servo_period_s", 0.001), "servo_period_s", SERVO_PERIOD_RANGE_S[0], strict=False,
+                      hi=SERVO_PERIOD_RANGE_S[1], unit="s")
     laser = m.get("laser", {}) or {}
     if not isinstance(laser, dict):
         ck.add("laser", "must be a mapping", laser, ", ".join(_LASER_KEYS), "e.g. laser: {gate_output: 0}")
@@ -340,7 +379,7 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
     outs = {}
     for k in ("gate_output", "power_output", "frequency_output", "dose_output", "radius_output"):
         if k in laser:
-            outs[k] = ck.number(laser[k], f"laser.{k}", 0, strict=False, integer=True)
+            outs[k] = ck.number(laser[k], f"laser.{k}", 0, strict=False, integer=True, hi=MAX_OUTPUT)
     spindle, spw = laser.get("spindle"), 0.0
     if dialect == "linuxcnc":
         if "gate_output" not in laser:
@@ -354,7 +393,8 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
             ck.add("laser." + next(iter(outs)), "GRBL has no motion-synchronised outputs", None, "spindle, s_per_watt",
                    "use laser.spindle: M4 and laser.s_per_watt")
         spindle = ck.choice(spindle if spindle is not None else "M4", "laser.spindle", ("M3", "M4"))
-        spw = ck.number(laser.get("s_per_watt"), "laser.s_per_watt") or 0.0
+        spw = ck.number(laser.get("s_per_watt"), "laser.s_per_watt", S_PER_WATT_RANGE[0], strict=False,
+                        hi=S_PER_WATT_RANGE[1], unit="S per W") or 0.0
     gating = ck.choice(laser.get("gating", "time"), "laser.gating", GATINGS)
     if gating == "distance":
         if dialect != "linuxcnc":
@@ -380,23 +420,27 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
                    f"give laser.{k} an output of its own")
         else:
             seen[v] = k
-    warn_factor = ck.number(m.get("warn_time_factor", 3.0), "warn_time_factor", 1.0, strict=False)
+    warn_factor = ck.number(m.get("warn_time_factor", 3.0), "warn_time_factor", WARN_FACTOR_RANGE[0], strict=False,
+                            hi=WARN_FACTOR_RANGE[1])
     from camtube.plan.planner import DEFAULT_ORDERING, ORDERINGS
 
     ordering = ck.choice(m.get("ordering", DEFAULT_ORDERING), "ordering", ORDERINGS)
     rng = m.get("rotary_range_deg")
     if rng is not None:
-        if not (isinstance(rng, list) and len(rng) == 2 and all(isinstance(v, (int, float)) for v in rng)
-                and rng[0] < rng[1]):
-            ck.add("rotary_range_deg", "must be [min, max] in deg with min < max", rng, "[min, max] deg",
-                   "e.g. rotary_range_deg: [-360, 720]")
+        lim_deg = ROTARY_RANGE_LIMIT_DEG
+        if not (isinstance(rng, list) and len(rng) == 2
+                and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in rng)
+                and all(-lim_deg <= v <= lim_deg for v in rng) and rng[0] < rng[1]):
+            ck.add("rotary_range_deg", f"must be [min, max] in deg with min < max, each within +-{_num(lim_deg)}", rng,
+                   f"[min, max] deg within -{_num(lim_deg)}..{_num(lim_deg)} (100 turns)",
+                   "e.g. rotary_range_deg: [-360, 720]; leave the key out for a continuous axis")
             rng = None
         else:
             rng = (float(rng[0]), float(rng[1]))
     wrap = ck.choice(m.get("wrap", "none"), "wrap", ("none",))
     comment = ck.choice(m.get("comment", "paren"), "comment", COMMENT_STYLES)
-    dec = ck.number(m.get("decimals", 6), "decimals", 0, strict=False, integer=True)
-    fdec = ck.number(m.get("feed_decimals", 3), "feed_decimals", 0, strict=False, integer=True)
+    dec = ck.number(m.get("decimals", 6), "decimals", 0, strict=False, integer=True, hi=MAX_DECIMALS)
+    fdec = ck.number(m.get("feed_decimals", 3), "feed_decimals", 0, strict=False, integer=True, hi=MAX_DECIMALS)
     suffix = m.get("suffix", ".ngc" if dialect == "linuxcnc" else ".nc")
     if not (isinstance(suffix, str) and suffix.startswith(".") and suffix.strip(".")
             and not any(c in suffix for c in "/\\\0")):

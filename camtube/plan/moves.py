@@ -277,11 +277,11 @@ def estimate(job, moves: Moves | Iterable[Moves] | None = None) -> Estimate:
 
 def time_warning(job, est: Estimate) -> str | None:
     """A warning when the estimated laser time exceeds ``job.process.max_time_h``, else None."""
-    from camtube.fmt import format_duration_s
+    from camtube.fmt import fixed, format_duration_s
 
     limit_h = getattr(job.process, "max_time_h", None)
     if limit_h is None or not est.total_s > limit_h * 3600.0:
         return None
-    return (f"the estimated laser time {format_duration_s(est.total_s)} exceeds process.max_time_h = {limit_h:g} h "
+    return (f"the estimated laser time {format_duration_s(est.total_s)} exceeds process.max_time_h = {fixed(limit_h)} h "
             f"({format_duration_s(limit_h * 3600.0)}) for {est.passes} passes of {est.cuts} cuts; split the job "
             f"(fewer notches per file) or raise process.max_time_h")

@@ -59,6 +59,24 @@ CASES = [
     (["notch.layout=directions"], "notch.directions_deg", ["needs a list of angles"]),
     (["process.repeats=0"], "process.repeats", ["out of range"]),
     (["process.kerf=0.3"], "process.kerf", ["half the narrowest cut"]),
+    # process values that wrote a meaningless or unsafe job (fuzz report E2): each has a physical range
+    (["process.frequency_khz=1e-12"], "process.frequency_khz", ["out of range", ">= 0.1 and <= 100000 kHz",
+                                                                "use a value >= 0.1"]),
+    (["process.frequency_khz=1e9"], "process.frequency_khz", ["out of range", "use a value <= 100000"]),
+    (["process.scan_speed_mm_s=1e12"], "process.scan_speed_mm_s", ["out of range", "> 0 and <= 2000 mm/s",
+                                                                   "use a value <= 2000"]),
+    (["process.defocus=1e6"], "process.defocus", ["out of range", ">= 0 and <= 100 mm", "use a value <= 100"]),
+    (["process.defocus=1.6"], "process.defocus", ["beyond the far side of the tube", "2 r_o = 1.5 mm",
+                                                  "<= 2 r_o = 1.5 mm", "fix: set process.defocus"]),
+    (["process.power_w=1e9"], "process.power_w", ["out of range", ">= 0.05 and <= 100 W", "use a value <= 100"]),
+    (["process.power_w=1e-9"], "process.power_w", ["out of range", "use a value >= 0.05"]),
+    (["process.wavelength_nm=1e300"], "process.wavelength_nm", ["out of range", ">= 100 and <= 20000 nm"]),
+    (["process.drill_offset=1e300"], "process.drill_offset", ["out of range", ">= 0 and <= 0.1 mm"]),
+    (["process.repeat_rule.0.max_depth=1e300"], "process.repeat_rule[0].max_depth", ["out of range", "<= 100 mm"]),
+    (["process.kerf=1e300"], "process.kerf", ["out of range", ">= 0 and <= 1 mm"]),
+    (["process.rapid_speed_mm_s=1e-300"], "process.rapid_speed_mm_s", ["out of range", ">= 0.1 and <= 10000 mm/s"]),
+    (["process.focus_speed_mm_s=1e300"], "process.focus_speed_mm_s", ["out of range", ">= 0.01 and <= 1000 mm/s"]),
+    (["process.max_time_h=1e-300"], "process.max_time_h", ["out of range", ">= 0.01 and <= 1000 h"]),
 ]
 CASES[3] = (["notch.spacing=.nan"], "notch.spacing", ["must be finite"])
 
@@ -119,6 +137,36 @@ def test_overlap_across_the_seam(tmp_path):
     raw["cuts"] = [{"x": 1.75, "width": 0.3, "arc": 0.4, "angle_deg": 350}]
     msg = reject([], write_pattern(tmp_path, raw))
     assert "overlaps" in msg
+
+
+def test_process_values_out_of_range_in_a_pattern_file_name_its_line(tmp_path):
+    """The same bounds hold for process values written in the pattern YAML (fuzz report E2)."""
+    raw = base_raw()
+    raw["process"] = {"defocus": 1e6}
+    p = write_pattern(tmp_path, raw)
+    line = next(i for i, t in enumerate(p.read_text().splitlines(), 1) if t.strip().startswith("defocus:"))
+    msg = reject([], p)
+    assert f"p.yaml:{line}: process.defocus: out of range" in msg and "fix: use a value <= 100" in msg
+
+
+def test_process_values_out_of_range_in_a_process_file(tmp_path):
+    """A process file the pattern names (process: NAME.yaml) is held to the same bounds."""
+    (tmp_path / "proc.yaml").write_text("process:\n  power_w: 1e9\n  frequency_khz: 60\n")
+    raw = base_raw()
+    raw["process"] = "proc.yaml"
+    msg = reject([], write_pattern(tmp_path, raw))
+    assert "process.power_w: out of range" in msg and ">= 0.05 and <= 100 W" in msg
+
+
+@pytest.mark.parametrize("bad", ["process.frequency_khz=1e-12", "process.scan_speed_mm_s=1e12",
+                                 "process.defocus=1e6", "process.power_w=1e9"])
+def test_a_process_value_out_of_range_writes_no_toolpath(tmp_path, capsys, bad):
+    """Before: exit 0 with M68 E1 Q0.000 (no pulses), F2e14, G0 Z-1000000, S100000000000 (fuzz report E2)."""
+    out = tmp_path / "out"
+    assert main(["toolpath", str(TUBE1), "-q", "--set", bad, "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "tube1.yaml" in err[0] and bad.split("=")[0] + ":" in err[0] and "fix:" in err[0], err
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_all_errors_reported_together():

@@ -117,3 +117,23 @@ def test_no_text_a_user_gives_becomes_a_gcode_line(dialect):
     assert not any(ln.strip() in ("M3 S1000", "G0 X500") for ln in evil)
     assert "x M3 S1000  G0 X500 M5" in evil[0]
     assert dialect.comment_line("a\nb\tc\x00d") in ("(a b c d)", "; a b c d")
+
+
+EXPONENT = re.compile(r"\d[eE][-+]?\d")
+
+
+def test_every_number_in_the_gcode_is_fixed_point(tmp_path):
+    """rs274ngc reads no exponent: ``G64 P{:g}`` wrote P5e-05 for a 50 nm tolerance, and the header's
+    ``{:g}`` process values 5e-05 mm (fuzz report E3); every number is now written in fixed-point notation."""
+    from camtube.export.dialects import dialect_from_profile
+    from camtube.machine import load_profile
+    from tests.conftest import ROOT
+
+    text = (ROOT / "machines" / "linuxcnc-path.yaml").read_text().replace("blending: 0.001 ", "blending: 0.00005 ")
+    (tmp_path / "m.yaml").write_text(text)
+    d = dialect_from_profile(load_profile(tmp_path / "m.yaml"))
+    job = plan_job(load_pattern(PATTERNS / "tube2.yaml", ["process.drill_offset=0.00005", "process.defocus=0.00007",
+                                                          "notch.count=2"]))
+    out = gcode(job, d)
+    assert "G64 P0.00005\n" in out and "0.00005 mm apart, defocus 0.00007 mm" in out and "at 0.00007 mm" in out
+    assert not EXPONENT.search(out), EXPONENT.search(out)

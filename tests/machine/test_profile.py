@@ -24,3 +24,47 @@ def test_a_profile_mistake_is_one_line_and_nothing_is_written(tmp_path, old, new
     r = camtube("toolpath", TUBE1, "-q", "-o", str(tmp_path / "o"), "--machine", str(m))
     assert_refused(r, f"{m}:", *words)
     assert listing(tmp_path) == ["m.yaml"]
+
+
+ROTARY = (ROOT / "machines" / "linuxcnc-rotary.yaml").read_text()
+BASES = {"rotary": ROTARY, "grbl": GRBL}
+
+
+@pytest.mark.parametrize("base,old,new,words", [
+    # fuzz report E3: each was accepted with exit 0 and wrote doubtful G-code or a meaningless estimate
+    ("rotary", "blending: exact_stop", "blending: 1e-9", ("machine.blending", "got 1e-09", ">= 0.000001 and <= 0.01 mm")),
+    ("rotary", "blending: exact_stop", "blending: 1e9", ("machine.blending", "a path tolerance", "<= 0.01 mm")),
+    ("rotary", "blending: exact_stop", "blending: 0", ("machine.blending", "got 0")),
+    ("rotary", "decimals: 6 ", "decimals: 50 ", ("machine.decimals", "got 50", ">= 0 and <= 9")),
+    ("rotary", "feed_decimals: 3", "feed_decimals: 30", ("machine.feed_decimals", "got 30", "<= 9")),
+    ("rotary", "X: {max_velocity: 50, max_acceleration: 500}", "X: {max_velocity: 50, max_acceleration: 1e-300}",
+     ("machine.limits.X.max_acceleration", ">= 0.1 and <= 10000000 mm/s^2")),
+    ("rotary", "A: {max_velocity: 3600,", "A: {max_velocity: 1e300,",
+     ("machine.limits.A.max_velocity", ">= 0.01 and <= 100000 deg/s")),
+    ("rotary", "servo_period_s: 0.001 ", "servo_period_s: 1e-300 ", ("machine.servo_period_s", "<= 0.01 s")),
+    ("rotary", "power_output: 0 ", "power_output: 1000000 ", ("machine.laser.power_output", "<= 63")),
+    ("rotary", "warn_time_factor: 3.0", "warn_time_factor: 1e300", ("machine.warn_time_factor", ">= 1 and <= 1000")),
+    ("rotary", "rotary_range_deg: [-360, 720]", "rotary_range_deg: [-1e300, 720]",
+     ("machine.rotary_range_deg", "-36000..36000", "continuous axis")),
+    ("grbl", "s_per_watt: 100 ", "s_per_watt: 1e300 ", ("machine.laser.s_per_watt", ">= 1 and <= 100000 S per W")),
+])
+def test_a_profile_number_out_of_its_range_is_one_line_naming_file_line_and_key(tmp_path, base, old, new, words):
+    """Before: exit 0 with G64 P1e-09 / P1e+09, 50-digit coordinates, a 150-digit time estimate (fuzz report E3)."""
+    m = tmp_path / "m.yaml"
+    assert old in BASES[base]
+    text = BASES[base].replace(old, new)
+    m.write_text(text)
+    line = next(i for i, t in enumerate(text.splitlines(), 1) if new.strip() in t)
+    r = camtube("toolpath", TUBE1, "-q", "-o", str(tmp_path / "o"), "--machine", str(m))
+    assert_refused(r, f"{m}:{line}: ", *words)
+    assert listing(tmp_path) == ["m.yaml"]
+
+
+def test_a_spindle_value_that_rounds_to_zero_is_refused(tmp_path):
+    """S = 0.3 W x 1 S/W is written S0: the GRBL beam never comes on, yet the job was written with exit 0."""
+    m = tmp_path / "m.yaml"
+    m.write_text(GRBL.replace("s_per_watt: 100 ", "s_per_watt: 1 "))
+    r = camtube("toolpath", TUBE1, "-q", "-o", str(tmp_path / "o"), "--machine", str(m),
+                "--set", "process.power_w=0.3")
+    assert_refused(r, "process.power_w", "'M4 S0'", "machine.laser.s_per_watt")
+    assert listing(tmp_path) == ["m.yaml"]
