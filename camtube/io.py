@@ -11,7 +11,12 @@ outputs too large to hold); this layer puts them on disk.
   job file). The set is written into a sibling staging directory; a new output
   directory is then renamed into place, an existing one is swapped with it in
   one ``renameat2(RENAME_EXCHANGE)`` call (Linux), keeping the entries of the
-  old directory that the new set does not replace. An output directory given as
+  old directory that the new set does not replace. A set written for a job
+  (``write_set(..., job=NAME)``) replaces the set an earlier run wrote for that
+  job: its files the new set does not have are gone with the swap (a hidden
+  list, ``.NAME.camtube-set``, names them), so a folder never holds a new
+  G-code beside an old one of another dialect or an old STEP beside a new STL;
+  every other entry stays. An output directory given as
   a symbolic link gets the set in the folder it links to; the link is kept.
 - :func:`write_together`: the outputs of one command that go to different places
   (``--json`` and ``--plot``, a CSV and a ``--report`` folder): every file and
@@ -280,18 +285,23 @@ def _contains_cwd(path: Path) -> bool:
 
 
 def _swap_in(stage: Path, out: Path, files: Mapping[str, Payload]) -> Path | None:
-    """Make the staged set ``out``'s; returns what is left to remove (the old folder), or None."""
+    """Make the staged set ``out``'s; returns what is left to remove (the old folder), or None. The files of the set
+    an earlier run wrote for the same job (:func:`_earlier_set`) go with the old folder."""
     if not out.exists():
         os.chmod(stage, 0o777 & ~_umask())
         os.rename(stage, out)
         return None
+    earlier = _earlier_set(out, files)
+    listed = [set_list_name(files.job)] if isinstance(files, JobSet) else []
     if _contains_cwd(out):
         # the working directory cannot be swapped away under the user: move the files in one by one
-        for name in files:
+        for name in [*files, *listed]:
             os.replace(stage / name, out / name)
+        for name in earlier:
+            os.unlink(out / name)
         return stage
     for entry in out.iterdir():
-        if entry.name not in files:
+        if entry.name not in files and entry.name not in listed and entry.name not in earlier:
             _link_tree(entry, stage / entry.name)
     os.chmod(stage, out.stat().st_mode & 0o7777)
     if not _exchange(stage, out):
@@ -327,18 +337,50 @@ def check_writable_dir(outdir: str | os.PathLike) -> None:
                           "give an output directory in a folder you can write to") from None
 
 
-def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload]) -> list[Path]:
+class JobSet(dict):
+    """The files of one job's set (a dict of file name -> payload) and the job's name (:func:`write_set`)."""
+
+    def __init__(self, files: Mapping[str, Payload], job: str):
+        super().__init__(files)
+        self.job = job
+
+
+def set_list_name(job: str) -> str:
+    """The hidden file in an output directory that lists the files of ``job``'s set written there last."""
+    return f".{job}.camtube-set"
+
+
+def _earlier_set(out: Path, files: Mapping[str, Payload]) -> set[str]:
+    """The files of the set an earlier run wrote into ``out`` for the job of ``files`` (a :class:`JobSet`) that the
+    new set does not have: plain names of files, as its list names them; empty for another payload or no list."""
+    if not isinstance(files, JobSet):
+        return set()
+    try:
+        names = (out / set_list_name(files.job)).read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError):
+        return set()
+    return {n for n in names if n and Path(n).name == n and n not in (".", "..") and n not in files
+            and (out / n).is_file() and not (out / n).is_symlink()}
+
+
+def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload], job: str | None = None) -> list[Path]:
     """Write a set of files into ``outdir`` so that they appear together or not at all.
 
     Parameters
     ----------
     outdir : path
         Output directory; created if missing. Entries already in it that the
-        set does not replace are kept. A symbolic link to a directory is
+        set does not replace are kept, but for the files of the set an earlier
+        run wrote there for the same ``job``. A symbolic link to a directory is
         followed: the set goes into the directory, the link stays.
     files : mapping of file name -> str | bytes | iterable of chunks
         File names relative to ``outdir`` (no sub-directories). Iterables are
         consumed once, chunk by chunk, so a large output is never held whole.
+    job : str, optional
+        The job the set is for (a pattern's name): the set replaces the one
+        written there for it before (its files the new set does not have are
+        removed in the same swap), and a hidden list of the set's files
+        (:func:`set_list_name`) is written with it.
 
     Returns
     -------
@@ -351,11 +393,14 @@ def write_set(outdir: str | os.PathLike, files: Mapping[str, Payload]) -> list[P
         ``outdir`` cannot be created or written (it names a file, the location is
         read-only, ...); nothing of the new set is visible then.
     """
-    return write_together([(outdir, files)])[0]
+    return write_together([(outdir, files if job is None else JobSet(files, job))])[0]
 
 
 def _check_set(out: Path, files: Mapping[str, Payload]) -> None:
     """Refuse, before anything is written, a set :func:`_stage_set` could not publish into ``out``."""
+    if isinstance(files, JobSet) and (Path(files.job).name != files.job or files.job in ("", ".", "..")
+                                      or set_list_name(files.job) in files):
+        raise ValueError(f"write_set: job {files.job!r} is not a plain name")
     if out.exists() and not out.is_dir():
         raise OutputError(out, "a file of that name exists", "name a directory (new or existing), not a file")
     for name in files:
@@ -373,7 +418,8 @@ def _stage_set(out: Path, files: Mapping[str, Payload], staged: list) -> None:
     parent.mkdir(parents=True, exist_ok=True)
     stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".staging", dir=parent))
     staged.append(stage)
-    for name, data in files.items():
+    listed = {set_list_name(files.job): "".join(f"{name}\n" for name in files)} if isinstance(files, JobSet) else {}
+    for name, data in {**files, **listed}.items():
         with open(stage / name, "wb") as fh:
             _write_payload(fh, data)
             fh.flush()

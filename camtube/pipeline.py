@@ -183,5 +183,5 @@ def run(loaded: Loaded, outdir: str | os.PathLike, request: Request, progress: P
         for w in (time_warning(job, est), slow_job_warning(job, est, profile)):
             if w:
                 warn(w)
-    paths = write_set(Path(outdir), files)
+    paths = write_set(Path(outdir), files, job=job.name)  # it replaces the set written there for this job before
     return Result(paths, job, est, cad)

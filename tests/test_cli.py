@@ -104,3 +104,16 @@ def test_preview_draws_slits_as_open_paths(tmp_path):
     root = ET.parse(out).getroot()
     lines = root.findall("{http://www.w3.org/2000/svg}polyline")
     assert len(lines) == 9 and all(len(e.get("points").split()) == 2 for e in lines)
+
+
+def test_a_toolpath_written_again_into_its_folder_leaves_no_g_code_of_the_earlier_run(tmp_path, capsys):
+    # the bad-input search: the 10-notch tube1.nc stayed beside the 5-notch tube1.ngc written over it for LinuxCNC only
+    out = tmp_path / "out"
+    assert main(["toolpath", str(PATTERNS / "tube1.yaml"), "-q", "-o", str(out)]) == 0
+    assert {"tube1.nc", "tube1.ngc", "tube1.job.json"} <= set(p.name for p in out.iterdir())
+    (out / "setup-notes.txt").write_text("the user's own file")
+    assert main(["toolpath", str(PATTERNS / "tube1.yaml"), "-q", "--set", "notch.count=5", "--dialect", "linuxcnc",
+                 "-o", str(out)]) == 0
+    capsys.readouterr()
+    names = set(p.name for p in out.iterdir() if not p.name.startswith("."))
+    assert names == {"tube1.ngc", "tube1.job.json", "tube1.toolpath.dxf", "setup-notes.txt"}, names

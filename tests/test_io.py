@@ -71,6 +71,38 @@ def test_write_set_appears_whole_or_not_at_all(tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["job"]
 
 
+@pytest.mark.parametrize("in_cwd", [False, True])
+def test_a_job_s_set_replaces_the_set_written_for_that_job_before(tmp_path, monkeypatch, in_cwd):
+    # the bad-input search: `toolpath tube1 -o out` (G-code for both dialects), then `toolpath tube1 --set
+    # notch.count=5 --dialect linuxcnc -o out` left the 10-notch tube1.nc beside the 5-notch tube1.ngc and job file.
+    # A job's set replaces that job's earlier set; the folder's other files (the user's, another job's) stay
+    from camtube.io import set_list_name, write_set
+
+    out = tmp_path / "out"
+    write_set(out, {"a.ngc": "G0 X0\n", "a.nc": "G0 X0\n", "a.job.json": "{}"}, job="a")
+    write_set(out, {"b.ngc": "G0 X7\n"}, job="b")
+    (out / "notes.txt").write_text("the user's own file")
+    write_set(out, {"loose.txt": "no job"})
+    if in_cwd:   # the working directory is not swapped away: the files are moved in, the earlier ones removed
+        monkeypatch.chdir(out)
+    paths = write_set(out, {"a.ngc": "G0 X5\n", "a.job.json": "{\"v\": 2}"}, job="a")
+    assert [p.name for p in paths] == ["a.ngc", "a.job.json"]
+    assert sorted(os.listdir(out)) == sorted([set_list_name("a"), set_list_name("b"), "a.job.json", "a.ngc", "b.ngc",
+                                              "loose.txt", "notes.txt"])
+    assert (out / "a.ngc").read_text() == "G0 X5\n" and (out / "b.ngc").read_text() == "G0 X7\n"
+    assert (out / set_list_name("a")).read_text() == "a.ngc\na.job.json\n"
+    # a list naming what is not a plain file of the folder removes nothing
+    (out / set_list_name("b")).write_text("../elsewhere.txt\nnotes.txt/\nsub\n")
+    (tmp_path / "elsewhere.txt").write_text("outside")
+    (out / "sub").mkdir()
+    write_set(out, {"b.ngc": "G0 X8\n"}, job="b")
+    assert (tmp_path / "elsewhere.txt").exists() and (out / "sub").is_dir() and (out / "notes.txt").exists()
+    # without a job the folder keeps every entry the set does not replace, as before
+    write_set(out, {"a.nc": "G0 X1\n"})
+    write_set(out, {"a.ngc": "G0 X6\n"})
+    assert (out / "a.nc").exists() and (out / "a.job.json").exists()
+
+
 def test_write_set_refuses_a_file_as_directory(tmp_path):
     from camtube.io import OutputError, write_set
 

@@ -163,7 +163,7 @@ def build_outputs(pattern: Pattern, job, outdir: str | os.PathLike, *, step: boo
     ``log`` (e.g. ``print``) receives the verification verdict lines. Returns the written paths.
     """
     out = cad_outputs(pattern, job, step=step, pictures=pictures, segments=segments, kerf_mm=kerf_mm)
-    paths = write_set(outdir, out.files)
+    paths = write_set(outdir, out.files, job=job.name)
     for line in out.verdict_lines():
         (log or (lambda _msg: None))(line)
     return paths

@@ -116,4 +116,4 @@ def write_toolpaths(job, outdir: str | os.PathLike, dialects: Sequence[Dialect] 
 
         streams[f"{job.name}.design.dxf"] = design_dxf(pattern)
     streams.update(toolpath_streams(job, dialects, progress))
-    return write_set(outdir, streams)
+    return write_set(outdir, streams, job=job.name)
