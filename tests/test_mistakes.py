@@ -236,6 +236,22 @@ def test_yaml_nested_too_deeply_is_a_yaml_error_not_a_recursion_traceback(tmp_pa
     assert listing(tmp_path) == ["f.yaml"]
 
 
+@pytest.mark.parametrize("argv,words", [
+    (["design", TUBE1, "-q", "--stroke", "1", "--calibration", "{f}"], ("the calibration is not JSON",)),
+    (["synthesize", str(ROOT / "examples" / "goals" / "01-tube1-uniform-60.yaml"), "-o", "{o}/p.yaml",
+      "--calibration", "{f}"], ("the calibration is not JSON",)),
+    (["model", "effect", "new", "okname", "--from", "{f}", "-o", "{o}/y.py"], ("not a diagnosis JSON",)),
+], ids=["design", "synthesize", "effect-new"])
+def test_json_nested_too_deeply_is_not_json_not_a_recursion_traceback(tmp_path, argv, words):
+    """A calibration or diagnosis of 100000 '[' then ']' (valid JSON, too deep for Python's parser) was a
+    RecursionError traceback, exit 1; the YAML readers already refused the same nesting in one line."""
+    f = tmp_path / "deep.json"
+    f.write_text("[" * 100_000 + "]" * 100_000)
+    r = camtube(*[a.replace("{f}", str(f)).replace("{o}", str(tmp_path / "o")) for a in argv])
+    assert_refused(r, str(f), *words, "nested too deeply", "fix: ")
+    assert listing(tmp_path) == ["deep.json"]
+
+
 def billion_laughs(levels: int = 9) -> str:
     """Anchors each aliased ten times in the next: a few lines that expand to 10**levels values."""
     lines = ["l0: &l0 [x, x, x, x, x, x, x, x, x, x]"]

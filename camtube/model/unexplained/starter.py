@@ -23,7 +23,7 @@ import re
 from pathlib import Path
 
 from camtube.errors import DataError
-from camtube.inputfile import read_input_text
+from camtube.inputfile import parse_json, read_input_text
 from camtube.model.unexplained.analysis import HINTS, LABELS, VARIABLES
 
 STAGES = ("force", "stroke", "elongation", "kinematics", "angle")
@@ -223,7 +223,7 @@ def starter_from_json(name: str, path: str | Path, *, stage: str | None = None,
     """:func:`starter_source` from a diagnosis JSON file's ``unexplained`` section."""
     path = Path(path)
     try:
-        doc = json.loads(read_input_text(path))
+        doc = parse_json(read_input_text(path))
     except FileNotFoundError:
         raise DataError(f"{path}: no such diagnosis file; fix: write one with camtube model diagnose ... --json "
                         f"{path.name}") from None
