@@ -493,7 +493,8 @@ def _control_polygon(rd: _Reading, entity, ent: _Entity, layer: str, role: str) 
     if closed and len(pts) > 1 and _isclose(pts[0], pts[-1], TOL.gap):
         pts = pts[:-1]
     if len(pts) < 2 or (closed and len(pts) < 3):
-        ent.status = "aside:zero length"
+        if not _no_area(rd, ent, layer, role, pts):
+            ent.status = "aside:zero length"
         return
     rd.pieces.append(_Piece(pts, closed, [ent], layer, role))
 
@@ -506,6 +507,24 @@ def _not_finite(rd: _Reading, ent: _Entity, coords: Sequence[float]) -> bool:
     rd.refuse(ent.describe(), "has a coordinate that is not a finite number (nan or inf)",
               "redraw or delete it (the file may be damaged: export it again)", entities=[ent])
     return True
+
+
+def _no_area(rd: _Reading, ent: _Entity, layer: str, role: str, pts: list[tuple[float, float]]) -> bool:
+    """A closed path of two points farther apart than :data:`TOL.gap` (a rectangle 0 wide, a polyline drawn out
+    and back) has a length but no area: refused on a cut layer, as a closed outline of three or more points with no
+    area is in :func:`_cuts` (not set aside as of zero length); set aside on an ignored layer. True when handled."""
+    if len(pts) != 2 or _isclose(pts[0], pts[1], TOL.gap):
+        return False
+    if role == "ignore":
+        _set_aside_on_ignored(rd, ent, layer)
+    else:
+        rd.refuse(ent.describe(), "the closed outline encloses no area", "delete it or redraw it", entities=[ent])
+    return True
+
+
+def _set_aside_on_ignored(rd: _Reading, ent: _Entity, layer: str) -> None:
+    up = layer.upper()
+    ent.status = "aside:hidden layer" if up in rd.hidden and up not in rd.roles else "aside:ignored layer"
 
 
 def _flatten(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
@@ -540,6 +559,8 @@ def _flatten(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
         if closed and _isclose(pts[0], pts[-1], TOL.gap):
             pts = pts[:-1]
         if closed and len(pts) < 3:
+            if _no_area(rd, ent, layer, role, pts):
+                return
             continue
         rd.pieces.append(_Piece(pts, closed, [ent], layer, role))
         found = True
@@ -638,7 +659,7 @@ def _close_and_chain(rd: _Reading) -> None:
 # ---------------------------------------------------------------- the tube outline
 def _rectangle(piece: _Piece) -> tuple[float, float, float, float] | None:
     """Bounds of a closed piece if it is an axis-aligned rectangle (within TOL.gap), else None."""
-    if not piece.closed:
+    if not piece.closed or len(piece.points) < 3:
         return None
     x0, y0, x1, y1 = piece.bounds
     if x1 - x0 <= TOL.gap or y1 - y0 <= TOL.gap:
@@ -812,6 +833,9 @@ def _cuts(rd: _Reading, outline: _Piece | None, ro: float, length: float):
                       f"{math.hypot(xa - xb, ya - yb):.4g} mm apart (joined only within {TOL.gap:g} mm)",
                       f"close the outline in CAD (snap the ends, JOIN), or map the layer to slit "
                       f"(--layer {p.layer}=slit) if it is a kerf path", "closed outlines", p.entities)
+            continue
+        if len(pts) < 3:  # two LINEs drawn over each other chain into a loop of two points
+            rd.refuse(desc, "the closed outline encloses no area", "delete it or redraw it", entities=p.entities)
             continue
         poly = Polygon(pts)
         if not poly.is_valid:

@@ -248,3 +248,33 @@ def test_a_spline_by_fit_points_only_is_refused(tmp_path):
     s.msp.add_spline([(3, 1), (3.5, 1.5), (3, 2), (2.5, 1.5), (3, 1)], dxfattribs={"layer": "NOTCHES"})
     with pytest.raises(PatternError, match=r"SPLINE #\w+ on layer NOTCHES: is a SPLINE given by fit points only"):
         load_drawing(save(s, tmp_path), [], DrawingOptions())
+
+
+@pytest.mark.parametrize("add,words", [
+    (lambda s: s.msp.add_lwpolyline([s.at(5.0, 2.0), s.at(5.0, 2.0), s.at(5.0, 4.5), s.at(5.0, 4.5)], close=True,
+                                    dxfattribs={"layer": "NOTCHES"}), r"LWPOLYLINE #\w+ on layer NOTCHES"),
+    (lambda s: (s.msp.add_line(s.at(5.0, 2.0), s.at(5.0, 4.5), dxfattribs={"layer": "HOLES"}),
+                s.msp.add_line(s.at(5.0, 4.5), s.at(5.0, 2.0), dxfattribs={"layer": "HOLES"})),
+     r"2 LINEs \(#\w+, #\w+\) on layer HOLES"),
+    (lambda s: s.msp.add_open_spline([s.at(5.0, 2.0), s.at(5.0, 4.5), s.at(5.0, 2.0)], degree=1,
+                           dxfattribs={"layer": "NOTCHES"}), r"SPLINE #\w+ on layer NOTCHES"),
+], ids=["rectangle-0-wide", "two-lines-over-each-other", "degree-1-spline-out-and-back"])
+def test_a_closed_outline_with_a_length_but_no_area_is_refused(tmp_path, add, words):
+    """A rectangle 0 mm wide and 2.5 mm long on NOTCHES was set aside as 'zero length' (exit 0) though docs/dxf.md
+    refuses an outline with no area (a flat ELLIPSE was refused); two LINEs drawn over each other were a shapely
+    ValueError traceback. A closed path of one point (a zero-radius CIRCLE) stays set aside as of zero length."""
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    add(s)
+    with pytest.raises(PatternError, match=words + ": the closed outline encloses no area; fix: delete it or "
+                       "redraw it"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    s.msp.add_circle(s.at(5.0, 3.0), 0.0, dxfattribs={"layer": "NOTCHES"})
+    s.msp.add_line(s.at(5.0, 2.0), s.at(6.0, 4.5), dxfattribs={"layer": "CONSTRUCTION"})  # drawn over each other on
+    s.msp.add_line(s.at(6.0, 4.5), s.at(5.0, 2.0), dxfattribs={"layer": "CONSTRUCTION"})  # an ignored layer: aside
+    loaded = load_drawing(save(s, tmp_path, "aside.dxf"), [], DrawingOptions())
+    assert len(loaded.pattern.cuts) == 1 and "1 (zero length)" in loaded.summary
