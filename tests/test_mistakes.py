@@ -798,6 +798,39 @@ def test_a_drawn_coordinate_that_is_not_a_number_is_refused_naming_the_entity(tm
     assert listing(tmp_path) == ["d.dxf"]
 
 
+@pytest.mark.parametrize("layer", ["HOLES", "CONSTRUCTION"])
+def test_a_circle_far_larger_than_any_tube_is_refused_or_set_aside_without_flattening_it(tmp_path, layer):
+    """A CIRCLE of radius 1e12 mm was flattened to 25 nm chords: the kernel killed camtube (exit 137, no message),
+    also on the ignored layer CONSTRUCTION. Run here with 2 GB of address space, so the old code fails at once."""
+    import resource
+    import subprocess
+    import sys
+
+    import ezdxf
+
+    doc = ezdxf.new(units=4)
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0.0, 0.0), (10.0, 0.0), (10.0, 6.283185307179586), (0.0, 6.283185307179586)], close=True,
+                       dxfattribs={"layer": "CONSTRUCTION"})
+    msp.add_lwpolyline([(2.0, 2.0), (2.5, 2.0), (2.5, 4.5), (2.0, 4.5)], close=True, dxfattribs={"layer": "NOTCHES"})
+    msp.add_circle((5.0, 3.0), 1e12, dxfattribs={"layer": layer})
+    path = tmp_path / "d.dxf"
+    doc.saveas(path)
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+
+    r = subprocess.run([sys.executable, "-m", "camtube", "design", str(path)], capture_output=True, text=True,
+                       timeout=120, env=dict(os.environ, PYTHONPATH=str(ROOT)), preexec_fn=limit)
+    if layer == "HOLES":
+        assert_refused(r, f"{path}: CIRCLE #", "on layer HOLES: is 2e+12 mm across, far larger than any tube",
+                       "fix: redraw it at the tube's size")
+    else:
+        assert r.returncode == 0, r.stderr
+        assert "set aside: 1 (ignored layer)" in r.stderr
+    assert listing(tmp_path) == ["d.dxf"]
+
+
 def test_a_tube_far_larger_than_any_stage_holds_is_refused_not_overflowed(tmp_path):
     """A radius of 1e103 mm overflowed the geometry (a traceback); the tube's sizes have an upper bound now."""
     assert_refused(camtube("design", TUBE1, "--set", "tube.outer_radius=1e103"), "tube.outer_radius",
