@@ -182,6 +182,14 @@ def test_bad_cycle_spec(spec):
         parse_cycles(spec if spec else " , ")
 
 
+@pytest.mark.parametrize("spec", ["", "  "])
+def test_an_empty_cycle_spec_is_refused_not_all(spec):
+    """``--cycles ''`` selected every cycle; None (not given) still means all."""
+    with pytest.raises(DataError, match="--cycles .*: an empty cycle selection; fix: e.g. --cycles last"):
+        parse_cycles(spec)
+    assert parse_cycles(None).everything
+
+
 def test_cycle_selection_matching_nothing_says_what_exists():
     with pytest.raises(DataError, match="1-50"):
         select_cycles(_cycles_data(), "60-70")
