@@ -3,11 +3,14 @@
 :func:`read_input_bytes` and :func:`read_input_text` read an input (a pattern, a measurement file, a log, a job
 file); a device (``/dev/zero``, ``/dev/urandom``, a terminal) raises an :class:`OSError` the readers already turn
 into their one line, instead of being read until memory runs out. A pipe (``<(gunzip -c data.csv.gz)``) ends, so it
-is read as a file is. (Files are written by :mod:`camtube.io`.)
+is read as a file is. (Files are written by :mod:`camtube.io`.) :func:`parse_json` parses the text of a JSON input
+(a calibration, a diagnosis, a job file); nesting too deep to parse is a :class:`json.JSONDecodeError` like any other
+text that is not JSON, not a ``RecursionError`` traceback.
 """
 from __future__ import annotations
 
 import errno
+import json
 import os
 import stat
 
@@ -35,3 +38,27 @@ def read_input_text(path: str | os.PathLike, encoding: str = "utf-8") -> str:
     refuse_device(path)
     with open(path, encoding=encoding) as fh:
         return fh.read()
+
+
+class JSONTooDeepError(json.JSONDecodeError):
+    """JSON nested deeper than Python's parser can follow (it recurses once per ``[`` or ``{``).
+
+    A :class:`json.JSONDecodeError` (so a :class:`ValueError`), so every reader that already turns a file that is
+    not JSON into its one line does the same for this one; its text is :attr:`problem` alone.
+    """
+
+    problem = "nested too deeply: thousands of levels of '[' or '{'"
+
+    def __init__(self, doc: str):
+        super().__init__(self.problem, doc, 0)
+
+    def __str__(self) -> str:
+        return self.problem
+
+
+def parse_json(text: str):
+    """``json.loads(text)``; nesting too deep to parse raises :class:`JSONTooDeepError`, not ``RecursionError``."""
+    try:
+        return json.loads(text)
+    except RecursionError:
+        raise JSONTooDeepError(text) from None

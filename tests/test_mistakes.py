@@ -236,6 +236,22 @@ def test_yaml_nested_too_deeply_is_a_yaml_error_not_a_recursion_traceback(tmp_pa
     assert listing(tmp_path) == ["f.yaml"]
 
 
+@pytest.mark.parametrize("argv,words", [
+    (["design", TUBE1, "-q", "--stroke", "1", "--calibration", "{f}"], ("the calibration is not JSON",)),
+    (["synthesize", str(ROOT / "examples" / "goals" / "01-tube1-uniform-60.yaml"), "-o", "{o}/p.yaml",
+      "--calibration", "{f}"], ("the calibration is not JSON",)),
+    (["model", "effect", "new", "okname", "--from", "{f}", "-o", "{o}/y.py"], ("not a diagnosis JSON",)),
+], ids=["design", "synthesize", "effect-new"])
+def test_json_nested_too_deeply_is_not_json_not_a_recursion_traceback(tmp_path, argv, words):
+    """A calibration or diagnosis of 100000 '[' then ']' (valid JSON, too deep for Python's parser) was a
+    RecursionError traceback, exit 1; the YAML readers already refused the same nesting in one line."""
+    f = tmp_path / "deep.json"
+    f.write_text("[" * 100_000 + "]" * 100_000)
+    r = camtube(*[a.replace("{f}", str(f)).replace("{o}", str(tmp_path / "o")) for a in argv])
+    assert_refused(r, str(f), *words, "nested too deeply", "fix: ")
+    assert listing(tmp_path) == ["deep.json"]
+
+
 def billion_laughs(levels: int = 9) -> str:
     """Anchors each aliased ten times in the next: a few lines that expand to 10**levels values."""
     lines = ["l0: &l0 [x, x, x, x, x, x, x, x, x, x]"]
@@ -779,6 +795,39 @@ def test_a_drawn_coordinate_that_is_not_a_number_is_refused_naming_the_entity(tm
     for cmd in ("design", "toolpath"):
         args = [cmd, str(path)] + (["-o", str(tmp_path / "o")] if cmd == "toolpath" else [])
         assert_refused(camtube(*args), "d.dxf", "LINE", "on layer SLIT", "not a finite number")
+    assert listing(tmp_path) == ["d.dxf"]
+
+
+@pytest.mark.parametrize("layer", ["HOLES", "CONSTRUCTION"])
+def test_a_circle_far_larger_than_any_tube_is_refused_or_set_aside_without_flattening_it(tmp_path, layer):
+    """A CIRCLE of radius 1e12 mm was flattened to 25 nm chords: the kernel killed camtube (exit 137, no message),
+    also on the ignored layer CONSTRUCTION. Run here with 2 GB of address space, so the old code fails at once."""
+    import resource
+    import subprocess
+    import sys
+
+    import ezdxf
+
+    doc = ezdxf.new(units=4)
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0.0, 0.0), (10.0, 0.0), (10.0, 6.283185307179586), (0.0, 6.283185307179586)], close=True,
+                       dxfattribs={"layer": "CONSTRUCTION"})
+    msp.add_lwpolyline([(2.0, 2.0), (2.5, 2.0), (2.5, 4.5), (2.0, 4.5)], close=True, dxfattribs={"layer": "NOTCHES"})
+    msp.add_circle((5.0, 3.0), 1e12, dxfattribs={"layer": layer})
+    path = tmp_path / "d.dxf"
+    doc.saveas(path)
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+
+    r = subprocess.run([sys.executable, "-m", "camtube", "design", str(path)], capture_output=True, text=True,
+                       timeout=120, env=dict(os.environ, PYTHONPATH=str(ROOT)), preexec_fn=limit)
+    if layer == "HOLES":
+        assert_refused(r, f"{path}: CIRCLE #", "on layer HOLES: is 2e+12 mm across, far larger than any tube",
+                       "fix: redraw it at the tube's size")
+    else:
+        assert r.returncode == 0, r.stderr
+        assert "set aside: 1 (ignored layer)" in r.stderr
     assert listing(tmp_path) == ["d.dxf"]
 
 

@@ -33,11 +33,11 @@ def register(model_sub) -> None:
     d.add_argument("-q", "--quiet", action="store_true", help="do not print design warnings")
     d.add_argument("--cycles", default="all", metavar="SPEC",
                    help="cycles to use: all (default), last20, 31-50, 2-, ... (comma lists allowed)")
-    d.add_argument("--effects", default="", metavar="A,B",
+    d.add_argument("--effects", default=None, metavar="A,B",
                    help="effects already in the model (default: none); built-in: " + ", ".join(EFFECT_NAMES))
     d.add_argument("--effect-file", action="append", default=[], metavar="F.py",
                    help="a .py file defining Effect objects; its effects become candidates too (repeatable)")
-    d.add_argument("--candidates", default="", metavar="A,B",
+    d.add_argument("--candidates", default=None, metavar="A,B",
                    help="effects to try (default: every registered effect not in the model, i.e. the built-in "
                         + ", ".join(EFFECT_NAMES) + " and those of --effect-file)")
     d.add_argument("--fit", dest="fit_params", default=None, metavar="P1,P2",
@@ -52,7 +52,7 @@ def register(model_sub) -> None:
                    help="plausible tendon E_t in GPa; a fit outside is not trusted (default 1,300)")
     d.add_argument("--no-stop-rule", dest="stop_rule", action="store_false",
                    help="do not stop at 1.15 x the noise floor (the significance tests alone decide)")
-    d.add_argument("--per-sample", dest="given_per_sample", default="", metavar="P1,P2",
+    d.add_argument("--per-sample", dest="given_per_sample", default=None, metavar="P1,P2",
                    help="parameters of --effects (full names, or effect names for all their parameters) fitted with "
                         "one value per sample from the start, as model fit's --per-sample: an effect an earlier "
                         "diagnosis recommended per sample")
@@ -189,12 +189,14 @@ def _diagnose(args: argparse.Namespace) -> int:
                         "--modulus-range 1,300")
     pattern = load_joint_pattern(args)
     reg, _ = build_registry(args.effect_file)
-    model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects, "--effects")])
+    model = model_for_pattern(pattern, [reg.get_effect(n)
+                                        for n in split_names(args.effects, "--effects", empty_ok=False)])
     # every parameter the model or a candidate has (its range), checked before the data are read
     specs = {**{f"{e.name}.{q.name}": q for e in reg.values() for q in e.params}, **model.param_specs}
     init = parse_in_range(args.init, "--init", specs)
     _check_init_names(init, specs)
-    given_ps = list(dict.fromkeys(model.per_sample_names(split_names(args.given_per_sample, "--per-sample"))))
+    given_ps = list(dict.fromkeys(model.per_sample_names(split_names(args.given_per_sample, "--per-sample",
+                                                                     empty_ok=False))))
     meas = read_measurements(args.data, strict=args.strict)
     rows = select_cycles(meas.data, args.cycles)
     ins = check_instruments(rows, lag_ms=args.lag_ms, dropped=meas.summary(),
@@ -210,7 +212,7 @@ def _diagnose(args: argparse.Namespace) -> int:
     check_units(model_for_pattern(pattern), ins.data, fixed, fit_names, args.data, (lo, hi))
     ins = confirm_lag(ins, model, fixed, fit_names)
     rows = ins.data
-    cands = [reg.get_effect(c) for c in split_names(args.candidates, "--candidates")] or None
+    cands = [reg.get_effect(c) for c in split_names(args.candidates, "--candidates", empty_ok=False)] or None
     d = diagnose(model, rows, fit_names, fixed, candidates=cands, given_per_sample=given_ps,
                  max_rows=args.max_rows, max_effects=args.max_effects, registry=reg,
                  stop_ratio=1.15 if args.stop_rule else None, modulus_range_gpa=(lo, hi),

@@ -49,12 +49,12 @@ def register(sub) -> None:
                         "e.g. E_t,arm_scale; 'none')")
     f.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
                    help="hold a parameter at a value (units as listed: E_t GPa, L0 mm); repeatable")
-    f.add_argument("--effects", default="", metavar="A,B",
+    f.add_argument("--effects", default=None, metavar="A,B",
                    help="effects to add to the base model, by name: " + ", ".join(EFFECT_NAMES)
                         + " (or one of an --effect-file)")
     f.add_argument("--effect-file", action="append", default=[], metavar="F.py",
                    help="a .py file defining or registering Effect objects (loaded before --effects)")
-    f.add_argument("--per-sample", default="", metavar="P1,P2",
+    f.add_argument("--per-sample", default=None, metavar="P1,P2",
                    help="parameters (full names, or effect names for all their parameters) fitted with one "
                         "value per sample, e.g. slack,play; JSON names <name>@<sample>")
     f.add_argument("--init", action="append", default=[], metavar="NAME=VALUE",
@@ -167,7 +167,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
                         "< 360 deg; fix: e.g. --deadband-threshold 0.5, or leave it out for max(0.5, 4 x noise)")
     pattern = load_joint_pattern(args)
     reg, _ = build_registry(args.effect_file)
-    model = model_for_pattern(pattern, [reg.get_effect(n) for n in split_names(args.effects, "--effects")])
+    model = model_for_pattern(pattern, [reg.get_effect(n)
+                                        for n in split_names(args.effects, "--effects", empty_ok=False)])
     if args.set_aside:
         from camtube.model.data import read_measurements
         from camtube.model.diagnose.instruments import check_instruments, zero_lines
@@ -201,7 +202,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
     fixed.update(held)
     check_units(model_for_pattern(pattern), rows, fixed, names, args.data)
     init = parse_in_range(args.init, "--init", model.param_specs)
-    params = model.make_params(rows, names, fixed, initial=init, per_sample=split_names(args.per_sample, "--per-sample"))
+    params = model.make_params(rows, names, fixed, initial=init,
+                               per_sample=split_names(args.per_sample, "--per-sample", empty_ok=False))
     warn = history_warning(model, args.branch, min((len(set(rows.cycle[sl].tolist()))
                                                     for _, sl in rows.sample_slices()), default=0),
                            params.varying)

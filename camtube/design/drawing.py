@@ -11,7 +11,10 @@ How a drawing is read (``docs/dxf.md`` has the long version):
 3. Every curve (LINE, ARC, CIRCLE, ELLIPSE, SPLINE, LWPOLYLINE / POLYLINE with
    bulges) becomes an ``ezdxf.path`` and is flattened to chords within
    :data:`camtube.tol.TOL.chord`; units follow ``$INSUNITS`` (or
-   ``DrawingOptions.units`` for a unitless drawing).
+   ``DrawingOptions.units`` for a unitless drawing). An entity beyond
+   :data:`MAX_ENTITY_MM` or :data:`MAX_COORD_MM` is refused (set aside on an
+   ignored layer) before it is flattened; a curve on an ignored layer is never
+   flattened.
 4. Loose open pieces on one layer are chained into loops with
    ``ezdxf.edgeminer`` (ends within :data:`camtube.tol.TOL.gap`).
 5. The tube outline -- the smallest axis-aligned rectangle, on any layer, that
@@ -364,6 +367,15 @@ MAX_BLOCK_DEPTH = 64
 #: placed in a mm drawing is scaled 1e-3 or 1e3, a unit square scaled to a cut by the cut's size; 0 flattens the
 #: block to a line or a point (and ezdxf's placing of it divides by zero).
 INSERT_SCALE_RANGE = (1e-9, 1e9)
+#: Largest size (mm, across in x or y) of one drawn entity: five times the longest tube a pattern may have
+#: (``tube.length`` <= 2000 mm; ``2 pi r_o`` <= 314 mm). Checked on the entity's control points before it is
+#: flattened: a CIRCLE of radius 1e9 mm flattened to :data:`TOL.chord` took 4 GB, one of 1e12 mm all the memory
+#: there was; one of this size stays under 1e5 points.
+MAX_ENTITY_MM = 10_000.0
+#: Farthest an entity may lie from the drawing's origin (mm, in x or y): within it a float64 coordinate resolves
+#: 1.5e-8 mm, finer than :data:`TOL.merge`; a drawing at 1e15 mm resolves 0.125 mm, and its outline read as
+#: r_o = 0.9947 mm for 1.
+MAX_COORD_MM = 1e8
 
 
 def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, ...] = ()) -> None:
@@ -480,7 +492,7 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
 def _control_polygon(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
     """A degree-1 SPLINE is its control polygon (closed when the spline is flagged closed or ends where it began)."""
     cps = [tuple(v) for v in entity.control_points]
-    if _not_finite(rd, ent, [c for v in cps for c in v]):
+    if _not_finite(rd, ent, [c for v in cps for c in v]) or _beyond_any_tube(rd, ent, layer, role, cps):
         return
     zs = [v[2] if len(v) > 2 else 0.0 for v in cps]
     if max(zs) - min(zs) > TOL.gap / rd.factor:
@@ -493,7 +505,8 @@ def _control_polygon(rd: _Reading, entity, ent: _Entity, layer: str, role: str) 
     if closed and len(pts) > 1 and _isclose(pts[0], pts[-1], TOL.gap):
         pts = pts[:-1]
     if len(pts) < 2 or (closed and len(pts) < 3):
-        ent.status = "aside:zero length"
+        if not _no_area(rd, ent, layer, role, pts):
+            ent.status = "aside:zero length"
         return
     rd.pieces.append(_Piece(pts, closed, [ent], layer, role))
 
@@ -505,6 +518,54 @@ def _not_finite(rd: _Reading, ent: _Entity, coords: Sequence[float]) -> bool:
         return False
     rd.refuse(ent.describe(), "has a coordinate that is not a finite number (nan or inf)",
               "redraw or delete it (the file may be damaged: export it again)", entities=[ent])
+    return True
+
+
+def _no_area(rd: _Reading, ent: _Entity, layer: str, role: str, pts: list[tuple[float, float]]) -> bool:
+    """A closed path of two points farther apart than :data:`TOL.gap` (a rectangle 0 wide, a polyline drawn out
+    and back) has a length but no area: refused on a cut layer, as a closed outline of three or more points with no
+    area is in :func:`_cuts` (not set aside as of zero length); set aside on an ignored layer. True when handled."""
+    if len(pts) != 2 or _isclose(pts[0], pts[1], TOL.gap):
+        return False
+    if role == "ignore":
+        _set_aside_on_ignored(rd, ent, layer)
+    else:
+        rd.refuse(ent.describe(), "the closed outline encloses no area", "delete it or redraw it", entities=[ent])
+    return True
+
+
+def _set_aside_on_ignored(rd: _Reading, ent: _Entity, layer: str) -> None:
+    up = layer.upper()
+    ent.status = "aside:hidden layer" if up in rd.hidden and up not in rd.roles else "aside:ignored layer"
+
+
+def _beyond_any_tube(rd: _Reading, ent: _Entity, layer: str, role: str, xy: Sequence[tuple[float, float]]) -> bool:
+    """Refuse ``ent`` (set it aside on an ignored layer) when its control points ``xy`` (drawing units, finite) span
+    more than :data:`MAX_ENTITY_MM` or lie farther than :data:`MAX_COORD_MM` from the origin: checked before it is
+    flattened, which for such a curve takes gigabytes. True when refused or set aside."""
+    if not xy:
+        return False
+    xs = [float(v[0]) * rd.factor for v in xy]
+    ys = [float(v[1]) * rd.factor for v in xy]
+    x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
+    size = max(x1 - x0, y1 - y0)
+    far = max(abs(x0), abs(x1), abs(y0), abs(y1))
+    if size <= MAX_ENTITY_MM and far <= MAX_COORD_MM:
+        return False
+    if role == "ignore":
+        _set_aside_on_ignored(rd, ent, layer)
+        return True
+    in_units = "" if rd.unit == "mm" else " (units {unit}: check $INSUNITS or --units)".format(unit=rd.unit)
+    if size > MAX_ENTITY_MM:
+        what = f"is {size:.4g} mm across{in_units}, far larger than any tube"
+        fix = "redraw it at the tube's size, or delete it (or move it to a CONSTRUCTION layer)"
+    else:
+        where = "(%.4g, %.4g)" % ((x0, y0) if abs(x0) + abs(y0) >= abs(x1) + abs(y1) else (x1, y1))
+        what = (f"lies at {where} mm{in_units}, too far from the origin for a tube drawing (coordinates that large "
+                "lose precision)")
+        fix = "move the drawing near the origin (MOVE in CAD), or delete the entity"
+    rd.refuse(ent.describe(), what, fix, f"at most {MAX_ENTITY_MM:g} mm across and within {MAX_COORD_MM:g} mm of "
+              "the origin", [ent])
     return True
 
 
@@ -521,7 +582,11 @@ def _flatten(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
         return
     distance = TOL.chord / rd.factor
     found = False
-    if _not_finite(rd, ent, [c for v in p.control_vertices() for c in v]):
+    cvs = p.control_vertices()
+    if _not_finite(rd, ent, [c for v in cvs for c in v]) or _beyond_any_tube(rd, ent, layer, role, cvs):
+        return
+    if role == "ignore" and p.has_curves:  # a curve is never the outline (a rectangle): set aside, not flattened
+        _set_aside_on_ignored(rd, ent, layer)
         return
     for sub in (p.sub_paths() if p.has_sub_paths else [p]):
         vs = list(sub.flattening(distance, segments=4))
@@ -540,6 +605,8 @@ def _flatten(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
         if closed and _isclose(pts[0], pts[-1], TOL.gap):
             pts = pts[:-1]
         if closed and len(pts) < 3:
+            if _no_area(rd, ent, layer, role, pts):
+                return
             continue
         rd.pieces.append(_Piece(pts, closed, [ent], layer, role))
         found = True
@@ -556,6 +623,10 @@ def _fill(rd: _Reading, entity, ent: _Entity) -> None:
             [ezpath.make_path(entity)]
     except (TypeError, ValueError):
         paths = []
+    cvs = [v for p in paths for v in p.control_vertices()]
+    if _not_finite(rd, ent, [c for v in cvs for c in v]) or _beyond_any_tube(rd, ent, ent.layer, rd.role(ent.layer),
+                                                                                cvs):
+        return
     loops = []
     for p in paths:
         for sub in (p.sub_paths() if p.has_sub_paths else [p]):
@@ -638,7 +709,7 @@ def _close_and_chain(rd: _Reading) -> None:
 # ---------------------------------------------------------------- the tube outline
 def _rectangle(piece: _Piece) -> tuple[float, float, float, float] | None:
     """Bounds of a closed piece if it is an axis-aligned rectangle (within TOL.gap), else None."""
-    if not piece.closed:
+    if not piece.closed or len(piece.points) < 3:
         return None
     x0, y0, x1, y1 = piece.bounds
     if x1 - x0 <= TOL.gap or y1 - y0 <= TOL.gap:
@@ -812,6 +883,9 @@ def _cuts(rd: _Reading, outline: _Piece | None, ro: float, length: float):
                       f"{math.hypot(xa - xb, ya - yb):.4g} mm apart (joined only within {TOL.gap:g} mm)",
                       f"close the outline in CAD (snap the ends, JOIN), or map the layer to slit "
                       f"(--layer {p.layer}=slit) if it is a kerf path", "closed outlines", p.entities)
+            continue
+        if len(pts) < 3:  # two LINEs drawn over each other chain into a loop of two points
+            rd.refuse(desc, "the closed outline encloses no area", "delete it or redraw it", entities=p.entities)
             continue
         poly = Polygon(pts)
         if not poly.is_valid:

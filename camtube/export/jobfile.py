@@ -21,7 +21,7 @@ import numpy as np
 
 from camtube import __version__
 from camtube.errors import DataError
-from camtube.inputfile import read_input_text
+from camtube.inputfile import parse_json, read_input_text
 from camtube.plan.safety import check_job
 from camtube.progress import NO_PROGRESS, Progress
 
@@ -195,7 +195,7 @@ def read_job(source) -> "camtube.plan.Job":  # noqa: F821
     else:
         where = os.fspath(source)
         try:
-            d = json.loads(read_input_text(source))
+            d = parse_json(read_input_text(source))
         except json.JSONDecodeError as e:
             raise _bad(where, f"not JSON (line {e.lineno}: {e.msg})") from None
     if not isinstance(d, dict) or d.get("schema") != SCHEMA:

@@ -37,7 +37,7 @@ from camtube.design.geometry import (
 )
 from camtube.design.pattern import Pattern
 from camtube.errors import CamtubeError
-from camtube.inputfile import read_input_text
+from camtube.inputfile import parse_json, read_input_text
 
 #: Tube modulus (GPa) when the material has no entry in MATERIAL_MODULUS_GPA.
 FALLBACK_MODULUS_GPA = 2.5
@@ -207,7 +207,7 @@ class Mechanics:
         """
         p = Path(path)
         try:
-            doc = json.loads(read_input_text(p))
+            doc = parse_json(read_input_text(p))
         except OSError as exc:
             raise CamtubeError(f"{p}: cannot read the calibration: {exc.strerror}; fix: check the path") from None
         except (json.JSONDecodeError, UnicodeDecodeError) as exc:

@@ -38,7 +38,6 @@ passes do not have, stated apart.
 """
 from __future__ import annotations
 
-import json
 import math
 import os
 from dataclasses import dataclass
@@ -47,7 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from camtube.errors import DataError
-from camtube.inputfile import read_input_text
+from camtube.inputfile import parse_json, read_input_text
 
 SPEED_BAND = 0.05
 
@@ -121,7 +120,7 @@ class JobGeometry:
         from camtube.export.jobfile import read_job
 
         try:
-            d = json.loads(read_input_text(path))
+            d = parse_json(read_input_text(path))
         except OSError as exc:
             raise DataError(f"{path}: cannot read the job file: {exc.strerror}; fix: give the NAME.job.json written "
                             "next to the G-code") from None

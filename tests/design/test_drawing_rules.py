@@ -248,3 +248,99 @@ def test_a_spline_by_fit_points_only_is_refused(tmp_path):
     s.msp.add_spline([(3, 1), (3.5, 1.5), (3, 2), (2.5, 1.5), (3, 1)], dxfattribs={"layer": "NOTCHES"})
     with pytest.raises(PatternError, match=r"SPLINE #\w+ on layer NOTCHES: is a SPLINE given by fit points only"):
         load_drawing(save(s, tmp_path), [], DrawingOptions())
+
+
+@pytest.mark.parametrize("add,words", [
+    (lambda s: s.msp.add_circle(s.at(5.0, 3.0), 2e4, dxfattribs={"layer": "HOLES"}),
+     r"CIRCLE #\w+ on layer HOLES: is 4e\+04 mm across, far larger than any tube"),
+    (lambda s: s.msp.add_line(s.at(3.0, 1.0), s.at(3.0, 1e5), dxfattribs={"layer": "SLITS"}),
+     r"LINE #\w+ on layer SLITS: is 1e\+05 mm across"),
+    (lambda s: s.msp.add_arc(s.at(5.0, 3.0), 1e12, 0.0, 1e-7, dxfattribs={"layer": "SLITS"}),
+     r"ARC #\w+ on layer SLITS: lies at \(1e\+12, .*\) mm, too far from the origin"),
+    (lambda s: s.msp.add_hatch(dxfattribs={"layer": "HOLES"}).paths.add_edge_path().add_arc(
+        s.at(5.0, 3.0), 2e4, 0.0, 360.0), r"HATCH #\w+ on layer HOLES: is 4e\+04 mm across"),
+], ids=["circle", "line", "arc", "hatch"])
+def test_an_entity_far_larger_than_any_tube_is_refused_before_it_is_flattened(tmp_path, add, words):
+    """A CIRCLE of radius 1e12 mm on a cut layer was flattened to 25 nm chords: the kernel killed camtube (out of
+    memory, no message); 1e9 mm took 4 GB and then 'out of memory'. Refused from its control points now (the sizes
+    here are small enough to flatten without the fix; test_mistakes runs the 1e12 mm circle)."""
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    add(s)
+    with pytest.raises(PatternError, match=words + ".*fix: ") as exc:
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    assert len(exc.value.issues) == 1
+
+
+def test_a_drawing_far_from_the_origin_is_refused_naming_the_entities(tmp_path):
+    """A drawing at 1e15 mm (where a float64 resolves 0.125 mm) was read with r_o = 0.9947 mm for 1."""
+    s = Sheet(origin=(1e15, 1e15))
+    draw_outline(s, layer="0")
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    with pytest.raises(PatternError, match=r"LWPOLYLINE #\w+ on layer 0: lies at \(1e\+15, 1e\+15\) mm, too far "
+                       r"from the origin.*fix: move the drawing near the origin"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    s = Sheet(origin=(5e4, -5e4))  # 50 m away: read as drawn
+    draw_outline(s, layer="0")
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    loaded = load_drawing(save(s, tmp_path, "near.dxf"), [], DrawingOptions())
+    assert loaded.pattern.tube.outer_radius_mm == pytest.approx(1.0, abs=1e-9)
+
+
+def test_curves_on_an_ignored_layer_are_set_aside_without_being_flattened(tmp_path, monkeypatch):
+    """A CIRCLE of radius 1e9 mm on layer CONSTRUCTION was flattened (4 GB) before it was set aside; a curve there
+    cannot be the tube outline (a rectangle), so no curve of an ignored layer is flattened at all."""
+    from ezdxf.path import Path as EzPath
+
+    flattened: list[int] = []
+    original = EzPath.flattening
+
+    def counting(self, *args, **kwargs):
+        pts = list(original(self, *args, **kwargs))
+        flattened.append(len(pts))
+        return iter(pts)
+
+    monkeypatch.setattr(EzPath, "flattening", counting)
+    s = Sheet()
+    draw_outline(s)
+    s.doc.layers.add("OLD").off()
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    s.msp.add_circle(s.at(5.0, 3.0), 2e4, dxfattribs={"layer": "CONSTRUCTION"})  # larger than any tube
+    s.msp.add_circle(s.at(5.0, 3.0), 1000.0, dxfattribs={"layer": "CONSTRUCTION"})
+    s.msp.add_ellipse(s.at(5.0, 3.0), (500.0, 0.0, 0.0), 0.5, dxfattribs={"layer": "OLD"})
+    s.msp.add_line(s.at(0.0, 0.0), (1e300, 1e300), dxfattribs={"layer": "CONSTRUCTION"})
+    loaded = load_drawing(save(s, tmp_path), [], DrawingOptions())
+    assert len(loaded.pattern.cuts) == 1
+    assert "3 (ignored layer)" in loaded.summary and "1 (hidden layer)" in loaded.summary
+    assert max(flattened) < 100, flattened  # the outline and the notch, never the circles
+
+
+@pytest.mark.parametrize("add,words", [
+    (lambda s: s.msp.add_lwpolyline([s.at(5.0, 2.0), s.at(5.0, 2.0), s.at(5.0, 4.5), s.at(5.0, 4.5)], close=True,
+                                    dxfattribs={"layer": "NOTCHES"}), r"LWPOLYLINE #\w+ on layer NOTCHES"),
+    (lambda s: (s.msp.add_line(s.at(5.0, 2.0), s.at(5.0, 4.5), dxfattribs={"layer": "HOLES"}),
+                s.msp.add_line(s.at(5.0, 4.5), s.at(5.0, 2.0), dxfattribs={"layer": "HOLES"})),
+     r"2 LINEs \(#\w+, #\w+\) on layer HOLES"),
+    (lambda s: s.msp.add_open_spline([s.at(5.0, 2.0), s.at(5.0, 4.5), s.at(5.0, 2.0)], degree=1,
+                           dxfattribs={"layer": "NOTCHES"}), r"SPLINE #\w+ on layer NOTCHES"),
+], ids=["rectangle-0-wide", "two-lines-over-each-other", "degree-1-spline-out-and-back"])
+def test_a_closed_outline_with_a_length_but_no_area_is_refused(tmp_path, add, words):
+    """A rectangle 0 mm wide and 2.5 mm long on NOTCHES was set aside as 'zero length' (exit 0) though docs/dxf.md
+    refuses an outline with no area (a flat ELLIPSE was refused); two LINEs drawn over each other were a shapely
+    ValueError traceback. A closed path of one point (a zero-radius CIRCLE) stays set aside as of zero length."""
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    add(s)
+    with pytest.raises(PatternError, match=words + ": the closed outline encloses no area; fix: delete it or "
+                       "redraw it"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    s.msp.add_circle(s.at(5.0, 3.0), 0.0, dxfattribs={"layer": "NOTCHES"})
+    s.msp.add_line(s.at(5.0, 2.0), s.at(6.0, 4.5), dxfattribs={"layer": "CONSTRUCTION"})  # drawn over each other on
+    s.msp.add_line(s.at(6.0, 4.5), s.at(5.0, 2.0), dxfattribs={"layer": "CONSTRUCTION"})  # an ignored layer: aside
+    loaded = load_drawing(save(s, tmp_path, "aside.dxf"), [], DrawingOptions())
+    assert len(loaded.pattern.cuts) == 1 and "1 (zero length)" in loaded.summary

@@ -97,6 +97,9 @@ def test_reader_refuses_other_schemas_and_contradictions(tmp_path, job):
     p.write_text("{not json")
     with pytest.raises(DataError, match="not JSON"):
         read_job(p)
+    p.write_text("[" * 100_000 + "]" * 100_000)  # valid JSON too deep for the parser: not a RecursionError
+    with pytest.raises(DataError, match="not JSON .*nested too deeply"):
+        read_job(p)
 
 
 def test_deterministic_streamed_and_compact(job):

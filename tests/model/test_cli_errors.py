@@ -356,6 +356,26 @@ def test_empty_or_repeated_names_and_an_infinite_range_are_refused(data_csv, tmp
 
 
 @pytest.mark.parametrize("cmd,tail,words", [
+    ("fit", ["--cycles", ""], ["--cycles ''", "an empty cycle selection", "fix: e.g. --cycles last"]),
+    ("diagnose", ["--cycles", " "], ["--cycles ' '", "an empty cycle selection"]),
+    ("fit", ["--effects", ""], ["--effects ''", "an empty list of names", "fix: e.g. --effects slack,play"]),
+    ("fit", ["--per-sample", ""], ["--per-sample ''", "an empty list of names"]),
+    ("diagnose", ["--effects", ""], ["--effects ''", "an empty list of names"]),
+    ("diagnose", ["--per-sample", ""], ["--per-sample ''", "an empty list of names"]),
+    ("diagnose", ["--candidates", ""], ["--candidates ''", "an empty list of names",
+                                        "fix: e.g. --candidates slack,play"]),
+])
+def test_an_empty_option_value_is_refused_as_an_empty_fit_is(data_csv, tmp_path, capsys, cmd, tail, words):
+    """Before: ``--cycles ''`` fitted every cycle (the header read 'cycles ,'), and an empty --effects,
+    --per-sample or --candidates was taken for the default, while ``--fit ''`` was refused (an unset shell
+    variable is not "the default")."""
+    js = tmp_path / "o.json"
+    _one_line_with_fix(["model", cmd, str(data_csv), "--pattern", TUBE2, "-q", *tail, "--json", str(js)],
+                       capsys, *words)
+    assert not js.exists()
+
+
+@pytest.mark.parametrize("cmd,tail,words", [
     ("fit", ["--effects", "relaxation2", "--init", "relaxation2.slow_fraction=nan"],
      ["--init relaxation2.slow_fraction=nan", "0..0.9;"]),
     ("fit", ["--init", "E_t=inf"], ["--init E_t=inf", "0.5..500 GPa"]),

@@ -52,6 +52,21 @@ def test_comments_blank_lines_column_order_and_interleaved_samples():
     np.testing.assert_array_equal(d.extra["extra"], [7.0, 9.0, 8.0])
 
 
+def test_a_line_of_separators_among_the_rows_is_a_row_with_every_cell_missing(tmp_path):
+    """A line ',,,,,' among the rows was dropped silently (fit, exit 0), while one empty cell was refused with its
+    line; after the last row it is a spreadsheet's padding, skipped as a blank line is."""
+    from camtube.model.data import read_measurements
+
+    path = tmp_path / "d.csv"
+    path.write_text(_csv(GOOD[:2] + [",,,,,"] + GOOD[2:] + [",,,,,", ",,,,,"]))
+    with pytest.raises(DataError, match=r"d\.csv:3: every cell is empty .*; fix: delete the line"):
+        load_csv(path)
+    m = read_measurements(path)  # diagnose: dropped and said, as a row with a missing value is
+    assert len(m.data) == 3 and m.missing_lines.tolist() == [3] and "dropped (lines 3)" in m.summary()
+    path.write_text(_csv(GOOD + [",,,,,", ",,,,,"]))
+    assert len(load_csv(path)) == 3
+
+
 @pytest.mark.parametrize("lines, line, words", [
     ([HEADER.replace("angle_deg", "angle")] + GOOD[1:], 1, ["angle_deg", "'angle' -> 'angle_deg'"]),
     ([HEADER.replace(",force_N", "")] + [",".join(r.split(",")[:4] + r.split(",")[5:]) for r in GOOD[1:]],
@@ -180,6 +195,14 @@ def test_cycle_selection(spec, a, b):
 def test_bad_cycle_spec(spec):
     with pytest.raises(DataError, match="cycle selection"):
         parse_cycles(spec if spec else " , ")
+
+
+@pytest.mark.parametrize("spec", ["", "  "])
+def test_an_empty_cycle_spec_is_refused_not_all(spec):
+    """``--cycles ''`` selected every cycle; None (not given) still means all."""
+    with pytest.raises(DataError, match="--cycles .*: an empty cycle selection; fix: e.g. --cycles last"):
+        parse_cycles(spec)
+    assert parse_cycles(None).everything
 
 
 def test_cycle_selection_matching_nothing_says_what_exists():

@@ -146,3 +146,27 @@ def test_cli_writes_a_starter_from_a_diagnosis_json(tmp_path, capsys):
     args = ap.parse_args(["effect", "new", "arm2", "--follows", "angle", "-o", str(tmp_path / "arm2.py")])
     assert args.func(args) == 0
     assert _effect_from((tmp_path / "arm2.py").read_text(), tmp_path, "arm2").stage == "kinematics"
+
+
+@pytest.mark.parametrize("argv", [["--follows", "stroke"], ["--from", "{diag}", "--follows", "stroke"]],
+                         ids=["follows", "from"])
+@pytest.mark.parametrize("name", ["slack", "force_zero"])
+def test_a_built_in_effect_name_is_refused_before_anything_is_written(tmp_path, capsys, name, argv):
+    """``model effect new slack --follows stroke`` wrote slack.py (exit 0), which ``model fit --effect-file`` then
+    refused: 'two different effects are named 'slack' (built-in and slack.py)'."""
+    from camtube.commands import main
+    from camtube.model import EFFECT_NAMES
+    from camtube.model.effects import BUILTINS
+
+    assert name in EFFECT_NAMES and name in BUILTINS
+    diag = tmp_path / "diag.json"
+    diag.write_text(json.dumps({"schema": "camtube.diagnose/1", "unexplained": None}), encoding="utf-8")
+    out = tmp_path / f"{name}.py"
+    argv = [a.replace("{diag}", str(diag)) for a in argv]
+    assert main(["model", "effect", "new", name, *argv, "-o", str(out)]) == 2
+    lines = [x for x in capsys.readouterr().err.splitlines() if x.strip()]
+    assert len(lines) == 1 and f"effect name '{name}': {name} is a built-in effect" in lines[0], lines
+    assert f"fix: choose another name, e.g. my_{name}" in lines[0]
+    assert not out.exists()
+    with pytest.raises(DataError, match="built-in effect"):
+        starter_source(name, None, follows="stroke")

@@ -138,3 +138,13 @@ def test_a_chained_job_is_scored_per_group_with_its_links_stated():
     # a beam that strays 2 um off its links is seen
     off = analyse(chained_trace(job, 25.0, 5e-5, link_shift_mm=0.002), geom, prof)
     assert off.max_path_dev_mm == pytest.approx(0.002, rel=0.05)
+
+
+def test_a_job_file_nested_too_deeply_is_not_a_job_file(tmp_path):
+    """100000 '[' then ']' (valid JSON, too deep for Python's parser) was a RecursionError traceback."""
+    from camtube.errors import DataError
+
+    p = tmp_path / "t.job.json"
+    p.write_text("[" * 100_000 + "]" * 100_000)
+    with pytest.raises(DataError, match="not a camtube job file .nested too deeply"):
+        JobGeometry.from_job_file(p)

@@ -143,9 +143,13 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
     rows: list[list[str]] = []
     lines: list[int] = []
     comments = 0  # '#' lines after the header
+    separators_only: list[int] = []  # lines of empty cells (',,,,,') after the header
     try:
         for rec in reader:
             ln = reader.line_num
+            if header is not None and len(rec) > 1 and not any(c.strip() for c in rec):
+                separators_only.append(ln)
+                continue
             if not rec or not any(c.strip() for c in rec) or rec[0].lstrip().startswith("#"):
                 comments += header is not None and bool(rec) and rec[0].lstrip().startswith("#")
                 continue
@@ -202,6 +206,12 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
         raise _err(source, header_line, "no data rows after the header",
                    "add the measurements, one row per sample time, below the header")
 
+    # a line of empty cells among the data is a row whose every measurement is missing (one empty cell is
+    # refused, or dropped and counted without strict); after the last row it is a spreadsheet's padding
+    among = [k for k in separators_only if k < lines[-1]]
+    if among and strict:
+        raise _err(source, among[0], "every cell is empty (a line of separators only, among the data rows)",
+                   "delete the line, or fill in its measurements")
     ln = np.asarray(lines, dtype=np.int64)
     cols = dict(zip(header, zip(*rows)))
     sample = np.array([s.strip() for s in cols["sample"]], dtype=object)
@@ -298,6 +308,8 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
                        f"{arr[k - 1]:g} (line {int(ln[k - 1])})", fix)
     data = Dataset(sample, cyc_f.astype(np.int64), num["time_s"], num["stroke_mm"], num["force_N"],
                    num["angle_deg"], extra)
+    if among:
+        missing_lines = np.sort(np.concatenate((missing_lines, np.asarray(among, dtype=np.int64))))
     return Measurements(data, missing_lines, backward_lines, source)
 
 

@@ -54,8 +54,11 @@ def parse_cycles(spec: str | None) -> CycleSpec:
     Raises
     ------
     DataError
-        For anything else.
+        For anything else, also an empty ``spec`` (``--cycles ''``, an unset shell variable: not "all"; None is).
     """
+    if spec is not None and not spec.strip():
+        raise DataError(f"--cycles {spec!r}: an empty cycle selection; fix: e.g. --cycles last (or all, last20, "
+                        "31-50, 2-)")
     text = (spec or "all").strip().lower()
     ranges, last, everything = [], [], False
     for item in (s.strip() for s in text.split(",")):

@@ -23,7 +23,8 @@ import re
 from pathlib import Path
 
 from camtube.errors import DataError
-from camtube.inputfile import read_input_text
+from camtube.inputfile import parse_json, read_input_text
+from camtube.model import EFFECT_NAMES
 from camtube.model.unexplained.analysis import HINTS, LABELS, VARIABLES
 
 STAGES = ("force", "stroke", "elongation", "kinematics", "angle")
@@ -58,9 +59,14 @@ def _to_stage(stage: str) -> str:
 
 
 def _ident(name: str) -> str:
+    """``name`` if it can name a new effect: a Python identifier that is not a built-in effect's name (which
+    ``--effect-file`` refuses: 'two different effects are named ...')."""
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name or "") or keyword.iskeyword(name):
         raise DataError(f"effect name {name!r}: not a Python identifier (letters, digits and _, not starting "
                         "with a digit); fix: e.g. drive_error")
+    if name in EFFECT_NAMES:
+        raise DataError(f"effect name {name!r}: {name} is a built-in effect, and --effect-file refuses a file "
+                        f"defining another effect of that name; fix: choose another name, e.g. my_{name}")
     return name
 
 
@@ -221,9 +227,10 @@ def _apply(ctx, {sig}: np.ndarray, p: dict) -> np.ndarray:
 def starter_from_json(name: str, path: str | Path, *, stage: str | None = None,
                       follows: str | None = None) -> str:
     """:func:`starter_source` from a diagnosis JSON file's ``unexplained`` section."""
+    _ident(name)  # a name that cannot be used is refused before the file is read
     path = Path(path)
     try:
-        doc = json.loads(read_input_text(path))
+        doc = parse_json(read_input_text(path))
     except FileNotFoundError:
         raise DataError(f"{path}: no such diagnosis file; fix: write one with camtube model diagnose ... --json "
                         f"{path.name}") from None
