@@ -159,6 +159,22 @@ def test_ingest_refuses_wrong_units_and_signs_in_one_line(tmp_path, capsys, extr
     assert not (tmp_path / "d.csv").exists()
 
 
+@pytest.mark.parametrize("log", ["daq", "motor"])
+def test_a_log_of_one_row_is_refused_in_one_line_without_a_wrong_fix(tmp_path, capsys, log):
+    # the bad-input search: a one-row DAQ or motor log spans no time; the duration check divided by it (numpy's
+    # RuntimeWarning on stderr, with the source line) and then advised another time unit
+    lines = (BENCH / f"{log}.csv").read_text().splitlines()
+    one = tmp_path / f"{log}_one.csv"
+    one.write_text("\n".join(lines[:2]) + "\n")
+    argv = _argv(tmp_path)
+    argv[argv.index(str(BENCH / f"{log}.csv"))] = str(one)
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "RuntimeWarning" not in err, err
+    assert f"{one}: column" in err and "spans no time (1 row" in err and "time_unit" not in err, err
+    assert not (tmp_path / "d.csv").exists()
+
+
 def test_tracker_in_metres_is_named_and_fixed_by_the_map(tmp_path, capsys):
     rows = list(csv.reader(open(BENCH / "aurora-export.csv", newline="")))
     head = rows[0]

@@ -137,6 +137,12 @@ def _gap_mask(t: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray, in
 
 def _check_duration(name: str, s: Series, unit: str, key: str, tracker_span: float) -> None:
     span = float(s.time_s[-1] - s.time_s[0])
+    if not span > 0.0:
+        # one row, or every stamp the same: no time unit makes a recording of it
+        raise DataError(f"{s.source}: column {key!r} spans no time ({s.time_s.size} row"
+                        f"{'s' if s.time_s.size != 1 else ''}, from {float(s.time_s[0]):g} s to "
+                        f"{float(s.time_s[-1]):g} s); fix: give the {name} log of the whole test, one row per "
+                        "sample in time order")
     ratio = span / tracker_span if tracker_span > 0 else 1.0
     if not 0.05 <= ratio <= 20.0:
         units = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "min": 60.0}
