@@ -133,7 +133,8 @@ def test_ctrl_c_while_the_set_is_published_publishes_it_whole_and_says_so(tmp_pa
     assert main(["toolpath", TUBE1, "-o", str(out), "-q"]) == 0
     err = capsys.readouterr().err
     assert "interrupted after the outputs were published" in err and str(out) in err
-    assert sorted(p.name for p in out.iterdir()) == ["tube1.job.json", "tube1.nc", "tube1.ngc", "tube1.toolpath.dxf"]
+    assert sorted(p.name for p in out.iterdir()) == [".tube1.camtube-set", "tube1.job.json", "tube1.nc", "tube1.ngc",
+                                                     "tube1.toolpath.dxf"]   # (the set's list: camtube.io)
 
 
 def test_ctrl_c_before_the_swap_publishes_nothing(tmp_path, monkeypatch, capsys):
@@ -849,8 +850,8 @@ def test_output_folder_given_as_a_link_gets_the_files_and_stays_a_link(tmp_path,
     assert main(["toolpath", TUBE1, "-o", str(tmp_path / "current"), "-q"]) == 0
     assert f"wrote {tmp_path / 'current' / 'tube1.ngc'}" in capsys.readouterr().out
     assert (tmp_path / "current").is_symlink()
-    assert listing(tmp_path) == ["current", "jobs", "jobs/v2", "jobs/v2/tube1.job.json", "jobs/v2/tube1.nc",
-                                 "jobs/v2/tube1.ngc", "jobs/v2/tube1.toolpath.dxf"]
+    assert listing(tmp_path) == ["current", "jobs", "jobs/v2", "jobs/v2/.tube1.camtube-set", "jobs/v2/tube1.job.json",
+                                 "jobs/v2/tube1.nc", "jobs/v2/tube1.ngc", "jobs/v2/tube1.toolpath.dxf"]
     assert (tmp_path / "jobs" / "v2" / "tube1.ngc").read_text() != "old"
 
 
