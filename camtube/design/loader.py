@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Iterable
@@ -419,15 +420,54 @@ def load(path: str | os.PathLike, overrides: Iterable[str] = ()) -> Loaded:
     """
     path = resolve_preset(path)
     raw, lines, file = read_yaml(path)
-    proc = raw.get("process")
-    if isinstance(proc, str):
-        praw, _, _ = read_yaml(find_process_file(proc, Path(path).parent, file, lines.get("process")))
-        raw = dict(raw)
-        raw["process"] = praw.get("process", praw)
+    raw, source = _process_file(raw, Path(path).parent, file, lines)
     raw = apply_overrides(raw, overrides, file)
     set_keys = {parse_override(o)[0] for o in overrides}
     lines = {k: v for k, v in lines.items() if k not in set_keys}  # a --set value has no line
-    return build(raw, file, lines, name=Path(path).stem)
+    return _build_naming_process_file(raw, file, lines, Path(path).stem, source, set_keys)
+
+
+def _process_file(raw: dict, folder: Path, file: str, lines: dict) -> tuple[dict, tuple | None]:
+    """``raw`` with the process file that ``process: NAME`` names read in, and ``(its path, its lines as
+    process.KEY -> line)`` (None when ``process:`` is not a file name). A pattern named there is refused."""
+    proc = raw.get("process")
+    if not isinstance(proc, str):
+        return raw, None
+    where = find_process_file(proc, folder, file, lines.get("process"))
+    praw, plines, pfile = read_yaml(where)
+    if set(praw) & (set(SCHEMA) - {"process", "name", "rules"}):   # tube, notch, tendon, ...: a pattern
+        raise PatternError([Issue("process", f"names {pfile}, a pattern file, not a process file", proc,
+                                  "a YAML file of process keys (power_w, frequency_khz, ...), with or without a "
+                                  "top-level 'process:'", "name the process file the pattern uses, or write the "
+                                  "process keys under 'process:'", file, lines.get("process"))])
+    inner = "process" in praw
+    raw = dict(raw)
+    raw["process"] = praw.get("process", praw)
+    plines = {(k if inner else f"process.{k}"): v for k, v in plines.items()
+              if not inner or k == "process" or k.startswith("process.")}
+    return raw, (pfile, plines)
+
+
+def _build_naming_process_file(raw: dict, file: str, lines: dict, name: str, source: tuple | None,
+                               set_keys: Iterable[str] = ()) -> Loaded:
+    """:func:`build`, a problem with a value the process file gave named in that file, at its line (it was named in
+    the pattern, without a line)."""
+    try:
+        return build(raw, file, lines, name=name)
+    except PatternError as exc:
+        if source is None:
+            raise
+        pfile, plines = source
+        # a --set KEY (process.repeat_rule.0.max_depth) names a value the pattern's command line gave, not the file
+        given = [re.sub(r"\.(\d+)(?=\.|$)", r"[\1]", k) for k in set_keys]
+
+        def from_file(key: str) -> bool:
+            return key.startswith("process.") and not any(key == g or key.startswith((g + ".", g + "["))
+                                                          for g in given)
+
+        issues = [replace(i, file=pfile, line=plines.get(i.key, plines.get(i.key.split("[")[0])))
+                  if i.file == file and from_file(i.key) else i for i in exc.issues]
+        raise PatternError(issues) from None
 
 
 def load_text(text: str, path: str | os.PathLike) -> Loaded:
@@ -444,12 +484,8 @@ def load_text(text: str, path: str | os.PathLike) -> Loaded:
     if not isinstance(raw, dict):
         raise PatternError([Issue("<top>", "a pattern must be a mapping of sections", None, "", "", file, 1)])
     lines = line_map(text)
-    proc = raw.get("process")
-    if isinstance(proc, str):
-        praw, _, _ = read_yaml(find_process_file(proc, Path(path).parent, file, lines.get("process")))
-        raw = dict(raw)
-        raw["process"] = praw.get("process", praw)
-    return build(raw, file, lines, name=Path(path).stem)
+    raw, source = _process_file(raw, Path(path).parent, file, lines)
+    return _build_naming_process_file(raw, file, lines, Path(path).stem, source)
 
 
 def find_process_file(name: str, folder: Path, file: str, line: int | None) -> Path:

@@ -158,6 +158,29 @@ def test_process_values_out_of_range_in_a_process_file(tmp_path):
     assert "process.power_w: out of range" in msg and ">= 0.05 and <= 100 W" in msg
 
 
+@pytest.mark.parametrize("top", [True, False])
+def test_a_problem_in_a_process_file_is_named_in_that_file_at_its_line(tmp_path, top):
+    """The bad-input search: an unknown key in the process file a pattern names was reported against the pattern,
+    without a line. It is named in the process file, at its line (with or without a top-level 'process:'); a value
+    given with --set is still the pattern's; a pattern named as the process file is refused as such."""
+    body = "  frequency_khz: 60\n  power_wx: 2.0\n  defocus: 1e6\n"
+    (tmp_path / "proc.yaml").write_text("# the lab's process\n" + ("process:\n" + body if top else body.replace("  ", "")))
+    raw = base_raw()
+    raw["process"] = "proc.yaml"
+    p = write_pattern(tmp_path, raw)
+    first = 3 if top else 2
+    msg = reject([], p)
+    assert f"proc.yaml:{first + 1}: process.power_wx: unknown key" in msg and "did you mean 'power_w'" in msg, msg
+    (tmp_path / "proc.yaml").write_text("process:\n  frequency_khz: 60\n  defocus: 1e6\n")
+    assert "proc.yaml:3: process.defocus: out of range" in reject([], p)
+    msg = reject(["process.power_w=1e9"], p)
+    assert "p.yaml: process.power_w: out of range" in msg and "proc.yaml:3: process.defocus" in msg, msg
+    raw2 = base_raw()
+    raw2["process"] = "p.yaml"
+    msg = reject([], write_pattern(tmp_path, raw2, "q.yaml"))
+    assert "q.yaml" in msg and "names" in msg and "a pattern file, not a process file" in msg, msg
+
+
 @pytest.mark.parametrize("bad", ["process.frequency_khz=1e-12", "process.scan_speed_mm_s=1e12",
                                  "process.defocus=1e6", "process.power_w=1e9"])
 def test_a_process_value_out_of_range_writes_no_toolpath(tmp_path, capsys, bad):
