@@ -156,8 +156,8 @@ def test_sigterm_during_the_swap_is_held_until_the_set_is_whole(tmp_path):
                        capture_output=True, text=True, timeout=120, env=dict(os.environ, PYTHONPATH=str(ROOT)))
     assert r.returncode == 0, (r.returncode, r.stderr)
     assert "interrupted after the outputs were published" in r.stderr and "Traceback" not in r.stderr
-    assert listing(tmp_path) == ["o", "o/notes.txt", "o/tube1.job.json", "o/tube1.nc", "o/tube1.ngc",
-                                 "o/tube1.toolpath.dxf"]
+    assert listing(tmp_path) == ["o", "o/.tube1.camtube-set", "o/notes.txt", "o/tube1.job.json", "o/tube1.nc",
+                                 "o/tube1.ngc", "o/tube1.toolpath.dxf"]
 
 
 def test_failed_verification_is_not_success(tmp_path):

@@ -44,8 +44,9 @@ def test_multi_direction_patterns_build_and_verify(tmp_path, overrides):
 def test_cad_request_writes_only_cad_files(tmp_path):
     loaded = load(PATTERNS / "tube1.yaml")
     res = run(loaded, tmp_path, Request(what=CAD, cad=CadOptions(step=False, pictures=False)))
-    assert sorted(x.name for x in tmp_path.iterdir()) == sorted(x.name for x in res.paths) == [
-        "tube1.ascut.stl", "tube1.design.stl", "tube1.verify.json", "tube1.verify.txt"]
+    assert sorted(x.name for x in tmp_path.iterdir() if x.name != ".tube1.camtube-set") == sorted(
+        x.name for x in res.paths) == ["tube1.ascut.stl", "tube1.design.stl", "tube1.verify.json", "tube1.verify.txt"]
+    assert (tmp_path / ".tube1.camtube-set").read_text().split() == [x.name for x in res.paths]   # the set's list
     assert res.estimate is None and res.verified
 
 

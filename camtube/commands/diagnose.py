@@ -190,13 +190,12 @@ def _diagnose(args: argparse.Namespace) -> int:
     pattern = load_joint_pattern(args)
     reg, _ = build_registry(args.effect_file)
     model = model_for_pattern(pattern, [reg.get_effect(n)
-                                        for n in split_names(args.effects, "--effects", empty_ok=False)])
+                                        for n in split_names(args.effects, "--effects")])
     # every parameter the model or a candidate has (its range), checked before the data are read
     specs = {**{f"{e.name}.{q.name}": q for e in reg.values() for q in e.params}, **model.param_specs}
     init = parse_in_range(args.init, "--init", specs)
     _check_init_names(init, specs)
-    given_ps = list(dict.fromkeys(model.per_sample_names(split_names(args.given_per_sample, "--per-sample",
-                                                                     empty_ok=False))))
+    given_ps = list(dict.fromkeys(model.per_sample_names(split_names(args.given_per_sample, "--per-sample"))))
     meas = read_measurements(args.data, strict=args.strict)
     rows = select_cycles(meas.data, args.cycles)
     ins = check_instruments(rows, lag_ms=args.lag_ms, dropped=meas.summary(),

@@ -168,7 +168,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     pattern = load_joint_pattern(args)
     reg, _ = build_registry(args.effect_file)
     model = model_for_pattern(pattern, [reg.get_effect(n)
-                                        for n in split_names(args.effects, "--effects", empty_ok=False)])
+                                        for n in split_names(args.effects, "--effects")])
     if args.set_aside:
         from camtube.model.data import read_measurements
         from camtube.model.diagnose.instruments import check_instruments, zero_lines
@@ -203,7 +203,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     check_units(model_for_pattern(pattern), rows, fixed, names, args.data)
     init = parse_in_range(args.init, "--init", model.param_specs)
     params = model.make_params(rows, names, fixed, initial=init,
-                               per_sample=split_names(args.per_sample, "--per-sample", empty_ok=False))
+                               per_sample=split_names(args.per_sample, "--per-sample"))
     warn = history_warning(model, args.branch, min((len(set(rows.cycle[sl].tolist()))
                                                     for _, sl in rows.sample_slices()), default=0),
                            params.varying)

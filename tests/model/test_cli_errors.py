@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import csv
+import json
 import math
 import os
 from pathlib import Path
@@ -358,21 +359,28 @@ def test_empty_or_repeated_names_and_an_infinite_range_are_refused(data_csv, tmp
 @pytest.mark.parametrize("cmd,tail,words", [
     ("fit", ["--cycles", ""], ["--cycles ''", "an empty cycle selection", "fix: e.g. --cycles last"]),
     ("diagnose", ["--cycles", " "], ["--cycles ' '", "an empty cycle selection"]),
-    ("fit", ["--effects", ""], ["--effects ''", "an empty list of names", "fix: e.g. --effects slack,play"]),
-    ("fit", ["--per-sample", ""], ["--per-sample ''", "an empty list of names"]),
-    ("diagnose", ["--effects", ""], ["--effects ''", "an empty list of names"]),
-    ("diagnose", ["--per-sample", ""], ["--per-sample ''", "an empty list of names"]),
     ("diagnose", ["--candidates", ""], ["--candidates ''", "an empty list of names",
                                         "fix: e.g. --candidates slack,play"]),
 ])
 def test_an_empty_option_value_is_refused_as_an_empty_fit_is(data_csv, tmp_path, capsys, cmd, tail, words):
-    """Before: ``--cycles ''`` fitted every cycle (the header read 'cycles ,'), and an empty --effects,
-    --per-sample or --candidates was taken for the default, while ``--fit ''`` was refused (an unset shell
-    variable is not "the default")."""
+    """Before: ``--cycles ''`` fitted every cycle (the header read 'cycles ,'), and an empty --candidates tried every
+    effect, while ``--fit ''`` was refused (an unset shell variable is not "the default"). An empty --effects or
+    --per-sample is a list of none, which is what they mean when not given (a script that joins the effects a
+    diagnosis recommended gives ``--effects ''`` when it recommended none: the test below)."""
     js = tmp_path / "o.json"
     _one_line_with_fix(["model", cmd, str(data_csv), "--pattern", TUBE2, "-q", *tail, "--json", str(js)],
                        capsys, *words)
     assert not js.exists()
+
+
+@pytest.mark.parametrize("option", ["--effects", "--per-sample"])
+def test_an_empty_list_of_effects_or_per_sample_names_is_none(data_csv, tmp_path, capsys, option):
+    js, js0 = tmp_path / "o.json", tmp_path / "o0.json"
+    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", option, "", "--json", str(js)]) == 0
+    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--json", str(js0)]) == 0
+    capsys.readouterr()
+    got, want = json.loads(js.read_text()), json.loads(js0.read_text())
+    assert got["effects"] == want["effects"] == [] and got["rmse_deg"] == want["rmse_deg"]
 
 
 @pytest.mark.parametrize("cmd,tail,words", [

@@ -16,7 +16,7 @@ def test_toolpath_writes_every_output_and_prints_the_summary(tmp_path, capsys):
         assert label in out
     assert "352" in out
     names = sorted(p.name for p in tmp_path.iterdir())
-    assert names == ["tube1.job.json", "tube1.nc", "tube1.ngc", "tube1.toolpath.dxf"]
+    assert names == [".tube1.camtube-set", "tube1.job.json", "tube1.nc", "tube1.ngc", "tube1.toolpath.dxf"]
     assert json.loads((tmp_path / "tube1.job.json").read_text())["summary"]["passes"] == 352
 
 
@@ -24,7 +24,8 @@ def test_toolpath_options(tmp_path, capsys):
     argv = ["toolpath", str(PATTERNS / "tube3.yaml"), "-o", str(tmp_path), "-q", "--ordering", "sequential",
             "--dialect", "linuxcnc", "--set", "process.repeats=2"]
     assert main(argv) == 0
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["tube3.job.json", "tube3.ngc", "tube3.toolpath.dxf"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".tube3.camtube-set", "tube3.job.json", "tube3.ngc",
+                                                          "tube3.toolpath.dxf"]
     d = json.loads((tmp_path / "tube3.job.json").read_text())
     assert d["ordering"] == "sequential" and d["repeats"] == 2 and d["summary"]["passes"] == 11 * 16
 
@@ -55,7 +56,8 @@ def test_machine_profile_chooses_the_gcode_and_is_recorded(tmp_path, capsys):
     assert main(["toolpath", str(PATTERNS / "tube1.yaml"), "-o", str(tmp_path), "-q",
                  "--machine", "linuxcnc-surface"]) == 0
     out = capsys.readouterr().out
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["tube1.job.json", "tube1.ngc", "tube1.toolpath.dxf"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".tube1.camtube-set", "tube1.job.json", "tube1.ngc",
+                                                          "tube1.toolpath.dxf"]
     d = json.loads((tmp_path / "tube1.job.json").read_text())
     assert d["machine"]["name"] == "linuxcnc-surface"
     assert "on machine linuxcnc-surface" in out
