@@ -391,6 +391,11 @@ HELDOUT49_KINDS = USUAL_KINDS + [("toe", "backbone3"), ("creep", "slack"), ("lag
 #: beside creep, a lag beside a three-arm backbone.
 HELDOUT50_KINDS = USUAL_KINDS + [("lost motion", "toe"), ("backbone", "creep"), ("lag", "backbone3"),
                                  "sharp friction", "tracker drift"]
+#: The fifty-first fresh held-out batch (issue 19, the method settled at the end of the session after
+#: bench-heldout50; every batch above looked at): cells not zeroed in half the samples, lost motion beside a backbone,
+#: slack beside friction, a three-arm backbone beside a toe.
+HELDOUT51_KINDS = USUAL_KINDS + [("lost motion", "backbone"), ("slack", "friction"), ("backbone3", "toe"),
+                                 "sharp friction", "tracker drift"]
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -516,7 +521,9 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            "bench-heldout49": (20281222, HELDOUT49_KINDS),
            # drawn once the drive's history ran through the rows set aside for the angle alone (every batch above
            # looked at); run once
-           "bench-heldout50": (20281223, HELDOUT50_KINDS)}
+           "bench-heldout50": (20281223, HELDOUT50_KINDS),
+           # drawn to measure the method settled after bench-heldout50 (every batch above looked at); run once
+           "bench-heldout51": (20281224, HELDOUT51_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
@@ -524,7 +531,8 @@ SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldo
            "bench-heldout33", "bench-heldout34", "bench-heldout35", "bench-heldout36", "bench-heldout37",
            "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-heldout41", "bench-heldout42",
            "bench-heldout43", "bench-heldout44", "bench-heldout45", "bench-sharp", "bench-heldout46",
-           "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50"}
+           "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50",
+           "bench-heldout51"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -536,10 +544,12 @@ ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19
            "bench-heldout31", "bench-heldout32", "bench-heldout33", "bench-heldout34", "bench-heldout35",
            "bench-heldout36", "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40",
            "bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45",
-           "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50"}
+           "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50",
+           "bench-heldout51"}
 #: Batches whose load cells may not be zeroed before the test (:func:`untared`).
 UNTARED = {"bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45",
-           "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50"}
+           "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50",
+           "bench-heldout51"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
