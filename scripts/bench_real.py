@@ -116,7 +116,7 @@ def rough_instruments(b: SampleBench, rng: np.random.Generator) -> SampleBench:
 
 #: The peak tension (N) the bench's tubes reach at the largest stroke (the 99.9th percentile of the force in the
 #: controls of bench-heldout15 and bench-heldout16): the scale of a load cell's range in :func:`rougher_instruments`.
-PEAK_TENSION_N = {"tube1": 3.05, "tube2": 3.85}
+PEAK_TENSION_N = {"tube1": 3.05, "tube2": 3.85, "tube3": 8.99}   # (tube3: a control of 20,000 rows at 25 Hz)
 
 
 def rougher_instruments(b: SampleBench, rng: np.random.Generator, tube: str, rate_hz: float) -> SampleBench:
@@ -138,19 +138,46 @@ def untared(b: SampleBench, rng: np.random.Generator) -> SampleBench:
     return b
 
 
-def draw_batch(seed: int, kinds: list, rough: bool = False, rougher: bool = False, untared_cells: bool = False) -> list:
+def shaped_protocol(rate_hz: float, max_stroke_mm: float, rng: np.random.Generator) -> Protocol:
+    """A record shape unlike :func:`protocol_for`'s: 20-80 cycles, 30,000-90,000 rows over two samples, ramps of
+    15-40 % of a cycle, no dwell at the top in a quarter of the files (else 5-30 %), rests of 5-30 %, a first dwell
+    of 0-2 cycles' dwells, a peak stroke of 60-100 % of the tube's largest (``max_stroke_mm``) in 70 % of the files."""
+    n_cycles = int(rng.integers(20, 81))
+    rows = float(rng.uniform(30_000, 90_000))
+    ramp, rest = float(rng.uniform(0.15, 0.4)), float(rng.uniform(0.05, 0.3))
+    dwell = 0.0 if rng.random() < 0.25 else float(rng.uniform(0.05, 0.3))
+    first = float(rng.uniform(0.0, 2.0)) * dwell
+    cycle_s = rows / 2.0 / rate_hz / n_cycles / (2 * ramp + dwell + rest)   # (the fractions: of a cycle's length)
+    peak = max_stroke_mm if rng.random() < 0.3 else float(rng.uniform(0.6, 1.0)) * max_stroke_mm
+    return Protocol(n_cycles=n_cycles, ramp_s=ramp * cycle_s, dwell_s=dwell * cycle_s, rest_s=rest * cycle_s,
+                    first_dwell_s=first * cycle_s, peak_mm=peak)
+
+
+def protocol_of(spec: tuple) -> Protocol:
+    """The commanded motion of a batch's file ``spec``: its own record shape (a batch of :data:`SHAPED`) or
+    :func:`protocol_for` its rate."""
+    return spec[6] if len(spec) > 6 else protocol_for(spec[2])
+
+
+def draw_batch(seed: int, kinds: list, rough: bool = False, rougher: bool = False, untared_cells: bool = False,
+               shapes: bool = False) -> list:
     """``[(name, tube, rate_hz, (SampleBench, SampleBench), (kind1, kind2), sim_seed)]`` drawn from ``seed``;
     ``rough``: each tracker's artefacts drawn too (:func:`rough_instruments`, from ``seed + 1``: the mechanisms are
     those of the plain batch); ``rougher``: those and longer interference, a load cell's range
-    (:func:`rougher_instruments`)."""
+    (:func:`rougher_instruments`); ``shapes``: the three tubes, rates of 25-200 Hz and each file's own record shape
+    (:func:`shaped_protocol`, from ``seed + 3``), the shape a seventh item of each file."""
     rng = np.random.default_rng(seed)
     rng_ins = np.random.default_rng(seed + 1)
     rng_zero = np.random.default_rng(seed + 2)
+    rng_shape = np.random.default_rng(seed + 3)
     out = []
     for i, kind in enumerate(kinds):
         k1, k2 = kind if isinstance(kind, tuple) else (kind, kind)
         tube = str(rng.choice(["tube1", "tube2"]))
         rate = float(rng.choice([25.0, 40.0, 50.0, 100.0]))
+        if shapes:
+            tube = str(rng_shape.choice(["tube1", "tube2", "tube3"]))
+            rate = float(rng_shape.choice([25.0, 50.0, 100.0, 200.0]))
         b1 = dominant(k1, _mild(rng), rng)
         b2 = dominant(k2, _mild(rng), rng, strength=float(rng.uniform(0.7, 1.3)))
         if rougher:
@@ -162,7 +189,9 @@ def draw_batch(seed: int, kinds: list, rough: bool = False, rougher: bool = Fals
         if k1 == "lag" == k2:  # one tracker for both samples
             b2 = replace(b2, tracker=replace(b2.tracker, lag_ms=b1.tracker.lag_ms))
         name = k1 if k1 == k2 else f"{k1} / {k2}"
-        out.append((name, tube, rate, (b1, b2), (k1, k2), seed * 100 + i))
+        out.append((name, tube, rate, (b1, b2), (k1, k2), seed * 100 + i)
+                   + ((shaped_protocol(rate, load_pattern(ROOT / "patterns" / f"{tube}.yaml").rules.max_stroke_mm,
+                                       rng_shape),) if shapes else ()))
     return out
 
 
@@ -396,6 +425,14 @@ HELDOUT50_KINDS = USUAL_KINDS + [("lost motion", "toe"), ("backbone", "creep"), 
 #: slack beside friction, a three-arm backbone beside a toe.
 HELDOUT51_KINDS = USUAL_KINDS + [("lost motion", "backbone"), ("slack", "friction"), ("backbone3", "toe"),
                                  "sharp friction", "tracker drift"]
+#: A fresh held-out batch of record shapes (issue 19, the method settled after bench-heldout50): every batch above
+#: has 50 cycles of one shape, 60,000 rows at 25-100 Hz, tubes 1 and 2; here each file draws its tube among the three,
+#: its rate (25-200 Hz), its cycles, rows, ramps, dwells (none in some), rests and peak stroke
+#: (:func:`shaped_protocol`); the mechanisms and artefacts as bench-heldout51's.
+SHAPES_KINDS = USUAL_KINDS + [("toe", "creep"), ("friction", "slack"), ("backbone", "lost motion"), "sharp friction",
+                              "tracker drift"]
+#: Batches whose files draw their own record shapes (``draw_batch(shapes=True)``).
+SHAPED = {"bench-shapes"}
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -523,7 +560,9 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            # looked at); run once
            "bench-heldout50": (20281223, HELDOUT50_KINDS),
            # drawn to measure the method settled after bench-heldout50 (every batch above looked at); run once
-           "bench-heldout51": (20281224, HELDOUT51_KINDS)}
+           "bench-heldout51": (20281224, HELDOUT51_KINDS),
+           # drawn once bench-heldout51 had run, with record shapes the batches above lack (SHAPED); run once
+           "bench-shapes": (20281225, SHAPES_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
@@ -532,7 +571,7 @@ SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldo
            "bench-heldout38", "bench-heldout39", "bench-heldout40", "bench-heldout41", "bench-heldout42",
            "bench-heldout43", "bench-heldout44", "bench-heldout45", "bench-sharp", "bench-heldout46",
            "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50",
-           "bench-heldout51"}
+           "bench-heldout51", "bench-shapes"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -545,11 +584,11 @@ ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19
            "bench-heldout36", "bench-heldout37", "bench-heldout38", "bench-heldout39", "bench-heldout40",
            "bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45",
            "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50",
-           "bench-heldout51"}
+           "bench-heldout51", "bench-shapes"}
 #: Batches whose load cells may not be zeroed before the test (:func:`untared`).
 UNTARED = {"bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45",
            "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50",
-           "bench-heldout51"}
+           "bench-heldout51", "bench-shapes"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
@@ -572,9 +611,9 @@ def lag_right(lag, true_ms: list, row_ms: float) -> bool:
 
 def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
     """Simulate, write, read back, check the instruments and diagnose one file; a dict of the figures."""
-    name, tube, rate, benches, kinds, seed = spec
+    name, tube, rate, benches, kinds, seed = spec[:6]
     pattern = load_pattern(ROOT / "patterns" / f"{tube}.yaml")
-    rec = simulate_bench(pattern, benches, protocol_for(rate), Clock(rate_hz=rate), seed=seed)
+    rec = simulate_bench(pattern, benches, protocol_of(spec), Clock(rate_hz=rate), seed=seed)
     path = workdir / f"bench_{seed}.csv"
     path.write_text(format_csv(rec.data))
     t0 = time.perf_counter()
@@ -653,15 +692,16 @@ def run_file(spec, workdir: Path, verbose: bool = True) -> dict:
 def settle_drives(specs: list) -> list:
     """``specs`` with every sample's carriage settling (:attr:`Drive.settle`): pulled off its rail's hold, it
     slides only until the tension is back at the friction, rather than landing on the nut's flank."""
-    return [(name, tube, rate, tuple(replace(b, drive=replace(b.drive, settle=True)) for b in benches), kinds, seed)
-            for name, tube, rate, benches, kinds, seed in specs]
+    return [(name, tube, rate, tuple(replace(b, drive=replace(b.drive, settle=True)) for b in benches), kinds, seed,
+             *rest) for name, tube, rate, benches, kinds, seed, *rest in specs]
 
 
 def batch_specs(name: str, settled: bool = False) -> list:
     """The files of batch ``name`` (:func:`draw_batch`; the batches of :data:`ROUGH` with their trackers' artefacts;
     those of :data:`SETTLED`, or all with ``settled``, with their carriages settling, :func:`settle_drives`)."""
     seed, kinds = BATCHES[name]
-    specs = draw_batch(seed, kinds, rough=name in ROUGH, rougher=name in ROUGHER, untared_cells=name in UNTARED)
+    specs = draw_batch(seed, kinds, rough=name in ROUGH, rougher=name in ROUGHER, untared_cells=name in UNTARED,
+                       shapes=name in SHAPED)
     return settle_drives(specs) if settled or name in SETTLED else specs
 
 
@@ -694,9 +734,9 @@ def write_file(batch: str, kind: str, path: str) -> None:
         print(f"bench_real.py --write: {batch} has no file {kind!r}; fix: give a name or an index: "
               + ", ".join(f"{i} {s[0]!r}" for i, s in enumerate(specs)), file=sys.stderr)
         sys.exit(2)
-    name, tube, rate, benches, _, sim_seed = spec
+    name, tube, rate, benches, _, sim_seed = spec[:6]
     pattern = load_pattern(ROOT / "patterns" / f"{tube}.yaml")
-    rec = simulate_bench(pattern, benches, protocol_for(rate), Clock(rate_hz=rate), seed=sim_seed)
+    rec = simulate_bench(pattern, benches, protocol_of(spec), Clock(rate_hz=rate), seed=sim_seed)
     Path(path).write_text(format_csv(rec.data))
     print(f"wrote {path}: {name}, {tube}, {rate:g} Hz, {len(rec.data)} rows; true floor {rec.floor_deg:.3f} deg, "
           f"spikes {len(rec.spike_rows)}, missing angles {len(rec.dropout_rows)}")

@@ -28,8 +28,9 @@ unknown = [b for b in batches if b not in B.BATCHES]
 if unknown:
     ap.error(f"unknown batch {unknown[0]!r}; fix: give one of {', '.join(B.BATCHES)}")
 for batch in batches or ["bench", "bench-heldout"]:
-    for name, tube, rate, benches, _, s in B.batch_specs(batch):
-        rec = simulate_bench(load_pattern(ROOT / "patterns" / f"{tube}.yaml"), benches, B.protocol_for(rate),
+    for spec in B.batch_specs(batch):
+        name, tube, rate, benches, _, s = spec[:6]
+        rec = simulate_bench(load_pattern(ROOT / "patterns" / f"{tube}.yaml"), benches, B.protocol_of(spec),
                              Clock(rate_hz=rate), seed=s)
         ok = np.isfinite(rec.data.angle_deg)
         ins = check_instruments(rec.data.take(ok))
