@@ -327,3 +327,40 @@ def test_hardstop_is_refused_where_the_angle_keeps_rising_past_the_stop():
     assert HARDSTOP.check(d0.with_angle(_stopped(d0.angle_deg, top - 4.0, 0.03)), stopped) == ""
     reason = HARDSTOP.check(d0.with_angle(np.asarray(d0.angle_deg) + drift), stopped)
     assert reason.startswith("no plateau"), reason
+
+
+def test_where_nothing_is_recommended_a_builtin_refused_only_for_its_bound_that_halves_the_error_is_named_nearest():
+    # bench-shapes: tube 3's backbone, its set ratcheting from 10 to 46 deg; relaxation2 took the error from 14.1 to
+    # 1.9 deg with its slow arm's ratio on its bound (not recommended), and the answer named only angle_bias and slack,
+    # partial at 26x the floor: the user was pointed at the instruments and the tendon, not the backbone. The answer now
+    # names the nearest built-in, its bound and where it sits; a candidate that gains less, or is refused for another
+    # reason, is not named
+    from dataclasses import replace
+
+    from camtube.model.diagnose.search import Candidate
+    from camtube.model.report.diagnosis import answer_lines, diagnosis_dict, nearest_on_bound
+
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    sim = simulate(p, Hidden(), n_samples=2, n_cycles=10, rate_hz=10.0, seed=5)
+    d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
+    assert not d.recommended and nearest_on_bound(d) is None      # the control: nothing named
+
+    def cand(effect, ho, why, significant=False):
+        return Candidate(effect, (effect,), ho, ho, -100.0, {}, significant=significant, why=why)
+
+    left = replace(d.waterfall[0], rmse_deg=4.6)
+    rounds = ((cand("angle_bias", 9.7, "", True), cand("relaxation2", 1.95, "relaxation2.slow_ratio@S1 = 2 is on its "
+                                                      "bound; cannot be told apart from relaxation"),
+               cand("creep", 1.0, "held-out RMSE falls by 1.0% < 2%")),
+              (cand("slack", 4.6, "", True), cand("relaxation2", 1.29, "relaxation2.slow_ratio@S1 = 2 is on its bound"),
+               cand("relaxation", 2.4, "relaxation.fraction = 0.9 is on its bound")))
+    steps = (replace(d.waterfall[0], rmse_deg=14.1), replace(d.waterfall[0], rmse_deg=9.7), left)
+    hit = replace(d, rounds=rounds, partial=("angle_bias", "slack"), partial_steps=steps)
+    near = nearest_on_bound(hit)
+    assert near["effect"] == "relaxation2" and near["heldout_rmse_deg"] == pytest.approx(1.29)
+    assert near["bound"] == "relaxation2.slow_ratio@S1 = 2 is on its bound" and "backbone" in near["side"]
+    line = next(x for x in answer_lines(hit) if x.startswith("  nearest:"))
+    assert "relaxation2 lowers the error most (1.290 deg held out, against 4.600 with the effects listed partial)" in line
+    assert diagnosis_dict(hit)["nearest_on_bound"]["effect"] == "relaxation2"
+    # one that does not halve what the partial effects leave is not named
+    assert nearest_on_bound(replace(hit, partial_steps=steps[:2] + (replace(left, rmse_deg=2.0),))) is None

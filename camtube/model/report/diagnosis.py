@@ -169,6 +169,7 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
     out["rounds"] = [[_candidate_dict(d, c) for c in r] for r in d.rounds]
     out["recommended"] = list(d.recommended)
     out["explanation"] = d.explanation or None
+    out["nearest_on_bound"] = nearest_on_bound(d)
     ins = d.instruments
     if ins is not None:
         out["instruments"] = {
@@ -314,6 +315,37 @@ def _at_sharp_limit(d: Diagnosis, key: str, value: float) -> bool:
     return spec is not None and spec.at_sharp_limit(value)
 
 
+#: A candidate refused for a parameter on its bound is named as the nearest built-in when its held-out RMSE is at most
+#: this share of what the effects listed partial leave (or of the model's, when none is).
+NEAREST_SHARE = 0.5
+
+
+def nearest_on_bound(d: Diagnosis) -> dict | None:
+    """The built-in that lowers the error most where nothing is recommended, refused only because a parameter ended on
+    its bound: ``{"effect", "heldout_rmse_deg", "left_rmse_deg", "bound", "side"}``, or None. Its family is what is
+    missing, beyond the range of its law (``bench-shapes``: tube 3's backbone, its set ratcheting from 10 to 46 deg;
+    ``relaxation2`` took the error from 14.1 to 1.9 deg with its slow arm's ratio on its bound, and the answer named
+    ``angle_bias`` and ``slack``, partial at 26x the floor, alone). Only where its held-out RMSE is at most
+    :data:`NEAREST_SHARE` of what the partial effects leave (of the model's where none is listed)."""
+    if d.recommended or not d.rounds:
+        return None
+    left = d.partial_steps[-1].rmse_deg if d.partial else d.waterfall[0].rmse_deg
+    best = None
+    for rnd in d.rounds:
+        for c in rnd:
+            if c.significant or c.replaces or "is on its bound" not in c.why:
+                continue
+            if not math.isfinite(c.heldout_rmse_deg) or c.heldout_rmse_deg > NEAREST_SHARE * left:
+                continue
+            if best is None or c.heldout_rmse_deg < best.heldout_rmse_deg:
+                best = c
+    if best is None:
+        return None
+    bound = next(part.strip() for part in best.why.split(";") if "is on its bound" in part)
+    return {"effect": best.effect, "heldout_rmse_deg": float(best.heldout_rmse_deg), "left_rmse_deg": float(left),
+            "bound": bound, "side": SIDES.get(best.effect, "")}
+
+
 def answer_lines(d: Diagnosis) -> list[str]:
     """The answer first: what to add in order with the error before and after each step, what is left and what
     it follows, per sample, and the instruments' findings (rows set aside, lag)."""
@@ -377,6 +409,14 @@ def answer_lines(d: Diagnosis) -> list[str]:
     else:
         out.append(f"answer: nothing to add: the model is at {_times(steps[0].rmse_deg, floor)} the noise floor "
                    f"({steps[0].rmse_deg:.3f} vs {floor:.3f} deg)")
+    near = nearest_on_bound(d)
+    if near is not None:
+        out.append(f"  nearest: {near['effect']} lowers the error most ({near['heldout_rmse_deg']:.3f} deg held out, "
+                   f"against {near['left_rmse_deg']:.3f}{' with the effects listed partial' if d.partial else ''}), "
+                   f"but {near['bound']}: what is missing is of its family"
+                   + (f" (it sits in the {near['side']})" if near["side"] else "")
+                   + ", beyond the range of its law; write an effect of that family with a wider law (see the "
+                   "tutorial in docs/diagnose.md)")
     u = unexplained_report.of_diagnosis(d)
     if u is not None and u.get("drift"):
         out.append(f"  left: {u['sentence']}")
