@@ -1935,8 +1935,30 @@ class Search:
                     out.setdefault((e.name, smp), why)
         return out
 
+    def _samples_differ(self) -> bool:
+        """The chain holds chosen effects off in at least two samples (a per-sample copy at its ``off`` value, on
+        its bound, or held so): the samples show different effects. A chain can then reach the floor with a stand-in
+        that serves both samples first (``bench-heldout51``: a toe for one sample's slack and part of the other's guide
+        friction, then ``capstan`` and ``force_zero``, at 0.92x the floor), where each sample diagnosed alone names its
+        own (``slack``; ``capstan``): :meth:`try_sample_wise` then tries the samples' union too, taken only where it
+        lowers the error and the BIC."""
+        chosen = {e.name: e for e in self.chain.chosen}
+        off = _off_on_bound(chosen, self.chain.all_rows.params)
+        # each of two samples lacks an effect the chain holds off there (one sample lacking one effect, the chain's
+        # first in both, is a chain of shared effects with a sliver in one sample: bench-shapes' weak lost motion,
+        # relaxation held off in S1, the samples alone changed nothing and took 11 s)
+        def held_off(k: str, v: float) -> bool:
+            """``k`` is held at its effect's off value (not a copy held because the rows barely depend on it)."""
+            eff_name, _, pname = k.split("@")[0].partition(".")
+            e = chosen.get(eff_name)
+            return e is not None and pname in (e.off or {}) and abs(float(v) - float(e.off[pname])) <= 1e-12
+        lacking = {k.partition("@")[2] for k in off} | {k.partition("@")[2] for k, v in self.held.items()
+                                                        if held_off(k, v)}
+        return len(lacking - {""}) >= 2
+
     def try_sample_wise(self) -> bool:
-        """When the chain leaves the error above :data:`REACH_RATIO` x the floor and there are several samples:
+        """When the chain leaves the error above :data:`REACH_RATIO` x the floor, or reaches it holding effects off in
+        two samples (:meth:`_samples_differ`), and there are several samples:
         diagnose each sample alone; when each is explained (something recommended, or nothing to add) and they
         show different effects, fit the union with each effect held off
         (at its ``off`` values) in the samples that do not show it, and take it as the chain when it lowers the
@@ -1945,7 +1967,9 @@ class Search:
         serves both wins its first round); one sample at a time does not. True when the chain changed."""
         ch, s, data = self.chain, self.settings, self.data
         samples = list(data.samples)
-        if not s.per_sample or len(samples) < 2 or ch.all_rows.rmse <= REACH_RATIO * self.floor:
+        if not s.per_sample or len(samples) < 2:
+            return False
+        if ch.all_rows.rmse <= REACH_RATIO * self.floor and not self._samples_differ():
             return False
         got = self._samples_alone(samples)
         if got is None:
