@@ -664,19 +664,19 @@ def _per_sample_lag_line(lg: Lag, rates_hz: Mapping[str, float]) -> str:
                 + " (whole rows)")
     by_model = {smp: (a, b) for smp, a, b in lg.model_rmse_deg}
 
-    def anothers(smp: str, ms: float, se: float, applied: float) -> bool:
+    def anothers(smp: str, ms: float, applied: float, row_ms: float) -> bool:
         """The lag corrected in ``smp`` is another sample's, beyond the rows its own estimate was tried at (its
         whole rows and one either side, :func:`_model_lag`)."""
-        row_ms = 1e3 / rates_hz[smp] if rates_hz.get(smp) else 0.0
         return row_ms > 0.0 and abs(applied / row_ms - round(ms / row_ms)) > 1.0 + 1e-9 and any(
             abs(a - applied) <= 0.5 * row_ms for o, _, _, _, a in lg.per_sample if o != smp)
 
     def how(smp: str, ms: float, se: float, applied: float) -> str:
         if not applied:
             return ", none to correct"
-        if not _resolved(ms, se, 1e3 / rates_hz[smp] if rates_hz.get(smp) else 0.0):
+        row_ms = 1e3 / rates_hz[smp] if rates_hz.get(smp) else 0.0
+        if not _resolved(ms, se, row_ms):
             what = ", unresolved, corrected by the lag another sample shows"
-        elif anothers(smp, ms, se, applied):
+        elif anothers(smp, ms, applied, row_ms):
             what = ", corrected by the lag another sample shows, which the model fits better than its own"
         else:
             what = ", corrected"
@@ -789,10 +789,14 @@ def _steps(w: np.ndarray, scale: float, span: np.ndarray | None = None) -> tuple
     sample's median time steps each change spans (1 where no row is missing); a change across rows that are not in
     the record (a dropout) is read against the motion's change per step times its span, so a ramp's progress across
     the gap is not a jump (a 0.1 s dropout inside a 0.9 s burst read -2.2 deg and left the burst unpaired)."""
-    got = _off_the_sides(w, span)
-    if got is None:
+    return _jumps(_off_the_sides(w, span), scale)
+
+
+def _jumps(sides: tuple[np.ndarray, np.ndarray] | None, scale: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_steps` from the changes ``sides`` (:func:`_off_the_sides`; None: too short, no jump)."""
+    if sides is None:
         return np.zeros(0, int), np.zeros(0)
-    a, b = got
+    a, b = sides
     hit = (np.abs(a) > SPIKE_Z * scale) & (np.abs(b) > SPIKE_Z * scale) & (np.sign(a) == np.sign(b))
     k = np.flatnonzero(hit)
     return k + 1, 0.5 * (a[k] + b[k])
@@ -830,9 +834,10 @@ def _off_the_sides(w: np.ndarray, span: np.ndarray | None = None) -> tuple[np.nd
 OWN_JUMPS_MIN = 5
 
 
-def _beyond_own(w: np.ndarray, span: np.ndarray, rows: np.ndarray, size: np.ndarray, own: np.ndarray,
+def _beyond_own(sides: tuple[np.ndarray, np.ndarray], rows: np.ndarray, size: np.ndarray, own: np.ndarray,
                 own_size: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]:
-    """The angle's jumps ``(rows, size)`` (:func:`_steps` of ``w``) that are not the joint's own: a jump in a row
+    """The angle's jumps ``(rows, size)`` (:func:`_jumps` of its changes ``sides``, :func:`_off_the_sides`) that are
+    not the joint's own: a jump in a row
     where the force jumps too (``own``, ``own_size``: the force's jumps) is the joint's (a guide's Coulomb friction
     switched the tension), as far as it is the angle's typical change in the rows where the force jumps the same way
     (the median over them, at least :data:`OWN_JUMPS_MIN`: the guide switches at every reversal alike); what is
@@ -846,13 +851,13 @@ def _beyond_own(w: np.ndarray, span: np.ndarray, rows: np.ndarray, size: np.ndar
         return rows, size
     keep = ~same
     size = size.copy()
-    ab = _off_the_sides(w, span)
+    a, b = sides
     at = {int(r): float(z) for r, z in zip(own, own_size)}
     for direction in (1.0, -1.0):
         group = own[np.sign(own_size) == direction]
-        if group.size < OWN_JUMPS_MIN or ab is None:
+        if group.size < OWN_JUMPS_MIN:
             continue
-        typical = float(np.median(0.5 * (ab[0][group - 1] + ab[1][group - 1])))
+        typical = float(np.median(0.5 * (a[group - 1] + b[group - 1])))
         for i in np.flatnonzero(same):
             if np.sign(at[int(rows[i])]) != direction:
                 continue
@@ -906,7 +911,8 @@ def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: n
         idx = np.flatnonzero(good)
         w = v[idx]
         span = np.diff(idx).astype(float) if t is None else np.maximum(_spans(t[sl][idx], step), np.diff(idx))
-        rows, size = _steps(w, scale, span)
+        sides = _off_the_sides(w, span)
+        rows, size = _jumps(sides, scale)
         steady = False   # (the force's own jumps read: an angle's jump that is not in a row of one)
         if force is not None and rows.size:
             f = force[sl][idx]
@@ -918,7 +924,7 @@ def _long_bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, known: n
                     # in the same row only: interference that ends a row from the joint's own jump is still an edge
                     # (a burst's end beside a carriage let go at the rest, in bench-heldout21); and one that begins
                     # in that row is the angle's jump beyond the joint's own there
-                    rows, size = _beyond_own(w, span, rows, size, own, own_size, scale)
+                    rows, size = _beyond_own(sides, rows, size, own, own_size, scale)
         rows = idx[rows]   # (the sample's own rows again: the longest displacement is counted in them)
         longest, noise = int(LONG_BURST_S / step), STEP_NOISE * scale
         pairs = _paired_jumps(rows, size, longest, noise)
@@ -1831,8 +1837,7 @@ def _confirm_per_sample(ins: Instruments, model, fixed: dict, fit_names) -> Inst
     # late, S2's cell at its limit in 45 % of its rows; S2 read 28.8 +- 4.6 ms beside S1's 55.8 +- 0.8, and 40 ms,
     # the last of the rows tried around its own, was corrected there). A sample whose tracker lags differently keeps
     # its own: the others' lag fits it worse
-    own_confirmed = {smp: ms for smp, ms in confirmed.items() if smp not in split}
-    for smp in own_confirmed:
+    for smp in [smp for smp in confirmed if smp not in split]:
         others = sorted(set(ms for o, ms in confirmed.items() if o != smp) - {confirmed[smp]})
         if not others:
             continue
