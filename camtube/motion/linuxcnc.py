@@ -138,6 +138,12 @@ def _coordinates(profile) -> str:
     return "".join(sorted(profile.axes, key=_CANONICAL.index))
 
 
+def _ini_number(value: float) -> str:
+    """``value`` as the INI file gives it to LinuxCNC: every digit of the profile's number (``{:g}`` kept six, so a
+    limit of 33.3333333 mm/s was written 33.3333), in plain decimal (no exponent: 1e6 is 1000000)."""
+    return np.format_float_positional(float(value), trim="-")
+
+
 def config_texts(profile, workdir: str | os.PathLike, driver: str) -> dict[str, str]:
     """File name -> text of the INI and HAL files for ``profile`` in ``workdir``."""
     if profile.dialect != "linuxcnc":
@@ -158,19 +164,20 @@ def config_texts(profile, workdir: str | os.PathLike, driver: str) -> dict[str, 
         "[EMCIO]", "EMCIO = io", "CYCLE_TIME = 0.100", f"TOOL_TABLE = {w / 'tool.tbl'}",
         "[HAL]", f"HALFILE = {w / 'camtube.hal'}",
         "[TRAJ]", f"COORDINATES = {coords}", "LINEAR_UNITS = mm", "ANGULAR_UNITS = degree",
-        f"DEFAULT_LINEAR_VELOCITY = {lin_v:g}", f"MAX_LINEAR_VELOCITY = {lin_v:g}",
+        f"DEFAULT_LINEAR_VELOCITY = {_ini_number(lin_v)}", f"MAX_LINEAR_VELOCITY = {_ini_number(lin_v)}",
         "NO_FORCE_HOMING = 1", f"POSITION_FILE = {w / 'position.txt'}",
     ]
     if rot:
         v = profile.axis(rot).max_velocity
-        ini += [f"DEFAULT_ANGULAR_VELOCITY = {v:g}", f"MAX_ANGULAR_VELOCITY = {v:g}"]
+        ini += [f"DEFAULT_ANGULAR_VELOCITY = {_ini_number(v)}", f"MAX_ANGULAR_VELOCITY = {_ini_number(v)}"]
     ini += ["[KINS]", f"JOINTS = {len(coords)}", f"KINEMATICS = trivkins coordinates={coords}"]
     for j, letter in enumerate(coords):
         lim = profile.axis(letter)
         angular = letter == rot
         span = 1e6 if angular else 1e4
-        common = [f"MIN_LIMIT = {-span:g}", f"MAX_LIMIT = {span:g}", f"MAX_VELOCITY = {lim.max_velocity:g}",
-                  f"MAX_ACCELERATION = {lim.max_acceleration:g}"]
+        common = [f"MIN_LIMIT = {_ini_number(-span)}", f"MAX_LIMIT = {_ini_number(span)}",
+                  f"MAX_VELOCITY = {_ini_number(lim.max_velocity)}",
+                  f"MAX_ACCELERATION = {_ini_number(lim.max_acceleration)}"]
         ini += [f"[AXIS_{letter}]"] + common
         ini += [f"[JOINT_{j}]", f"TYPE = {'ANGULAR' if angular else 'LINEAR'}"] + common + [
             "FERROR = 1000", "MIN_FERROR = 1000", "HOME = 0", "HOME_OFFSET = 0", "HOME_SEARCH_VEL = 0",

@@ -86,3 +86,21 @@ def test_machines_lists_the_profiles(capsys):
 def test_a_grbl_profile_cannot_run_on_linuxcnc(tmp_path):
     with pytest.raises(CamtubeError, match="linuxcnc profile"):
         lc.config_texts(load_profile("grbl-flat"), tmp_path, "driver.py")
+
+
+def test_the_ini_gives_limits_with_every_digit_and_no_exponent(tmp_path):
+    """LinuxCNC is given the profile's own limits: ``{:g}`` wrote a velocity of 33.3333333 mm/s as 33.3333 (above
+    or below the profile by the digits dropped) and the travel of the rotary axis as 1e+06."""
+    import dataclasses
+
+    profile = load_profile("linuxcnc-rotary")
+    odd = {"max_velocity": 33.3333333, "max_acceleration": 1234.56789}
+    limits = tuple((k, dataclasses.replace(v, **odd)) for k, v in profile.limits)
+    ini = lc.config_texts(dataclasses.replace(profile, limits=limits), tmp_path, "driver.py")["camtube.ini"]
+    lines = [ln for ln in ini.splitlines() if " = " in ln]
+    values = {ln.split(" = ")[0]: ln.split(" = ")[1] for ln in lines}
+    assert values["MAX_VELOCITY"] == "33.3333333" and values["MAX_ACCELERATION"] == "1234.56789"
+    assert values["MAX_LINEAR_VELOCITY"] == "33.3333333"
+    limits_written = [ln.split(" = ")[1] for ln in lines if ln.startswith(("MIN_LIMIT", "MAX_LIMIT"))]
+    assert limits_written and all("e" not in v.lower() for v in limits_written)
+    assert "-1000000" in limits_written
