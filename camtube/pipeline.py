@@ -133,11 +133,12 @@ def outputs(loaded: Loaded, request: Request, progress: Progress = NO_PROGRESS):
 
             files[f"{job.name}.design.dxf"] = design_dxf(pattern)
         dialects = tuple(request.dialects) if request.dialects else tuple(DIALECTS.values())
-        from camtube.machine.kinematics import check_feeds, check_laser_values
+        from camtube.machine.kinematics import check_feeds, check_laser_values, check_speeds
 
         for d in dialects:  # a feed or laser value the G-code cannot carry makes the job meaningless: refused
             check_feeds(job, d)  # before writing
             check_laser_values(job, d)
+            check_speeds(job, d)
         # the estimate on the first dialect's machine, computed once here: the G-code header and the
         # job file of that machine read the same one from the job's cache
         est = job_estimate(job, dialects[0])

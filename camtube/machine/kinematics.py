@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import math
+
 import numpy as np
 
 from camtube.machine.profile import MachineProfile
@@ -151,6 +153,70 @@ def check_feeds(job, machine) -> None:
         f"written {printed} with {profile.feed_decimals} decimals (off by more than {100 * FEED_ROUNDING:g} %); "
         "the job would be meaningless", f"{v:g} mm/s", f">= {v_min:.3g} mm/s on this machine",
         f"set process.scan_speed_mm_s to at least {v_min:.3g}")])
+
+
+def check_speeds(job, machine) -> None:
+    """Refuse a job whose cut moves the machine's axes cannot run at the scan speed, where its laser fires in time
+    (before anything is written).
+
+    A cut move along ``(dx, dy)`` (mm on the outer surface) at ``v`` mm/s needs ``v |dx| / L`` mm/s of the axial
+    axis and ``v |dy| / L`` of the circumferential one (in deg/s on a rotary axis: ``/ r_o x 180 / pi``); a LinuxCNC
+    profile's path speed is capped too, by its fastest linear axis (``[TRAJ] MAX_LINEAR_VELOCITY``). Where a move
+    needs more, the controller runs it slower than planned. With the laser gated in time (a constant pulse rate)
+    the pulses per mm then rise by the same factor, a dose the process was not tuned for: refused. A profile gated
+    by distance keeps the pulses per mm whatever the speed (only the time grows): allowed.
+
+    Raises
+    ------
+    PatternError
+        One issue naming ``process.scan_speed_mm_s``, the axis, what the move needs and the fastest speed that works.
+    """
+    from camtube.errors import Issue, PatternError
+
+    profile = getattr(machine, "profile", machine)
+    pk = job.packed
+    if pk.n_pass == 0 or getattr(profile, "gating", "time") == "distance":
+        return
+    n_geom = len(pk.geom_offset) - 1
+    speed = np.zeros(n_geom)
+    np.maximum.at(speed, np.asarray(pk.pass_geom), np.asarray(pk.pass_speed, float))
+    v_edge = pk.vertices
+    nxt = np.arange(1, len(v_edge) + 1)
+    last = pk.geom_offset[1:] - 1
+    nxt[last] = pk.geom_offset[:-1]
+    d = np.abs(v_edge[nxt] - v_edge)
+    seg = np.hypot(d[:, 0], d[:, 1])
+    seg[last[~pk.geom_closed]] = 0.0
+    v = np.repeat(speed, np.diff(pk.geom_offset))
+    cut = (seg > 0) & (v > 0)
+    if not cut.any():
+        return
+    d, seg, v = d[cut], seg[cut], v[cut]
+    ax, ay = profile.axes[0], profile.axes[1]
+    deg_per_mm = 180.0 / (math.pi * job.outer_radius_mm) if profile.rotary else 1.0
+    unit_y = "deg/s" if profile.rotary else "mm/s"
+    needs = [(ax, v * d[:, 0] / seg, profile.axis(ax).max_velocity, "mm/s"),
+             (ay, v * d[:, 1] / seg * deg_per_mm, profile.axis(ay).max_velocity, unit_y)]
+    if profile.dialect == "linuxcnc":
+        linear = [c for c in profile.axes[:2] if c in "XYZUVW"]
+        path = v * (d[:, 0] / seg if profile.rotary else 1.0)
+        needs.append(("path", path, max(profile.axis(c).max_velocity for c in linear), "mm/s"))
+    worst = max(needs, key=lambda n: float(np.max(n[1] / n[2])))
+    letter, need, limit, unit = worst
+    k = int(np.argmax(need / limit))
+    ratio = float(need[k] / limit)
+    if ratio <= 1.0 + 1e-9:
+        return
+    what = ("the path speed (LinuxCNC's [TRAJ] MAX_LINEAR_VELOCITY, its fastest linear axis)" if letter == "path"
+            else f"axis {letter}")
+    v_max = float(v[k]) / ratio
+    raise PatternError([Issue(
+        "process.scan_speed_mm_s",
+        f"too fast for machine {profile.name}: a cut move at {float(v[k]):g} mm/s needs {float(need[k]):.4g} {unit} "
+        f"of {what}, whose limit is {limit:g} {unit}; the controller would cut slower, and with its laser gated in "
+        f"time the pulses per mm would rise {ratio:.3g}x", f"{float(v[k]):g} mm/s", f"<= {v_max:.4g} mm/s on this machine",
+        f"set process.scan_speed_mm_s to at most {v_max:.4g}, or use a machine whose laser is gated by distance "
+        "(see `camtube machines`)")])
 
 
 #: Process key (and what else sets it) of each value a dialect's laser lines write.
