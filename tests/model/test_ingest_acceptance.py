@@ -143,6 +143,18 @@ def test_ingest_command_writes_the_measurement_file_and_the_report(tmp_path, cap
                  "--cycles", "all"]) == 0
 
 
+def test_a_daq_line_written_twice_is_set_aside_and_said(tmp_path, capsys):
+    lines = (BENCH / "daq.csv").read_text().splitlines(keepends=True)
+    daq = tmp_path / "daq.csv"
+    daq.write_text("".join(lines[:101] + [lines[100]] + lines[101:]))   # the line of 495 ms twice: file line 102
+    argv = _argv(tmp_path)
+    argv[argv.index("--daq") + 1] = str(daq)
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert f"set aside: {daq}: 1 line(s) whose time stamp repeats the line before (lines 102;" in out
+    assert (tmp_path / "d.csv").exists()
+
+
 @pytest.mark.parametrize("extra, message", [
     (["--map", "motor.sign=-1"], "column 'enc_counts' gives a stroke that runs negative"),
     (["--map", "daq.N_per_V=-2.5"], "column 'load_V' falls as the stroke rises"),

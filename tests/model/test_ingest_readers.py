@@ -110,6 +110,19 @@ def test_series_errors():
         parse_series("t,v\n2,2\n1,3\n", "l.csv", "t", "s", "v")
 
 
+def test_a_repeated_stamp_is_set_aside_and_a_clock_that_repeats_often_refused():
+    """A logger that writes a stamp twice now and then: the later line set aside (it was refused, the whole run lost);
+    a time column that repeats on more than 5 % of its lines (seconds written as whole numbers) refused, naming it."""
+    rows = [f"{k * 0.01:.2f},{k}" for k in range(100)]
+    rows.insert(41, "0.40,999")   # line 43: the stamp of line 42 again
+    got = parse_series("t,v\n" + "\n".join(rows) + "\n", "l.csv", "t", "s", "v")
+    assert got.repeated.tolist() == [43] and got.time_s.size == 100 and 999.0 not in got.value
+    assert np.all(np.diff(got.time_s) > 0) and got.lines[41] == 44
+    coarse = "t,v\n" + "\n".join(f"{k // 10},{k}" for k in range(100)) + "\n"
+    with pytest.raises(DataError, match=r"l.csv:3: column 't' repeats its time stamp on 90 of 100 lines.*fix: map"):
+        parse_series(coarse, "l.csv", "t", "s", "v", role="daq")
+
+
 def test_bench_map_overrides_and_unknown_keys():
     bm = bench_map_from_dict({"motor": {"gear_ratio": 64}}, "b.yaml", ["motor.sign=-1", "daq.offset_V=rest"])
     assert bm.motor.gear_ratio == 64.0 and bm.motor.sign == -1 and bm.daq.offset_V == "rest"

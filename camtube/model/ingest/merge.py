@@ -48,6 +48,8 @@ class Ingested:
         ``tip_state``, ``base_state``.
     sources : dict of str -> str
         The files.
+    set_aside : dict of str -> (k,) int
+        Lines of a log (``daq``, ``motor``, ``tracker`` for an angle log) set aside because their time stamp repeats the line's before.
     """
 
     data: Dataset
@@ -59,6 +61,7 @@ class Ingested:
     gaps: dict
     traces: dict = field(default_factory=dict)
     sources: dict = field(default_factory=dict)
+    set_aside: dict = field(default_factory=dict)
 
     @property
     def dropouts(self) -> int:
@@ -249,7 +252,9 @@ def ingest(tracker: TrackerLog | Series, daq: Series, motor: Series, bench: Benc
               "row_t": tk, "t0_s": t0}
     return Ingested(data, bend, {"motor": c_motor, "daq": c_daq}, flagged, absent, dropped,
                     {"tracker": int(np.sum(dtt > 1.5 * med)), "daq": n_gap_d, "motor": n_gap_m}, traces,
-                    {"tracker": tracker.source, "daq": daq.source, "motor": motor.source})
+                    {"tracker": tracker.source, "daq": daq.source, "motor": motor.source},
+                    {k: x.repeated for k, x in (("tracker", tracker), ("daq", daq), ("motor", motor))
+                     if isinstance(x, Series) and x.repeated.size})
 
 
 def ingest_files(tracker_path, daq_path, motor_path, bench: BenchMap, sample: str | None = None, *,

@@ -143,6 +143,10 @@ def summary_lines(ing: Ingested) -> list[str]:
     out.append(f"tracker dropouts: {ing.dropouts} frames (flagged: {fl}; absent from the export: {ing.absent_frames})")
     out.append("frames without a row: " + ", ".join(f"{k} {v}" for k, v in ing.dropped.items()))
     out.append(f"gaps: " + ", ".join(f"{k} {v}" for k, v in ing.gaps.items()))
+    for k, lines in ing.set_aside.items():
+        shown = ", ".join(str(int(x)) for x in lines[:3]) + (", ..." if lines.size > 3 else "")
+        out.append(f"set aside: {ing.sources.get(k, k)}: {lines.size} line(s) whose time stamp repeats the line "
+                   f"before (lines {shown}; the first at each stamp kept)")
     oop = ing.bend.out_of_plane_deg[ing.bend.valid]
     if np.isfinite(oop).any():
         out.append(f"out-of-plane rotation: RMS {ing.bend.out_of_plane_rms_deg:.3f} deg, max {np.nanmax(oop):.3f} deg")

@@ -285,6 +285,8 @@ class Series:
         The trigger column, if mapped.
     lines : (n,) int
         File line of each sample.
+    repeated : (k,) int
+        File lines set aside because their time stamp repeats the line's before (the first at each stamp is kept).
     """
 
     source: str
@@ -293,10 +295,15 @@ class Series:
     value: np.ndarray
     trigger: np.ndarray | None
     lines: np.ndarray
+    repeated: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
 
     def with_value(self, value: np.ndarray) -> "Series":
         """The same samples with another value column (e.g. calibrated)."""
         return replace(self, value=np.asarray(value, float))
+
+
+#: Most lines of a log whose time stamp may repeat the one before (set aside); more is refused.
+MAX_REPEATED_SHARE = 0.05
 
 
 def parse_series(text: str, source: str, time: str, time_unit: str, value: str, trigger: str = "",
@@ -307,7 +314,8 @@ def parse_series(text: str, source: str, time: str, time_unit: str, value: str, 
     ------
     DataError
         A missing column (with a "did you mean" and the map key to change), a non-numeric or empty cell
-        (file, line and column), a time that does not increase.
+        (file, line and column), a time that goes back, or that repeats on more than 5 % of the lines (a repeat
+        on fewer is set aside: :attr:`Series.repeated`).
     """
     table = read_table(text, source, comments=True)
     log = role if role == "log" else f"{role} log"
@@ -348,12 +356,25 @@ def parse_series(text: str, source: str, time: str, time_unit: str, value: str, 
                                 "(a gap is found from the time stamps)")
         out[what] = col
     t = out["time"] * TIME_UNITS[time_unit]
-    back = np.flatnonzero(np.diff(t) <= 0)
+    step = np.diff(t)
+    back = np.flatnonzero(step < 0)
     if back.size:
         k = int(back[0]) + 1
         raise DataError(f"{source}:{lines[k]}: column {time!r} does not increase ({out['time'][k]:g} after "
                         f"{out['time'][k - 1]:g} on line {lines[k - 1]}); fix: one recording per file, in time order")
-    return Series(source, value, t, out["value"], out.get("trigger"), ln)
+    # a stamp that repeats the one before (a logger writing a line twice, a clock coarser than the sampling now and
+    # then): the later lines set aside and counted, the first kept; a clock that repeats often is refused (the wrong
+    # column or unit, or a clock too coarse to align the logs by)
+    same = np.flatnonzero(step == 0) + 1
+    if same.size > MAX_REPEATED_SHARE * len(t):
+        k = int(same[0])
+        raise DataError(f"{source}:{lines[k]}: column {time!r} repeats its time stamp on {same.size} of {len(t)} "
+                        f"lines ({out['time'][k]:g} again; at most {100 * MAX_REPEATED_SHARE:g} % are set aside); fix: "
+                        f"map the {log}'s time column with its finest resolution (is it the right column and unit?)")
+    keep = np.ones(len(t), bool)
+    keep[same] = False
+    return Series(source, value, t[keep], out["value"][keep],
+                  out["trigger"][keep] if "trigger" in out else None, ln[keep], ln[same])
 
 
 def load_series(path: str | Path, time: str, time_unit: str, value: str, trigger: str = "",
