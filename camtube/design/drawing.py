@@ -298,6 +298,16 @@ def _read_document(path, file: str):
     except ezdxf.DXFError as exc:
         raise PatternError([Issue("file", f"not a valid DXF file: {exc}", None, "a DXF file (R12 or later)",
                                   "save the drawing as DXF again from your CAD program", file)]) from None
+    except StopIteration:   # ezdxf's tag reader runs out of tags: the file ends inside a section
+        raise PatternError([Issue("file", "not a valid DXF file: it ends inside a section (cut short: a copy or "
+                                  "download that did not finish?)", None, "a whole DXF file (R12 or later)",
+                                  "save the drawing as DXF again from your CAD program", file)]) from None
+    except (ValueError, IndexError, KeyError, TypeError, AttributeError, UnicodeError) as exc:
+        # a damaged file ezdxf's reader fails on without a DXFError of its own
+        why = " ".join(str(exc).split())[:120] or type(exc).__name__
+        raise PatternError([Issue("file", f"not a valid DXF file ({type(exc).__name__}: {why})", None,
+                                  "a DXF file (R12 or later)", "save the drawing as DXF again from your CAD program",
+                                  file)]) from None
 
 
 def _units(doc, given: str | None, file: str) -> tuple[float, str]:

@@ -174,6 +174,28 @@ def test_not_a_dxf_is_one_clear_error(tmp_path):
         load_drawing(tmp_path / "missing.dxf", [], DrawingOptions())
 
 
+def test_a_drawing_cut_short_anywhere_is_one_clear_error_or_read(tmp_path):
+    """A DXF file cut short (a copy that did not finish) was a StopIteration traceback where it ends inside the
+    header; cut anywhere, it is read, or refused as not a valid DXF file."""
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    whole = save(s, tmp_path).read_bytes()
+    cut = tmp_path / "cut.dxf"
+    refused = 0
+    for k in [50, 51, 200, 1000] + [int(f * len(whole)) for f in (0.1, 0.3, 0.5, 0.7, 0.9, 0.99)]:
+        cut.write_bytes(whole[:k])
+        try:
+            load_drawing(cut, [], DrawingOptions())
+        except PatternError as exc:
+            assert "not a valid DXF" in str(exc) or "cannot" in str(exc), str(exc)
+            refused += 1
+    assert refused >= 1
+    cut.write_bytes(whole[:50])
+    with pytest.raises(PatternError, match="it ends inside a section"):
+        load_drawing(cut, [], DrawingOptions())
+
+
 def test_fills_are_set_aside_only_when_their_boundary_is_drawn(tmp_path):
     s = Sheet()
     draw_outline(s)
