@@ -234,6 +234,11 @@ def build_goal(raw: dict, file: str | None = None, lines: dict[str, int] | None 
     if not tube["inner_radius"] < tube["outer_radius"]:
         r.issue("tube.inner_radius", "inner radius must be smaller than the outer radius", tube["inner_radius"],
                 f"< tube.outer_radius = {tube['outer_radius']:g} mm", "check r_i and r_o (radii, not diameters)")
+    elif not tendon["radius"] < tube["inner_radius"]:
+        # (the design rules refuse such a pattern; here the solver searched on and named the force instead)
+        r.issue("tendon.radius", "the tendon is thicker than the tube's lumen (it runs inside the tube)",
+                tendon["radius"], f"< tube.inner_radius = {tube['inner_radius']:g} mm",
+                "check r_t (a radius, not a diameter) and r_i")
     bends = goal["bends"] or ()
     arcs = goal["centerline"] or ()
     if arcs:

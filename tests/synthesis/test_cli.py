@@ -73,6 +73,9 @@ limits: {max_strain: 0.04}
     (("bend_deg: 40", "bend_deg: -40"), ["goal.bends[0].bend_deg", "> 0", "-40"]),
     (("stroke_mm: 1.2", "stroke_mm: 1.2mm"), ["goal.bends[0].stroke_mm", "expected a number"]),
     (("inner_radius: 0.45", "inner_radius: 0.95"), ["tube.inner_radius", "smaller than the outer radius"]),
+    # (the solver searched on and named limits.max_force_N: "the stroke stretches the tendon beyond any force")
+    (("tube: {", "tendon: {radius: 0.5}\ntube: {"), ["tendon.radius", "thicker than the tube's lumen", ":1:",
+                                                       "< tube.inner_radius = 0.45 mm"]),
     (("goal:", "goal:\n  distribution: tipfirst"), ["goal.distribution", "did you mean 'tip_first'"]),
     (("goal:", "goal:\n  curve: [2, 4]\n  curve_length: 10"), ["goal.bends[0].bend_deg", "30.00"]),
     (("limits:", "limit:"), ["did you mean 'limits'"]),
