@@ -123,12 +123,19 @@ def _interrupted(exc: BaseException) -> KeyboardInterrupt | None:
 def _libraries_quiet(quiet: bool):
     """With ``-q``: no Python warning (numpy's RuntimeWarning, scipy's OptimizeWarning) and no library log record
     below ERROR (ezdxf's 'Found non-unique entity handle') reaches stderr while the command runs. What matters to the
-    user camtube says itself, as a warning line (which ``-q`` drops too) or an error (which it never drops)."""
+    user camtube says itself, as a warning line (which ``-q`` drops too) or an error (which it never drops).
+
+    Without ``-q`` numpy's arithmetic warnings (``RuntimeWarning``: an overflow in a value of 1e300, the mean of an
+    empty slice in a log of one frame) are dropped too: they name a line of numpy or camtube, not of the input, and
+    stood between the user and the one line that says what is wrong with it."""
+    import warnings
+
     if not quiet:
-        yield
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            yield
         return
     import logging
-    import warnings
 
     before = logging.root.manager.disable
     with warnings.catch_warnings():

@@ -22,6 +22,7 @@ from camtube.model.sim.rawlogs import BenchSetup, random_setups, simulate_bench
 from tests.conftest import PATTERNS, ROOT
 
 BENCH = ROOT / "examples" / "bench"
+HEAD = next(csv.reader(open(BENCH / "aurora-export.csv", newline="")))
 
 TUNED = [("tube2", BenchSetup(seed=0)), ("tube2", BenchSetup(seed=1, n_cycles=8))]
 SEEN = [
@@ -185,6 +186,44 @@ def test_a_log_of_one_row_is_refused_in_one_line_without_a_wrong_fix(tmp_path, c
     assert len(err.strip().splitlines()) == 1 and "RuntimeWarning" not in err, err
     assert f"{one}: column" in err and "spans no time (1 row" in err and "time_unit" not in err, err
     assert not (tmp_path / "d.csv").exists()
+
+
+def _export_lines(edit):
+    rows = list(csv.reader(open(BENCH / "aurora-export.csv", newline="")))
+    return rows[:1] + edit(rows[1:])
+
+
+@pytest.mark.parametrize("name, edit, words", [
+    # a one-frame export: numpy's 'Mean of empty slice' twice on stderr, then "do not overlap in time after alignment"
+    ("one", lambda rows: rows[:1], ["one.csv:2: the export holds one frame: it spans no time"]),
+    # an infinite time stamp was called "empty"
+    ("inf", lambda rows: rows[:5] + [[("inf" if h == "Time [sec]" else c) for h, c in zip(HEAD, rows[5])]] + rows[6:],
+     ["inf.csv:7:", "is not a finite number (inf)"]),
+])
+def test_a_broken_tracker_export_is_one_line_without_numpy_warnings(tmp_path, name, edit, words):
+    from tests.test_cli_errors import camtube
+
+    bad = tmp_path / f"{name}.csv"
+    with open(bad, "w", newline="") as fh:
+        csv.writer(fh).writerows(_export_lines(edit))
+    r = camtube(*_argv(tmp_path, tracker=bad))   # a process of its own: numpy's warnings reach its stderr
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "Warning" not in r.stderr, r.stderr
+    for w in words:
+        assert w in r.stderr, r.stderr
+
+
+def test_a_huge_value_in_the_export_brings_no_numpy_warning(tmp_path):
+    """A quaternion component of 1e300 (an export glitch): the frame is read and judged by camtube; numpy's
+    'overflow encountered in multiply' with its source line reached stderr."""
+    q0 = HEAD.index("Q0")
+    big = tmp_path / "big.csv"
+    with open(big, "w", newline="") as fh:
+        csv.writer(fh).writerows(_export_lines(lambda rows: rows[:9] + [rows[9][:q0] + ["1e300"] + rows[9][q0 + 1:]]
+                                              + rows[10:]))
+    from tests.test_cli_errors import camtube
+
+    r = camtube(*_argv(tmp_path, tracker=big))   # a process of its own: numpy's warnings reach its stderr
+    assert "RuntimeWarning" not in r.stderr and "Traceback" not in r.stderr, r.stderr
 
 
 def test_tracker_in_metres_is_named_and_fixed_by_the_map(tmp_path, capsys):

@@ -260,8 +260,9 @@ def parse_ndi(text: str, source: str = "<ndi>", *, unit: str = "mm", rate_hz: fl
         if not np.all(np.isfinite(time)):
             if "time" in fields:
                 k = int(np.flatnonzero(~np.isfinite(time))[0])
-                raise _err(source, lines[k], f"column {fields['time'] + 1} ('Time' of {label!r}) is empty",
-                           "every line needs its time")
+                what = "is empty" if np.isnan(time[k]) else f"is not a finite number ({float(time[k])})"
+                raise _err(source, lines[k], f"column {fields['time'] + 1} ('Time' of {label!r}) {what}",
+                           "every line needs its time, a number of seconds")
             if rate_hz is None or not rate_hz > 0:
                 raise _err(source, hline, "the export has no time column",
                            "give the tracker's frame rate (--map tracker.rate_hz=40), or export with time stamps")
@@ -273,6 +274,10 @@ def parse_ndi(text: str, source: str = "<ndi>", *, unit: str = "mm", rate_hz: fl
             port = f"{int(p, 16):02X}" if p.lower().startswith("0x") or re.search("[a-f]", p, re.I) else f"{int(p):02X}"
             name = (m.group("rest") or "").strip()
         tools.append(ToolTrack(label, port, name, frame.astype(np.int64), time, state, quat, pos, num["error"]))
+    if len(lines) < 2:
+        # (it spans no time: aligned with the logs it overlapped nothing, and numpy warned of an empty mean)
+        raise _err(source, lines[0], "the export holds one frame: it spans no time",
+                   "give the whole export of the run, every frame of the recording")
     back = np.flatnonzero(np.diff(tools[0].time_s) <= 0)
     if back.size:
         k = int(back[0]) + 1
