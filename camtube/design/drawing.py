@@ -296,7 +296,9 @@ def _read_document(path, file: str):
         raise PatternError([Issue("file", f"cannot read the drawing: {exc.strerror or exc}", file,
                                   "a readable DXF file", "check the path", file)]) from None
     except ezdxf.DXFError as exc:
-        raise PatternError([Issue("file", f"not a valid DXF file: {exc}", None, "a DXF file (R12 or later)",
+        # (on one line: ezdxf's message may quote the bad tag with its line break)
+        raise PatternError([Issue("file", f"not a valid DXF file: {' '.join(str(exc).split())}", None,
+                                  "a DXF file (R12 or later)",
                                   "save the drawing as DXF again from your CAD program", file)]) from None
     except StopIteration:   # ezdxf's tag reader runs out of tags: the file ends inside a section
         raise PatternError([Issue("file", "not a valid DXF file: it ends inside a section (cut short: a copy or "
@@ -496,6 +498,16 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
     if t == "SPLINE" and entity.dxf.degree == 1:
         _control_polygon(rd, entity, ent, layer, role)
         return
+    if t in ("CIRCLE", "ARC"):
+        # a radius of nan was dropped without a word (the drawing then 'has no cuts'), a negative one cut as its size
+        r = float(entity.dxf.get("radius", 0.0))
+        if not (math.isfinite(r) and r >= 0.0):
+            if role == "ignore":
+                ent.status = "aside:ignored layer"
+            else:
+                rd.refuse(ent.describe(), f"has a radius of {r:g}, not a number >= 0 (the file may be damaged)",
+                          "redraw it with its radius, or export the drawing again", entities=[ent])
+            return
     _flatten(rd, entity, ent, layer, role)
 
 

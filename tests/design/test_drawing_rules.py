@@ -196,6 +196,34 @@ def test_a_drawing_cut_short_anywhere_is_one_clear_error_or_read(tmp_path):
         load_drawing(cut, [], DrawingOptions())
 
 
+@pytest.mark.parametrize("radius, layer", [(-0.1, "HOLES"), (float("nan"), "HOLES"), (float("nan"), "CONSTRUCTION")])
+def test_a_circle_whose_radius_is_negative_or_nan_is_refused_on_a_cut_layer(tmp_path, radius, layer):
+    """A radius of nan was dropped without a word (the drawing then 'has no cuts', or cut nothing there); a
+    negative one was cut as a hole of its size."""
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    s.msp.add_circle(s.at(5.0, MID), 0.15, dxfattribs={"layer": layer}).dxf.radius = radius
+    if layer == "CONSTRUCTION":   # set aside there, as any entity of an ignored layer
+        assert len(load_drawing(save(s, tmp_path), [], DrawingOptions()).pattern.cuts) == 1
+        return
+    with pytest.raises(PatternError, match=rf"CIRCLE #\w+ on layer HOLES: has a radius of {radius:g}, not a number"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+
+
+def test_a_bad_tag_is_named_on_one_line(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    text = save(s, tmp_path).read_text().splitlines(keepends=True)
+    at = next(k for k, ln in enumerate(text) if ln.strip() == "LWPOLYLINE")
+    text[at - 1] = "abc\n"   # the entity's group code 0 replaced
+    bad = tmp_path / "bad.dxf"
+    bad.write_text("".join(text))
+    with pytest.raises(PatternError) as err:
+        load_drawing(bad, [], DrawingOptions())
+    assert "not a valid DXF" in str(err.value) and "\n" not in str(err.value).strip()
+
+
 def test_fills_are_set_aside_only_when_their_boundary_is_drawn(tmp_path):
     s = Sheet()
     draw_outline(s)
