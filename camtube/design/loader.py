@@ -325,6 +325,10 @@ def build_settings(raw: dict, file: str | None = None) -> tuple[Tube, Process, T
             Rules(rl["min_backbone_arc"], rl["min_web"], rl["max_strain"], rl["max_stroke"]))
 
 
+#: Characters a file name on Windows may not hold (besides '/' and '\\', refused as folders).
+WINDOWS_RESERVED = '<>:"|?*'
+
+
 def check_name(r: _Reader, name) -> None:
     """``name:`` names the output files (NAME.ngc, NAME.job.json, ...): one plain file name, no folders."""
     if name is None:
@@ -343,6 +347,13 @@ def check_name(r: _Reader, name) -> None:
         r.issue("name", "names the output files (NAME.ngc, NAME.job.json, ...), so it must be a plain file name",
                 name, "letters, digits, '-', '_', '.'; no '/' or '\\'", "drop the folder part, e.g. name: tube2 "
                 "(choose the folder with -o)")
+    elif any(c in str(name) for c in WINDOWS_RESERVED):
+        # (written on Linux, a*b?.ngc cannot be copied to the controller's PC if that runs Windows, nor typed in a
+        # shell without quotes)
+        bad = "".join(dict.fromkeys(c for c in str(name) if c in WINDOWS_RESERVED))
+        r.issue("name", f"holds {' '.join(repr(c) for c in bad)}, which a file name on Windows may not hold (the "
+                "output files are named after it)", name,
+                "letters, digits, '-', '_', '.', spaces; none of < > : \" | ? * / \\", "write e.g. name: tube2")
 
 
 def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = None, name: str | None = None) -> Loaded:
