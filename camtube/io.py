@@ -114,6 +114,18 @@ def _uninterrupted():
             old[signum](signum, frame)  # raises KeyboardInterrupt (or Terminated) here
 
 
+def import_whole(*modules: str) -> None:
+    """Import ``modules`` with Ctrl-C and SIGTERM held back (:func:`_uninterrupted`): one that comes meanwhile is raised
+    once they are imported. A library that guards its optional imports with ``except BaseException`` (trimesh) swallowed
+    a Ctrl-C that came while it imported, so the command ran on and published its outputs, or left a module it was
+    importing half made (scipy.ndimage: a ``NameError`` later)."""
+    import importlib
+
+    with _uninterrupted():
+        for name in modules:
+            importlib.import_module(name)
+
+
 class OutputError(CamtubeError, OSError):
     """An output could not be written; the message names the path and the fix.
 

@@ -189,3 +189,32 @@ def test_write_atomic_through_a_link_to_a_file_replaces_the_file_and_keeps_the_l
     (tmp_path / "dir.html").symlink_to(tmp_path / "runs")
     with pytest.raises(OutputError, match="directory"):
         write_atomic(tmp_path / "dir.html", "x")
+
+
+def test_a_ctrl_c_while_a_library_imports_is_raised_once_it_is_imported(tmp_path, monkeypatch):
+    """A library that guards its optional imports with ``except BaseException`` (trimesh) swallowed a Ctrl-C that came
+    while it imported: ``camtube cad`` then ran on and published its outputs. Held by import_whole, it is raised
+    after the import, which is whole."""
+    import sys
+
+    from camtube.io import import_whole
+
+    (tmp_path / "greedy_lib.py").write_text(
+        "import os, signal\n"
+        "try:\n"
+        "    os.kill(os.getpid(), signal.SIGINT)   # Ctrl-C arrives while an optional part imports\n"
+        "    import time; time.sleep(0.05)\n"
+        "except BaseException:\n"
+        "    pass\n"
+        "WHOLE = True\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "greedy_lib", raising=False)
+    with pytest.raises(KeyboardInterrupt):
+        import_whole("greedy_lib")
+    assert sys.modules["greedy_lib"].WHOLE
+    # without it, the library eats the Ctrl-C: nothing is raised
+    monkeypatch.delitem(sys.modules, "greedy_lib")
+    import importlib
+
+    importlib.import_module("greedy_lib")   # (returns: the Ctrl-C is gone)
+    assert sys.modules["greedy_lib"].WHOLE

@@ -110,6 +110,10 @@ def cad_outputs(pattern: Pattern, job, *, step: bool = True, pictures: bool = Tr
     kerf_mm : float, optional
         Beam kerf for the simulation (default: the process's, or 0.02 mm).
     """
+    from camtube.io import import_whole
+
+    # (a Ctrl-C while they import is raised here, once they are whole: see import_whole)
+    import_whole("trimesh", *(("build123d",) if step else ()))
     from camtube.cad.mesh import stl_bytes
     from camtube.cad.verify import report_json, report_text, verify
 
