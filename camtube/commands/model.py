@@ -193,6 +193,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
                             "--set-aside")
         raw = load_csv(args.data)
         check_time_varies(raw, args.data)
+        _check_stroke_spikes(raw, args.data)
         rows = prepare(raw, args.cycles, args.branch, args.deadband, args.deadband_threshold)
     check_fittable(rows, f"{args.data} (cycles {args.cycles}, {args.branch} branch)")
     check_signs(rows, args.data)
@@ -260,6 +261,28 @@ def cmd_synth(args: argparse.Namespace) -> int:
     print(f"wrote {path}: {len(data)} rows, {args.samples} sample(s) x {args.cycles} cycles, "
           f"stroke 0-{pattern.rules.max_stroke_mm:g} mm; a perfect fit leaves RMSE ~{floor:.3f} deg")
     return 0
+
+
+def _check_stroke_spikes(raw, source: str) -> None:
+    """Refuse rows as read whose stroke jumps for one row (:func:`~camtube.model.diagnose.instruments.stroke_spikes`),
+    naming the first: the fit would be made to a stroke the motor never had (one of 1e6 mm read as a stroke logged in
+    um, and the fix said to divide it by 1000); ``--set-aside`` sets them aside instead."""
+    import numpy as np
+
+    from camtube.errors import DataError
+    from camtube.model.diagnose.instruments import stroke_spikes
+
+    bad = np.flatnonzero(stroke_spikes(np.asarray(raw.stroke_mm, float), raw.sample_slices()))
+    if not bad.size:
+        return
+    k = int(bad[0])
+    s = raw.stroke_mm
+    more = f" (and {bad.size - 1} more such row(s))" if bad.size > 1 else ""
+    raise DataError(f"{source}: sample {raw.sample[k]}, cycle {int(raw.cycle[k])}, t = {float(raw.time_s[k]):g} s: "
+                    f"stroke_mm jumps to {float(s[k]):g} mm for one row, the rows either side read "
+                    f"{float(s[k - 1]):g} and {float(s[k + 1]) if k + 1 < len(s) else float('nan'):g} mm{more}: a "
+                    "glitch of the motor's log, not a motion; fix: correct or delete that line, or add --set-aside "
+                    "(the instruments' check sets such rows aside and says so)")
 
 
 def cmd_ingest(args: argparse.Namespace) -> int:

@@ -117,3 +117,29 @@ def test_fit_per_sample_init_and_starts(data_csv, tmp_path, capsys):
     assert "--init 'E_t'" in capsys.readouterr().err
     assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--effects", "slack",
                  "--per-sample", "slak"]) == 2
+
+
+@pytest.mark.parametrize("spike_mm", [50.0, 1e6])
+def test_a_stroke_that_jumps_for_one_row_is_named_or_set_aside(data_csv, tmp_path, capsys, spike_mm):
+    """The bad-input search: a stroke of 50 mm for one row was fitted as is (E_t at its bound); one of 1e6 mm was
+    called 'a stroke logged in um: divide it by 1000'. The row is named (sample, cycle, time); --set-aside sets it
+    aside and the fit is the clean file's."""
+    rows = list(csv.reader(open(data_csv, newline="")))
+    k = 40
+    t = rows[k][rows[0].index("time_s")]
+    rows[k][rows[0].index("stroke_mm")] = f"{spike_mm:g}"
+    bad = tmp_path / "spike.csv"
+    with open(bad, "w", newline="") as fh:
+        csv.writer(fh).writerows(rows)
+    assert main(["model", "fit", str(bad), "--pattern", TUBE2, "-q", "--cycles", "all"]) == 2
+    err = capsys.readouterr().err
+    assert f"t = {float(t):g} s: stroke_mm jumps to {spike_mm:g} mm for one row" in err and "reads like" not in err, err
+    assert "fix: correct or delete that line, or add --set-aside" in err
+    j_bad, j_clean = tmp_path / "bad.json", tmp_path / "clean.json"
+    assert main(["model", "fit", str(bad), "--pattern", TUBE2, "-q", "--cycles", "all", "--set-aside",
+                 "--json", str(j_bad)]) == 0
+    assert "1 stroke spike" in capsys.readouterr().out
+    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--cycles", "all", "--set-aside",
+                 "--json", str(j_clean)]) == 0
+    e_bad, e_clean = (json.loads(p.read_text())["params"]["E_t"]["value"] for p in (j_bad, j_clean))
+    assert e_bad == pytest.approx(e_clean, rel=0.01)

@@ -88,6 +88,8 @@ from camtube.model.data.dataset import SPEED_COLUMN, Dataset, Rests, at_bottom, 
 SPIKE_Z = 8.0
 #: Neighbours either side whose range a row is compared with.
 NEIGHBOURS = 2
+#: A stroke spike lies beyond its neighbours' range by this share of the sample's stroke span too (:func:`stroke_spikes`).
+STROKE_SPIKE_SPAN = 0.05
 #: The longest burst (rows displaced together) set aside, in seconds of the sample's median interval ...
 BURST_S = 0.5
 #: ... and in rows.
@@ -724,6 +726,30 @@ def _spikes(x: np.ndarray, slices: list, limit: np.ndarray | None = None) -> np.
         pad = np.concatenate((np.full(h, v[0]), v, np.full(h, v[-1])))
         win = np.delete(np.lib.stride_tricks.sliding_window_view(pad, 2 * h + 1), h, axis=1)
         out[sl] = (v > win.max(axis=1) + SPIKE_Z * scale) | (v < win.min(axis=1) - SPIKE_Z * scale)
+    return out
+
+
+def stroke_spikes(stroke: np.ndarray, slices: list) -> np.ndarray:
+    """Rows whose stroke lies outside the range of their neighbours (:data:`NEIGHBOURS` rows either side, same sample)
+    by more than :data:`SPIKE_Z` typical steps of the motion and :data:`STROKE_SPIKE_SPAN` of the sample's span: a
+    motor's log glitching for one row (a value of 50 mm in a 2 mm stroke). The motor's own steps are smooth, its
+    turning points within a step of their neighbours; its rests repeat a value, so the typical step is read on the
+    rows that move (the angle's and force's noise scale would be 0 where the stroke dwells half the time)."""
+    out = np.zeros(stroke.size, bool)
+    h = NEIGHBOURS
+    for _, sl in slices:
+        v = stroke[sl]
+        if v.size < 10 * h:
+            continue
+        d = np.abs(np.diff(v))
+        d = d[np.isfinite(d) & (d > 0)]
+        if d.size < 10:
+            continue
+        lo, hi = np.percentile(v, [0.5, 99.5])
+        beyond = max(SPIKE_Z * float(np.median(d)), STROKE_SPIKE_SPAN * float(hi - lo))
+        pad = np.concatenate((np.full(h, v[0]), v, np.full(h, v[-1])))
+        win = np.delete(np.lib.stride_tricks.sliding_window_view(pad, 2 * h + 1), h, axis=1)
+        out[sl] = (v > win.max(axis=1) + beyond) | (v < win.min(axis=1) - beyond)
     return out
 
 
@@ -1556,47 +1582,53 @@ def shift_angle(data: Dataset, lag_ms: float | Mapping[str, float]) -> tuple[Dat
     return data.with_angle(ang).take(keep), keep, out, past_end
 
 def _artefacts(data: Dataset, slices: list) -> tuple[dict, np.ndarray, np.ndarray, dict]:
-    """The instruments' artefacts of ``data`` (rows as read): ``(aside {why: rows}, kept (n,) bool, repeated stamps
-    (n,) bool, the load cells' limits {sample: (reading N, rows)})``; see :func:`check_instruments`."""
+    """The instruments' artefacts of ``data`` (rows as read): ``(aside {why: rows}, kept (n,) bool, rows whose stamp
+    repeats or whose stroke spikes (n,) bool: read nowhere, the drive's speed and history included, the load cells' limits {sample: (reading N, rows)})``; see :func:`check_instruments`."""
     aside: dict[str, np.ndarray] = {}
     rep = np.zeros(len(data), bool)
     for _, sl in slices:
         t = data.time_s[sl]
         rep[sl.start + 1:sl.stop] = np.diff(t) <= 0.0
     aside["repeated time stamp"] = np.flatnonzero(rep)
-    sa = _spikes(data.angle_deg, slices) & ~rep
+    # a stroke that jumps for one row: its row set aside whole (its force and angle are read at a stroke it never had),
+    # and left out of the others' tests as a repeated stamp is
+    ss = stroke_spikes(data.stroke_mm, slices) & ~rep
+    rep_or_ss = rep | ss
+    sa = _spikes(data.angle_deg, slices) & ~rep_or_ss
     sat, limits = _saturated(data.force_N, data.stroke_mm, slices)
-    sat &= ~rep
-    sf = _spikes(data.force_N, slices, limit=sat) & ~rep & ~sa & ~sat
+    sat &= ~rep_or_ss
+    sf = _spikes(data.force_N, slices, limit=sat) & ~rep_or_ss & ~sa & ~sat
     steps = data.median_steps_s(positive=True)
-    ba = _bursts(data.angle_deg, steps, slices, sa) & ~rep & ~sa & ~sf
-    bf = _bursts(data.force_N, steps, slices, sf, limit=sat) & ~rep & ~sa & ~sf & ~ba
+    ba = _bursts(data.angle_deg, steps, slices, sa) & ~rep_or_ss & ~sa & ~sf
+    bf = _bursts(data.force_N, steps, slices, sf, limit=sat) & ~rep_or_ss & ~sa & ~sf & ~ba
     frozen = _frozen(data.angle_deg, data.stroke_mm, slices)
-    fz = frozen & ~rep & ~sa & ~sf & ~ba & ~bf & ~sat
-    ahead = _force_ahead(data.force_N, data.stroke_mm, data.time_s, slices, rep | sf | bf | sat, sat)
+    fz = frozen & ~rep_or_ss & ~sa & ~sf & ~ba & ~bf & ~sat
+    ahead = _force_ahead(data.force_N, data.stroke_mm, data.time_s, slices, rep_or_ss | sf | bf | sat, sat)
     # (read across the angle's own artefacts only: where the force was set aside the angle is still read; a tracker
     # that wrote a fixed value, such as 0, is one of them though the burst test took it first: 9 rows of 0 just
     # before a burst of 8 deg for 0.9 s split its jump in two, -16 and +6, and its 94 rows were kept
     # (bench-heldout35's tracker drift: twice the floor, the misfit read as following the angle))
-    lb = _long_bursts(data.angle_deg, steps, slices, rep | sa | fz | (ba & frozen), data.time_s, data.force_N,
+    lb = _long_bursts(data.angle_deg, steps, slices, rep_or_ss | sa | fz | (ba & frozen), data.time_s, data.force_N,
                       data.stroke_mm, sat) & ~(sf | bf | sat)
     if lb.any():
         # the short bursts read again across the long ones: rows displaced for a second beside a run of real rows
         # made it look displaced (5 rows after a 2 s burst, where the carriage slipped, in one file of 244)
-        ba = (_bursts(data.angle_deg, steps, slices, sa, across=lb) & ~rep & ~sa & ~sf & ~lb) | lb
+        ba = (_bursts(data.angle_deg, steps, slices, sa, across=lb) & ~rep_or_ss & ~sa & ~sf & ~lb) | lb
         # (a fixed value the first reading took as a burst, beside a long one, is still a frozen tracker's)
-        fz = frozen & ~rep & ~sa & ~sf & ~ba & ~bf & ~sat
+        fz = frozen & ~rep_or_ss & ~sa & ~sf & ~ba & ~bf & ~sat
     ba &= ~sat
     bf &= ~sat
     ahead &= ~(sa | ba | fz)
+    if ss.any():
+        aside["stroke spike"] = np.flatnonzero(ss)
     aside["angle spike"] = np.flatnonzero(sa)
     aside["force spike"] = np.flatnonzero(sf)
     for why, rows in (("angle burst row", ba), ("force burst row", bf), ("frozen angle row", fz),
                       ("load cell limit row", sat), ("force ahead of the stroke row", ahead)):
         if rows.any():   # (the findings name only the kinds found)
             aside[why] = np.flatnonzero(rows)
-    kept = ~(rep | sa | sf | fz | ba | bf | sat | ahead)
-    return aside, kept, rep, limits
+    kept = ~(rep_or_ss | sa | sf | fz | ba | bf | sat | ahead)
+    return aside, kept, rep_or_ss, limits
 
 
 def check_instruments(data: Dataset, lag_ms: float | Mapping[str, float] | None = None, dropped: str = "",
