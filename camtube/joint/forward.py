@@ -117,6 +117,13 @@ def row_webs_mm(x_mm, width_mm) -> list[tuple[float, float]]:
     return [(gaps[i - 1] if i > 0 else math.inf, gaps[i] if i < len(gaps) else math.inf) for i in range(len(x))]
 
 
+#: The largest value of each parameter a calibration may give (and its unit): the stiffest fibre's modulus, a tendon
+#: of 10 m, an arm ten times the section's, a slack, toe or kerf of 100 mm, a compliance of 100 mm/N, mu of 10.
+CALIBRATION_MAX = {"E_t": (1000.0, "GPa"), "L0": (10_000.0, "mm"), "arm_scale": (10.0, ""),
+                   "slack.deadband_mm": (100.0, "mm"), "toe.toe_mm": (100.0, "mm"), "kerf.kerf_mm": (100.0, "mm"),
+                   "series.compliance_mm_per_N": (100.0, "mm/N"), "friction.mu": (10.0, "")}
+
+
 @dataclass(frozen=True)
 class Mechanics:
     """Physical constants of the forward model beyond the cut geometry.
@@ -231,6 +238,12 @@ class Mechanics:
                 raise CamtubeError(f"{p}: parameter {name} = {v:g}{' ' + unit if unit else ''}: outside its physical "
                                    f"range ({'> 0' if name in positive else '>= 0'}); fix: pass the JSON of a fit "
                                    "whose parameters are physical (hold a parameter with --fix NAME=VALUE)")
+            if name in used and v > CALIBRATION_MAX[name][0]:
+                # (E_t = 1e300 GPa was taken: a tendon that does not stretch, the design computed without a word)
+                top, unit = CALIBRATION_MAX[name]
+                raise CamtubeError(f"{p}: parameter {name} = {v:g}{' ' + unit if unit else ''}: beyond any joint's "
+                                   f"(at most {top:g}{' ' + unit if unit else ''}); fix: pass the JSON of a fit whose "
+                                   "parameters are physical (hold a parameter with --fix NAME=VALUE)")
             if name in used:
                 values[used[name]] = v
             else:
