@@ -14,7 +14,9 @@ import math
 import re
 from typing import Sequence
 
-from camtube.design.geometry import DirectionBend, bends_at_stroke
+import numpy as np
+
+from camtube.design.geometry import DirectionBend, beam_depth_mm, bends_at_stroke
 from camtube.design.pattern import ASSUMED_KERF_MM, Cut, Pattern
 from camtube.errors import Issue
 from camtube.tol import TOL
@@ -153,8 +155,6 @@ def section_arc_mm(cut: Cut) -> float:
     """
     if cut.outline is None or cut.kind == "slit":
         return cut.arc_mm
-    import numpy as np
-
     a = np.asarray(cut.outline, dtype=float)
     b = np.roll(a, -1, axis=0)
     xs = np.unique(a[:, 0])
@@ -209,6 +209,20 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
             f"tube (outer diameter 2 r_o = {2.0 * ro:g} mm), where it cuts nothing", defocus,
             f">= 0 and <= 2 r_o = {2.0 * ro:g} mm", "set process.defocus to the depth of the second focus level "
             "(0.1 mm in the paper's process)")
+    proc = pattern.process
+    if proc.repeats is None and pattern.cuts:
+        # the repeats by the beam depth of the deepest cut (as the planner reads them): a rule that covers no depth
+        # this pattern has was refused only by toolpath, naming no file or line, after design had passed it
+        from camtube.design.contour import cut_contours
+
+        arc = min(max(float(np.ptp(np.asarray(c.points, float)[:, 1])) for c in cut_contours(pattern)), circ)
+        depth = beam_depth_mm(ro, arc)
+        deepest = max((r.max_depth_mm for r in proc.repeat_rule), default=None)
+        if deepest is None or depth > deepest:
+            err("process.repeat_rule", f"no row covers the beam depth {depth:.3f} mm of the deepest cut (arc "
+                f"{arc:.3f} mm)" + ("" if deepest is not None else ": the rule is empty"),
+                [] if deepest is None else deepest, f"a row with max_depth >= {depth:.3f} mm",
+                "add a repeat_rule row with a larger max_depth, or set process.repeats")
     rt = pattern.tendon.radius_mm
     if not rt < ri:
         err("tendon.radius", "the tendon is thicker than the tube's lumen (it runs inside the tube)", rt,

@@ -143,7 +143,11 @@ def test_units_option_and_conflicts():
         load_drawing(EXAMPLES / "unitless.dxf", [], DrawingOptions(units="furlong"))
     with pytest.raises(PatternError, match="says its units are inch"):
         load_drawing(EXAMPLES / "inches.dxf", [], DrawingOptions(units="mm"))
-    p = load_drawing(EXAMPLES / "unitless.dxf", [], DrawingOptions(units="inch")).pattern
+    # (read in inches the cuts are 25 times larger: their beam depth, 23.6 mm, is beyond the process's repeat rule,
+    # a design rule since the bad-input search; the repeats given, the drawing is read)
+    with pytest.raises(PatternError, match="no row covers the beam depth 23.603 mm"):
+        load_drawing(EXAMPLES / "unitless.dxf", [], DrawingOptions(units="inch"))
+    p = load_drawing(EXAMPLES / "unitless.dxf", ["process.repeats=2"], DrawingOptions(units="inch")).pattern
     assert p.tube.length_mm == pytest.approx(254.0)
 
 

@@ -77,6 +77,9 @@ CASES = [
     (["process.rapid_speed_mm_s=1e-300"], "process.rapid_speed_mm_s", ["out of range", ">= 0.1 and <= 10000 mm/s"]),
     (["process.focus_speed_mm_s=1e300"], "process.focus_speed_mm_s", ["out of range", ">= 0.01 and <= 1000 mm/s"]),
     (["process.max_time_h=1e-300"], "process.max_time_h", ["out of range", ">= 0.01 and <= 1000 h"]),
+    # the bad-input search: design passed an empty repeat rule, and toolpath refused it naming no file or line
+    (["process.repeat_rule=[]"], "process.repeat_rule", ["no row covers the beam depth 0.983 mm", "the rule is empty",
+                                                         "add a repeat_rule row"]),
     # the bad-input search: written as a*b?.ngc, a name that said "letters, digits, '-', '_', '.'" only
     (["name=a*b?"], "name", ["holds '*' '?'", "a file name on Windows may not hold", "none of < > : \" | ? *"]),
     (["name=run:2"], "name", ["holds ':'"]),
