@@ -103,6 +103,9 @@ def test_bad_csv_names_file_and_line(tmp_path, lines, line, words):
     (HEADER.replace("cycle,", ""), ["number each sample's pulls in a column 'cycle'", "camtube model ingest"]),
     (HEADER.replace("cycle,", "cycles,"), ["rename 'cycles' -> 'cycle'"]),
     (HEADER.replace("sample,", ""), ["name the tube each row was measured on in a column 'sample'"]),
+    # the bad-input search: an upper-case header was told to "convert 'TIME_S' from S to s"
+    (HEADER.upper(), ["rename 'SAMPLE' -> 'sample', 'CYCLE' -> 'cycle', 'TIME_S' -> 'time_s'",
+                      "'FORCE_N' -> 'force_N'", "letter case included"]),
 ])
 def test_missing_column_fix_converts_other_units_and_renames_near_names(header, words):
     rows = GOOD[1:]

@@ -178,7 +178,12 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
     missing = [c for c in COLUMNS if c not in header]
     if missing:
         hints = []
-        for c in missing:
+        # a name in other letter case (SAMPLE, TIME_S: the hint was to convert 'TIME_S' from S to s)
+        cased = [(h, c) for c in missing for h in header if h.strip().lower() == c.lower()]
+        if cased:
+            hints.append("rename " + ", ".join(f"{h!r} -> {c!r}" for h, c in cased) + " (the names are written as "
+                         f"{', '.join(COLUMNS)}, letter case included)")
+        for c in [c for c in missing if c not in {c for _, c in cased}]:
             quantity, unit = c.rsplit("_", 1) if "_" in c else (c, "")
             other = [h for h in header if "_" in h and h.rsplit("_", 1)[0].lower() == quantity.lower()
                      and h.rsplit("_", 1)[1] != unit]
