@@ -109,9 +109,9 @@ def test_bad_csv_names_file_and_line(tmp_path, lines, line, words):
 ])
 def test_missing_column_fix_converts_other_units_and_renames_near_names(header, words):
     rows = GOOD[1:]
-    if "cycle" not in header:
+    if "cycle" not in header.lower():   # (a column dropped from the header: its cells too)
         rows = [r.replace("A,1,", "A,").replace("A,2,", "A,") for r in rows]
-    if "sample" not in header:
+    if "sample" not in header.lower():
         rows = [r.split(",", 1)[1] for r in rows]
     with pytest.raises(DataError) as err:
         parse_csv(_csv([header] + rows), source="m.csv")
