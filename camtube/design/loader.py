@@ -289,11 +289,21 @@ def _process(proc: dict) -> Process:
 _NOTCH_LISTS = {"widths": ("width", 0), "arcs": ("arc", 0), "spacings": ("spacing", -1), "angles_deg": (None, 0)}
 
 
-def _check_notch_lists(r: _Reader, gen: dict) -> None:
-    """Each per-notch list has one value per notch (per gap for ``spacings``); a scalar is given or replaced."""
+def _check_notch_lists(r: _Reader, gen: dict, written: dict | None = None) -> None:
+    """Each per-notch list has one value per notch (per gap for ``spacings``); a scalar is given or replaced.
+    ``written``: the section as written (a list given empty is refused as a list of the wrong length is: it was
+    taken as not given, so ``angles_deg: []`` cut every notch at ``angle_deg`` without a word)."""
     count = gen.get("count")
+    written = written if isinstance(written, dict) else {}
     for key, (scalar, extra) in _NOTCH_LISTS.items():
         values = gen.get(key) or ()
+        if key in written and isinstance(written[key], (list, tuple)) and not written[key] and count is not None \
+                and max(count + extra, 0) > 0:
+            need = max(count + extra, 0)
+            r.issue(f"notch.{key}", f"is empty, for notch.count = {count}", [],
+                    f"{need} values ({'one per gap between notches' if extra else 'one per notch'}, from the tip)",
+                    f"give {need} values, or delete the key" + (f" (notch.{scalar} then applies to every notch)"
+                                                               if scalar else ""))
         if values and count is not None and len(values) != max(count + extra, 0):
             need = max(count + extra, 0)
             r.issue(f"notch.{key}", f"has {len(values)} values for notch.count = {count}", len(values),
@@ -373,7 +383,7 @@ def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = Non
     holes = r.convert(raw.get("holes") or [], SCHEMA["holes"], "holes")
     extra = r.convert(raw.get("cuts") or [], SCHEMA["cuts"], "cuts")
     if gen:
-        _check_notch_lists(r, gen)
+        _check_notch_lists(r, gen, raw.get("notch"))
     if gen and gen.get("layout") == "directions" and not gen.get("directions_deg") and not gen.get("angles_deg"):
         r.issue("notch.directions_deg", "layout 'directions' needs a list of angles", None,
                 "a non-empty list of angles in deg", "add e.g. directions_deg: [0, 90, 180, 270]")

@@ -80,6 +80,9 @@ CASES = [
     # the bad-input search: design passed an empty repeat rule, and toolpath refused it naming no file or line
     (["process.repeat_rule=[]"], "process.repeat_rule", ["no row covers the beam depth 0.983 mm", "the rule is empty",
                                                          "add a repeat_rule row"]),
+    # the bad-input search: taken as not given, every notch cut at notch.angle_deg without a word
+    (["notch.angles_deg=[]"], "notch.angles_deg", ["is empty, for notch.count = 10", "give 10 values"]),
+    (["notch.spacings=[]"], "notch.spacings", ["9 values (one per gap", "notch.spacing then applies"]),
     # the bad-input search: written as a*b?.ngc, a name that said "letters, digits, '-', '_', '.'" only
     (["name=a*b?"], "name", ["holds '*' '?'", "a file name on Windows may not hold", "none of < > : \" | ? *"]),
     (["name=run:2"], "name", ["holds ':'"]),
