@@ -875,3 +875,14 @@ def test_the_largest_repeats_is_accepted():
     from camtube.design.schema import MAX_REPEATS
 
     assert load(PATTERNS / "tube1.yaml", [f"process.repeats={MAX_REPEATS}"]).pattern.process.repeats == MAX_REPEATS
+
+
+@pytest.mark.parametrize("argv,words", [
+    # the bad-input search: each was taken, the option ignored without a word (the last --layer won)
+    (["design", TUBE1, "--overcut", "0.1"], ("--overcut 0.1 is used by the forward model", "add --stroke MM")),
+    (["design", str(ROOT / "examples" / "dxf" / "slits.dxf"), "--layer", "KERF=slit", "--layer", "kerf=notch"],
+     ("layer 'kerf' is given a role twice (slit and notch)", "one --layer NAME=ROLE")),
+])
+def test_an_option_that_would_be_ignored_or_overridden_is_refused(tmp_path, argv, words):
+    assert_refused(camtube(*argv, cwd=tmp_path), *words)
+    assert listing(tmp_path) == []

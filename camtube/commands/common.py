@@ -83,6 +83,10 @@ def drawing_options(args: argparse.Namespace):
         if not sep or not name or role not in LAYER_ROLES:
             raise CamtubeError(f"--layer {item!r}: expected NAME=ROLE with ROLE one of {', '.join(LAYER_ROLES)}; "
                                "fix: e.g. --layer CUTS=notch")
+        same = [r for n, r in layers if n.upper() == name.upper()]
+        if same:   # (the last one given won without a word)
+            raise CamtubeError(f"--layer {item!r}: layer {name!r} is given a role twice ({same[0]} and {role}); fix: "
+                               "give each layer one --layer NAME=ROLE")
         layers.append((name, role))
     for opt in ("outer_radius", "length"):
         v = getattr(args, opt, None)

@@ -104,6 +104,8 @@ def cmd_design(args: argparse.Namespace) -> int:
                            "stroke in mm, e.g. --stroke 1.5")
     if args.calibration and args.stroke is None:
         raise CamtubeError("--calibration is used by the forward model; fix: add --stroke MM")
+    if args.overcut is not None and args.stroke is None:   # (it was ignored without a word)
+        raise CamtubeError(f"--overcut {args.overcut:g} is used by the forward model; fix: add --stroke MM")
     loaded = load_from_args(args)
     mech = None
     if args.stroke is not None:
