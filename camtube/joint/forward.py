@@ -117,6 +117,8 @@ def row_webs_mm(x_mm, width_mm) -> list[tuple[float, float]]:
     return [(gaps[i - 1] if i > 0 else math.inf, gaps[i] if i < len(gaps) else math.inf) for i in range(len(x))]
 
 
+#: The schemas of the files a calibration is read from (``model fit --json``, ``model diagnose --json``).
+CALIBRATION_SCHEMAS = ("camtube.fit/1", "camtube.diagnose/1")
 #: The largest value of each parameter a calibration may give (and its unit): the stiffest fibre's modulus, a tendon
 #: of 10 m, an arm ten times the section's, a slack, toe or kerf of 100 mm, a compliance of 100 mm/N, mu of 10.
 CALIBRATION_MAX = {"E_t": (1000.0, "GPa"), "L0": (10_000.0, "mm"), "arm_scale": (10.0, ""),
@@ -220,6 +222,10 @@ class Mechanics:
         except (json.JSONDecodeError, UnicodeDecodeError) as exc:
             raise CamtubeError(f"{p}: the calibration is not JSON ({exc}); fix: pass the file written by "
                                "'camtube model fit --json' or 'camtube model diagnose --json'") from None
+        schema = doc.get("schema") if isinstance(doc, dict) else None
+        if schema is not None and schema not in CALIBRATION_SCHEMAS:   # (taken without a word)
+            raise CamtubeError(f"{p}: schema {schema!r} is not a fit's ({' or '.join(CALIBRATION_SCHEMAS)}); fix: pass "
+                               "the JSON of 'camtube model fit --json' or 'camtube model diagnose --json'")
         params = _fit_params(doc, p)
         if not params:
             raise CamtubeError(f"{p}: no fitted parameters found (expected 'params' or 'final.params' of a "
