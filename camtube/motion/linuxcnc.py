@@ -259,6 +259,24 @@ def dose_hal(profile) -> list[str]:
     return hal
 
 
+def controller_error(program: str, errors: list) -> str:
+    """The line that says what LinuxCNC's controller reported running ``program`` (its errors, or none: the sampler's
+    FIFO overflowed), with the line of the program it names and the fix (the message had neither)."""
+    if not errors:
+        return (f"{program}: the controller reported: the sampler FIFO overflowed (samples lost); fix: run it again "
+                "on a quieter machine (the recorder runs in real time)")
+    text = "; ".join(" ".join(str(e).split()) for e in errors)
+    m = re.search(r"\bline (\d+)", text, re.IGNORECASE)
+    at = f" at line {m.group(1)}" if m else ""
+    return (f"{program}: the controller reported: {text}; fix: correct the program{at} (a program camtube toolpath "
+            "wrote runs as written: write it again if it was edited)")
+
+
+#: A word's letter followed by no value (a number, an expression ``[..]`` or a parameter ``#n``): ``X=abc``, ``F``.
+_WORD_WITHOUT_NUMBER = re.compile(r"(?<![A-Z])([A-Z])\s*(?![-+\d.\[#\s])(?=\S|$)")
+#: A line of LinuxCNC's O-word flow control (its keywords are letters without numbers): not checked word by word.
+_FLOW = re.compile(r"(^|\s)O\s*(\d|<)|\b(SUB|ENDSUB|CALL|IF|ELSEIF|ELSE|ENDIF|WHILE|ENDWHILE|DO|REPEAT|ENDREPEAT|RETURN|"
+                   r"BREAK|CONTINUE)\b")
 _AXIS_WORD = re.compile(r"(?<![A-Z])([XYZABCUVW])\s*[-+]?(?:\d+\.?\d*|\.\d+)")
 _HEADER_MACHINE = re.compile(r"on machine ([\w.-]+)")
 
@@ -292,6 +310,15 @@ def check_program(path: str | os.PathLike, profile) -> str:
                              f"and give DIR/NAME.ngc")
     if not moves:
         raise MotionRunError(f"{path}: no G0/G1 moves: not a G-code program camtube wrote; {fix}")
+    for k, raw in enumerate(text.splitlines()):
+        ln = re.sub(r"\([^)]*\)", "", raw).split(";", 1)[0].split("(", 1)[0].strip().upper()
+        # a word whose letter has no number (X=abc): the controller said only "bad number format ... parsing ''",
+        # naming no line, after a real-time start
+        w = None if _FLOW.search(ln) else _WORD_WITHOUT_NUMBER.search(ln)
+        if w:
+            raise MotionRunError(f"{path}:{k + 1}: the word {w.group(1)} has no number ({raw.strip()!r}); fix: "
+                                 f"correct that line (a program camtube toolpath wrote runs as written: write it again "
+                                 "if it was edited)")
     used = sorted({m for ln in moves for m in _AXIS_WORD.findall(ln)})
     foreign = [a for a in used if a not in profile.axes]
     if foreign:
@@ -450,8 +477,7 @@ def _run(ngc: Path, profile, work: Path, timeout_s: float, keep_every_s: float, 
         raise MotionRunError(f"LinuxCNC did not run the driver (exit {proc.returncode}): " + " | ".join(tail)
                              ) from None
     if status["errors"] or status["overrun"]:
-        why = "; ".join(status["errors"]) or "the sampler FIFO overflowed (samples lost)"
-        raise MotionRunError(f"{ngc.name}: the controller reported: {why}")
+        raise MotionRunError(controller_error(ngc.name, status["errors"]))
     data = np.fromstring(samples.read_text(), sep=" ")  # noqa: NPY201 (fast text parse)
     data = data.reshape(-1, 6 if profile.gating == "distance" else 5)
     return Recording(data[:, 0].astype(np.int64), data[:, 1], data[:, 2], data[:, 3], data[:, 4] > 0.5,

@@ -104,3 +104,11 @@ def test_the_ini_gives_limits_with_every_digit_and_no_exponent(tmp_path):
     limits_written = [ln.split(" = ")[1] for ln in lines if ln.startswith(("MIN_LIMIT", "MAX_LIMIT"))]
     assert limits_written and all("e" not in v.lower() for v in limits_written)
     assert "-1000000" in limits_written
+
+
+def test_the_controllers_error_names_the_line_and_the_fix():
+    """The bad-input search: 'the controller reported: bad number format ...' gave no line of the program and no fix."""
+    text = lc.controller_error("t.ngc", ["Bad number format (conversion failed) parsing '1.2.3'", "near line 14"])
+    assert text.startswith("t.ngc: the controller reported: Bad number format") and "fix: correct the program at line 14" in text
+    assert "\n" not in text
+    assert "fix: run it again" in lc.controller_error("t.ngc", [])

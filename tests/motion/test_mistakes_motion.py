@@ -73,3 +73,21 @@ def test_check_program_accepts_what_camtube_wrote(tmp_path):
     assert main(["toolpath", str(PATTERNS / "tube1.yaml"), "--set", "notch.count=2", "-o", str(tmp_path), "-q"]) == 0
     text = lc.check_program(tmp_path / "tube1.ngc", load_profile())
     assert text.startswith("(camtube")
+
+
+@pytest.mark.parametrize("edit", ["G1 X=abc", "G1 X A10.0 F60"])
+def test_a_word_without_a_number_is_named_at_its_line_before_linuxcnc_starts(tmp_path, capsys, linuxcnc_here, edit):
+    """The bad-input search: the controller, after a real-time start, said only "bad number format (conversion
+    failed) parsing ''", naming no line and no fix. Programs camtube writes (their header comments hold ';' and
+    words in parentheses) pass."""
+    assert main(["toolpath", str(PATTERNS / "tube1.yaml"), "--set", "notch.count=2", "-o", str(tmp_path), "-q"]) == 0
+    capsys.readouterr()
+    ngc = tmp_path / "tube1.ngc"
+    lines = ngc.read_text().splitlines()
+    k = next(i for i, ln in enumerate(lines) if ln.startswith("G1 "))
+    assert lc.check_program(ngc, load_profile("linuxcnc-rotary"))   # as written: passes
+    lines[k] = edit
+    ngc.write_text("\n".join(lines) + "\n")
+    assert main(["motion", str(ngc)]) == 2
+    line = one_line(capsys)
+    assert f"tube1.ngc:{k + 1}: the word X has no number ({edit!r})" in line and "fix: correct that line" in line
