@@ -888,3 +888,17 @@ def test_the_largest_repeats_is_accepted():
 def test_an_option_that_would_be_ignored_or_overridden_is_refused(tmp_path, argv, words):
     assert_refused(camtube(*argv, cwd=tmp_path), *words)
     assert listing(tmp_path) == []
+
+
+def test_set_process_names_a_process_file_as_the_pattern_may(tmp_path):
+    """The bad-input search: --set process=femto-polyimide.yaml was refused as 'expected a mapping', though a
+    pattern's 'process:' may name a file; a file that is not there is named as such."""
+    (tmp_path / "slow.yaml").write_text((ROOT / "patterns" / "femto-polyimide.yaml").read_text().replace(
+        "scan_speed_mm_s: 25", "scan_speed_mm_s: 12.5"))
+    pattern = tmp_path / "t.yaml"
+    pattern.write_text((ROOT / "patterns" / "tube1.yaml").read_text())
+    r = camtube("toolpath", str(pattern), "-q", "-o", str(tmp_path / "o"), "--set", "process=slow.yaml")
+    assert r.returncode == 0, r.stderr
+    assert "12.5 mm/s" in (tmp_path / "o" / "tube1.ngc").read_text()[:2000]
+    assert_refused(camtube("design", str(pattern), "--set", "process=nothere.yaml"),
+                   "process: names a process file that is not there", "'nothere.yaml'")

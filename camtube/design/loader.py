@@ -441,8 +441,15 @@ def load(path: str | os.PathLike, overrides: Iterable[str] = ()) -> Loaded:
     """
     path = resolve_preset(path)
     raw, lines, file = read_yaml(path)
+    overrides = list(overrides)
+    # --set process=NAME.yaml names a process file as 'process:' may: read in as the file's own would be (it was
+    # applied after the file's, and refused as 'expected a mapping')
+    whole = [o for o in overrides if parse_override(o)[0] == "process"]
+    if whole:
+        raw = apply_overrides(raw, whole, file)
+        lines = {k: v for k, v in lines.items() if k != "process" and not k.startswith("process.")}
     raw, source = _process_file(raw, Path(path).parent, file, lines)
-    raw = apply_overrides(raw, overrides, file)
+    raw = apply_overrides(raw, [o for o in overrides if o not in whole], file)
     set_keys = {parse_override(o)[0] for o in overrides}
     lines = {k: v for k, v in lines.items() if k not in set_keys}  # a --set value has no line
     return _build_naming_process_file(raw, file, lines, Path(path).stem, source, set_keys)
