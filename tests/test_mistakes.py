@@ -906,3 +906,11 @@ def test_set_process_names_a_process_file_as_the_pattern_may(tmp_path):
     assert "12.5 mm/s" in (tmp_path / "o" / "tube1.ngc").read_text()[:2000]
     assert_refused(camtube("design", str(pattern), "--set", "process=nothere.yaml"),
                    "process: names a process file that is not there", "'nothere.yaml'")
+
+
+@pytest.mark.parametrize("option,value", [("--lag-ms", "-1e9"), ("--modulus-range", "-1,5")])
+def test_a_negative_value_after_an_option_gets_its_fix(tmp_path, option, value):
+    """The bad-input search: argparse reads -1e9 as an option and said only 'expected one argument'."""
+    r = camtube("model", "diagnose", "x.csv", "--pattern", "tube1", option, value, cwd=tmp_path)
+    assert_refused(r, f"{option} {value}: a value that starts with '-' is read as an option",
+                   f"fix: write {option}={value}")

@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import signal
 import sys
 import threading
@@ -27,11 +28,24 @@ COMMAND_MODULES = (
 )
 
 
+#: The arguments :func:`main` parses (the parser's error reads the value after an option from them).
+_ARGV: list[str] | None = None
+
+
 class _Parser(argparse.ArgumentParser):
     """An argument parser whose mistakes are one line with a fix, like every other camtube error
     (argparse's own prints the whole usage first). Sub-command parsers are of this class too."""
 
     def error(self, message: str):
+        m = re.match(r"argument (--[\w-]+)(?:/[\w-]+)?: expected one argument$", message)
+        if m:
+            # a negative value argparse takes for an option (-1e9, -1,5: its own test knows only -1 and -1.5)
+            argv = _ARGV if _ARGV is not None else sys.argv[1:]
+            at = [i for i, a in enumerate(argv) if a == m.group(1)]
+            nxt = argv[at[0] + 1] if at and at[0] + 1 < len(argv) else ""
+            if re.match(r"^-[\d.]", nxt):
+                self.exit(2, f"{self.prog}: error: {m.group(1)} {nxt}: a value that starts with '-' is read as an "
+                             f"option; fix: write {m.group(1)}={nxt}\n")
         self.exit(2, f"{self.prog}: error: {message}; fix: see `{self.prog} --help`\n")
 
 
@@ -55,7 +69,9 @@ def main(argv: list[str] | None = None) -> int:
     verification); 2 a user mistake or unsafe job, printed as one clear
     message (no traceback); 130 interrupted (Ctrl-C); 143 terminated (SIGTERM).
     """
+    global _ARGV
     parser = build_parser()
+    _ARGV = list(argv) if argv is not None else None
     try:
         with _sigterm_as_interrupt():
             args = parser.parse_args(argv)
