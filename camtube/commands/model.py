@@ -308,6 +308,11 @@ def cmd_ingest(args: argparse.Namespace) -> int:
             raise CamtubeError(f"--report {args.report}: is also the -o file; fix: give the report a folder of its "
                                f"own, e.g. --report {Path(args.output).with_suffix('')}-report")
         check_outputs_apart([("-o", args.output, True), ("--report", args.report, False)])
+    unused = [m for m in (args.map_overrides or []) if args.tracker and m.split("=", 1)[0].strip().startswith("angle.")]
+    if unused:   # (the angle section is read with --angle-log only: it was ignored without a word)
+        raise CamtubeError(f"--map {unused[0]}: the bench map's angle section is read with --angle-log only, and "
+                           "--tracker was given (the tracker's export gives poses, in tracker.unit); fix: drop it, or "
+                           "give the angle log with --angle-log")
     bench = load_bench_map(args.bench, args.map_overrides)
     first = args.tracker or args.angle_log
     ing = ingest_files(first, args.daq, args.motor, bench, args.sample, max_lag_s=args.max_lag,

@@ -164,6 +164,8 @@ def test_a_daq_line_written_twice_is_set_aside_and_said(tmp_path, capsys):
     (["--map", "tracker.tip=0C"], "no tool '0C' for the tip"),
     (["--max-lag", "-1"], "--max-lag -1.0: the largest clock offset must be"),  # was a ValueError traceback
     (["--max-lag", "nan"], "fix: give e.g. --max-lag 5"),
+    # the bad-input search: ignored without a word beside --tracker
+    (["--map", "angle.unit=rad"], "--map angle.unit=rad: the bench map's angle section is read with --angle-log only"),
 ])
 def test_ingest_refuses_wrong_units_and_signs_in_one_line(tmp_path, capsys, extra, message):
     assert main(_argv(tmp_path, *extra)) == 2
