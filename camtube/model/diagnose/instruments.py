@@ -723,10 +723,17 @@ def _spikes(x: np.ndarray, slices: list, limit: np.ndarray | None = None) -> np.
         scale = _noise_scale(v, None if limit is None else limit[sl])
         if scale <= 0.0:
             continue
-        pad = np.concatenate((np.full(h, v[0]), v, np.full(h, v[-1])))
-        win = np.delete(np.lib.stride_tricks.sliding_window_view(pad, 2 * h + 1), h, axis=1)
-        out[sl] = (v > win.max(axis=1) + SPIKE_Z * scale) | (v < win.min(axis=1) - SPIKE_Z * scale)
+        out[sl] = _beyond_neighbours(v, SPIKE_Z * scale)
     return out
+
+
+def _beyond_neighbours(v: np.ndarray, beyond: float) -> np.ndarray:
+    """(n,) bool: rows of ``v`` above the largest or below the smallest of their :data:`NEIGHBOURS` rows either side
+    by more than ``beyond`` (the ends read against the first and last row)."""
+    h = NEIGHBOURS
+    pad = np.concatenate((np.full(h, v[0]), v, np.full(h, v[-1])))
+    win = np.delete(np.lib.stride_tricks.sliding_window_view(pad, 2 * h + 1), h, axis=1)
+    return (v > win.max(axis=1) + beyond) | (v < win.min(axis=1) - beyond)
 
 
 def stroke_spikes(stroke: np.ndarray, slices: list) -> np.ndarray:
@@ -746,10 +753,7 @@ def stroke_spikes(stroke: np.ndarray, slices: list) -> np.ndarray:
         if d.size < 10:
             continue
         lo, hi = np.percentile(v, [0.5, 99.5])
-        beyond = max(SPIKE_Z * float(np.median(d)), STROKE_SPIKE_SPAN * float(hi - lo))
-        pad = np.concatenate((np.full(h, v[0]), v, np.full(h, v[-1])))
-        win = np.delete(np.lib.stride_tricks.sliding_window_view(pad, 2 * h + 1), h, axis=1)
-        out[sl] = (v > win.max(axis=1) + beyond) | (v < win.min(axis=1) - beyond)
+        out[sl] = _beyond_neighbours(v, max(SPIKE_Z * float(np.median(d)), STROKE_SPIKE_SPAN * float(hi - lo)))
     return out
 
 
