@@ -132,6 +132,9 @@ def test_bench_map_overrides_and_unknown_keys():
         bench_map_from_dict({"daq": {"time_unit": "sec"}}, "b.yaml")
     with pytest.raises(DataError, match="motor.lead_mm_per_rev: .* out of range"):
         bench_map_from_dict({}, "b.yaml", ["motor.lead_mm_per_rev=0"])
+    # the bad-input search: taken, the whole record read as the rest
+    with pytest.raises(DataError, match="tracker.rest_s: '1e9' is out of range: a rest of more than 600 s"):
+        bench_map_from_dict({}, "b.yaml", ["tracker.rest_s=1e9"])
 
 
 # ------------------------------------------------------------------ bend angle from poses

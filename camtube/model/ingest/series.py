@@ -161,6 +161,8 @@ _ALLOWED = {
     ("angle", "time_unit"): tuple(TIME_UNITS), ("angle", "unit"): ("", "deg", "rad"),
     ("daq", "force_unit"): ("V", "N"), ("motor", "stroke_unit"): ("counts", "rev", "mm"),
 }
+#: Longest rest at the start of a recording a bench map may give (``tracker.rest_s``), s.
+MAX_REST_S = 600.0
 _POSITIVE = {("motor", "counts_per_rev"), ("motor", "gear_ratio"), ("motor", "lead_mm_per_rev")}
 
 
@@ -188,6 +190,9 @@ def _coerce(section: str, name: str, value, default, source: str):
         if (not np.isfinite(v) or ((section, name) in _POSITIVE and v <= 0) or (v < 0 and name in ("rate_hz", "rest_s"))
                 or (name == "N_per_V" and v == 0)):
             raise _map_err(source, key, f"{value!r} is out of range", "give a positive number")
+        if name == "rest_s" and v > MAX_REST_S:   # (1e9 read the whole record as the rest: zero bend, zero force)
+            raise _map_err(source, key, f"{value!r} is out of range: a rest of more than {MAX_REST_S:g} s at the "
+                           "start of the recording", f"give the rest before the first pull, in s (e.g. {default:g})")
         return v
     v = "" if value is None else str(value).strip()
     allowed = _ALLOWED.get((section, name))
