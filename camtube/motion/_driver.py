@@ -48,13 +48,13 @@ def main() -> int:
                 return
             status["errors"].append(str(m[1]).strip())
 
-    def wait(cond, limit, what):
+    def wait(cond, limit, what, every=0.05):
         t0 = time.time()
         while time.time() - t0 < limit:
             s.poll()
             if cond():
                 return
-            time.sleep(0.05)
+            time.sleep(every)
         raise RuntimeError(f"timed out waiting for {what}")
 
     sampler = None
@@ -135,7 +135,9 @@ def main() -> int:
                 errors()
             subprocess.run(["halcmd", "setp", "sampler.0.enable", "1"], check=True)
             c.auto(linuxcnc.AUTO_RUN, 0)
-            wait(lambda: s.interp_state != linuxcnc.INTERP_IDLE or s.queue > 0, 10, "the program to start")
+            # polled every ms: a short piece on a fast stage (the last of a chained drawing on air bearings) may begin
+            # and end within the 50 ms the other waits poll at, and was once taken as never started (a CI run)
+            wait(lambda: s.interp_state != linuxcnc.INTERP_IDLE or s.queue > 0, 10, "the program to start", 0.001)
             last["key"], last["t"] = None, time.time()
             wait(finished, timeout_s, "the program to finish")
             time.sleep(0.02)

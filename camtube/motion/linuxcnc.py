@@ -266,6 +266,9 @@ def controller_error(program: str, errors: list) -> str:
         return (f"{program}: the controller reported: the sampler FIFO overflowed (samples lost); fix: run it again "
                 "on a quieter machine (the recorder runs in real time)")
     text = "; ".join(" ".join(str(e).split()) for e in errors)
+    if "timed out waiting for" in text or "stalled for" in text:   # the driver's own watch, not the program
+        return (f"{program}: the controller reported: {text}; fix: run it again on a quieter machine (LinuxCNC runs "
+                "in real time)")
     m = re.search(r"\bline (\d+)", text, re.IGNORECASE)
     at = f" at line {m.group(1)}" if m else ""
     return (f"{program}: the controller reported: {text}; fix: correct the program{at} (a program camtube toolpath "

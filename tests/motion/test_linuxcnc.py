@@ -112,3 +112,6 @@ def test_the_controllers_error_names_the_line_and_the_fix():
     assert text.startswith("t.ngc: the controller reported: Bad number format") and "fix: correct the program at line 14" in text
     assert "\n" not in text
     assert "fix: run it again" in lc.controller_error("t.ngc", [])
+    # the driver's own watch timed out: not the program's fault
+    late = lc.controller_error("t.ngc", ["RuntimeError: timed out waiting for the program to start"])
+    assert "fix: run it again on a quieter machine" in late and "correct the program" not in late
