@@ -129,12 +129,7 @@ def check_feeds(job, machine) -> None:
     if pk.n_pass == 0:
         return
     v = float(np.min(pk.pass_speed))
-    v_edge = pk.vertices
-    nxt = np.arange(1, len(v_edge) + 1)
-    last = pk.geom_offset[1:] - 1
-    nxt[last] = pk.geom_offset[:-1]
-    seg = np.hypot(*(v_edge[nxt] - v_edge).T)
-    seg[last[~pk.geom_closed]] = 0.0
+    seg = np.hypot(*pk.edge_mm.T)
     L = float(seg.max()) if len(seg) else 0.0
     if not L > 0:
         return
@@ -180,14 +175,9 @@ def check_speeds(job, machine) -> None:
     n_geom = len(pk.geom_offset) - 1
     speed = np.zeros(n_geom)
     np.maximum.at(speed, np.asarray(pk.pass_geom), np.asarray(pk.pass_speed, float))
-    v_edge = pk.vertices
-    nxt = np.arange(1, len(v_edge) + 1)
-    last = pk.geom_offset[1:] - 1
-    nxt[last] = pk.geom_offset[:-1]
-    d = np.abs(v_edge[nxt] - v_edge)
+    d = np.abs(pk.edge_mm)
     seg = np.hypot(d[:, 0], d[:, 1])
-    seg[last[~pk.geom_closed]] = 0.0
-    v = np.repeat(speed, np.diff(pk.geom_offset))
+    v = np.repeat(speed, pk.geom_size)
     cut = (seg > 0) & (v > 0)
     if not cut.any():
         return

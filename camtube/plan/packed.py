@@ -138,16 +138,26 @@ class Packed:
         return np.diff(self.geom_offset)
 
     @cached_property
-    def geom_length_mm(self) -> np.ndarray:
-        """(G,) float: length of each path (perimeter if closed), mm."""
+    def edge_mm(self) -> np.ndarray:
+        """(nv, 2) float: from each vertex to the next of its path, mm (a closed path's last vertex to its first; an
+        open path's last vertex: 0, no edge). Read only: the machine's feed and speed checks read it too."""
         v = self.vertices
         if len(v) == 0:
-            return np.zeros(len(self.geom_size))
+            return np.zeros((0, 2))
         nxt = np.arange(1, len(v) + 1)
         last = self.geom_offset[1:] - 1
         nxt[last] = self.geom_offset[:-1]  # closed paths return to their first vertex
-        seg = np.hypot(*(v[nxt] - v).T)
-        seg[last[~self.geom_closed]] = 0.0  # open paths do not
+        d = v[nxt] - v
+        d[last[~self.geom_closed]] = 0.0  # open paths do not
+        d.flags.writeable = False
+        return d
+
+    @cached_property
+    def geom_length_mm(self) -> np.ndarray:
+        """(G,) float: length of each path (perimeter if closed), mm."""
+        if len(self.vertices) == 0:
+            return np.zeros(len(self.geom_size))
+        seg = np.hypot(*self.edge_mm.T)
         c = np.concatenate(([0.0], np.cumsum(seg)))
         return c[self.geom_offset[1:]] - c[self.geom_offset[:-1]]
 
