@@ -91,6 +91,21 @@ def cut_contour(cut: Cut, outer_radius_mm: float, cut_index: int = -1) -> Contou
     return rectangle(cut.x_start_mm, y0, cut.x_end_mm, y1, cut.kind, cut_index)
 
 
+def deepest_arc_mm(outer_radius_mm: float, contours) -> float:
+    """The largest circumferential extent of ``contours`` (mm on the outer surface), at most the circumference: the
+    cut the beam goes deepest for (:func:`depth_for_contours`)."""
+    arc = max(max(p[1] for p in c.points) - min(p[1] for p in c.points) for c in contours)
+    return min(arc, 2.0 * math.pi * outer_radius_mm)
+
+
+def depth_for_contours(outer_radius_mm: float, contours) -> float:
+    """Beam depth (mm) of the deepest cut: ``beam_depth_mm(r_o, largest circumferential extent)``; the depth the
+    repeat rule must cover (read by the planner for the repeats, and by the design rules before it)."""
+    from camtube.design.geometry import beam_depth_mm
+
+    return beam_depth_mm(outer_radius_mm, deepest_arc_mm(outer_radius_mm, contours))
+
+
 def cut_contours(pattern: Pattern) -> tuple[Contour, ...]:
     """Unwrapped contours of every cut of ``pattern``, in ``pattern.cuts`` order."""
     ro = pattern.tube.outer_radius_mm

@@ -213,9 +213,9 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
     if proc.repeats is None and pattern.cuts:
         # the repeats by the beam depth of the deepest cut (as the planner reads them): a rule that covers no depth
         # this pattern has was refused only by toolpath, naming no file or line, after design had passed it
-        from camtube.design.contour import cut_contours
+        from camtube.design.contour import cut_contours, deepest_arc_mm
 
-        arc = min(max(float(np.ptp(np.asarray(c.points, float)[:, 1])) for c in cut_contours(pattern)), circ)
+        arc = deepest_arc_mm(ro, cut_contours(pattern))
         depth = beam_depth_mm(ro, arc)
         deepest = max((r.max_depth_mm for r in proc.repeat_rule), default=None)
         if deepest is None or depth > deepest:

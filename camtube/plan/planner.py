@@ -43,8 +43,7 @@ from typing import Sequence
 
 import numpy as np
 
-from camtube.design.contour import Contour, cut_contours
-from camtube.design.geometry import beam_depth_mm
+from camtube.design.contour import Contour, cut_contours, depth_for_contours
 from camtube.design.pattern import Pattern, Process
 from camtube.errors import Issue, PatternError
 from camtube.plan.job import Job
@@ -58,13 +57,6 @@ DEFAULT_ORDERING = "interleaved"
 
 
 # ---------------------------------------------------------------- repeats
-def depth_for_contours(outer_radius_mm: float, contours: Sequence[Contour]) -> float:
-    """Beam depth (mm) of the deepest cut: ``beam_depth_mm(r_o, largest circumferential extent)``."""
-    arc = max(b[3] - b[1] for b in map(points_bounds, (c.points for c in contours)))
-    arc = min(arc, 2.0 * math.pi * outer_radius_mm)
-    return beam_depth_mm(outer_radius_mm, arc)
-
-
 def repeats_for(process: Process, depth_mm: float) -> int:
     """Repeats of the focus+defocus group: ``process.repeats`` or the first rule row covering ``depth_mm``.
 
