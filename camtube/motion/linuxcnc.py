@@ -305,21 +305,23 @@ def check_program(path: str | os.PathLike, profile) -> str:
         bad = exc.start if bad < 0 else min(bad, exc.start)
     if bad >= 0:
         raise MotionRunError(f"{path}: not a G-code program (binary data at byte {bad}); {fix}")
-    lines = [ln.split(";", 1)[0] for ln in text.splitlines()]
-    body = [re.sub(r"\(.*?\)", "", ln).strip().upper() for ln in lines]
+    raw_lines = text.splitlines()
+    lines = [ln.split(";", 1)[0] for ln in raw_lines]
+    # each line's words: (comments) first (camtube's header comments hold ';'), then a ';' comment, then a '(' left
+    # open to the line's end
+    body = [re.sub(r"\([^)]*\)", "", ln).split(";", 1)[0].split("(", 1)[0].strip().upper() for ln in raw_lines]
     moves = [ln for ln in body if re.match(r"^(N\d+\s*)?G0?[01](?!\d)", ln)]
     if path.suffix.lower() in (".yaml", ".yml") or (not moves and any(re.match(r"^[a-z_]+:", ln) for ln in lines)):
         raise MotionRunError(f"{path}: a YAML file, not a G-code program; run `camtube toolpath {path.name} -o DIR` "
                              f"and give DIR/NAME.ngc")
     if not moves:
         raise MotionRunError(f"{path}: no G0/G1 moves: not a G-code program camtube wrote; {fix}")
-    for k, raw in enumerate(text.splitlines()):
-        ln = re.sub(r"\([^)]*\)", "", raw).split(";", 1)[0].split("(", 1)[0].strip().upper()
+    for k, ln in enumerate(body):
         # a word whose letter has no number (X=abc): the controller said only "bad number format ... parsing ''",
         # naming no line, after a real-time start
         w = None if _FLOW.search(ln) else _WORD_WITHOUT_NUMBER.search(ln)
         if w:
-            raise MotionRunError(f"{path}:{k + 1}: the word {w.group(1)} has no number ({raw.strip()!r}); fix: "
+            raise MotionRunError(f"{path}:{k + 1}: the word {w.group(1)} has no number ({raw_lines[k].strip()!r}); fix: "
                                  f"correct that line (a program camtube toolpath wrote runs as written: write it again "
                                  "if it was edited)")
     used = sorted({m for ln in moves for m in _AXIS_WORD.findall(ln)})
