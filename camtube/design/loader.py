@@ -297,18 +297,16 @@ def _check_notch_lists(r: _Reader, gen: dict, written: dict | None = None) -> No
     written = written if isinstance(written, dict) else {}
     for key, (scalar, extra) in _NOTCH_LISTS.items():
         values = gen.get(key) or ()
-        if key in written and isinstance(written[key], (list, tuple)) and not written[key] and count is not None \
-                and max(count + extra, 0) > 0:
+        if count is not None:
             need = max(count + extra, 0)
-            r.issue(f"notch.{key}", f"is empty, for notch.count = {count}", [],
-                    f"{need} values ({'one per gap between notches' if extra else 'one per notch'}, from the tip)",
-                    f"give {need} values, or delete the key" + (f" (notch.{scalar} then applies to every notch)"
-                                                               if scalar else ""))
-        if values and count is not None and len(values) != max(count + extra, 0):
-            need = max(count + extra, 0)
-            r.issue(f"notch.{key}", f"has {len(values)} values for notch.count = {count}", len(values),
-                    f"{need} values ({'one per gap between notches' if extra else 'one per notch'}, from the tip)",
-                    f"give {need} values or set notch.count to match")
+            allowed = f"{need} values ({'one per gap between notches' if extra else 'one per notch'}, from the tip)"
+            if values and len(values) != need:
+                r.issue(f"notch.{key}", f"has {len(values)} values for notch.count = {count}", len(values), allowed,
+                        f"give {need} values or set notch.count to match")
+            elif need and isinstance(written.get(key), (list, tuple)) and not written[key]:
+                r.issue(f"notch.{key}", f"is empty, for notch.count = {count}", [], allowed,
+                        f"give {need} values, or delete the key" + (f" (notch.{scalar} then applies to every notch)"
+                                                                   if scalar else ""))
         if (scalar and not values and gen.get(scalar) is None and not (scalar == "spacing" and count == 1)
                 and not any(i.key == f"notch.{scalar}" for i in r.issues)):  # given but refused: said already
             r.issue(f"notch.{scalar}", "required key is missing", None, SCHEMA["notch"][scalar].allowed(),
