@@ -714,16 +714,37 @@ def _spikes(x: np.ndarray, slices: list, limit: np.ndarray | None = None) -> np.
     sample) by more than :data:`SPIKE_Z` noise scales (:func:`_noise_scale`; ``limit`` (n,) bool: a load cell's rows
     at its limit, left out of the scale). A turning point or a kink of the motion stays within its neighbours' range
     (within a row's change), so only isolated jumps qualify."""
+    return _rows_beyond(x, slices, lambda v, sl: SPIKE_Z * _noise_scale(v, None if limit is None else limit[sl]))
+
+
+def stroke_spikes(stroke: np.ndarray, slices: list) -> np.ndarray:
+    """Rows whose stroke lies outside the range of their neighbours (:data:`NEIGHBOURS` rows either side, same sample)
+    by more than :data:`SPIKE_Z` typical steps of the motion and :data:`STROKE_SPIKE_SPAN` of the sample's span: a
+    motor's log glitching for one row (a value of 50 mm in a 2 mm stroke). The motor's own steps are smooth, its
+    turning points within a step of their neighbours; its rests repeat a value, so the typical step is read on the
+    rows that move (the angle's and force's noise scale would be 0 where the stroke dwells half the time)."""
+    def beyond(v: np.ndarray, sl: slice) -> float:
+        d = np.abs(np.diff(v))
+        d = d[np.isfinite(d) & (d > 0)]
+        if d.size < 10:
+            return 0.0
+        lo, hi = np.percentile(v, [0.5, 99.5])
+        return max(SPIKE_Z * float(np.median(d)), STROKE_SPIKE_SPAN * float(hi - lo))
+
+    return _rows_beyond(stroke, slices, beyond)
+
+
+def _rows_beyond(x: np.ndarray, slices: list, beyond_of) -> np.ndarray:
+    """(n,) bool: per sample of at least ``10 x`` :data:`NEIGHBOURS` rows, the rows of ``x`` beyond their neighbours'
+    range by ``beyond_of(the sample's values, its slice)`` (a sample whose threshold is not > 0: none)."""
     out = np.zeros(x.size, bool)
-    h = NEIGHBOURS
     for _, sl in slices:
         v = x[sl]
-        if v.size < 10 * h:
+        if v.size < 10 * NEIGHBOURS:
             continue
-        scale = _noise_scale(v, None if limit is None else limit[sl])
-        if scale <= 0.0:
-            continue
-        out[sl] = _beyond_neighbours(v, SPIKE_Z * scale)
+        beyond = beyond_of(v, sl)
+        if beyond > 0.0:
+            out[sl] = _beyond_neighbours(v, beyond)
     return out
 
 
@@ -734,27 +755,6 @@ def _beyond_neighbours(v: np.ndarray, beyond: float) -> np.ndarray:
     pad = np.concatenate((np.full(h, v[0]), v, np.full(h, v[-1])))
     win = np.delete(np.lib.stride_tricks.sliding_window_view(pad, 2 * h + 1), h, axis=1)
     return (v > win.max(axis=1) + beyond) | (v < win.min(axis=1) - beyond)
-
-
-def stroke_spikes(stroke: np.ndarray, slices: list) -> np.ndarray:
-    """Rows whose stroke lies outside the range of their neighbours (:data:`NEIGHBOURS` rows either side, same sample)
-    by more than :data:`SPIKE_Z` typical steps of the motion and :data:`STROKE_SPIKE_SPAN` of the sample's span: a
-    motor's log glitching for one row (a value of 50 mm in a 2 mm stroke). The motor's own steps are smooth, its
-    turning points within a step of their neighbours; its rests repeat a value, so the typical step is read on the
-    rows that move (the angle's and force's noise scale would be 0 where the stroke dwells half the time)."""
-    out = np.zeros(stroke.size, bool)
-    h = NEIGHBOURS
-    for _, sl in slices:
-        v = stroke[sl]
-        if v.size < 10 * h:
-            continue
-        d = np.abs(np.diff(v))
-        d = d[np.isfinite(d) & (d > 0)]
-        if d.size < 10:
-            continue
-        lo, hi = np.percentile(v, [0.5, 99.5])
-        out[sl] = _beyond_neighbours(v, max(SPIKE_Z * float(np.median(d)), STROKE_SPIKE_SPAN * float(hi - lo)))
-    return out
 
 
 def _bursts(x: np.ndarray, steps_s: Sequence[float], slices: list, single: np.ndarray,
