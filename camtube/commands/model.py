@@ -144,7 +144,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     )
     from camtube.model.core.fit import FitError, fit
     from camtube.model.core.predict import model_for_pattern, pattern_values
-    from camtube.model.data import check_fittable, find_slack, load_csv, prepare, remove_deadband, select_cycles
+    from camtube.model.data import check_fittable, check_row_count, find_slack, load_csv, prepare, remove_deadband, select_cycles
     from camtube.model.data.csvfile import check_signs, check_time_varies, check_zeros
     from camtube.model.diagnose.instruments import check_units
     from camtube.errors import DataError
@@ -195,7 +195,10 @@ def cmd_fit(args: argparse.Namespace) -> int:
         check_time_varies(raw, args.data)
         _check_stroke_spikes(raw, args.data)
         rows = prepare(raw, args.cycles, args.branch, args.deadband, args.deadband_threshold)
-    check_fittable(rows, f"{args.data} (cycles {args.cycles}, {args.branch} branch)")
+    chosen = f"{args.data} (cycles {args.cycles}, {args.branch} branch)"
+    # (the rows' count is checked once the parameters are known: as many rows as parameters or fewer is the fit's
+    # own refusal, which names both)
+    check_fittable(rows, chosen, min_rows=0)
     check_signs(rows, args.data)
     check_zeros(raw, args.data)   # (every row: the slack deadband's removal shifts the stroke by its own zero)
     names, held = fitted_and_held(model, args.fit_params, args.fix)
@@ -208,6 +211,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
     warn = history_warning(model, args.branch, min((len(set(rows.cycle[sl].tolist()))
                                                     for _, sl in rows.sample_slices()), default=0),
                            params.varying)
+    if len(rows) > len(params.varying):
+        check_row_count(len(rows), chosen)
     result = fit(model, rows, params=params, grid=args.starts)
 
     sel = (f"cycles {args.cycles}, {args.branch} branch, "

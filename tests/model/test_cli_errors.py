@@ -97,6 +97,21 @@ def test_a_directory_or_unreadable_path_is_one_line(tmp_path, capsys, cmd):
 
 
 @pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+@pytest.mark.parametrize("n_rows", [1, 2, 9])
+def test_a_handful_of_rows_is_refused_not_fitted(data_csv, tmp_path, capsys, cmd, n_rows):
+    # two rows of a loading ramp were fitted (E_t on its bound at 20 deg RMSE, or "near" it, exit 0)
+    lines = data_csv.read_text().splitlines()
+    f = tmp_path / "few.csv"
+    f.write_text("\n".join([lines[0]] + lines[100:100 + n_rows]) + "\n")
+    for extra in ([], ["--no-deadband", "--cycles", "all", "--branch", "both"]) if cmd == "fit" else ([],):
+        # (the default selection drops the slack deadband's rows first: fewer are left)
+        err = _fails_cleanly(["model", cmd, str(f), "--pattern", TUBE2, "-q", *extra], capsys,
+                             " row", "too few", "few.csv", *([f" {n_rows} row"] if extra or cmd == "diagnose" else []))
+        assert len(err.strip().splitlines()) == 1, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["few.csv"]
+
+
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
 @pytest.mark.parametrize("kind", ["constant", "zero stroke"])
 def test_constant_or_zero_stroke_data_is_refused(data_csv, tmp_path, capsys, cmd, kind):
     cols = ({"stroke_mm": "1.0", "force_N": "0.5", "angle_deg": "3.0"} if kind == "constant"

@@ -41,12 +41,12 @@ API
 from __future__ import annotations
 
 from camtube.model.data.csvfile import (
-    COLUMNS, Measurements, check_fittable, format_csv, load_csv, parse_csv, read_measurements,
+    COLUMNS, Measurements, check_fittable, check_row_count, format_csv, load_csv, parse_csv, read_measurements,
 )
 from camtube.model.data.dataset import Dataset
 from camtube.model.data.select import (
     BRANCHES, CycleSpec, Slack, find_slack, parse_cycles, prepare, remove_deadband, select_branch, select_cycles,
 )
 
-__all__ = ["BRANCHES", "COLUMNS", "CycleSpec", "Dataset", "Measurements", "read_measurements", "Slack", "check_fittable", "find_slack", "format_csv",
+__all__ = ["BRANCHES", "COLUMNS", "CycleSpec", "Dataset", "Measurements", "read_measurements", "Slack", "check_fittable", "check_row_count", "find_slack", "format_csv",
            "load_csv", "parse_csv", "parse_cycles", "prepare", "remove_deadband", "select_branch", "select_cycles"]

@@ -359,14 +359,30 @@ def _read_text(path: Path) -> str:
     return text
 
 
-def check_fittable(data: Dataset, what: str = "the selected rows") -> None:
-    """Refuse rows the joint model cannot be fitted to: a stroke or an angle that never changes.
+#: Fewest rows a fit or a diagnosis takes: fewer say nothing about the joint (two rows of one loading ramp fitted E_t on
+#: its bound at 20 deg RMSE, or "near" it, as if it were a result).
+MIN_FIT_ROWS = 10
+
+
+def check_row_count(n_rows: int, what: str = "the selected rows") -> None:
+    """Refuse fewer than :data:`MIN_FIT_ROWS` rows (:class:`DataError` naming ``what``)."""
+    if n_rows < MIN_FIT_ROWS:
+        raise DataError(f"{what}: {n_rows} row{'' if n_rows == 1 else 's'}, too few to fit the joint model "
+                        f"(at least {MIN_FIT_ROWS}); fix: give the whole record (check the file and the --cycles "
+                        "selection)")
+
+
+def check_fittable(data: Dataset, what: str = "the selected rows", min_rows: int = MIN_FIT_ROWS) -> None:
+    """Refuse rows the joint model cannot be fitted to: fewer than ``min_rows`` (:func:`check_row_count`; 0: not
+    checked here), a stroke or an angle that never changes.
 
     Raises
     ------
     DataError
         Naming the column, its value range and the fix.
     """
+    if min_rows or len(data) < 2:   # (one row "never changes": it is too few)
+        check_row_count(len(data), what)
     for col, unit in (("stroke_mm", "mm"), ("angle_deg", "deg")):
         v = np.asarray(getattr(data, col), float)
         if v.size and float(np.ptp(v)) <= 1e-12 * max(1.0, float(np.max(np.abs(v)))):
