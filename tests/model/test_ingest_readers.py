@@ -135,6 +135,10 @@ def test_bench_map_overrides_and_unknown_keys():
     # the bad-input search: taken, the whole record read as the rest
     with pytest.raises(DataError, match="tracker.rest_s: '1e9' is out of range: a rest of more than 600 s"):
         bench_map_from_dict({}, "b.yaml", ["tracker.rest_s=1e9"])
+    # taken, the first frame alone read as the rest (its noise an offset in every angle)
+    with pytest.raises(DataError, match="tracker.rest_s: '0' is out of range: the rest before the first pull takes"):
+        bench_map_from_dict({}, "b.yaml", ["tracker.rest_s=0"])
+    assert bench_map_from_dict({}, "b.yaml", ["tracker.rest_s=0.2"]).tracker.rest_s == 0.2
 
 
 # ------------------------------------------------------------------ bend angle from poses

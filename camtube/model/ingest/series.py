@@ -187,9 +187,13 @@ def _coerce(section: str, name: str, value, default, source: str):
             v = float(value)
         except (TypeError, ValueError):
             raise _map_err(source, key, f"{value!r} is not a number", f"give a number (default {default:g})") from None
-        if (not np.isfinite(v) or ((section, name) in _POSITIVE and v <= 0) or (v < 0 and name in ("rate_hz", "rest_s"))
+        if (not np.isfinite(v) or ((section, name) in _POSITIVE and v <= 0) or (v < 0 and name == "rate_hz")
+                or (v < 0 and name == "rest_s")
                 or (name == "N_per_V" and v == 0)):
             raise _map_err(source, key, f"{value!r} is out of range", "give a positive number")
+        if name == "rest_s" and v <= 0:   # (0 took the first frame alone as the rest: its noise in every angle)
+            raise _map_err(source, key, f"{value!r} is out of range: the rest before the first pull takes some time",
+                           f"give it in s (e.g. {default:g})")
         if name == "rest_s" and v > MAX_REST_S:   # (1e9 read the whole record as the rest: zero bend, zero force)
             raise _map_err(source, key, f"{value!r} is out of range: a rest of more than {MAX_REST_S:g} s at the "
                            "start of the recording", f"give the rest before the first pull, in s (e.g. {default:g})")
