@@ -441,8 +441,13 @@ HELDOUT52_KINDS = USUAL_KINDS + [("slack", "backbone3"), ("friction", "lost moti
 #: motion beside slack, a creeping tendon beside a guide's friction: pairs no batch above drew.
 HELDOUT53_KINDS = USUAL_KINDS + [("toe", "backbone"), ("lost motion", "slack"), ("creep", "friction"),
                                  "sharp friction", "tracker drift"]
+#: The fifty-fourth fresh held-out batch (issue 19, drawn a session after bench-heldout53, the diagnosis unchanged
+#: since but for a refusal of fewer than ten rows): record shapes drawn per file as bench-shapes', a three-arm backbone
+#: beside a guide's friction, a toe beside a sharp guide, a lag beside a sharp guide.
+HELDOUT54_KINDS = USUAL_KINDS + [("backbone3", "friction"), ("toe", "sharp friction"), ("lag", "sharp friction"),
+                                 "sharp friction", "tracker drift"]
 #: Batches whose files draw their own record shapes (``draw_batch(shapes=True)``).
-SHAPED = {"bench-shapes", "bench-heldout52", "bench-heldout53"}
+SHAPED = {"bench-shapes", "bench-heldout52", "bench-heldout53", "bench-heldout54"}
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -576,7 +581,9 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            # drawn once the method was settled after bench-heldout51 and bench-shapes (both looked at); run once
            "bench-heldout52": (20281226, HELDOUT52_KINDS),
            # drawn a session after bench-heldout52 (looked at), the diagnosis unchanged since; run once
-           "bench-heldout53": (20281227, HELDOUT53_KINDS)}
+           "bench-heldout53": (20281227, HELDOUT53_KINDS),
+           # drawn a session after bench-heldout53 (looked at), the diagnosis unchanged since; run once
+           "bench-heldout54": (20281228, HELDOUT54_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
@@ -586,7 +593,7 @@ SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldo
            "bench-heldout43", "bench-heldout44", "bench-heldout45", "bench-sharp", "bench-heldout46",
            "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50",
            "bench-heldout51", "bench-shapes",
-           "bench-heldout52", "bench-heldout53"}
+           "bench-heldout52", "bench-heldout53", "bench-heldout54"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -600,12 +607,12 @@ ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19
            "bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45",
            "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50",
            "bench-heldout51", "bench-shapes",
-           "bench-heldout52", "bench-heldout53"}
+           "bench-heldout52", "bench-heldout53", "bench-heldout54"}
 #: Batches whose load cells may not be zeroed before the test (:func:`untared`).
 UNTARED = {"bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45",
            "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50",
            "bench-heldout51", "bench-shapes",
-           "bench-heldout52", "bench-heldout53"}
+           "bench-heldout52", "bench-heldout53", "bench-heldout54"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
