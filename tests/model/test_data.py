@@ -359,6 +359,23 @@ def test_far_zeros_names_an_absolute_stroke_or_a_tracker_s_offset_not_a_joint_re
     assert far_zeros(record(x, spiky)) == {}
 
 
+def test_far_zeros_names_a_load_cell_not_zeroed_not_one_that_drifts_a_little():
+    from camtube.model.data.csvfile import far_zeros
+    from camtube.model.data.dataset import Dataset
+
+    t = np.arange(0.0, 40.0, 0.02)
+    x = 1.0 - np.cos(2 * np.pi * t / 8.0)
+
+    def record(force):
+        return Dataset(np.full(t.size, "A", dtype=object), (t // 8).astype(int) + 1, t, x, force, 20 * x)
+
+    assert far_zeros(record(2 * x)) == {}
+    assert far_zeros(record(2 * x + 0.3 + 0.01 * t)) == {}                # an offset and a drift within the span
+    for off in (-10.0, -5.0, 5.0, 100.0):                                 # every reading below zero, or far above
+        got = far_zeros(record(2 * x + off))
+        assert list(got) == ["force_N"] and got["force_N"][0][1] == pytest.approx(off, abs=0.05), got
+
+
 def test_a_clock_that_counts_from_elsewhere_reads_as_the_same_record(tube2, tmp_path):
     # a logger counting Unix seconds, or a second sample logged 1000 s after the first: the physics reads the time since
     # each sample's first row. Before, a file in Unix seconds was refused ("beyond 1e9 ... no bench measures that"),

@@ -466,26 +466,33 @@ def far_zeros(data: Dataset) -> dict[str, list[tuple[str, float, float]]]:
     absolute position (100.0 to 102.5 mm), or a tracker whose straight joint reads 90 deg, is off by more than the
     record's own span: the stroke's lowest value beyond its span from 0, or the angle at the lowest stroke (the
     median over the rows within 1 % of the stroke's span of it) beyond the angle's span (1st to 99th percentile: a
-    spike does not widen it). A joint resting a little bent (a permanent set) is well within."""
+    spike does not widen it). A joint resting a little bent (a permanent set) is well within. So is the force: a load
+    cell not zeroed before the test (every reading below zero, or 100 N at rest) reads at the lowest stroke beyond its
+    own span; a cell whose zero drifts a little is well within (the instruments' check re-zeroes it)."""
     out: dict[str, list[tuple[str, float, float]]] = {}
     for smp, sl in data.sample_slices():
-        s, a = (np.asarray(getattr(data, c)[sl], float) for c in ("stroke_mm", "angle_deg"))
+        s, f, a = (np.asarray(getattr(data, c)[sl], float) for c in ("stroke_mm", "force_N", "angle_deg"))
         ok = np.isfinite(s) & np.isfinite(a)
-        s, a = s[ok], a[ok]
+        s, f, a = s[ok], f[ok], a[ok]
         if s.size < 20 or not np.ptp(s) > 0:
             continue
         lo, span = float(np.min(s)), float(np.ptp(s))
         if abs(lo) > span:
             out.setdefault("stroke_mm", []).append((str(smp), lo, span))
             continue
-        rest = float(np.median(a[s <= lo + 0.01 * span]))
-        a_span = float(np.percentile(a, 99) - np.percentile(a, 1))
-        if a_span > 0 and abs(rest) > a_span:
-            out.setdefault("angle_deg", []).append((str(smp), rest, a_span))
+        at_rest = s <= lo + 0.01 * span
+        for col, v in (("angle_deg", a), ("force_N", f)):
+            fine = np.isfinite(v)
+            if not (fine & at_rest).any():
+                continue
+            rest = float(np.median(v[fine & at_rest]))
+            v_span = float(np.percentile(v[fine], 99) - np.percentile(v[fine], 1))
+            if v_span > 0 and abs(rest) > v_span:
+                out.setdefault(col, []).append((str(smp), rest, v_span))
     return out
 
 
-def check_zeros(data: Dataset, what: str) -> None:
+def check_zeros(data: Dataset, what: str, force_hint: str = "") -> None:
     """Refuse rows whose stroke or angle is not taken from the straight, unloaded joint (:func:`far_zeros`), naming
     the column, each sample's value at rest and the fix (subtract it).
 
@@ -498,12 +505,14 @@ def check_zeros(data: Dataset, what: str) -> None:
         return
     parts = []
     for col, hits in bad.items():
-        unit = "mm" if col == "stroke_mm" else "deg"
+        unit = {"stroke_mm": "mm", "angle_deg": "deg", "force_N": "N"}[col]
         at = ", ".join(f"{v:.4g} {unit} in {smp}" for smp, v, _ in hits)
         parts.append(f"column {col!r} reads {at} with the joint at rest, beyond the {hits[0][2]:.3g} {unit} it spans")
     cols = " and ".join(bad)
-    raise DataError(f"{what}: {'; '.join(parts)}: the model takes the stroke and the angle from the straight, unloaded "
-                    f"joint (0 at rest); fix: subtract each sample's value at rest from {cols}")
+    cell = "force_N" in bad
+    raise DataError(f"{what}: {'; '.join(parts)}: the model takes the stroke{', the angle and the force' if cell else ' and the angle'} "
+                    f"from the straight, unloaded joint (0 at rest{': the load cell zeroed before the test' if cell else ''}); "
+                    f"fix: subtract each sample's value at rest from {cols}" + (force_hint if cell else ""))
 
 
 def check_time_varies(data: Dataset, what: str) -> None:
