@@ -142,6 +142,12 @@ class OutputError(CamtubeError, OSError):
 
 def output_error(path: str | os.PathLike, exc: OSError) -> OutputError:
     """An :class:`OutputError` for an ``OSError`` raised while writing ``path``."""
+    if exc.errno in (errno.EEXIST, errno.ENOTDIR):
+        # a folder of the path is a file ("cannot write: File exists" said nothing of which one)
+        blocker = next((q for q in Path(path).parents if q.exists() and not q.is_dir()), None)
+        if blocker is not None:
+            return OutputError(path, f"{blocker} is a file, not a folder",
+                               "choose an output path under a folder, or move that file away")
     reason = exc.strerror or str(exc)
     return OutputError(path, reason, _FIXES.get(exc.errno or 0, "check the output path"))
 

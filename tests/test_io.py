@@ -112,6 +112,17 @@ def test_write_set_refuses_a_file_as_directory(tmp_path):
     assert (tmp_path / "f").read_text() == "x"
 
 
+@pytest.mark.parametrize("under", ["f/x.csv", "f/a/b/x.csv"])
+def test_a_file_where_a_folder_of_the_path_should_be_is_named(tmp_path, under):
+    # was "cannot write: File exists; fix: name a directory that does not exist yet or is a directory, not a file"
+    (tmp_path / "f").write_text("x")
+    with pytest.raises(OutputError) as exc:
+        write_atomic(tmp_path / under, "data")
+    assert f"{tmp_path / 'f'} is a file, not a folder" in str(exc.value), exc.value
+    assert "fix: choose an output path under a folder" in str(exc.value)
+    assert (tmp_path / "f").read_text() == "x"
+
+
 def test_write_together_puts_back_a_published_file_when_the_set_fails(tmp_path, monkeypatch):
     """Bug 13: the outputs of one command in different places (a JSON, a report folder) appear all or none."""
     import camtube.io as io
