@@ -335,6 +335,9 @@ def build_settings(raw: dict, file: str | None = None) -> tuple[Tube, Process, T
 
 #: Characters a file name on Windows may not hold (besides '/' and '\\', refused as folders).
 WINDOWS_RESERVED = '<>:"|?*'
+#: Device names Windows reserves, with any extension (NUL.ngc is the null device there).
+WINDOWS_DEVICES = frozenset({"CON", "PRN", "AUX", "NUL", *(f"COM{i}" for i in range(1, 10)),
+                             *(f"LPT{i}" for i in range(1, 10))})
 
 
 def check_name(r: _Reader, name) -> None:
@@ -355,6 +358,12 @@ def check_name(r: _Reader, name) -> None:
         r.issue("name", "names the output files (NAME.ngc, NAME.job.json, ...), so it must be a plain file name",
                 name, "letters, digits, '-', '_', '.'; no '/' or '\\'", "drop the folder part, e.g. name: tube2 "
                 "(choose the folder with -o)")
+    elif not name.strip():
+        r.issue("name", "is blank (the output files would be named '.ngc', '.job.json', ...)", name,
+                "letters, digits, '-', '_', '.'", "write e.g. name: tube2")
+    elif name.split(".")[0].strip().upper() in WINDOWS_DEVICES:
+        r.issue("name", f"is {name.split('.')[0]!r}, a device name on Windows (NUL.ngc is the null device there, not "
+                "a file)", name, "any name but CON, PRN, AUX, NUL, COM1-9, LPT1-9", f"write e.g. name: {name}-joint")
     elif any(c in str(name) for c in WINDOWS_RESERVED):
         # (written on Linux, a*b?.ngc cannot be copied to the controller's PC if that runs Windows, nor typed in a
         # shell without quotes)

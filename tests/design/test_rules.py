@@ -86,6 +86,11 @@ CASES = [
     # the bad-input search: written as a*b?.ngc, a name that said "letters, digits, '-', '_', '.'" only
     (["name=a*b?"], "name", ["holds '*' '?'", "a file name on Windows may not hold", "none of < > : \" | ? *"]),
     (["name=run:2"], "name", ["holds ':'"]),
+    # the bad-input search: written as NUL.ngc (the null device on Windows) and as '  .ngc'
+    (["name=NUL"], "name", ["a device name on Windows", "CON, PRN, AUX, NUL, COM1-9, LPT1-9"]),
+    (["name=com1.job"], "name", ["is 'com1', a device name on Windows"]),
+    (["name=lpt9"], "name", ["a device name on Windows"]),
+    (["name='  '"], "name", ["is blank", "write e.g. name: tube2"]),
 ]
 CASES[3] = (["notch.spacing=.nan"], "notch.spacing", ["must be finite"])
 
