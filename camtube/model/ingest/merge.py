@@ -69,6 +69,15 @@ class Ingested:
         return int(np.sum(~self.bend.valid)) + self.absent_frames
 
 
+#: Largest stroke (mm) and force (N) a notched-tube joint's tendon may show in an ingested log: beyond them a map's
+#: unit or scale is wrong (the presets' strokes are 2-5 mm; a UHMWPE tendon of r_t 0.04 mm breaks near 15 N).
+MAX_STROKE_MM = 100.0
+MAX_FORCE_N = 200.0
+#: Smallest peak stroke (mm) of a log that moves: below it the motor's scale is wrong (a lead of 1e-12 mm per rev).
+MIN_STROKE_MM = 1e-3
+#: Fewest tracked frames the rest at the start of a recording (``tracker.rest_s``) must hold: zero bend is their mean.
+MIN_REST_FRAMES = 3
+
 def _pick_tools(log: TrackerLog, bm: BenchMap):
     tip_key, base_key = bm.tracker.tip, bm.tracker.base
     if not tip_key:
@@ -99,6 +108,15 @@ def _angle_from_poses(tracker: TrackerLog, bench: BenchMap):
     except ValueError:
         raise DataError(f"{tracker.source}: no frame in which the tip{' and the base' if base else ''} coil is "
                         "tracked (state OK); fix: check the tool names (tracker.tip, tracker.base)") from None
+    if bend.n_rest < MIN_REST_FRAMES:
+        # (a rest of 1e-9 s took the first frame alone as zero bend: its noise an offset in every angle)
+        ts = np.asarray(tip.time_s, float)[np.asarray(tip.valid, bool)]
+        dt = float(np.median(np.diff(ts))) if ts.size > 1 else 0.0
+        every = f" (a frame every {dt * 1e3:.3g} ms)" if dt > 0 else ""
+        raise DataError(f"{tracker.source}: tracker.rest_s = {tm.rest_s:g} s holds {bend.n_rest} tracked frame"
+                        f"{'' if bend.n_rest == 1 else 's'}{every}: zero bend read from so few carries their noise "
+                        f"into every angle; fix: give the rest before the first pull, at least {MIN_REST_FRAMES} "
+                        f"frames (--map tracker.rest_s={max(MIN_REST_FRAMES * dt, 0.1):.2g} or more; default 1)")
     flagged: dict = {}
     for role, tool in (("tip", tip), ("base", base)):
         if tool is None:
@@ -201,6 +219,7 @@ def ingest(tracker: TrackerLog | Series, daq: Series, motor: Series, bench: Benc
                         f"({stroke.max():.3g} to {stroke.min():.3g} mm); fix: --map motor.sign=-1 (the position counts "
                         "down as the tendon is pulled)")
     force = force_N(daq, bench.daq, bench.tracker.rest_s)
+    _check_magnitudes(motor, stroke, daq, force, bench)
 
     # ---- clocks: the motor and the DAQ onto the tracker
     ang = bend.angle_deg
@@ -286,3 +305,33 @@ def ingest_files(tracker_path, daq_path, motor_path, bench: BenchMap, sample: st
     m = bench.motor
     motor = load_series(motor_path, m.time, m.time_unit, m.stroke, m.trigger, role="motor")
     return ingest(log, daq, motor, bench, name, max_lag_s=max_lag_s)
+
+
+def _check_magnitudes(motor: Series, stroke: np.ndarray, daq: Series, force: np.ndarray, bench: BenchMap) -> None:
+    """Refuse a stroke or a force no tendon-driven tube joint shows: a map's scale or unit is wrong (a motor read
+    with half a count per revolution stroked 2.6 m; a DAQ logged in mV read as V pulled 3.8 kN; a zero of 5 V left every
+    force below zero). One line naming the file, the column, the values and the keys to check."""
+    motor_keys = ("motor.stroke_unit, motor.counts_per_rev, motor.gear_ratio and motor.lead_mm_per_rev"
+                  if bench.motor.stroke_unit == "counts" else "motor.stroke_unit and motor.lead_mm_per_rev")
+    peak = float(np.max(stroke)) if stroke.size else 0.0
+    if peak > MAX_STROKE_MM:
+        raise DataError(f"{motor.source}: column {motor.column!r} gives a stroke of up to {peak:.4g} mm, more than the "
+                        f"{MAX_STROKE_MM:g} mm any notched-tube joint's tendon travels; fix: check {motor_keys}")
+    if 0.0 < float(np.ptp(motor.value)) and peak < MIN_STROKE_MM:
+        raise DataError(f"{motor.source}: column {motor.column!r} moves, but gives a stroke of at most {peak:.3g} mm; "
+                        f"fix: check {motor_keys}")
+    scale = ("daq.force_unit and daq.N_per_V (a log in mV read as V is 1000x too large)"
+             if bench.daq.force_unit == "V" else "daq.force_unit (N: the column holds newtons)")
+    big = float(np.max(np.abs(force))) if force.size else 0.0
+    if big > MAX_FORCE_N:
+        raise DataError(f"{daq.source}: column {daq.column!r} gives forces up to {big:.4g} N, more than the "
+                        f"{MAX_FORCE_N:g} N any notched-tube joint's tendon carries; fix: check {scale}")
+    at_rest = daq.time_s <= daq.time_s[0] + max(bench.tracker.rest_s, 0.0)
+    if at_rest.any() and force.size > 2:
+        rest = float(np.median(force[at_rest]))
+        span = float(np.percentile(force, 99) - np.percentile(force, 1))
+        if span > 0 and abs(rest) > span:
+            raise DataError(f"{daq.source}: column {daq.column!r} gives {rest:.4g} N at the rest before the first pull "
+                            f"(the first {bench.tracker.rest_s:g} s), beyond the {span:.3g} N the force spans: its zero "
+                            f"(daq.offset_V = {bench.daq.offset_V}) is not the load cell's reading at rest; fix: "
+                            "--map daq.offset_V=rest (the median over that rest)")

@@ -191,6 +191,9 @@ def _coerce(section: str, name: str, value, default, source: str):
                 or (v < 0 and name == "rest_s")
                 or (name == "N_per_V" and v == 0)):
             raise _map_err(source, key, f"{value!r} is out of range", "give a positive number")
+        if (section, name) == ("motor", "counts_per_rev") and (v < 1 or v != round(v)):
+            raise _map_err(source, key, f"{value!r} is not a count: an encoder gives a whole number of counts per "
+                           "revolution", "give the encoder's counts per revolution from its data sheet, e.g. 512")
         if name == "rest_s" and v <= 0:   # (0 took the first frame alone as the rest: its noise in every angle)
             raise _map_err(source, key, f"{value!r} is out of range: the rest before the first pull takes some time",
                            f"give it in s (e.g. {default:g})")
