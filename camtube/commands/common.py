@@ -48,6 +48,9 @@ def lag_value(value: str) -> float | dict[str, float]:
         if not eq or not smp.strip() or lag is None:
             raise argparse.ArgumentTypeError(f"{part.strip()!r} in {value!r} is not SAMPLE=MS: give e.g. S1=76,S2=0 "
                                              "(one lag per sample), or one number for all")
+        if smp.strip() in out:   # (the last one won without a word)
+            raise argparse.ArgumentTypeError(f"sample {smp.strip()!r} is given twice in {value!r} ({out[smp.strip()]:g} "
+                                             f"and {lag:g} ms): give each sample once")
         out[smp.strip()] = lag
     return out
 

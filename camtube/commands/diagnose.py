@@ -86,7 +86,8 @@ def _rows_left(args: argparse.Namespace, meas, ins) -> str:
         why.append(f"{meas.missing_lines.size} with a missing value")
     if meas.backward_lines.size:
         why.append(f"{meas.backward_lines.size} whose time_s goes backwards")
-    why += [f"{len(idx)} with a {reason}" for reason, idx in ins.aside.items() if len(idx)]
+    why += [f"{len(idx)} with {'an' if reason[:1] in 'aeiou' else 'a'} {reason}" for reason, idx in ins.aside.items()
+            if len(idx)]
     if not why:
         return f"{args.data} (cycles {args.cycles})"
     total = len(ins.data) + int(meas.missing_lines.size + meas.backward_lines.size) + int((~ins.kept).sum())
@@ -148,7 +149,8 @@ def _diagnose(args: argparse.Namespace) -> int:
     )
     from camtube.errors import DataError
     from camtube.io import write_together
-    from camtube.model.core.build import build_registry, check_suffix, fitted_and_held, parse_in_range, split_names
+    from camtube.model.core.build import (build_registry, check_fix_and_init, check_suffix, fitted_and_held,
+                                         parse_assignments, parse_in_range, split_names)
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import check_fittable, read_measurements, select_cycles
     from camtube.model.data.csvfile import check_force_identifies, check_signs, check_zeros
@@ -195,9 +197,12 @@ def _diagnose(args: argparse.Namespace) -> int:
     specs = {**{f"{e.name}.{q.name}": q for e in reg.values() for q in e.params}, **model.param_specs}
     init = parse_in_range(args.init, "--init", specs)
     _check_init_names(init, specs)
+    check_fix_and_init(parse_assignments(args.fix, "--fix"), init)
     given_ps = list(dict.fromkeys(model.per_sample_names(split_names(args.given_per_sample, "--per-sample"))))
     meas = read_measurements(args.data, strict=args.strict)
     rows = select_cycles(meas.data, args.cycles)
+    # (a column that never changes, or a handful of rows, is said as such before the instruments read a lag in it)
+    check_fittable(rows, f"{args.data} (cycles {args.cycles})")
     ins = check_instruments(rows, lag_ms=args.lag_ms, dropped=meas.summary(),
                             n_dropped=int(meas.missing_lines.size + meas.backward_lines.size), rezero=args.rezero)
     check_fittable(ins.data, _rows_left(args, meas, ins))

@@ -140,7 +140,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     )
     from camtube.io import write_together
     from camtube.model.core.build import (
-        build_registry, fitted_and_held, history_warning, parse_in_range, split_names,
+        build_registry, check_fix_and_init, fitted_and_held, history_warning, parse_in_range, split_names,
     )
     from camtube.model.core.fit import FitError, fit
     from camtube.model.core.predict import model_for_pattern, pattern_values
@@ -200,12 +200,15 @@ def cmd_fit(args: argparse.Namespace) -> int:
     # own refusal, which names both)
     check_fittable(rows, chosen, min_rows=0)
     check_signs(rows, args.data)
-    check_zeros(raw, args.data)   # (every row: the slack deadband's removal shifts the stroke by its own zero)
+    check_zeros(raw, args.data,   # (every row: the slack deadband's removal shifts the stroke by its own zero)
+                "" if args.rezero else " (or re-zero the force at the rests of the whole record: --set-aside "
+                "--rezero --cycles all)")
     names, held = fitted_and_held(model, args.fit_params, args.fix)
     fixed = pattern_values(pattern)
     fixed.update(held)
     check_units(model_for_pattern(pattern), rows, fixed, names, args.data)
     init = parse_in_range(args.init, "--init", model.param_specs)
+    check_fix_and_init(held, init)
     params = model.make_params(rows, names, fixed, initial=init,
                                per_sample=split_names(args.per_sample, "--per-sample"))
     warn = history_warning(model, args.branch, min((len(set(rows.cycle[sl].tolist()))

@@ -55,6 +55,10 @@ def _fails_cleanly(argv, capsys, *words):
     ("--slack", "-0.1", "--slack"), ("--slack", "9", "--slack"), ("--modulus", "0", "--modulus"),
     ("--samples", "0", "--samples"), ("--cycles", "0", "--cycles"),
     ("--seed", "-1", "--seed"),  # was a ValueError traceback from numpy
+    # taken: a file its own fit refuses, a "perfect fit RMSE" of 300 digits
+    ("--modulus", "1e-300", "0.5..500 GPa"), ("--modulus", "1e300", "0.5..500 GPa"),
+    ("--noise-angle", "1e9", "0..10 deg"), ("--noise-force", "1e9", "0..1 N"),
+    ("--seed", "99999999999999999999", "2**63"),
 ])
 def test_synth_refuses_nonsense_and_writes_nothing(tmp_path, capsys, opt, value, word):
     out = tmp_path / "x.csv"
@@ -587,3 +591,75 @@ def test_out_of_memory_in_a_model_command_names_the_rows_not_the_notches(data_cs
     err = _fails_cleanly(["model", "diagnose", str(data_csv), "--pattern", TUBE2, "-q"], capsys,
                          "out of memory; fix: give fewer rows (--cycles SPEC)")
     assert "notches" not in err
+
+
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+@pytest.mark.parametrize("tail,words", [
+    # the start took the held value's place: E_t held at 40, written so to the JSON, exit 0
+    (["--fix", "E_t=28", "--init", "E_t=40"], ["--fix E_t=28 and --init E_t=40 both name E_t", "fix: drop"]),
+    # the last one won without a word
+    (["--fix", "E_t=28", "--fix", "E_t=30"], ["--fix names E_t twice (28 and 30)", "fix: give it once"]),
+    (["--init", "E_t=20", "--init", "E_t=30"], ["--init names E_t twice (20 and 30)", "fix: give it once"]),
+    (["--set-aside", "--lag-ms", "1=200,1=6"], ["sample '1' is given twice", "give each sample once"]),
+])
+def test_an_option_that_contradicts_itself_is_refused(data_csv, tmp_path, capsys, cmd, tail, words):
+    if cmd == "diagnose" and "--set-aside" in tail:
+        tail = tail[1:]
+    out = tmp_path / "f.json"
+    argv = ["model", cmd, str(data_csv), "--pattern", TUBE2, "-q", *tail, "--json", str(out)]
+    if "--lag-ms" in tail:   # refused as argparse reads it (its exit: SystemExit 2)
+        with pytest.raises(SystemExit) as exc:
+            main(argv)
+        assert exc.value.code == 2
+        err = capsys.readouterr().err
+        assert "Traceback" not in err and all(w in err for w in words), err
+    else:
+        err = _fails_cleanly(argv, capsys, *words)
+    assert len(err.strip().splitlines()) == 1, err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("cmd", ["fit", "diagnose"])
+@pytest.mark.parametrize("offset_N", [-10.0, -5.0, 100.0])
+def test_a_load_cell_not_zeroed_is_named_not_read_as_another_unit(data_csv, tmp_path, capsys, cmd, offset_N):
+    # every force below zero was "angle_deg reads like radians" or "stroke_mm reads like um": a fix that made it worse
+    rows = list(csv.DictReader(open(data_csv, newline="")))
+    f = tmp_path / "off.csv"
+    with open(f, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        for r in rows:
+            w.writerow({**r, "force_N": repr(float(r["force_N"]) + offset_N)})
+    err = _fails_cleanly(["model", cmd, str(f), "--pattern", TUBE2, "-q"], capsys,
+                         "column 'force_N' reads", "with the joint at rest", "the load cell zeroed before the test",
+                         "fix: subtract each sample's value at rest from force_N")
+    assert "radians" not in err and " um" not in err and len(err.strip().splitlines()) == 1, err
+
+
+@pytest.mark.parametrize("rest_s", ["1e-9", "0.001"])
+def test_a_rest_shorter_than_three_tracker_frames_is_refused(tmp_path, capsys, rest_s):
+    # taken: the first frame alone as zero bend, its noise an offset in every angle of the file written
+    out = tmp_path / "m.csv"
+    err = _fails_cleanly(["model", "ingest", "--tracker", str(BENCH / "aurora-export.csv"), "--daq", str(BENCH / "daq.csv"),
+                          "--motor", str(BENCH / "motor.csv"), "--bench", str(BENCH / "bench.yaml"), "-o", str(out),
+                          "--map", f"tracker.rest_s={rest_s}"], capsys,
+                         "aurora-export.csv: tracker.rest_s", "holds 1 tracked frame (a frame every 25 ms)",
+                         "fix: give the rest before the first pull, at least 3 frames")
+    assert len(err.strip().splitlines()) == 1 and not out.exists(), err
+
+
+@pytest.mark.parametrize("override,words", [
+    # each was written (exit 0): a stroke of 2.6 m, a force of 3 kN, every force below zero, a stroke of 0 mm
+    ("motor.counts_per_rev=0.5", ["motor.counts_per_rev: '0.5' is not a count", "e.g. 512"]),
+    ("daq.N_per_V=2000", ["column 'load_V' gives forces up to", "more than the 200 N", "check daq.force_unit and daq.N_per_V"]),
+    ("daq.offset_V=5", ["at the rest before the first pull", "its zero (daq.offset_V = 5.0)", "--map daq.offset_V=rest"]),
+    ("motor.lead_mm_per_rev=1e-12", ["column 'enc_counts' moves, but gives a stroke of at most",
+                                     "motor.lead_mm_per_rev"]),
+    ("motor.lead_mm_per_rev=100", ["gives a stroke of up to", "more than the 100 mm"]),
+])
+def test_an_ingest_map_whose_scale_is_wrong_is_refused(tmp_path, capsys, override, words):
+    out = tmp_path / "m.csv"
+    err = _fails_cleanly(["model", "ingest", "--tracker", str(BENCH / "aurora-export.csv"), "--daq", str(BENCH / "daq.csv"),
+                          "--motor", str(BENCH / "motor.csv"), "--bench", str(BENCH / "bench.yaml"), "-o", str(out),
+                          "--map", override], capsys, *words)
+    assert len(err.strip().splitlines()) == 1 and not out.exists(), err

@@ -50,13 +50,28 @@ def parse_assignments(items: Iterable[str], option: str = "--fix") -> dict[str, 
     out = {}
     for it in items:
         name, sep, val = it.partition("=")
+        key = name.strip()
         try:
-            out[name.strip()] = float(val)
+            value = float(val)
         except ValueError:
             sep = ""
-        if not sep or not name.strip():
+        if not sep or not key:
             raise FitError(f"{option} {it!r}: use NAME=VALUE with a number; fix: e.g. {option} L0=70")
+        if key in out:   # (the last one won without a word)
+            raise FitError(f"{option} names {key} twice ({out[key]:g} and {value:g}); fix: give it once")
+        out[key] = value
     return out
+
+
+def check_fix_and_init(held: Mapping[str, float], init: Mapping[str, float]) -> None:
+    """Refuse a parameter both held (``--fix``) and given a start (``--init``): the start took the held value's place
+    (``--fix E_t=28 --init E_t=40`` held E_t at 40 and wrote it so)."""
+    both = [n for n in init if n in held]
+    if both:
+        n = both[0]
+        raise FitError(f"--fix {n}={held[n]:g} and --init {n}={init[n]:g} both name {n}: a held parameter has no "
+                       f"start; fix: drop --init {n}=... to hold it at {held[n]:g}, or drop --fix {n}=... to fit it "
+                       f"from {init[n]:g}")
 
 
 def parse_fix(items: Iterable[str], model: JointModel | None = None) -> dict[str, float]:

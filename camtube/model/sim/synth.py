@@ -54,6 +54,10 @@ def triangle_stroke(max_stroke_mm: float, speed_mm_s: float, rate_hz: float,
     return time, stroke, cycle
 
 
+#: Largest sensor noise a synthetic file may have (a standard deviation): more is no measurement (``model fit`` refuses
+#: such readings) but a typing error.
+MAX_NOISE_ANGLE_DEG = 10.0
+MAX_NOISE_FORCE_N = 1.0
 #: Most rows one synthetic file may have (about 100 MB of CSV); more is a typing error, not a data set.
 MAX_ROWS = 2_000_000
 
@@ -73,26 +77,30 @@ def check_arguments(n_samples: int, n_cycles: int, noise_angle_deg: float, noise
     DataError
         Naming the setting (with its command-line option), the value and the allowed range.
     """
+    from camtube.model.core.model import BASE_PARAMS
+
+    e_lo, e_hi = next((p.lo, p.hi) for p in BASE_PARAMS if p.name == "E_t")
+
     def bad(name: str, value, allowed: str) -> DataError:
         return DataError(f"{name} = {value!r}: allowed {allowed}; fix: give a value in that range")
 
     checks = (
         (n_samples >= 1, "samples (--samples)", n_samples, ">= 1"),
         (n_cycles >= 1, "cycles (--cycles)", n_cycles, ">= 1"),
-        (math.isfinite(noise_angle_deg) and noise_angle_deg >= 0, "angle noise (--noise-angle)",
-         noise_angle_deg, ">= 0 deg (a standard deviation)"),
-        (math.isfinite(noise_force_N) and noise_force_N >= 0, "force noise (--noise-force)", noise_force_N,
-         ">= 0 N (a standard deviation)"),
+        (math.isfinite(noise_angle_deg) and 0 <= noise_angle_deg <= MAX_NOISE_ANGLE_DEG, "angle noise (--noise-angle)",
+         noise_angle_deg, f"0..{MAX_NOISE_ANGLE_DEG:g} deg (a standard deviation)"),
+        (math.isfinite(noise_force_N) and 0 <= noise_force_N <= MAX_NOISE_FORCE_N, "force noise (--noise-force)",
+         noise_force_N, f"0..{MAX_NOISE_FORCE_N:g} N (a standard deviation)"),
         (math.isfinite(speed_mm_s) and speed_mm_s > 0, "stroke speed (--speed)", speed_mm_s, "> 0 mm/s"),
         (math.isfinite(rate_hz) and rate_hz > 0, "sampling rate (--rate)", rate_hz, "> 0 Hz"),
         (math.isfinite(max_stroke_mm) and max_stroke_mm > 0, "peak stroke (rules.max_stroke)", max_stroke_mm,
          "> 0 mm"),
         (math.isfinite(slack_mm) and 0 <= slack_mm < max_stroke_mm, "slack (--slack)", slack_mm,
          f"0 <= slack < the peak stroke {max_stroke_mm:g} mm"),
-        (modulus_gpa is None or (math.isfinite(modulus_gpa) and modulus_gpa > 0), "tendon modulus (--modulus)",
-         modulus_gpa, "> 0 GPa"),
+        (modulus_gpa is None or (math.isfinite(modulus_gpa) and e_lo <= modulus_gpa <= e_hi),
+         "tendon modulus (--modulus)", modulus_gpa, f"{e_lo:g}..{e_hi:g} GPa (the range a fit takes E_t in)"),
         (0 <= stiffness_spread < 1, "stiffness spread", stiffness_spread, "0 <= spread < 1"),
-        (seed is None or 0 <= seed < 2 ** 63, "random seed (--seed)", seed, "a whole number >= 0"),
+        (seed is None or 0 <= seed < 2 ** 63, "random seed (--seed)", seed, "a whole number 0 <= seed < 2**63"),
     )
     for ok, name, value, allowed in checks:
         if not ok:
@@ -100,6 +108,7 @@ def check_arguments(n_samples: int, n_cycles: int, noise_angle_deg: float, noise
     m = rows_per_cycle(max_stroke_mm, speed_mm_s, rate_hz, dwell_s)
     rows = m * n_cycles * n_samples
     if m < 12:
+        m = int(round((2.0 * max_stroke_mm / speed_mm_s + dwell_s) * rate_hz))   # (as sampled: not the floor of 6)
         raise DataError(f"sampling rate (--rate) = {rate_hz!r}: only {m} rows per cycle "
                         f"({2 * max_stroke_mm / speed_mm_s:g} s); allowed: at least 12 rows per cycle, "
                         f"i.e. --rate >= {12 * speed_mm_s / (2 * max_stroke_mm):.3g} Hz at --speed {speed_mm_s:g}; "
