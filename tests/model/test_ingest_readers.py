@@ -139,6 +139,16 @@ def test_bench_map_overrides_and_unknown_keys():
     with pytest.raises(DataError, match="tracker.rest_s: '0' is out of range: the rest before the first pull takes"):
         bench_map_from_dict({}, "b.yaml", ["tracker.rest_s=0"])
     assert bench_map_from_dict({}, "b.yaml", ["tracker.rest_s=0.2"]).tracker.rest_s == 0.2
+    # the bad-input search: read, then not used without a word
+    with pytest.raises(DataError, match="daq.trigger: 'sync' is given, but motor.trigger is not"):
+        bench_map_from_dict({"daq": {"trigger": "sync"}}, "b.yaml")
+    with pytest.raises(DataError, match="motor.trigger: 'sync' is given, but daq.trigger is not"):
+        bench_map_from_dict({"motor": {"trigger": "sync"}}, "b.yaml")
+    assert bench_map_from_dict({"daq": {"trigger": "s"}, "motor": {"trigger": "s"}}, "b.yaml").daq.trigger == "s"
+    with pytest.raises(DataError, match="daq.N_per_V: '7' is given, but daq.force_unit is N"):
+        bench_map_from_dict({}, "b.yaml", ["daq.force_unit=N", "daq.N_per_V=7"])
+    with pytest.raises(DataError, match="motor.counts_per_rev: '0.5' is not a count"):
+        bench_map_from_dict({}, "b.yaml", ["motor.counts_per_rev=0.5"])
 
 
 # ------------------------------------------------------------------ bend angle from poses

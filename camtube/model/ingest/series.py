@@ -255,7 +255,19 @@ def bench_map_from_dict(doc: dict, source: str = "<bench map>", overrides: list[
                                f"did you mean {hint[0]!r}?" if hint else f"known keys: {', '.join(names)}")
             vals[name] = _coerce(sec, name, value, names[name], source)
         sections[sec] = replace(default, **vals)
-    return replace(base, **sections)
+    out = replace(base, **sections)
+    # keys that would be read without a word and then not used
+    if bool(out.daq.trigger) != bool(out.motor.trigger):
+        given, other = ("daq", "motor") if out.daq.trigger else ("motor", "daq")
+        raise _map_err(source, f"{given}.trigger", f"{getattr(out, given).trigger!r} is given, but {other}.trigger is "
+                       "not: a trigger aligns the two logs by a column both hold (the clocks were aligned by the "
+                       "motion instead, and the trigger ignored)",
+                       f"name the trigger column of the {other} log too ({other}.trigger: ...), or drop {given}.trigger")
+    if out.daq.force_unit == "N" and "N_per_V" in (doc.get("daq") or {}):
+        raise _map_err(source, "daq.N_per_V", f"{doc['daq']['N_per_V']!r} is given, but daq.force_unit is N: the "
+                       "column holds newtons and the calibration is not used",
+                       "drop daq.N_per_V, or set daq.force_unit: V if the column holds volts")
+    return out
 
 
 def load_bench_map(path: str | Path | None, overrides: list[str] = ()) -> BenchMap:
