@@ -165,6 +165,9 @@ def cmd_fit(args: argparse.Namespace) -> int:
     if t is not None and not (0 < t < 360):
         raise DataError(f"--deadband-threshold {t}: the smallest angle rise that counts as motion must be > 0 and "
                         "< 360 deg; fix: e.g. --deadband-threshold 0.5, or leave it out for max(0.5, 4 x noise)")
+    if t is not None and not args.deadband:   # (ignored without a word)
+        raise DataError(f"--deadband-threshold {t:g} with --no-deadband: the threshold finds the slack deadband that "
+                        "--no-deadband keeps, so it would not be used; fix: drop one of the two")
     pattern = load_joint_pattern(args)
     reg, _ = build_registry(args.effect_file)
     model = model_for_pattern(pattern, [reg.get_effect(n)

@@ -663,3 +663,11 @@ def test_an_ingest_map_whose_scale_is_wrong_is_refused(tmp_path, capsys, overrid
                           "--motor", str(BENCH / "motor.csv"), "--bench", str(BENCH / "bench.yaml"), "-o", str(out),
                           "--map", override], capsys, *words)
     assert len(err.strip().splitlines()) == 1 and not out.exists(), err
+
+
+def test_a_deadband_threshold_beside_no_deadband_is_refused(data_csv, tmp_path, capsys):
+    # the threshold was ignored without a word (the same fit with and without it)
+    err = _fails_cleanly(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--no-deadband",
+                          "--deadband-threshold", "20"], capsys,
+                         "--deadband-threshold 20 with --no-deadband", "fix: drop one of the two")
+    assert len(err.strip().splitlines()) == 1, err
