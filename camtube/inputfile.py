@@ -56,9 +56,31 @@ class JSONTooDeepError(json.JSONDecodeError):
         return self.problem
 
 
+class JSONDuplicateKeyError(json.JSONDecodeError):
+    """A JSON object that gives one key twice: ``json.loads`` keeps the last without a word (a calibration's
+    ``"E_t"`` given twice). A :class:`json.JSONDecodeError`, read by every reader as a file that is not JSON is; its
+    text is :attr:`problem` alone."""
+
+    def __init__(self, doc: str, key: str):
+        self.problem = f"the key {key!r} is given twice in one object"
+        super().__init__(self.problem, doc, 0)
+
+    def __str__(self) -> str:
+        return self.problem
+
+
 def parse_json(text: str):
-    """``json.loads(text)``; nesting too deep to parse raises :class:`JSONTooDeepError`, not ``RecursionError``."""
+    """``json.loads(text)``; nesting too deep to parse raises :class:`JSONTooDeepError`, not ``RecursionError``; a
+    key given twice in one object :class:`JSONDuplicateKeyError`."""
+    def pairs(items: list) -> dict:
+        out = {}
+        for k, v in items:
+            if k in out:
+                raise JSONDuplicateKeyError(text, k)
+            out[k] = v
+        return out
+
     try:
-        return json.loads(text)
+        return json.loads(text, object_pairs_hook=pairs)
     except RecursionError:
         raise JSONTooDeepError(text) from None

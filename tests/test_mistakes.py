@@ -656,7 +656,12 @@ def test_a_drawing_finds_a_shipped_process_and_names_a_missing_one(tmp_path):
                                           ('{"E_t": 1e300}', ("parameter E_t = 1e+300 GPa", "at most 1000 GPa")),
                                           ('{"E_t": 20, "L0": 1e9}', ("L0 = 1e+09 mm", "at most 10000 mm")),
                                           ('{"E_t": 20}, "schema": "other/9"', ("schema 'other/9' is not a fit's",
-                                                                                "camtube.fit/1"))])
+                                                                                "camtube.fit/1")),
+                                          # the bad-input search: taken, 1e295 mm of tendon travel asked for
+                                          ('{"E_t": 1e-300}', ("parameter E_t = 1e-300 GPa", "at least 0.5 GPa")),
+                                          ('{"E_t": 20, "arm_scale": 0.01}', ("arm_scale = 0.01", "at least 0.3")),
+                                          # the bad-input search: one of the two kept without a word
+                                          ('{"E_t": 28, "E_t": 50}', ("the key 'E_t' is given twice in one object",))])
 def test_a_calibration_with_an_unphysical_value_names_it(tmp_path, params, words):
     """A calibration with E_t = -5 was used as given: 'the joint cannot take up the stroke (no finite force found)',
     no fix; a kerf of 5 mm was blamed on --overcut, which was not given."""

@@ -125,6 +125,10 @@ CALIBRATION_MAX = {"E_t": (1000.0, "GPa"), "L0": (10_000.0, "mm"), "arm_scale": 
                    "slack.deadband_mm": (100.0, "mm"), "toe.toe_mm": (100.0, "mm"), "kerf.kerf_mm": (100.0, "mm"),
                    "series.compliance_mm_per_N": (100.0, "mm/N"), "friction.mu": (10.0, "")}
 
+#: The smallest value of each base parameter a calibration may give (and its unit): the lower bounds a fit takes them in
+#: (:data:`camtube.model.core.model.BASE_PARAMS`).
+CALIBRATION_MIN = {"E_t": (0.5, "GPa"), "L0": (1.0, "mm"), "arm_scale": (0.3, "")}
+
 
 @dataclass(frozen=True)
 class Mechanics:
@@ -244,6 +248,12 @@ class Mechanics:
                 raise CamtubeError(f"{p}: parameter {name} = {v:g}{' ' + unit if unit else ''}: outside its physical "
                                    f"range ({'> 0' if name in positive else '>= 0'}); fix: pass the JSON of a fit "
                                    "whose parameters are physical (hold a parameter with --fix NAME=VALUE)")
+            if name in CALIBRATION_MIN and v < CALIBRATION_MIN[name][0]:
+                # (E_t = 1e-300 GPa was taken: the design then asked for 1e295 mm of tendon travel)
+                low, unit = CALIBRATION_MIN[name]
+                raise CamtubeError(f"{p}: parameter {name} = {v:g}{' ' + unit if unit else ''}: below any fit's (at "
+                                   f"least {low:g}{' ' + unit if unit else ''}, the lower bound a fit takes it in); fix: "
+                                   "pass the JSON of a fit whose parameters are physical")
             if name in used and v > CALIBRATION_MAX[name][0]:
                 # (E_t = 1e300 GPa was taken: a tendon that does not stretch, the design computed without a word)
                 top, unit = CALIBRATION_MAX[name]
