@@ -115,7 +115,8 @@ SCHEMA: dict[str, dict[str, Field]] | dict = {
     "tendon": {
         "radius": Field("float", "mm", "tendon radius r_t", 0.04, **POS),
         "length": Field("float", "mm", "unloaded tendon length L0", 70.0, **POS),
-        "modulus_gpa": Field("float", "GPa", "tendon Young's modulus E_t (initial value for fits)", 28.0, **POS),
+        "modulus_gpa": Field("float", "GPa", "tendon Young's modulus E_t (initial value for fits; within the range a "
+                             "fit takes it in)", 28.0, 0.5, 500.0),
         "material": Field("str", "", "tendon material", "UHMWPE"),
         "friction": Field("float", "", "capstan friction coefficient of the tendon on the notch edges "
                           "(forward model)", 0.0, 0.0, 2.0),
@@ -157,7 +158,8 @@ SCHEMA: dict[str, dict[str, Field]] | dict = {
     "rules": {
         "min_backbone_arc": Field("float", "mm", "smallest backbone arc 2 pi r_o - s allowed", 0.3, 0.0),
         "min_web": Field("float", "mm", "smallest material bridge between two cuts", 0.1, 0.0),
-        "max_strain": Field("float", "", "backbone strain limit of the tube material (warning)", 0.03, **POS),
+        "max_strain": Field("float", "", "backbone strain limit of the tube material (warning; at most 1: no tube's "
+                            "backbone bends back from more)", 0.03, 1e-4, 1.0),
         "max_stroke": Field("float", "mm", "largest tendon stroke the joint is driven to", 2.0, **POS),
     },
 }

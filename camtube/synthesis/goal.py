@@ -40,7 +40,8 @@ GOAL_SCHEMA: dict = {
         "inner_radius": Field("float", "mm", "inner radius r_i (< r_o)", ..., 0.0, 50.0, True),
         "material": Field("choice", "", "tube material", "polyimide",
                           choices=("polyimide", "pebax", "nitinol", "other")),
-        "modulus_gpa": Field("float", "GPa", "Young's modulus of the tube (default: 2.5 for polyimide)", None, **POS),
+        "modulus_gpa": Field("float", "GPa", "Young's modulus of the tube (default: 2.5 for polyimide)", None, 0.001,
+                             1000.0),
         "hinge": Field("choice", "", "notch stiffness: fe_row (h plus a root length that shrinks with the webs to "
                        "the neighbours, fitted to FE runs of notches in rows: within 7 % of the FE), beam (E I / h, the "
                        "paper's: 1.3-4.6 x too stiff) or fe_fit (h plus a lone notch's root length: 11-45 % too soft in "
@@ -49,7 +50,8 @@ GOAL_SCHEMA: dict = {
     "tendon": {
         "radius": Field("float", "mm", "tendon radius r_t", 0.04, **POS),
         "length": Field("float", "mm", "unloaded tendon length L0", 70.0, **POS),
-        "modulus_gpa": Field("float", "GPa", "tendon Young's modulus E_t", 28.0, **POS),
+        "modulus_gpa": Field("float", "GPa", "tendon Young's modulus E_t (within the range a fit takes it in)", 28.0,
+                             0.5, 500.0),
         "material": Field("str", "", "tendon material", "UHMWPE"),
         "friction": Field("float", "", "capstan friction coefficient on the notch edges", 0.0, 0.0, 2.0),
     },
@@ -76,7 +78,8 @@ GOAL_SCHEMA: dict = {
         "base_length": Field("float", "mm", "plain tube kept beyond the last notch", 1.5, 0.0),
     },
     "limits": {
-        "max_strain": Field("float", "", "backbone strain limit at the design stroke", 0.03, **POS),
+        "max_strain": Field("float", "", "backbone strain limit at the design stroke (at most 1: no tube's backbone "
+                            "bends back from more)", 0.03, 1e-4, 1.0),
         "max_force_N": Field("float", "N", "largest tendon force the motor gives", 5.0, **POS),
         "max_length": Field("float", "mm", "longest joint (first notch's tip edge to the last notch's base edge)",
                             20.0, **POS),

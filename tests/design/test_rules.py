@@ -91,6 +91,9 @@ CASES = [
     (["name=com1.job"], "name", ["is 'com1', a device name on Windows"]),
     (["name=lpt9"], "name", ["a device name on Windows"]),
     (["name='  '"], "name", ["is blank", "write e.g. name: tube2"]),
+    # the bad-input search: 500 % strain for a polyimide tube turned the strain warning off; 1e-300 GPa was taken
+    (["rules.max_strain=5"], "rules.max_strain", ["out of range", ">= 0.0001 and <= 1", "use a value <= 1"]),
+    (["tendon.modulus_gpa=1e-300"], "tendon.modulus_gpa", ["out of range", ">= 0.5 and <= 500 GPa"]),
 ]
 CASES[3] = (["notch.spacing=.nan"], "notch.spacing", ["must be finite"])
 
