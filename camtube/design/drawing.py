@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable, Sequence
 
-from camtube.design.loader import Loaded, apply_overrides, build_settings, parse_override, read_yaml
+from camtube.design.loader import Loaded, apply_overrides, build_settings, parse_override
 from camtube.design.pattern import Cut, Pattern, drawn, sort_cuts
 from camtube.errors import Issue, PatternError
 from camtube.inputfile import refuse_device
@@ -262,13 +262,12 @@ def _settings_raw(overrides: list[str], file: str, folder: Path) -> dict:
         raise PatternError(bad)
     raw: dict = {}
     if process_file is not None:
-        from camtube.design.loader import find_process_file
+        from camtube.design.loader import find_process_file, read_process_file
 
         # as given (from the working directory), else beside the drawing or shipped, as a YAML pattern's process:
         found = Path(process_file) if Path(process_file).is_file() else find_process_file(process_file, folder,
                                                                                               file, None)
-        praw, _, _ = read_yaml(found)
-        raw["process"] = dict(praw.get("process", praw))
+        raw["process"] = read_process_file(found)
     return apply_overrides(raw, plain, file)
 
 

@@ -259,14 +259,20 @@ def _section(reader: _Reader, raw: dict, name: str) -> dict:
     return {k: reader.value(body, k, f, f"{name}.{k}") for k, f in spec.items()}
 
 
-def read_yaml(path: str | os.PathLike) -> tuple[dict, dict[str, int], str]:
-    """Read a YAML mapping; returns ``(raw, line_map, file)``; every failure names the file and line."""
+def read_yaml(path: str | os.PathLike, kind: str = "pattern") -> tuple[dict, dict[str, int], str]:
+    """Read a YAML mapping; returns ``(raw, line_map, file)``; every failure names the file and line. ``kind``:
+    ``pattern`` or ``process`` (a file a pattern's ``process:`` names), for the words of the messages."""
     file = str(path)
-    raw, text = read_yaml_file(path, "pattern",
-                               lambda: f"check the path, or give a preset name ({', '.join(preset_names())})")
+    raw, text = read_yaml_file(path, kind,
+                               lambda: f"check the path, or give a preset name ({', '.join(preset_names())})"
+                               if kind == "pattern" else "check the file the pattern's process: names")
     if raw is None:
         raw = {}
     if not isinstance(raw, dict):
+        if kind == "process":
+            raise PatternError([Issue("<top>", "a process file must be a mapping of process keys", None,
+                                      "keys " + ", ".join(SCHEMA["process"]), "write one 'key: value' per line "
+                                      "(power_w: 2.0, ...), with or without a top-level 'process:'", file, 1)])
         raise PatternError([Issue("<top>", "a pattern file must be a mapping of sections", None,
                                   "sections " + ", ".join(SCHEMA), "start the file with 'tube:'", file, 1)])
     return raw, line_map(text), file
@@ -469,18 +475,37 @@ def _process_file(raw: dict, folder: Path, file: str, lines: dict) -> tuple[dict
     if not isinstance(proc, str):
         return raw, None
     where = find_process_file(proc, folder, file, lines.get("process"))
-    praw, plines, pfile = read_yaml(where)
+    praw, plines, pfile = read_yaml(where, "process")
     if set(praw) & (set(SCHEMA) - {"process", "name", "rules"}):   # tube, notch, tendon, ...: a pattern
         raise PatternError([Issue("process", f"names {pfile}, a pattern file, not a process file", proc,
                                   "a YAML file of process keys (power_w, frequency_khz, ...), with or without a "
                                   "top-level 'process:'", "name the process file the pattern uses, or write the "
                                   "process keys under 'process:'", file, lines.get("process"))])
+    _refuse_chained(praw, plines, pfile)
     inner = "process" in praw
     raw = dict(raw)
     raw["process"] = praw.get("process", praw)
     plines = {(k if inner else f"process.{k}"): v for k, v in plines.items()
               if not inner or k == "process" or k.startswith("process.")}
     return raw, (pfile, plines)
+
+
+def _refuse_chained(praw: dict, plines: dict, pfile: str) -> None:
+    """Refuse a process file whose ``process:`` names another process file (it was taken as the pattern's own
+    ``process:`` and blamed on the pattern's line)."""
+    if isinstance(praw.get("process"), str):
+        raise PatternError([Issue("process", f"names another process file ({praw['process']!r}): a process file holds "
+                                  "the process keys themselves", praw["process"], "keys " + ", ".join(SCHEMA["process"]),
+                                  "name that file from the pattern, or copy its keys here", pfile,
+                                  plines.get("process", 1))])
+
+
+def read_process_file(path: str | os.PathLike) -> dict:
+    """The process keys of a process file (with or without a top-level ``process:``), read as a pattern's
+    ``process:`` reads them; a :class:`PatternError` naming the file when it is not one."""
+    praw, plines, pfile = read_yaml(path, "process")
+    _refuse_chained(praw, plines, pfile)
+    return praw.get("process", praw)
 
 
 def _build_naming_process_file(raw: dict, file: str, lines: dict, name: str, source: tuple | None,
@@ -531,6 +556,11 @@ def find_process_file(name: str, folder: Path, file: str, line: int | None) -> P
         for cand in (folder / name, folder / f"{name}.yaml"):
             if cand.is_file():
                 return cand
+            if cand.exists() and (cand.is_dir() or folder is folders[0]):
+                # (a folder or a device was "a process file that is not there")
+                what = "a folder" if cand.is_dir() else "not a regular file (a device or a pipe)"
+                raise PatternError([Issue("process", f"names {cand}, which is {what}", name,
+                                          "a process YAML file", "name the process YAML file", file, line)])
     raise PatternError([Issue("process", "names a process file that is not there", name,
                               f"a process YAML in {folder} or a shipped one: "
                               + ", ".join(_shipped()[1]), "put the file beside the pattern, name a "

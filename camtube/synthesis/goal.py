@@ -367,15 +367,14 @@ def goal_process(goal: Goal):
 
     A process file name is looked up beside the goal file, then among the shipped presets.
     """
-    from camtube.design.loader import PRESETS_DIR, build_settings, read_yaml
+    from camtube.design.loader import PRESETS_DIR, build_settings, read_process_file
 
     proc = goal.process
     if isinstance(proc, str):
         here = Path(goal.source).parent if goal.source else Path(".")
         for cand in (here / proc, here / f"{proc}.yaml", PRESETS_DIR / proc, PRESETS_DIR / f"{proc}.yaml"):
             if cand.is_file():
-                praw, _, _ = read_yaml(cand)
-                proc = praw.get("process", praw)
+                proc = read_process_file(cand)
                 break
         else:
             raise PatternError([Issue("process", "names a process file that is not there", goal.process,

@@ -265,3 +265,30 @@ def test_bidirectional_and_directions_layouts():
                      "notch.arc=1.0", "holes.0.angle_deg=45"]).pattern
     assert [n.angle_deg for n in q.notches][:5] == [0.0, 90.0, 180.0, 270.0, 0.0]
     assert math.isclose(q.notches[1].x_mm - q.notches[0].x_mm, 1.0)
+
+
+@pytest.mark.parametrize("kind", ["list", "chain", "folder", "latin-1"])
+def test_a_process_file_that_is_not_one_is_named_as_a_process_file(tmp_path, kind):
+    """The bad-input search: a process file holding a list was "a pattern file must be a mapping of sections; fix:
+    start the file with 'tube:'"; one naming another process file was blamed on the pattern's line; a folder was "a
+    process file that is not there"; a Latin-1 one asked for "a UTF-8 pattern YAML file"."""
+    proc = tmp_path / "proc.yaml"
+    if kind == "list":
+        proc.write_text("[1, 2]\n")
+    elif kind == "chain":
+        proc.write_text("# the lab's\nprocess: femto-polyimide.yaml\n")
+    elif kind == "folder":
+        proc.mkdir()
+    else:
+        proc.write_bytes("# r\xe9glage du laser\npower_w: 2.0\n".encode("latin-1"))
+    raw = base_raw()
+    raw["process"] = "proc.yaml"
+    msg = reject([], write_pattern(tmp_path, raw))
+    want = {"list": ["proc.yaml:1: <top>: a process file must be a mapping of process keys", "power_w"],
+            "chain": ["proc.yaml:2: process: names another process file ('femto-polyimide.yaml')",
+                      "name that file from the pattern, or copy its keys here"],
+            "folder": ["p.yaml", "process: names", "which is a folder"],
+            "latin-1": ["proc.yaml", "a UTF-8 process YAML file"]}[kind]
+    for w in want:
+        assert w in msg, msg
+    assert "start the file with 'tube:'" not in msg and "not there" not in msg, msg
