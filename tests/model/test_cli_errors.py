@@ -671,3 +671,14 @@ def test_a_deadband_threshold_beside_no_deadband_is_refused(data_csv, tmp_path, 
                           "--deadband-threshold", "20"], capsys,
                          "--deadband-threshold 20 with --no-deadband", "fix: drop one of the two")
     assert len(err.strip().splitlines()) == 1, err
+
+
+def test_a_log_cut_to_a_few_rows_is_named_as_such_not_given_another_time_unit(tmp_path, capsys):
+    # "column 'time_ms' read in ms spans 0.01 s ...; fix: daq.time_unit: s", and that unit gave another error
+    daq = tmp_path / "daq.csv"
+    daq.write_text("\n".join((BENCH / "daq.csv").read_text().splitlines()[:4]) + "\n")
+    out = tmp_path / "m.csv"
+    err = _fails_cleanly(["model", "ingest", "--tracker", str(BENCH / "aurora-export.csv"), "--daq", str(daq),
+                          "--motor", str(BENCH / "motor.csv"), "--bench", str(BENCH / "bench.yaml"), "-o", str(out)],
+                         capsys, f"{daq}: 3 rows, too few for a daq log", "a file cut short?")
+    assert "time_unit" not in err and len(err.strip().splitlines()) == 1 and not out.exists(), err

@@ -75,6 +75,8 @@ MAX_STROKE_MM = 100.0
 MAX_FORCE_N = 200.0
 #: Smallest peak stroke (mm) of a log that moves: below it the motor's scale is wrong (a lead of 1e-12 mm per rev).
 MIN_STROKE_MM = 1e-3
+#: Fewest rows a motor or DAQ log may hold: a test of cycles logged in fewer is a file cut short.
+MIN_LOG_ROWS = 20
 #: Fewest tracked frames the rest at the start of a recording (``tracker.rest_s``) must hold: zero bend is their mean.
 MIN_REST_FRAMES = 3
 
@@ -164,6 +166,11 @@ def _check_duration(name: str, s: Series, unit: str, key: str, tracker_span: flo
                         f"{'s' if s.time_s.size != 1 else ''}, from {float(s.time_s[0]):g} s to "
                         f"{float(s.time_s[-1]):g} s); fix: give the {name} log of the whole test, one row per "
                         "sample in time order")
+    if s.time_s.size < MIN_LOG_ROWS:
+        # (a DAQ log cut to 3 rows was told its time unit was wrong; the next unit gave another error)
+        raise DataError(f"{s.source}: {s.time_s.size} rows, too few for a {name} log of a test the tracker export "
+                        f"spans {tracker_span:g} s (at least {MIN_LOG_ROWS}); fix: give the {name} log of the whole "
+                        "test (a file cut short?)")
     ratio = span / tracker_span if tracker_span > 0 else 1.0
     if not 0.05 <= ratio <= 20.0:
         units = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "min": 60.0}
