@@ -79,9 +79,14 @@ def _is_index(part: str) -> bool:
     return part.isascii() and part.isdigit()
 
 
-def _past_end(key: str, idx: str, node: list) -> Issue:
+def _past_end(key: str, idx: str, node: list, file: str | None = None) -> Issue:
+    """``--set`` names an entry the list does not have (the pattern's file named, where it has one)."""
+    top = key.split(".")[0]
+    if not node:   # (was "allowed: 0..-1")
+        return Issue(key, f"index {idx}, but the pattern has no {top} entries", None, "an index of an entry the "
+                     "YAML gives", f"add the entry under '{top}:' in the YAML first", file)
     return Issue(key, f"index {idx} is past the end of the list", None, f"0..{len(node) - 1}",
-                 "add the entry in the YAML first")
+                 "add the entry in the YAML first", file)
 
 
 def _schema_node(parts: list[str]):
@@ -122,7 +127,7 @@ def apply_overrides(raw: dict, overrides: Iterable[str], file: str | None = None
         for depth, p in enumerate(parts[:-1]):
             if isinstance(node, list) and _is_index(p):
                 if len(p) > 9 or int(p) >= len(node):
-                    issues.append(_past_end(key, p, node))
+                    issues.append(_past_end(key, p, node, file))
                     node = None
                     break
                 node = node[int(p)]
@@ -138,7 +143,7 @@ def apply_overrides(raw: dict, overrides: Iterable[str], file: str | None = None
         last = parts[-1]
         if isinstance(node, list) and _is_index(last):
             if len(last) > 9 or int(last) >= len(node):
-                issues.append(_past_end(key, last, node))
+                issues.append(_past_end(key, last, node, file))
                 continue
             node[int(last)] = value
         elif isinstance(node, dict):

@@ -255,6 +255,10 @@ def test_override_types_and_list_index():
     p = load(TUBE1, ["notch.count=12", "holes.0.angle_deg=170", "process.repeats=5"]).pattern
     assert len(p.notches) == 12 and p.holes[0].angle_deg == 170 and p.process.repeats == 5
     assert "past the end" in reject(["holes.3.x=1"])
+    # the bad-input search: "allowed: 0..-1", and no file named
+    msg = reject(["cuts.0.x=3"])
+    assert "tube1.yaml: cuts.0.x: index 0, but the pattern has no cuts entries" in msg and "0..-1" not in msg, msg
+    assert "tube1.yaml: holes.3.x: index 3 is past the end" in reject(["holes.3.x=1"])
 
 
 def test_bidirectional_and_directions_layouts():
