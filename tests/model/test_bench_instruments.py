@@ -441,12 +441,18 @@ def test_more_backward_stamps_than_glitches_are_refused(tmp_path):
 
 
 def test_explanation_label_is_complete_partial_or_nothing():
-    # complete within 1.15 x; partial when >= 95 % of the excess is explained and within 1.5 x; else nothing
+    # complete within 1.15 x; partial when >= 95 % of the excess is explained and within 1.5 x, or >= 98 % and
+    # within 3 x; else nothing
     assert explanation_label(5.0, 1.1, 1.0) == "complete"
     assert explanation_label(16.0, 1.3, 1.0) == "partial"
     assert explained_share(16.0, 1.3, 1.0) == pytest.approx((256 - 1.69) / 255)
     assert explanation_label(1.5, 1.16, 1.0) == ""      # a stand-in: 72 % of a small misfit
     assert explanation_label(8.67, 2.01, 1.0) == ""     # 96 % but far above the floor
+    assert explanation_label(9.93, 2.84, 1.0) == ""     # 93 %: the foreign batches' stand-ins stay at or below 96 %
+    # >= 98 % of the misfit explained, within 3x: a three-arm backbone beside the library's two (bench-heldout54)
+    assert explanation_label(78.8, 1.79, 1.0) == "partial"
+    assert explanation_label(17.08, 2.02, 1.0) == "partial"
+    assert explanation_label(40.0, 3.1, 1.0) == ""      # beyond 3x, however much is explained
 
 
 def test_motor_profile_dwells_rests_and_a_longer_first_dwell():
