@@ -433,3 +433,19 @@ def test_a_minor_effect_the_samples_together_cannot_resolve_is_left_out_of_their
     assert s.chain.all_rows.rmse < before
     note = next(n for n in s.notes_late if n.startswith("each sample diagnosed alone"))
     assert f"viscoelastic left out in {s1}" in note and "on its bound" in note, note
+
+
+def test_a_sample_of_a_handful_of_rows_has_no_answer_alone_and_the_search_goes_on():
+    # fewer than ten rows are refused (DataError) by a search: a sample diagnosed alone on so few gives no answer,
+    # as one that cannot be fitted does, rather than ending the whole diagnosis
+    from camtube.model.diagnose.search import Search
+    from camtube.model.sim.synth import synthesize
+
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    data = synthesize(p, n_samples=2, n_cycles=3, seed=3)
+    smp = np.asarray(data.sample)
+    keep = np.flatnonzero(smp == "1").tolist() + np.flatnonzero(smp == "2")[200:206].tolist()
+    s = Search(model_for_pattern(p), data.take(np.asarray(keep)))
+    s.fixed.update(pattern_values(p))
+    s.fit_base()
+    assert s._samples_alone(["1", "2"]) is None

@@ -114,6 +114,7 @@ from typing import Mapping, NamedTuple, Sequence
 
 import numpy as np
 
+from camtube.errors import DataError
 from camtube.model.core.fit import FitResult, fit
 from camtube.model.core.model import Effect, FitError, JointModel, check_reads_chain, form_problem, sample_views
 from camtube.model.core.noise import ORDERS
@@ -1788,7 +1789,7 @@ class Search:
             try:
                 d_s = Search(self.given_model, sub, sub_settings, candidates=list(self.all_pool),
                              registry=self.registry).run()
-            except FitError:
+            except (FitError, DataError):   # (a sample of a handful of rows, or one whose angle never changes)
                 return None
             rmse = [w.rmse_deg for w in d_s.waterfall]
             explained = {e: len(sub) * (a * a - b * b) for e, a, b in zip(d_s.recommended, rmse, rmse[1:])}
