@@ -590,11 +590,52 @@ def _beyond_any_tube(rd: _Reading, ent: _Entity, layer: str, role: str, xy: Sequ
     return True
 
 
+def _unclamped_spline_path(entity, tolerance: float):
+    """The path of a SPLINE whose knot vector is not clamped (a uniform or periodic spline, as some CAD programs write a
+    closed one), or None for a clamped one. Such a spline is defined on its knots ``t_p .. t_n`` only (p its degree,
+    n its count of control points); ``ezdxf.path.make_path`` and ``BSpline.flattening`` run it over every knot, through
+    the region where it is not defined: a slit drawn at y = 10.2 mm was cut up to y = 23.7 mm, a closed spline read as
+    open. Sampled here on its domain until every chord lies within ``tolerance`` of the curve (drawing units)."""
+    import numpy as np
+    from ezdxf import path as ezpath
+
+    knots = [float(k) for k in entity.knots]
+    deg = int(entity.dxf.degree)
+    n_cp = entity.control_point_count()
+    if len(knots) != n_cp + deg + 1 or deg < 2:
+        return None
+    if len(set(knots[:deg + 1])) == 1 and len(set(knots[-deg - 1:])) == 1:
+        return None   # clamped: make_path reads it right
+    lo, hi = knots[deg], knots[n_cp]
+    if not hi > lo:
+        return None
+    bs = entity.construction_tool()
+    n = 16 * max(1, n_cp - deg)
+    for _ in range(12):
+        ts = np.linspace(lo, hi, n + 1)
+        pts = np.array([tuple(v) for v in bs.points(ts)], float)
+        mid = np.array([tuple(v) for v in bs.points((ts[:-1] + ts[1:]) / 2.0)], float)
+        a, b, m = pts[:-1, :2], pts[1:, :2], mid[:, :2]
+        ab = b - a
+        length = np.hypot(ab[:, 0], ab[:, 1])
+        cross = np.abs(ab[:, 0] * (m[:, 1] - a[:, 1]) - ab[:, 1] * (m[:, 0] - a[:, 0]))
+        dev = np.where(length > 0, cross / np.maximum(length, 1e-300), np.hypot(*(m - a).T))
+        if float(np.max(dev)) <= tolerance:
+            break
+        n *= 2
+    closed = bool(entity.closed) and float(np.hypot(*(pts[0, :2] - pts[-1, :2]))) <= 1e3 * tolerance
+    return ezpath.from_vertices([tuple(v) for v in pts], close=closed)
+
+
 def _flatten(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
     from ezdxf import path as ezpath
 
     try:
-        p = ezpath.make_path(entity, segments=16, level=8)
+        p = None
+        if entity.dxftype() == "SPLINE":
+            p = _unclamped_spline_path(entity, TOL.chord / rd.factor)
+        if p is None:
+            p = ezpath.make_path(entity, segments=16, level=8)
     except (TypeError, ValueError) as exc:
         if role == "ignore":
             ent.status = "aside:ignored layer"

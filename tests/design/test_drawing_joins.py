@@ -95,3 +95,65 @@ def test_a_cut_past_a_correct_outline_is_named(tmp_path):
     msg = str(err.value)
     assert "no tube outline found" not in msg
     assert "on layer OUTLINE" in msg and "lies outside it" in msg and "on layer NOTCH" in msg and "fix:" in msg
+
+
+def _spline_on_domain(cps, knots, degree, n=400):
+    """Points of the B-spline on its domain t_p .. t_n (the textbook's: de Boor)."""
+    from ezdxf.math import BSpline
+
+    bs = BSpline(cps, order=degree + 1, knots=knots)
+    return np.array([tuple(v)[:2] for v in bs.points(np.linspace(knots[degree], knots[len(cps)], n))])
+
+
+def test_a_spline_with_unclamped_knots_is_cut_where_it_is_drawn(tmp_path):
+    """The bad-input search: a cubic slit with a uniform knot vector (0..9), as some CAD programs write one, drawn
+    within y = 1.17..1.33 mm, was cut up to y = 14.7 mm (ezdxf's path runs it over every knot, where it is not
+    defined): the beam outside the drawn cut, exit 0."""
+    cps = [(2.0, 1.0, 0), (2.5, 1.5, 0), (3.0, 1.0, 0), (3.5, 1.5, 0), (4.0, 1.0, 0), (4.5, 1.5, 0)]
+    knots = list(range(10))
+
+    def add(m):
+        sp = m.add_spline(dxfattribs={"layer": "SLITS"})
+        sp.dxf.degree = 3
+        sp.control_points = cps
+        sp.knots = knots
+
+    p = load_drawing(drawing(tmp_path, add), [], DrawingOptions()).pattern
+    assert len(p.slits) == 1
+    got = slit_points(p)[0]
+    want = _spline_on_domain(cps, knots, 3)
+    # every cut point on the drawn curve, and the cut from its start to its end
+    from shapely.geometry import LineString, Point
+
+    curve = LineString(want)
+    assert max(curve.distance(Point(q)) for q in got) < 1e-3   # (the chord tolerance is 1 um)
+    assert got[:, 1].min() > 1.16 and got[:, 1].max() < 1.34
+    ends = sorted([tuple(got[0]), tuple(got[-1])])
+    assert ends[0] == pytest.approx(tuple(want[0]), abs=1e-6) and ends[1] == pytest.approx(tuple(want[-1]), abs=1e-6)
+
+
+def test_a_closed_periodic_spline_is_a_closed_cut(tmp_path):
+    """The bad-input search: a closed spline as AutoCAD writes a periodic one (flag closed, uniform knots, the first
+    three control points repeated at the end) was refused as 'an open path on a notch layer: its ends ... 1.82 mm
+    apart; fix: close the outline in CAD'."""
+    import math as _m
+
+    ring = [(3.0 + 0.3 * _m.cos(a), 2.0 + 0.9 * _m.sin(a), 0.0) for a in np.linspace(0, 2 * _m.pi, 8, endpoint=False)]
+    cps = ring + ring[:3]
+    knots = list(range(len(cps) + 4))
+
+    def add(m):
+        sp = m.add_spline(dxfattribs={"layer": "NOTCH"})
+        sp.dxf.degree = 3
+        sp.control_points = cps
+        sp.knots = knots
+        sp.closed = True
+
+    p = load_drawing(drawing(tmp_path, add), [], DrawingOptions()).pattern
+    assert len(p.notches) == 1
+    want = _spline_on_domain(cps, knots, 3)
+    from shapely.geometry import Polygon
+
+    area = Polygon(want).area
+    got = cut_contour(p.notches[0], RO)
+    assert got.closed and Polygon(np.asarray(got.points)).area == pytest.approx(area, rel=1e-3)
