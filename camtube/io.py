@@ -304,12 +304,12 @@ def _contains_cwd(path: Path) -> bool:
 
 def _swap_in(stage: Path, out: Path, files: Mapping[str, Payload]) -> Path | None:
     """Make the staged set ``out``'s; returns what is left to remove (the old folder), or None. The files of the set
-    an earlier run wrote for the same job (:func:`_earlier_set`) go with the old folder."""
+    an earlier run wrote for the same job (:func:`earlier_set`) go with the old folder."""
     if not out.exists():
         os.chmod(stage, 0o777 & ~_umask())
         os.rename(stage, out)
         return None
-    earlier = _earlier_set(out, files)
+    earlier = earlier_set(out, files)
     listed = [set_list_name(files.job)] if isinstance(files, JobSet) else []
     if _contains_cwd(out):
         # the working directory cannot be swapped away under the user: move the files in one by one
@@ -368,7 +368,7 @@ def set_list_name(job: str) -> str:
     return f".{job}.camtube-set"
 
 
-def _earlier_set(out: Path, files: Mapping[str, Payload]) -> set[str]:
+def earlier_set(out: Path, files: Mapping[str, Payload]) -> set[str]:
     """The files of the set an earlier run wrote into ``out`` for the job of ``files`` (a :class:`JobSet`) that the
     new set does not have: plain names of files, as its list names them; empty for another payload or no list."""
     if not isinstance(files, JobSet):

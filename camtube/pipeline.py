@@ -164,15 +164,17 @@ def _add_outputs(files: dict, more: dict) -> None:
 
 
 def run(loaded: Loaded, outdir: str | os.PathLike, request: Request, progress: Progress = NO_PROGRESS,
-        warn: Callable[[str], None] | None = None) -> Result:
+        warn: Callable[[str], None] | None = None, inputs: Sequence[str | os.PathLike] = ()) -> Result:
     """Build the outputs of ``request`` for ``loaded`` and write them into ``outdir`` as one set.
 
     ``warn`` (e.g. a print to stderr) hears the laser-time warning of the job, if any,
-    before the (possibly long) writing starts.
+    before the (possibly long) writing starts. ``inputs``: the files the job was read from; a set that would replace
+    or remove one of them is refused before anything is written (:func:`check_inputs_kept`).
     """
     from camtube.io import write_set
 
     files, job, est, cad = outputs(loaded, request, progress)
+    check_inputs_kept(Path(outdir), files, job.name, inputs)
     if warn is not None and est is not None:
         from camtube.machine.motion_time import slow_job_warning
         from camtube.plan.moves import time_warning
@@ -186,3 +188,27 @@ def run(loaded: Loaded, outdir: str | os.PathLike, request: Request, progress: P
                 warn(w)
     paths = write_set(Path(outdir), files, job=job.name)  # it replaces the set written there for this job before
     return Result(paths, job, est, cad)
+
+
+def check_inputs_kept(outdir: Path, files, job: str, inputs: Sequence[str | os.PathLike]) -> None:
+    """Refuse a set for ``job`` in ``outdir`` that would replace an input file, or remove it as a file of the set written
+    there before for that job (``build t.design.dxf -o .`` replaced the drawing it was reading with its own design
+    DXF, exit 0: the CAD work lost)."""
+    from camtube.errors import CamtubeError
+    from camtube.io import JobSet, earlier_set
+
+    names = set(files) | earlier_set(outdir, JobSet(files, job))
+    for src in inputs:
+        src = Path(src)
+        if not src.is_file():
+            continue
+        for name in sorted(names):
+            target = outdir / name
+            try:
+                same = target.exists() and os.path.samefile(target, src)
+            except OSError:
+                same = False
+            if same:
+                raise CamtubeError(f"-o {outdir}: the set of job {job!r} written there would replace its own input "
+                                   f"{src} (as {name}); fix: write to another folder (-o), or give the job another "
+                                   "name (--set name=...)")

@@ -919,3 +919,22 @@ def test_a_negative_value_after_an_option_gets_its_fix(tmp_path, option, value):
     r = camtube("model", "diagnose", "x.csv", "--pattern", "tube1", option, value, cwd=tmp_path)
     assert_refused(r, f"{option} {value}: a value that starts with '-' is read as an option",
                    f"fix: write {option}={value}")
+
+
+@pytest.mark.parametrize("how", ["same name", "earlier set"])
+def test_a_job_that_would_replace_its_own_input_drawing_is_refused(tmp_path, how):
+    """The bad-input search: ``build t.design.dxf --set name=t -o DIR`` (the design DXF camtube wrote, edited in CAD)
+    replaced the drawing it was reading with its own design DXF, exit 0; ``toolpath`` removed it as a file of the set
+    the earlier ``build`` of job t had written there."""
+    drawing = tmp_path / "t.design.dxf"
+    if how == "same name":
+        assert camtube("dxf", TUBE1, "-q", "--set", "name=t", "-o", str(drawing)).returncode == 0
+        argv = ("build", str(drawing), "--set", "name=t", "-o", str(tmp_path), "-q", "--no-step", "--no-pictures")
+    else:
+        r = camtube("build", TUBE1, "-q", "--set", "name=t", "-o", str(tmp_path), "--no-step", "--no-pictures")
+        assert r.returncode == 0, r.stderr
+        argv = ("toolpath", str(drawing), "--set", "name=t", "-o", str(tmp_path), "-q")
+    before = drawing.read_bytes()
+    files = listing(tmp_path)
+    assert_refused(camtube(*argv), f"would replace its own input {drawing}", "fix: write to another folder")
+    assert drawing.read_bytes() == before and listing(tmp_path) == files

@@ -256,7 +256,8 @@ def run_outputs(args: argparse.Namespace, what: str) -> int:
                       **({"cad": cad} if cad is not None else {}))
     with make_progress(quiet=args.quiet) as progress:
         result = run(loaded, args.output, request, progress,
-                     warn=None if args.quiet else (lambda w: print(f"warning: {w}", file=sys.stderr)))
+                     warn=None if args.quiet else (lambda w: print(f"warning: {w}", file=sys.stderr)),
+                     inputs=[args.pattern])
     try:
         _report(args, result, summary_table)
     except KeyboardInterrupt:
