@@ -406,6 +406,9 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
             rd.entities.append(ent)
             return ent
 
+        if entity.dxf.get("invisible", 0):   # (CAD programs show neither it nor its block's entities)
+            unplaced().status = "aside:invisible entity"
+            return
         if block is None or block.block.is_xref:
             ent = unplaced()
             if rd.role(layer) == "ignore":
@@ -467,6 +470,10 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
     ent = _Entity(t, entity.dxf.handle or "-", layer, via)
     rd.entities.append(ent)
     role = rd.role(layer)
+    if entity.dxf.get("invisible", 0):
+        # (flag 60 = 1: CAD programs do not show it; it was cut as any other)
+        ent.status = "aside:invisible entity"
+        return
     if t in ANNOTATIONS:
         ent.status = "aside:annotation"
         return

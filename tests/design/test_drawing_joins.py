@@ -157,3 +157,22 @@ def test_a_closed_periodic_spline_is_a_closed_cut(tmp_path):
     area = Polygon(want).area
     got = cut_contour(p.notches[0], RO)
     assert got.closed and Polygon(np.asarray(got.points)).area == pytest.approx(area, rel=1e-3)
+
+
+@pytest.mark.parametrize("what", ["polyline", "insert"])
+def test_an_invisible_entity_is_set_aside_not_cut(tmp_path, what):
+    """The bad-input search: an LWPOLYLINE with the DXF 'invisible' flag (group 60 = 1), which CAD programs do not
+    show, was cut as any other notch."""
+    def add(m):
+        m.add_lwpolyline([(2, 1), (2.5, 1), (2.5, 3), (2, 3)], close=True, dxfattribs={"layer": "NOTCH"})
+        if what == "polyline":
+            m.add_lwpolyline([(5, 1), (5.5, 1), (5.5, 3), (5, 3)], close=True,
+                             dxfattribs={"layer": "NOTCH", "invisible": 1})
+        else:
+            blk = m.doc.blocks.new("N")
+            blk.add_lwpolyline([(0, 0), (0.5, 0), (0.5, 2), (0, 2)], close=True, dxfattribs={"layer": "NOTCH"})
+            m.add_blockref("N", (5, 1), dxfattribs={"layer": "NOTCH", "invisible": 1})
+
+    loaded = load_drawing(drawing(tmp_path, add), [], DrawingOptions())
+    assert len(loaded.pattern.notches) == 1 and loaded.pattern.notches[0].x_mm == pytest.approx(2.25)
+    assert "set aside: 1 (invisible entity)" in loaded.summary, loaded.summary
