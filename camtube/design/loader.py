@@ -324,6 +324,23 @@ def _check_notch_lists(r: _Reader, gen: dict, written: dict | None = None) -> No
                     f"add '{scalar}: <value>' or a per-notch list '{key}: [...]'")
 
 
+def _check_unused_notch_keys(r: _Reader, written) -> None:
+    """Refuse notch keys the pattern gives that its other keys leave unused (each was dropped without a word): a
+    scalar beside the per-notch list that replaces it (``width: 0.5`` beside ``widths: [0.3, 0.4]``), and
+    ``directions_deg`` under a layout that does not cycle through it."""
+    if not isinstance(written, dict):
+        return
+    for key, scalar in (("widths", "width"), ("arcs", "arc"), ("spacings", "spacing"), ("angles_deg", "angle_deg")):
+        if written.get(scalar) is not None and written.get(key):
+            r.issue(f"notch.{scalar}", f"is given beside notch.{key}, which sets every notch's value: notch.{scalar} "
+                    "would not be used", written[scalar], f"notch.{scalar} or notch.{key}", "delete one of the two")
+    layout = written.get("layout", SCHEMA["notch"]["layout"].default)
+    if written.get("directions_deg") and layout != "directions" and not written.get("angles_deg"):
+        r.issue("notch.directions_deg", f"is given, but notch.layout is {layout!r}: the directions would not be used",
+                written["directions_deg"], "directions_deg with layout: directions",
+                "set layout: directions, or delete directions_deg")
+
+
 def build_settings(raw: dict, file: str | None = None) -> tuple[Tube, Process, Tendon, Rules]:
     """The tube, process, tendon and rules sections of raw pattern data, validated.
 
@@ -402,6 +419,7 @@ def build(raw: dict, file: str | None = None, lines: dict[str, int] | None = Non
     extra = r.convert(raw.get("cuts") or [], SCHEMA["cuts"], "cuts")
     if gen:
         _check_notch_lists(r, gen, raw.get("notch"))
+        _check_unused_notch_keys(r, raw.get("notch"))
     if gen and gen.get("layout") == "directions" and not gen.get("directions_deg") and not gen.get("angles_deg"):
         r.issue("notch.directions_deg", "layout 'directions' needs a list of angles", None,
                 "a non-empty list of angles in deg", "add e.g. directions_deg: [0, 90, 180, 270]")

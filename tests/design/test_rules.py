@@ -94,6 +94,13 @@ CASES = [
     # the bad-input search: 500 % strain for a polyimide tube turned the strain warning off; 1e-300 GPa was taken
     (["rules.max_strain=5"], "rules.max_strain", ["out of range", ">= 0.0001 and <= 1", "use a value <= 1"]),
     (["tendon.modulus_gpa=1e-300"], "tendon.modulus_gpa", ["out of range", ">= 0.5 and <= 500 GPa"]),
+    # the bad-input search: each dropped without a word
+    (["notch.widths=[0.4, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.6]"], "notch.width",
+     ["is given beside notch.widths", "notch.width would not be used", "delete one of the two"]),
+    (["notch.angles_deg=[180, 0, 180, 0, 180, 0, 180, 0, 180, 0]", "notch.angle_deg=90"], "notch.angle_deg",
+     ["is given beside notch.angles_deg"]),
+    (["notch.directions_deg=[0, 90]"], "notch.directions_deg",
+     ["notch.layout is 'uan': the directions would not be used", "set layout: directions"]),
 ]
 CASES[3] = (["notch.spacing=.nan"], "notch.spacing", ["must be finite"])
 
