@@ -304,6 +304,19 @@ def build_goal(raw: dict, file: str | None = None, lines: dict[str, int] | None 
                     f"of {most:g} deg, more than the {hi:g} a direction may have", goal["max_notch_bend_deg"],
                     f">= {most / hi:.4g} deg", f"raise it to {math.ceil(most / hi * 1e4) / 1e4:g} deg or more, or "
                     "give goal.notches")
+    written = raw.get("goal") if isinstance(raw.get("goal"), dict) else {}
+    if "tip_ratio" in written and dist not in ("tip_first", "base_first"):   # (dropped without a word)
+        r.issue("goal.tip_ratio", f"is given, but goal.distribution is {dist if isinstance(dist, str) else 'a list'}: "
+                "the ratio would not be used", goal["tip_ratio"], "tip_ratio with distribution tip_first or base_first",
+                "set distribution: tip_first (or base_first), or delete tip_ratio")
+    if "max_notch_bend_deg" in written and goal["notches"] not in (None, "auto") and not isinstance(dist, tuple):
+        # (notches: 3 for 60 deg wrote 20 deg per notch, ten times the maximum given, without a word)
+        most = max((b["bend_deg"] for b in bends), default=0.0)
+        if most / goal["notches"] > goal["max_notch_bend_deg"] * (1.0 + 1e-9):
+            r.issue("goal.notches", f"gives {most / goal['notches']:.3g} deg per notch for a bend of {most:g} deg, more "
+                    f"than goal.max_notch_bend_deg = {goal['max_notch_bend_deg']:g} deg", goal["notches"],
+                    f">= {math.ceil(most / goal['max_notch_bend_deg'] - 1e-9)} notches, or auto",
+                    "give more notches, or notches: auto (the count from max_notch_bend_deg)")
     if lim["min_web"] > goal["web"]:
         r.issue("goal.web", "is thinner than limits.min_web", goal["web"], f">= {lim['min_web']:g} mm",
                 "raise goal.web")

@@ -255,6 +255,11 @@ def test_a_backbone_arc_that_leaves_no_notch_is_refused_with_one_line(tmp_path):
     (GOOD.replace("limits: {max_strain: 0.04}", "limits: {max_strain: 5}"),
      ["limits.max_strain: out of range", "<= 1", "fix: use a value <= 1"]),
     (GOOD.replace("goal:", "tendon: {modulus_gpa: 1e-300}\ngoal:"), ["tendon.modulus_gpa: out of range", ">= 0.5"]),
+    # the bad-input search: dropped without a word (20 deg per notch written for a maximum of 2)
+    (GOOD.replace("goal:", "goal:\n  tip_ratio: 10"), ["goal.tip_ratio: is given, but goal.distribution is uniform",
+                                                      "set distribution: tip_first"]),
+    (GOOD.replace("goal:", "goal:\n  notches: 2\n  max_notch_bend_deg: 4"),
+     ["goal.notches: gives 20 deg per notch", "more than goal.max_notch_bend_deg = 4 deg", ">= 10 notches, or auto"]),
 ])
 def test_bad_goal_files_are_one_line_naming_the_key_with_a_fix(tmp_path, capsys, text, words):
     from camtube.commands import main
