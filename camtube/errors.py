@@ -61,7 +61,20 @@ class PatternError(CamtubeError):
 
     def __init__(self, issues: list[Issue]):
         self.issues = list(issues)
-        super().__init__("\n".join(str(i) for i in self.issues))
+        super().__init__("\n".join(_lines(self.issues)))
+
+
+def _lines(issues: list[Issue]) -> list[str]:
+    """One line per problem: issues of one key with one fix in one file (one mistake: ``notch.spacing`` too small
+    made nine pairs of notches too close, nine lines) are said once, with how many more there are."""
+    groups: dict[tuple, list[Issue]] = {}
+    for i in issues:
+        groups.setdefault((i.file, i.key, i.fix, i.allowed), []).append(i)
+    out = []
+    for same in groups.values():
+        more = len(same) - 1
+        out.append(str(same[0]) + (f" (and {more} more like it)" if more else ""))
+    return out
 
 
 class DataError(CamtubeError):

@@ -303,3 +303,13 @@ def test_a_process_file_that_is_not_one_is_named_as_a_process_file(tmp_path, kin
     for w in want:
         assert w in msg, msg
     assert "start the file with 'tube:'" not in msg and "not there" not in msg, msg
+
+
+def test_one_mistake_that_breaks_a_rule_many_times_is_one_line():
+    """The bad-input search: --set notch.spacing=0.0001 printed nine lines, one per pair of notches too close."""
+    msg = reject(["notch.spacing=0.0001"])
+    assert len(msg.splitlines()) == 1, msg
+    assert "notch.spacing: notch at x=2.25 mm" in msg and "(and 8 more like it)" in msg, msg
+    # different keys stay one line each
+    msg = reject(["notch.arc=9", "notch.spacing=0.0001"])
+    assert any(line.count("notch.arc") for line in msg.splitlines()), msg
