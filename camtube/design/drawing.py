@@ -797,8 +797,9 @@ def _rectangle(piece: _Piece) -> tuple[float, float, float, float] | None:
 
 
 def _largest_rectangle_with_a_cut_outside(pieces, cut_pieces, bounds):
-    """``(rectangle, a cut outside it)`` when the largest drawn rectangle holds at least one other cut
-    but not all of them (a cut drawn past a correctly drawn outline), else None."""
+    """``(rectangle, a cut outside it)`` when the largest drawn rectangle holds at least one other cut (or lies on a
+    layer that is not cut, or is four times the size of every other cut) but not all of them (a cut drawn past a
+    correctly drawn outline), else None."""
     rects = [(p, _rectangle(p)) for p in pieces]
     rects = [(p, box) for p, box in rects if box is not None]
     if not rects:
@@ -810,7 +811,11 @@ def _largest_rectangle_with_a_cut_outside(pieces, cut_pieces, bounds):
             continue
         ok = bb[0] >= x0 - TOL.gap and bb[2] <= x1 + TOL.gap and y0 - TOL.gap <= 0.5 * (bb[1] + bb[3]) <= y1 + TOL.gap
         (inside if ok else outside).append(q)
-    return (p, outside[0]) if inside and outside else None
+    # (a rectangle on a layer that is not cut is the outline even when no cut lies inside it: the one cut drawn past
+    # its end was "no tube outline found")
+    area = (x1 - x0) * (y1 - y0)
+    larger = all(area >= 4.0 * (bb[2] - bb[0]) * (bb[3] - bb[1]) for q, bb in zip(cut_pieces, bounds) if q is not p)
+    return (p, outside[0]) if outside and (inside or p.role == "ignore" or larger) else None
 
 
 def _find_outline(rd: _Reading, ro: float | None, length: float | None):
@@ -866,7 +871,7 @@ def _find_outline(rd: _Reading, ro: float | None, length: float | None):
             largest = _largest_rectangle_with_a_cut_outside(rd.pieces, cut_pieces, b)
             if largest is not None:
                 p, out = largest
-                rd.refuse(p.describe(), "would be the tube outline (the largest rectangle, around the other cuts) but "
+                rd.refuse(p.describe(), "would be the tube outline (the largest rectangle drawn) but "
                           f"{out.describe()} lies outside it", "move that cut inside the outline (or delete it), or "
                           "pass " + " and ".join(missing) + " if the tube is not this rectangle",
                           entities=p.entities + out.entities)

@@ -176,3 +176,22 @@ def test_an_invisible_entity_is_set_aside_not_cut(tmp_path, what):
     loaded = load_drawing(drawing(tmp_path, add), [], DrawingOptions())
     assert len(loaded.pattern.notches) == 1 and loaded.pattern.notches[0].x_mm == pytest.approx(2.25)
     assert "set aside: 1 (invisible entity)" in loaded.summary, loaded.summary
+
+
+@pytest.mark.parametrize("cut", ["slit", "notch"])
+def test_the_one_cut_drawn_past_the_outline_is_named_not_the_outline_missed(tmp_path, cut):
+    """The bad-input search: with the only cut drawn past the tube's end, a drawn outline was 'no tube outline found;
+    fix: draw the unrolled tube outline'."""
+    def add(m):
+        m.doc.layers.add("CONSTRUCTION")
+        if cut == "slit":
+            m.add_line((9.5, 1.0), (11.0, 1.0), dxfattribs={"layer": "SLITS"})
+        else:
+            m.add_lwpolyline([(9.8, 1), (10.3, 1), (10.3, 3), (9.8, 3)], close=True, dxfattribs={"layer": "NOTCH"})
+
+    path = drawing(tmp_path, add)
+    with pytest.raises(PatternError) as err:
+        load_drawing(path, [], DrawingOptions())
+    msg = str(err.value)
+    assert "on layer OUTLINE: would be the tube outline" in msg and "lies outside it" in msg, msg
+    assert "no tube outline found" not in msg
