@@ -924,7 +924,7 @@ def _find_outline(rd: _Reading, ro: float | None, length: float | None):
 # ---------------------------------------------------------------- cuts
 def _cuts(rd: _Reading, outline: _Piece | None, ro: float, length: float):
     """Cuts (and their entity descriptions) from the remaining pieces, in the tube frame."""
-    from shapely.geometry import Polygon
+    from shapely.geometry import LineString, Polygon
     from shapely.validation import explain_validity
 
     from camtube.design.contour import Contour, merge_seam_polygons
@@ -947,6 +947,12 @@ def _cuts(rd: _Reading, outline: _Piece | None, ro: float, length: float):
                 rd.refuse(desc, "a closed outline on a slit layer (a slit is an open path the beam follows)",
                           f"draw the slit as an open path, or map the layer to notch (--layer {p.layer}=notch) "
                           "to cut out the area", entities=p.entities)
+                continue
+            if len(pts) > 3 and not LineString(pts).is_simple:
+                # (accepted: the beam passed the crossing twice, where two crossing slits are refused as overlapping)
+                rd.refuse(desc, "the slit crosses itself (the beam would pass the crossing twice)",
+                          "redraw it as a path that does not cross itself, or as separate slits that meet end to end",
+                          entities=p.entities)
                 continue
             contours.append(Contour(tuple(pts), "slit", len(contours), False))
             owners.append(p)

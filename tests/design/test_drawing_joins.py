@@ -195,3 +195,15 @@ def test_the_one_cut_drawn_past_the_outline_is_named_not_the_outline_missed(tmp_
     msg = str(err.value)
     assert "on layer OUTLINE: would be the tube outline" in msg and "lies outside it" in msg, msg
     assert "no tube outline found" not in msg
+
+
+def test_a_slit_that_crosses_itself_is_refused(tmp_path):
+    """The bad-input search: one polyline on a slit layer crossing itself was cut (the beam over the crossing twice),
+    where two crossing slits are refused as overlapping."""
+    path = drawing(tmp_path, lambda m: m.add_lwpolyline([(2, 1), (4, 3), (4, 1), (2, 3)], dxfattribs={"layer": "SLITS"}))
+    with pytest.raises(PatternError, match=r"LWPOLYLINE #\w+ on layer SLITS: the slit crosses itself"):
+        load_drawing(path, [], DrawingOptions())
+    # a zigzag that does not cross itself is a slit
+    ok = drawing(tmp_path, lambda m: m.add_lwpolyline([(2, 1), (3, 3), (4, 1), (5, 3)], dxfattribs={"layer": "SLITS"}),
+                 "ok.dxf")
+    assert len(load_drawing(ok, [], DrawingOptions()).pattern.slits) == 1
