@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Callable, Sequence
 
 from camtube.design.loader import Loaded
+from camtube.errors import PatternError
 from camtube.progress import NO_PROGRESS, Progress
 
 #: What each command writes.
@@ -100,7 +101,23 @@ def plan(loaded: Loaded, ordering: str | None = None, progress: Progress = NO_PR
     from camtube.plan import plan_job
 
     kwargs = {} if ordering is None else {"ordering": ordering}
-    return plan_job(loaded.pattern, progress=progress, **kwargs)
+    try:
+        return plan_job(loaded.pattern, progress=progress, **kwargs)
+    except PatternError as exc:
+        raise PatternError([_named(i, loaded) for i in exc.issues]) from None
+
+
+def _named(issue, loaded: Loaded):
+    """A planner's issue about ``cut[i]`` named by where that cut came from (the drawing's entity, the YAML key) and in
+    the pattern's file (the planner knows neither: "cut[0] (hole at x ...): the contour vanishes" named no file)."""
+    import re
+    from dataclasses import replace
+
+    m = re.match(r"cut\[(\d+)\] \((.*)\)$", issue.key or "")
+    key = issue.key
+    if m and int(m.group(1)) < len(loaded.origins):
+        key = f"{loaded.origins[int(m.group(1))]} ({m.group(2)})"
+    return replace(issue, key=key, file=issue.file or loaded.pattern.source)
 
 
 def outputs(loaded: Loaded, request: Request, progress: Progress = NO_PROGRESS):

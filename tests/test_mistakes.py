@@ -3,6 +3,7 @@ fix, exit 2 (130 / 0 for Ctrl-C as said), and nothing left behind."""
 from __future__ import annotations
 
 import json
+import math
 import os
 import signal
 import time
@@ -938,3 +939,27 @@ def test_a_job_that_would_replace_its_own_input_drawing_is_refused(tmp_path, how
     files = listing(tmp_path)
     assert_refused(camtube(*argv), f"would replace its own input {drawing}", "fix: write to another folder")
     assert drawing.read_bytes() == before and listing(tmp_path) == files
+
+
+@pytest.mark.parametrize("how", ["yaml", "drawing"])
+def test_a_cut_the_passes_cannot_offset_is_named_by_its_file_and_origin(tmp_path, how):
+    """The bad-input search: "cut[0] (hole at x ...): the contour vanishes" named neither the file nor the entity (or
+    the YAML key) the cut came from."""
+    if how == "yaml":
+        r = camtube("toolpath", TUBE1, "--set", "notch.width=0.01", "-o", str(tmp_path / "o"), "-q")
+        assert_refused(r, "tube1.yaml: notch (notch at x", "the contour vanishes")
+    else:
+        import ezdxf
+
+        doc = ezdxf.new("R2013", setup=False)
+        doc.header["$INSUNITS"] = 4
+        msp = doc.modelspace()
+        msp.add_lwpolyline([(0, 0), (10, 0), (10, 2 * math.pi), (0, 2 * math.pi)], close=True,
+                           dxfattribs={"layer": "CONSTRUCTION"})
+        msp.add_lwpolyline([(3, 1), (3.5, 1), (3.5, 3), (3, 3)], close=True, dxfattribs={"layer": "NOTCHES"})
+        msp.add_circle((5, 3), 0.004, dxfattribs={"layer": "HOLES"})
+        path = tmp_path / "d.dxf"
+        doc.saveas(path)
+        r = camtube("toolpath", str(path), "-o", str(tmp_path / "o"), "-q")
+        assert_refused(r, f"{path}: CIRCLE #", "on layer HOLES (hole at x", "the contour vanishes")
+    assert not (tmp_path / "o").exists()
