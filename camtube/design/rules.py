@@ -277,16 +277,20 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
                 break
             hole_pair = "hole" in (a.kind, b.kind)
             key = _pair_key(origins[i], origins[j], a, b)
+            # (a drawing's cuts were told to "increase notch.spacing", a YAML key a drawing does not have)
+            drawn = not (_is_key(origins[i]) and _is_key(origins[j]))
             if _same(a, b, ro):
                 err(key, f"{_describe(b)} is a duplicate of {_describe(a)} (drawn or listed twice)", None,
                     "each cut once", "delete one of the two")
             elif cuts_overlap(a, b, ro):
                 what = "collides with" if hole_pair else "overlaps"
                 err(key, f"{_describe(b)} {what} {_describe(a)}", None, "cuts must not overlap",
+                    "move the two cuts apart in the drawing, or delete one" if drawn else
                     "move the hole along x or around the tube" if hole_pair else "increase notch.spacing or move the cut")
             else:
                 d = cut_distance_mm(a, b, ro)
-                widen = "move the hole away from the notches" if hole_pair else "increase notch.spacing"
+                widen = ("move the two cuts apart in the drawing" if drawn else
+                         "move the hole away from the notches" if hole_pair else "increase notch.spacing")
                 if d < rules.min_web_mm - TOL.rule:  # (the CAD verification's min_web: the same slack)
                     what = "is too close to" if not hole_pair else "collides with (web too thin)"
                     err(key, f"{_describe(b)} {what} {_describe(a)}: web {d:.4g} mm", round(d, 9),

@@ -207,3 +207,18 @@ def test_a_slit_that_crosses_itself_is_refused(tmp_path):
     ok = drawing(tmp_path, lambda m: m.add_lwpolyline([(2, 1), (3, 3), (4, 1), (5, 3)], dxfattribs={"layer": "SLITS"}),
                  "ok.dxf")
     assert len(load_drawing(ok, [], DrawingOptions()).pattern.slits) == 1
+
+
+@pytest.mark.parametrize("gap", [-0.1, 0.05])
+def test_drawn_cuts_too_close_get_a_drawing_s_fix_not_a_yaml_key(tmp_path, gap):
+    """The bad-input search: two drawn notches that overlap (or leave a web under rules.min_web) were told to
+    "increase notch.spacing", a key a drawing does not have (--set notch.* is refused for drawings)."""
+    def add(m):
+        m.add_lwpolyline([(2, 1), (2.5, 1), (2.5, 3), (2, 3)], close=True, dxfattribs={"layer": "NOTCH"})
+        x = 2.5 + gap
+        m.add_lwpolyline([(x, 1), (x + 0.5, 1), (x + 0.5, 3), (x, 3)], close=True, dxfattribs={"layer": "NOTCH"})
+
+    with pytest.raises(PatternError) as err:
+        load_drawing(drawing(tmp_path, add), [], DrawingOptions())
+    msg = str(err.value)
+    assert "fix: move the two cuts apart in the drawing" in msg and "notch.spacing" not in msg, msg
