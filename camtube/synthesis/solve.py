@@ -593,11 +593,14 @@ def synthesize(goal: Goal, calibration: Mechanics | None = None, time_limit_s: f
     b = goal.bends[i]
     where = f"{goal.source}: " if goal.source else ""
     what = f"goal.centerline[{i}]" if goal.centerline else f"goal.bends[{i}]"
+    found = not nearest.startswith("none found")
+    knob = "bend_deg" if fail.knob == "bend" else "stroke_mm"
+    # (with none found, "lower bend_deg to the nearest target" pointed at a target the same line said was not there)
+    lower = f"lower {knob} to the nearest target, or " if found else ""
     raise InfeasibleGoal(f"{where}{what} ({b.bend_deg:g} deg at {b.stroke_mm:g} mm towards {b.angle_deg:g} deg) "
                          f"is infeasible: {fail.limit}: {fail.why}; nearest feasible target: {nearest}; fix: "
-                         + (f"lower bend_deg to the nearest target, or give more stroke or relax {fail.limit}"
-                            if fail.knob == "bend" else
-                            f"lower stroke_mm to the nearest target, or relax {fail.limit}"),
+                         + (f"{lower}give more stroke or relax {fail.limit}" if fail.knob == "bend" else
+                            f"{lower}relax {fail.limit}") + ("" if found else ", or change the stock (the tube)"),
                          fail.limit, nearest)
 
 
@@ -620,7 +623,7 @@ def _nearest(goal: Goal, mech: Mechanics, grid: _Grid, knob: str, deadline: floa
             return ("none found within the time limit by scaling the " + ("bends" if knob == "bend" else "strokes")
                     + f" down to {q:g} x")
     else:
-        return "none found by scaling the " + ("bends" if knob == "bend" else "strokes") + " down (change the stock)"
+        return "none found by scaling the " + ("bends" if knob == "bend" else "strokes") + " down"
     for _ in range(9):
         if time.perf_counter() > deadline:
             break

@@ -292,3 +292,15 @@ def test_a_designed_pattern_the_rules_refuse_names_the_goal_not_the_unwritten_ou
     assert len(err.splitlines()) == 1 and "p.yaml" not in err and str(g) in err, err
     assert "notch.spacings" in err and "more)" in err and "fix: relax the goal's" in err, err
     assert listing(tmp_path) == ["g.yaml"]
+
+
+def test_an_infeasible_goal_with_no_nearest_target_is_not_told_to_go_to_it(tmp_path, capsys):
+    """The bad-input search: "nearest feasible target: none found ...; fix: lower bend_deg to the nearest target"."""
+    from camtube.commands import main
+
+    goal = tmp_path / "g.yaml"
+    goal.write_text(GOOD.replace("stroke_mm: 1.2", "stroke_mm: 0.000001"))
+    assert main(["synthesize", str(goal), "-o", str(tmp_path / "p.yaml")]) == 2
+    err = capsys.readouterr().err
+    assert "nearest feasible target: none found" in err and "to the nearest target" not in err, err
+    assert "or change the stock (the tube)" in err and len(err.strip().splitlines()) == 1, err
