@@ -251,6 +251,13 @@ def build_goal(raw: dict, file: str | None = None, lines: dict[str, int] | None 
     elif not bends:
         r.issue("goal.bends", "needs at least one target", None, "a list of {angle_deg, bend_deg, stroke_mm}",
                 "add e.g. '- {angle_deg: 180, bend_deg: 60, stroke_mm: 1.5}' (or a 3-D goal.centerline)")
+    for i, b in enumerate(bends):
+        if tendon.get("length") is not None and b["stroke_mm"] >= tendon["length"]:
+            # (was "a notch must bend 6.00 deg, more than 0.75 of its closure angle; fix: ... give more stroke")
+            key = f"goal.centerline[{i}].stroke_mm" if arcs else f"goal.bends[{i}].stroke_mm"
+            r.issue(key, f"is as long as the tendon or longer (tendon.length = {tendon['length']:g} mm): the motor "
+                    "cannot draw in more tendon than there is", b["stroke_mm"], f"< {tendon['length']:g} mm",
+                    "give the stroke in mm (a few mm for these joints), or the tendon's length")
     seen: dict[float, int] = {}
     for i, b in enumerate(() if arcs else bends):
         a = round(b["angle_deg"] % 360.0, 6)

@@ -258,6 +258,9 @@ def test_a_backbone_arc_that_leaves_no_notch_is_refused_with_one_line(tmp_path):
     # the bad-input search: dropped without a word (20 deg per notch written for a maximum of 2)
     (GOOD.replace("goal:", "goal:\n  tip_ratio: 10"), ["goal.tip_ratio: is given, but goal.distribution is uniform",
                                                       "set distribution: tip_first"]),
+    # the bad-input search: "a notch must bend 6.00 deg, more than 0.75 of its closure angle; fix: give more stroke"
+    (GOOD.replace("stroke_mm: 1.2", "stroke_mm: 100"), ["goal.bends[0].stroke_mm: is as long as the tendon or longer",
+                                                      "tendon.length = 70 mm", "< 70 mm"]),
     (GOOD.replace("goal:", "goal:\n  notches: 2\n  max_notch_bend_deg: 4"),
      ["goal.notches: gives 20 deg per notch", "more than goal.max_notch_bend_deg = 4 deg", ">= 10 notches, or auto"]),
 ])
