@@ -54,9 +54,14 @@ def cmd_synthesize(args: argparse.Namespace) -> int:
     except PatternError as exc:  # (named after the output file, which is not written: the goal's problem)
         first = exc.issues[0]
         more = f" (and {len(exc.issues) - 1} more)" if len(exc.issues) > 1 else ""
+        fix = f"relax the goal's lengths or limits behind {first.key}"
+        if first.key.startswith("holes[") and "collides with hole" in first.message:
+            # (each direction's tendon is anchored in a hole at the same x: directions 10 deg apart collide there;
+            # no length or limit fixes that)
+            fix = ("set the bending directions (goal.bends[].angle_deg) further apart: each direction's tendon is "
+                   "anchored in its own hole, and these holes collide")
         raise CamtubeError(f"{args.goal}: the pattern designed for this goal breaks camtube's pattern rules: "
-                           f"{first.key}: {first.message}{more}; fix: relax the goal's lengths or limits behind "
-                           f"{first.key} (nothing was written)") from None
+                           f"{first.key}: {first.message}{more}; fix: {fix} (nothing was written)") from None
     checks = check_design(design, loaded.pattern)
     path = write_atomic(out, text)
     print(summary_text(design, checks, seconds, loaded.pattern))

@@ -307,3 +307,17 @@ def test_an_infeasible_goal_with_no_nearest_target_is_not_told_to_go_to_it(tmp_p
     err = capsys.readouterr().err
     assert "nearest feasible target: none found" in err and "to the nearest target" not in err, err
     assert "or change the stock (the tube)" in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_two_directions_whose_anchor_holes_collide_are_told_to_move_apart(tmp_path, capsys):
+    """The bad-input search: directions 0 and 10 deg: "holes[1] ... collides with hole ...; fix: relax the goal's
+    lengths or limits behind holes[1]", which no length or limit fixes."""
+    from camtube.commands import main
+
+    goal = tmp_path / "g.yaml"
+    goal.write_text("tube: {outer_radius: 0.75, inner_radius: 0.45}\ngoal: {bends: [{angle_deg: 0, bend_deg: 30, "
+                    "stroke_mm: 1.5}, {angle_deg: 10, bend_deg: 30, stroke_mm: 1.5}]}\n")
+    assert main(["synthesize", str(goal), "-o", str(tmp_path / "p.yaml")]) == 2
+    err = capsys.readouterr().err
+    assert "collides with hole" in err and "set the bending directions (goal.bends[].angle_deg) further apart" in err, err
+    assert not (tmp_path / "p.yaml").exists()
