@@ -280,7 +280,10 @@ class _Checker:
             what = "a whole number" if integer else "a finite number"
             rng = f"{what} {'>' if strict else '>='} {_num(lo)}" + (f" and <= {_num(hi)}" if hi < math.inf else "")
             rng += f" {unit}" if unit else ""
-            self.add(key, f"must be {rng}", v, rng, f"set {key} to {rng}")
+            if v is None:   # (a key left out read "must be a finite number ...", never that it was missing)
+                self.add(key, "is missing", None, rng, f"add {key.split('.')[-1]}: <value> (your stage's figure)")
+            else:
+                self.add(key, f"must be {rng}", v, rng, f"set {key} to {rng}")
             return None
         return int(v) if integer else float(v)
 
@@ -383,8 +386,8 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
     spindle, spw = laser.get("spindle"), 0.0
     if dialect == "linuxcnc":
         if "gate_output" not in laser:
-            ck.add("laser.gate_output", "LinuxCNC gates the beam with a digital output", None, "0..3",
-                   "add laser.gate_output: 0")
+            ck.add("laser.gate_output", "is missing: LinuxCNC gates the beam with a digital output", None,
+                   f"a digital output 0..{MAX_OUTPUT}", "add laser.gate_output: 0")
         if spindle is not None or "s_per_watt" in laser:
             ck.add("laser.spindle", "LinuxCNC profiles gate the beam with outputs, not a spindle", spindle,
                    "gate_output/power_output/frequency_output", "remove laser.spindle and laser.s_per_watt")

@@ -68,3 +68,23 @@ def test_a_spindle_value_that_rounds_to_zero_is_refused(tmp_path):
                 "--set", "process.power_w=0.3")
     assert_refused(r, "process.power_w", "'M4 S0'", "machine.laser.s_per_watt")
     assert listing(tmp_path) == ["m.yaml"]
+
+
+@pytest.mark.parametrize("drop,words", [
+    # the bad-input search: a key left out read "must be a finite number ...", never that it was missing
+    ("    A: {max_velocity: 3600, max_acceleration: 36000}", ("machine.limits.A.max_acceleration: is missing",
+                                                         "add max_acceleration:")),
+    # and "allowed: 0..3", while outputs 0..63 are taken
+    ("gate_output: 0", ("machine.laser.gate_output: is missing", "a digital output 0..63")),
+])
+def test_a_key_left_out_of_a_profile_is_said_to_be_missing(tmp_path, drop, words):
+    text = (ROOT / "machines" / "linuxcnc-rotary.yaml").read_text()
+    assert drop in text
+    if drop.startswith("    A:"):
+        text = text.replace(drop, "    A: {max_velocity: 3600}")
+    else:
+        text = text.replace("gate_output: 0, ", "").replace("gate_output: 0}", "}").replace("gate_output: 0", "")
+    m = tmp_path / "m.yaml"
+    m.write_text(text)
+    assert_refused(camtube("toolpath", TUBE1, "-q", "-o", str(tmp_path / "o"), "--machine", str(m)), *words)
+    assert listing(tmp_path) == ["m.yaml"]
