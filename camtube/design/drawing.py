@@ -630,8 +630,8 @@ def _unclamped_spline_path(entity, tolerance: float):
         if float(np.max(dev)) <= tolerance:
             break
         n *= 2
-    closed = bool(entity.closed) and float(np.hypot(*(pts[0, :2] - pts[-1, :2]))) <= 1e3 * tolerance
-    return ezpath.from_vertices([tuple(v) for v in pts], close=closed)
+    # (closed or not as its ends lie: :func:`_flatten` joins ends within the gap tolerance, as for any curve)
+    return ezpath.from_vertices([tuple(v) for v in pts])
 
 
 def _flatten(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
