@@ -110,13 +110,14 @@ def plan(loaded: Loaded, ordering: str | None = None, progress: Progress = NO_PR
 def _named(issue, loaded: Loaded):
     """A planner's issue about ``cut[i]`` named by where that cut came from (the drawing's entity, the YAML key) and in
     the pattern's file (the planner knows neither: "cut[0] (hole at x ...): the contour vanishes" named no file)."""
-    import re
     from dataclasses import replace
 
-    m = re.match(r"cut\[(\d+)\] \((.*)\)$", issue.key or "")
+    from camtube.plan.planner import cut_of_key
+
+    cut = cut_of_key(issue.key)
     key = issue.key
-    if m and int(m.group(1)) < len(loaded.origins):
-        key = f"{loaded.origins[int(m.group(1))]} ({m.group(2)})"
+    if cut is not None and cut[0] < len(loaded.origins):
+        key = f"{loaded.origins[cut[0]]} ({cut[1]})"
     return replace(issue, key=key, file=issue.file or loaded.pattern.source)
 
 

@@ -85,6 +85,15 @@ def _describe(contour: Contour, index: int) -> str:
     return f"cut[{index}] ({contour.kind} at x {x0:.4f}..{x1:.4f} mm, y {y0:.4f}..{y1:.4f} mm)"
 
 
+def cut_of_key(key: str) -> tuple[int, str] | None:
+    """``(index, where)`` of an issue key :func:`_describe` wrote (``cut[3] (notch at x ...)``), else None: the caller
+    that knows where cut ``index`` came from (a drawing's entity, a YAML key) names it so."""
+    import re
+
+    m = re.match(r"cut\[(\d+)\] \((.*)\)$", key or "")
+    return (int(m.group(1)), m.group(2)) if m else None
+
+
 def offset_contour(contour: Contour, offset_mm: float, index: int = -1) -> Contour:
     """The contour moved ``offset_mm`` into the region it bounds (the material removed).
 
