@@ -163,3 +163,17 @@ def test_centerline_png_draws_the_3d_shape():
     img = plt.imread(io.BytesIO(png), format="png")
     assert img.shape[:2] == (912, 960)
     assert (img[..., :3] < 0.9).any()  # something drawn
+
+
+def test_the_copies_of_a_fit_s_bounds_agree_with_the_model_s():
+    """The layers below the model (the pattern and goal schemas, the calibration reader) cannot import it, so they
+    hold the fit's bounds as copies: a tendon modulus, L0 and arm scale a fit could not give are refused by each."""
+    from camtube.design.schema import SCHEMA
+    from camtube.joint.forward import CALIBRATION_MIN
+    from camtube.model.core.model import BASE_PARAMS
+    from camtube.synthesis.goal import GOAL_SCHEMA
+
+    bounds = {p.name: (p.lo, p.hi) for p in BASE_PARAMS}
+    assert {k: v[0] for k, v in CALIBRATION_MIN.items()} == {k: bounds[k][0] for k in CALIBRATION_MIN}
+    for f in (SCHEMA["tendon"]["modulus_gpa"], GOAL_SCHEMA["tendon"]["modulus_gpa"]):
+        assert (f.lo, f.hi) == bounds["E_t"]
