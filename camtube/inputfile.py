@@ -40,33 +40,34 @@ def read_input_text(path: str | os.PathLike, encoding: str = "utf-8") -> str:
         return fh.read()
 
 
-class JSONTooDeepError(json.JSONDecodeError):
-    """JSON nested deeper than Python's parser can follow (it recurses once per ``[`` or ``{``).
+class JSONProblem(json.JSONDecodeError):
+    """JSON that :func:`parse_json` refuses though ``json.loads`` would not say why in words.
 
     A :class:`json.JSONDecodeError` (so a :class:`ValueError`), so every reader that already turns a file that is
     not JSON into its one line does the same for this one; its text is :attr:`problem` alone.
     """
 
-    problem = "nested too deeply: thousands of levels of '[' or '{'"
+    def __init__(self, doc: str, problem: str):
+        self.problem = problem
+        super().__init__(problem, doc, 0)
+
+    def __str__(self) -> str:
+        return self.problem
+
+
+class JSONTooDeepError(JSONProblem):
+    """JSON nested deeper than Python's parser can follow (it recurses once per ``[`` or ``{``)."""
 
     def __init__(self, doc: str):
-        super().__init__(self.problem, doc, 0)
-
-    def __str__(self) -> str:
-        return self.problem
+        super().__init__(doc, "nested too deeply: thousands of levels of '[' or '{'")
 
 
-class JSONDuplicateKeyError(json.JSONDecodeError):
+class JSONDuplicateKeyError(JSONProblem):
     """A JSON object that gives one key twice: ``json.loads`` keeps the last without a word (a calibration's
-    ``"E_t"`` given twice). A :class:`json.JSONDecodeError`, read by every reader as a file that is not JSON is; its
-    text is :attr:`problem` alone."""
+    ``"E_t"`` given twice)."""
 
     def __init__(self, doc: str, key: str):
-        self.problem = f"the key {key!r} is given twice in one object"
-        super().__init__(self.problem, doc, 0)
-
-    def __str__(self) -> str:
-        return self.problem
+        super().__init__(doc, f"the key {key!r} is given twice in one object")
 
 
 def parse_json(text: str):
