@@ -23,8 +23,8 @@ How a drawing is read (``docs/dxf.md`` has the long version):
    layer is a cut (a drawn rectangle stays a plain rectangle), each open path on
    a slit layer a slit; the design rules run with messages naming the entity.
 
-Every entity ends up imported, set aside by an explicit rule (annotation, ignored
-or hidden layer, the outline), or refused with a :class:`~camtube.errors.PatternError`.
+Every entity ends up imported, set aside by an explicit rule (annotation, ignored,
+hidden or non-plotting layer, the outline), or refused with a :class:`~camtube.errors.PatternError`.
 """
 from __future__ import annotations
 
@@ -126,7 +126,7 @@ class _Reading:
     factor: float                     # mm per drawing unit
     unit: str
     roles: dict[str, str]             # upper-case layer -> role (explicit overrides)
-    hidden: set[str]                  # upper-case names of layers switched off or frozen
+    hidden: dict[str, str]            # upper-case names of layers not shown or not printed -> why they are set aside
     entities: list[_Entity] = field(default_factory=list)
     pieces: list[_Piece] = field(default_factory=list)
     issues: list[Issue] = field(default_factory=list)
@@ -192,8 +192,7 @@ def load_drawing(path: str | os.PathLike, overrides: Iterable[str], options) -> 
     factor, unit = _units(doc, options.units, file)
     layer_names = _layer_names(doc)
     roles = _layer_roles(options.layers, layer_names, file)
-    hidden = {layer.dxf.name.upper() for layer in doc.layers if layer.is_off() or layer.is_frozen()}
-    rd = _Reading(file, factor, unit, roles, hidden)
+    rd = _Reading(file, factor, unit, roles, _hidden_layers(doc))
 
     for entity in doc.modelspace():
         _walk(rd, entity, "", "")
@@ -210,9 +209,9 @@ def load_drawing(path: str | os.PathLike, overrides: Iterable[str], options) -> 
     if rd.issues:
         raise PatternError(rd.issues)
     if not cuts:
-        raise PatternError([Issue("cuts", "the drawing has no cuts", None,
+        raise PatternError([Issue("cuts", "the drawing has no cuts" + _set_aside_note(rd), None,
                                   "closed outlines on notch/hole layers, open paths on slit layers",
-                                  "draw the cuts, or map their layer with --layer NAME=notch|hole|slit", file)])
+                                  _no_cuts_fix(rd), file)])
 
     tube_raw = raw.setdefault("tube", {})
     tube_raw["outer_radius"], tube_raw["length"] = ro, length
@@ -562,9 +561,56 @@ def _no_area(rd: _Reading, ent: _Entity, layer: str, role: str, pts: list[tuple[
     return True
 
 
-def _set_aside_on_ignored(rd: _Reading, ent: _Entity, layer: str) -> None:
+def _aside_by_layer(rd: _Reading) -> dict[str, tuple[str, int]]:
+    """Layers whose entities were set aside as hidden or not plotted: ``name -> (why, count)``, in drawing order."""
+    out: dict[str, tuple[str, int]] = {}
+    for e in rd.entities:
+        why = e.status.removeprefix("aside:")
+        if e.status.startswith("aside:") and why in ("hidden layer", "non-plotting layer"):
+            out[e.layer] = (why, out.get(e.layer, (why, 0))[1] + 1)
+    return out
+
+
+def _set_aside_note(rd: _Reading) -> str:
+    """``" (N entities on the hidden layer X were set aside)"``, or "" when none were."""
+    aside = _aside_by_layer(rd)
+    if not aside:
+        return ""
+    return " (" + "; ".join(f"{n} {'entity' if n == 1 else 'entities'} on the {why} {name} set aside"
+                            for name, (why, n) in aside.items()) + ")"
+
+
+def _no_cuts_fix(rd: _Reading) -> str:
+    """The fix of a drawing without cuts: cut the layers set aside as hidden or not plotted, when there are some."""
+    aside = _aside_by_layer(rd)
+    if not aside:
+        return "draw the cuts, or map their layer with --layer NAME=notch|hole|slit"
+    return ("to cut them, map the layer: " + ", ".join(f"--layer {name}=notch" for name in aside)
+            + " (or hole, slit), or switch it on and let it plot in the CAD program")
+
+
+def _hidden_layers(doc) -> dict[str, str]:
+    """Upper-case names of the layers a CAD program neither shows nor prints -> the reason they are set aside:
+    switched off or frozen ("hidden layer"), or not plotted ("non-plotting layer": DXF group 290 = 0, where a drafter
+    keeps construction and reference geometry; the beam cuts what the drawing prints)."""
+    out = {}
+    for layer in doc.layers:
+        if layer.is_off() or layer.is_frozen():
+            out[layer.dxf.name.upper()] = "hidden layer"
+        elif not layer.dxf.get("plot", 1):
+            out[layer.dxf.name.upper()] = "non-plotting layer"
+    return out
+
+
+def _why_ignored(rd: _Reading, layer: str) -> str:
+    """Why an entity of ``layer`` (role ``ignore``) is set aside: the layer is hidden or not plotted (and not
+    mapped to a role by the user), or its name says so."""
     up = layer.upper()
-    ent.status = "aside:hidden layer" if up in rd.hidden and up not in rd.roles else "aside:ignored layer"
+    return rd.hidden[up] if up in rd.hidden and up not in rd.roles else "ignored layer"
+
+
+def _set_aside_on_ignored(rd: _Reading, ent: _Entity, layer: str) -> None:
+    ent.status = f"aside:{_why_ignored(rd, layer)}"
 
 
 def _beyond_any_tube(rd: _Reading, ent: _Entity, layer: str, role: str, xy: Sequence[tuple[float, float]]) -> bool:
@@ -935,8 +981,7 @@ def _cuts(rd: _Reading, outline: _Piece | None, ro: float, length: float):
     owners: list[_Piece] = []
     for p in rd.pieces:
         if p.role == "ignore":
-            up = p.layer.upper()
-            why = "hidden layer" if up in rd.hidden and up not in rd.roles else "ignored layer"
+            why = _why_ignored(rd, p.layer)
             for e in p.entities:
                 e.status = e.status or f"aside:{why}"
             continue

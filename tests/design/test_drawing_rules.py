@@ -131,6 +131,38 @@ def test_hidden_and_construction_layers_are_set_aside_and_counted(tmp_path):
     assert len(again.pattern.cuts) == 2
 
 
+def test_a_non_plotting_layer_is_set_aside_as_cad_programs_leave_it_off_the_print(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    s.doc.layers.add("REF").dxf.plot = 0      # reference geometry: shown on screen, never printed
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    draw_polygon(s, [(5.0, 1.0), (5.5, 1.0), (5.5, 2.0), (5.0, 2.0)], "REF")
+    loaded = load_drawing(save(s, tmp_path), [], DrawingOptions())
+    assert len(loaded.pattern.cuts) == 1
+    assert "1 (non-plotting layer)" in loaded.summary
+    # mapped to a role by the user, it is cut
+    again = load_drawing(save(s, tmp_path), [], DrawingOptions(layers=(("REF", "notch"),)))
+    assert len(again.pattern.cuts) == 2
+
+
+@pytest.mark.parametrize("hide", ["off", "plot"])
+def test_cuts_only_on_a_layer_set_aside_are_named_with_the_way_to_cut_them(tmp_path, hide):
+    s = Sheet()
+    draw_outline(s)
+    layer = s.doc.layers.add("CUTS")
+    if hide == "off":
+        layer.off()
+    else:
+        layer.dxf.plot = 0
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "CUTS")
+    with pytest.raises(PatternError) as err:
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    text = str(err.value)
+    assert "the drawing has no cuts" in text
+    assert "layer CUTS" in text and "--layer CUTS=notch" in text
+    assert ("hidden layer" if hide == "off" else "non-plotting layer") in text
+
+
 def test_a_slit_across_the_seam_is_joined(tmp_path):
     s = Sheet()
     draw_outline(s)
