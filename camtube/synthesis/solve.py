@@ -261,6 +261,7 @@ def _solve_count_at(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget
     f_top = max(10.0 * lim.max_force_N, 1.0)
     fs = np.geomspace(1e-6, f_top, 100)
     prev = None
+    g_prev = 0.0
     bracket = None
     first_bad = None
     for f in fs:
@@ -269,7 +270,9 @@ def _solve_count_at(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget
             if first_bad is None:
                 first_bad = (float(f), idx, h, strain, h_close)
             if prev is not None:
-                break
+                # the notches bear no more force, and the stroke is not taken up yet: more stroke than this bend uses
+                return _stroke_surplus(goal, grid, (float(f), idx, h, strain, h_close), th, target, prev,
+                                       g_prev + stroke + mech.slack_mm)
             continue
         if g >= 0.0:
             if prev is None:
@@ -278,7 +281,7 @@ def _solve_count_at(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget
                              f"{target.stroke_mm:g} mm", "bend")
             bracket = (prev, float(f))
             break
-        prev = float(f)
+        prev, g_prev = float(f), g
     if bracket is None:
         if first_bad is not None:
             return _row_fail(goal, grid, first_bad, th)
@@ -342,6 +345,17 @@ def _solve_count_at(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget
         return _Fail("limits.max_length", f"the joint would be {_len(length)} mm long (notches {_len(sum(w_tip))} mm "
                      f"+ webs), more than {_len(budget_mm)} mm", "bend")
     return DirectionDesign(target, w_tip, a_tip, tuple(float(s) for s in shares), force, pitch)
+
+
+def _stroke_surplus(goal: Goal, grid: _Grid, bad, th: np.ndarray, target: BendTarget, f_ok: float,
+                    travel_mm: float) -> _Fail:
+    """The stroke is more than the bend takes up: at ``f_ok`` N, the most force the notches bear (above it
+    :func:`_row_fail`'s limit), the bend and the tendon's stretch take up ``travel_mm`` of it. The knob is the stroke
+    (a bend this small asks for less of it)."""
+    above = _row_fail(goal, grid, bad, th)
+    return _Fail("goal.bends[].stroke_mm", f"the stroke {target.stroke_mm:g} mm is more than a {target.bend_deg:g} deg "
+                 f"bend takes up: at {f_ok:.2f} N, the most its notches bear ({above.limit} above it), the bend and "
+                 f"the tendon's stretch take up {_len(travel_mm, 3)} mm", "stroke")
 
 
 def _row_fail(goal: Goal, grid: _Grid, bad, th: np.ndarray) -> _Fail:
@@ -600,6 +614,7 @@ def synthesize(goal: Goal, calibration: Mechanics | None = None, time_limit_s: f
     raise InfeasibleGoal(f"{where}{what} ({b.bend_deg:g} deg at {b.stroke_mm:g} mm towards {b.angle_deg:g} deg) "
                          f"is infeasible: {fail.limit}: {fail.why}; nearest feasible target: {nearest}; fix: "
                          + (f"{lower}give more stroke or relax {fail.limit}" if fail.knob == "bend" else
+                            f"{lower}ask for more bend" if fail.limit == "goal.bends[].stroke_mm" else
                             f"{lower}relax {fail.limit}") + ("" if found else ", or change the stock (the tube)"),
                          fail.limit, nearest)
 

@@ -122,6 +122,25 @@ def test_force_limit_asks_for_less_stroke():
     assert d.directions[0].force_N <= 0.5
 
 
+def test_a_bend_too_small_for_its_stroke_asks_for_less_stroke_and_that_target_is_feasible():
+    """The bad-input search: 0.1 deg at 1.5 mm was told "a notch must bend 0.05 deg, more than 0.75 of its closure
+    angle" and "give more stroke". The stroke is what is too much: no notch bears the force that would stretch the
+    tendon by the rest of it."""
+    goal = load_goal(ROOT / "examples" / "goals" / "01-tube1-uniform-60.yaml")
+    b = goal.bends[0]
+    small = goal.with_bends([type(b)(b.angle_deg, 0.1, 1.5)])
+    with pytest.raises(InfeasibleGoal) as ei:
+        synthesize(small)
+    msg = str(ei.value)
+    assert ei.value.limit == "goal.bends[].stroke_mm", msg
+    assert "is more than a 0.1 deg bend takes up" in msg and "give more stroke" not in msg, msg
+    assert "fix: lower stroke_mm to the nearest target, or ask for more bend" in msg, msg
+    bend, stroke = map(float, re.match(r"([\d.]+) deg at ([\d.]+) mm", ei.value.nearest).groups())
+    assert bend == pytest.approx(0.1) and stroke < 1.5
+    d = synthesize(small.with_bends([type(b)(b.angle_deg, 0.1, stroke)]))   # the nearest target is feasible
+    assert d.directions[0].count >= 1
+
+
 def test_fe_fit_hinge_design_meets_the_goal_under_that_model(tmp_path):
     from dataclasses import replace
 
