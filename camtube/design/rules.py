@@ -126,6 +126,35 @@ def _row_too_long(pattern: Pattern, origins: list, err) -> None:
         "or shorten notch.spacing / notch.first_offset")
 
 
+def _report_crossing_slits(pairs: list[tuple[int, int]], cuts, origins, err) -> None:
+    """Drawn slits that overlap: one line per pair, and one line for each group of three or more that overlap one
+    another (a T or a star of slits from one point: one mistake, not one line per pair)."""
+    parent: dict[int, int] = {}
+
+    def root(k: int) -> int:
+        while parent.setdefault(k, k) != k:
+            k = parent[k]
+        return k
+
+    for i, j in pairs:
+        parent[root(i)] = root(j)
+    groups: dict[int, list[int]] = {}
+    for k in sorted(parent):
+        groups.setdefault(root(k), []).append(k)
+    for members in sorted(groups.values()):
+        if len(members) == 2:
+            i, j = next(pair for pair in pairs if set(pair) == set(members))   # (in the sweep's order, as before)
+            err(_pair_key(origins[i], origins[j], cuts[i], cuts[j]), f"{_describe(cuts[j])} overlaps {_describe(cuts[i])}",
+                None, "cuts must not overlap", "move the two cuts apart in the drawing, or delete one")
+            continue
+        names = [origins[k] for k in members]
+        err(", ".join(names[:-1]) + f" and {names[-1]}",
+            f"{len(members)} slits meet or cross (a T or a star drawn as separate slits): "
+            + ", ".join(_describe(cuts[k]) for k in members) + " overlap one another", None,
+            "cuts must not overlap",
+            "draw each slit as one path that ends short of the others by the minimum web, or delete the extra ones")
+
+
 def _describe(cut: Cut) -> str:
     return f"{cut.kind} at x={cut.x_mm:.4g} mm, angle {cut.angle_deg:.4g} deg"
 
@@ -269,6 +298,7 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
     thinned_by_kerf = not pattern.process.kerf_mm > 0
     cuts = pattern.cuts
     reported = 0
+    crossing: list[tuple[int, int]] = []   # drawn slits that overlap, (i, j) by index
     for a_pos, i in enumerate(order):
         a = cuts[i]
         for j in order[a_pos + 1:]:
@@ -283,6 +313,10 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
                 err(key, f"{_describe(b)} is a duplicate of {_describe(a)} (drawn or listed twice)", None,
                     "each cut once", "delete one of the two")
             elif cuts_overlap(a, b, ro):
+                if drawn and a.kind == b.kind == "slit":
+                    crossing.append((i, j))   # reported below: three slits from one point are one mistake
+                    reported += 1
+                    continue
                 what = "collides with" if hole_pair else "overlaps"
                 err(key, f"{_describe(b)} {what} {_describe(a)}", None, "cuts must not overlap",
                     "move the two cuts apart in the drawing, or delete one" if drawn else
@@ -308,6 +342,7 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
             reported += 1
         if len(errors) > 50:
             break
+    _report_crossing_slits(crossing, cuts, origins, err)
 
     if pattern.notches and not errors:
         for d in bends_at_stroke(pattern):

@@ -163,6 +163,34 @@ def test_cuts_only_on_a_layer_set_aside_are_named_with_the_way_to_cut_them(tmp_p
     assert ("hidden layer" if hide == "off" else "non-plotting layer") in text
 
 
+def test_a_t_of_three_slits_is_one_line_naming_all_three(tmp_path):
+    """The bad-input search: a T drawn as three slits printed three lines, one per overlapping pair."""
+    s = Sheet()
+    draw_outline(s)
+    s.doc.layers.add("SLITS")
+    for a, b in [((3.0, MID - 1.0), (3.0, MID)), ((3.0, MID), (3.0, MID + 1.0)), ((3.0, MID), (4.0, MID))]:
+        s.msp.add_line(s.at(*a), s.at(*b), dxfattribs={"layer": "SLITS"})
+    with pytest.raises(PatternError) as err:
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    lines = str(err.value).splitlines()
+    assert len(lines) == 1, lines
+    assert "3 slits meet or cross" in lines[0] and lines[0].count("LINE #") == 3, lines[0]
+    assert "fix: draw each slit as one path" in lines[0]
+
+
+def test_two_crossing_slits_are_still_one_line_for_the_pair(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    s.doc.layers.add("SLITS")
+    s.msp.add_line(s.at(3.0, MID - 1.0), s.at(3.0, MID + 1.0), dxfattribs={"layer": "SLITS"})
+    s.msp.add_line(s.at(2.5, MID), s.at(3.5, MID), dxfattribs={"layer": "SLITS"})
+    with pytest.raises(PatternError) as err:
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    lines = str(err.value).splitlines()
+    assert len(lines) == 1 and " overlaps " in lines[0] and lines[0].count("LINE #") == 2, lines
+    assert "fix: move the two cuts apart in the drawing, or delete one" in lines[0]
+
+
 def test_a_slit_across_the_seam_is_joined(tmp_path):
     s = Sheet()
     draw_outline(s)
