@@ -449,3 +449,32 @@ def test_a_sample_of_a_handful_of_rows_has_no_answer_alone_and_the_search_goes_o
     s.fixed.update(pattern_values(p))
     s.fit_base()
     assert s._samples_alone(["1", "2"]) is None
+
+
+def test_one_sample_explained_alone_is_said_per_sample_when_the_other_is_beyond_the_library():
+    """bench-heldout56's toe beside a three-arm backbone (tube 3): sample 2's backbone takes a set of over 100 deg in
+    50 cycles, beyond every built-in, and nothing is recommended. Sample 1's toe, explained alone, went unsaid. Each
+    sample diagnosed alone is now said per sample: sample 1's toe family, sample 2 unexplained."""
+    from camtube.model.report.diagnosis import answer_lines
+    from camtube.model.sim.bench import Backbone, Drive, Guide
+
+    p = load_pattern(PATTERNS / "tube3.yaml")
+    trk = Tracker(noise_deg=0.15, n_spikes=0, n_dropouts=0)
+    mild = dict(drive=Drive(backlash_mm=0.003, rail_friction_N=0.05), guide=Guide(mu=0.001))
+    s1 = SampleBench(**mild, tendon=Tendon(crimp_mm=0.6, crimp_shape=2.0), tracker=trk)
+    s2 = SampleBench(**mild, tendon=Tendon(crimp_mm=0.005),
+                     backbone=Backbone(relax=((0.2, 1.0), (0.15, 8.0), (0.1, 100.0)), yield_nmm=4.0,
+                                       set_rate_per_s=0.04), tracker=trk)
+    prot = Protocol(n_cycles=20, ramp_s=2.0, dwell_s=1.0, rest_s=1.0, first_dwell_s=1.0)
+    rec = simulate_bench(p, (s1, s2), prot, Clock(rate_hz=25.0), seed=5)
+    d = diagnose(model_for_pattern(p), rec.data, ("E_t",), pattern_values(p))
+    assert not d.recommended, d.recommended   # sample 2 is beyond the library: no chain for both
+    assert set(d.alone) == {"S1", "S2"}, d.alone
+    assert d.alone["S1"]["recommended"] and d.alone["S1"]["recommended"][0] in TOE_FAMILY, d.alone
+    assert not d.alone["S2"]["recommended"], d.alone
+    lines = answer_lines(d)
+    s1_line = next(ln for ln in lines if ln.strip().startswith("S1: add "))
+    assert "x its noise floor" in s1_line
+    assert any(ln.strip().startswith("S2: nothing the library has explains it") for ln in lines), lines
+    js = diagnosis_dict(d)["alone"]
+    assert js["S1"]["recommended"] == d.alone["S1"]["recommended"] and js["S2"]["recommended"] == []

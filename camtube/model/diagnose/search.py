@@ -296,6 +296,10 @@ class Diagnosis:
         neighbouring rows, read from rows this far apart), on the final model's residual.
     noise_lags_rows : dict[str, int]
         Each sample's row spacing the floor is read at (:func:`noise_lags`), on the final model's residual.
+    alone : dict
+        Each sample diagnosed alone, when the samples differ in that some are explained alone (something recommended)
+        and some are not (their built-ins leave them partial), so no union could be fitted: ``{sample: {"recommended",
+        "explanation", "partial", "before_deg", "after_deg", "floor_deg"}}``; empty otherwise.
     replaced : tuple[tuple[tuple[str, ...], str], ...]
         Effects chosen earlier and dropped for a later one that explains what they did: ``((old, ...), new)``.
     chosen_round : dict
@@ -354,6 +358,7 @@ class Diagnosis:
     held: dict = field(default_factory=dict)
     noise_lag_rows: int = 1
     noise_lags_rows: dict = field(default_factory=dict)
+    alone: dict = field(default_factory=dict)
     cache: Cache = field(default_factory=Cache, init=False, compare=False, repr=False)
 
     @property
@@ -1046,6 +1051,8 @@ class Search:
         self.round_init: dict = dict(settings.init)
         self.swaps_tried = False
         self.full_retry = False
+        #: each sample diagnosed alone, when some are explained and some are not (see Diagnosis.alone)
+        self.alone: dict = {}
         self.retry_prev: tuple = ()
         self.retry_pool: list[Effect] = []
         self.stop = ""
@@ -1800,8 +1807,12 @@ class Search:
                 explained[stands[0][1]] += len(sub) * max(d_s.given.rmse_deg ** 2 - rmse[0] ** 2, 0.0)
             base = [b for b in d_s.baseline
                     if not all(n in d_s.held for n in self.registry[b].full_names())]
+            last = d_s.partial_steps[-1] if d_s.partial else d_s.final
+            summary = {"recommended": list(d_s.recommended), "explanation": d_s.explanation,
+                       "partial": list(d_s.partial), "before_deg": float(d_s.waterfall[0].rmse_deg),
+                       "after_deg": float(last.rmse_deg), "floor_deg": float(d_s.noise_floor_deg)}
             return (tuple(d_s.partial), list(d_s.recommended), base,
-                    dict(d_s.final.params) if d_s.recommended or base else {}, explained)
+                    dict(d_s.final.params) if d_s.recommended or base else {}, explained, summary)
 
         # the samples' searches are independent: one per core (speed; the same results as one after another)
         found = map_forked(alone, len(samples))
@@ -1809,11 +1820,17 @@ class Search:
         bases: dict[str, list[str]] = {}
         inits: dict[str, dict] = {}
         explained: dict[str, float] = {}
+        if any(got is None for got in found):
+            return None
+        summaries = {smp: got[-1] for smp, got in zip(samples, found)}
         for smp, got in zip(samples, found):
-            if got is None:
-                return None
-            partial, chains[smp], bases[smp], inits[smp], gains = got
+            partial, chains[smp], bases[smp], inits[smp], gains, _ = got
             if partial:
+                # no answer to combine; but where another sample is explained alone, the samples differ: said per
+                # sample (bench-heldout56's toe beside a three-arm backbone: one sample's backbone took a set of
+                # 110 deg, beyond every built-in, and the other sample's toe, explained alone, went unsaid)
+                if any(v["recommended"] for v in summaries.values()):
+                    self.alone = summaries
                 return None
             for e, g in gains.items():
                 explained[e] = explained.get(e, 0.0) + g
@@ -2139,7 +2156,7 @@ class Search:
                          held={k: v for k, v in self.held.items() if k.split(".")[0] in set(recommended)
                                or ("@" in k and recommended and k.split(".")[0] in set(self.baseline_added))
                                or set(BASELINE_STAND_INS.get(k.split(".")[0], ())) & set(recommended)},
-                         noise_lag_rows=max(lags.values(), default=1), noise_lags_rows=lags)
+                         noise_lag_rows=max(lags.values(), default=1), noise_lags_rows=lags, alone=dict(self.alone))
 
 
 def _sample_notes(model: JointModel, r: FitResult, samples: Sequence[str], ps: Sequence[str]) -> list[str]:

@@ -206,6 +206,10 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
     out["per_sample"] = list(d.per_sample)
     out["held"] = {k: _num(v) for k, v in d.held.items()}
     out["sample_notes"] = list(d.sample_notes)
+    out["alone"] = {smp: {"recommended": list(a["recommended"]), "explanation": a["explanation"] or None,
+                          "partial": list(a["partial"]), "rmse_before_deg": _num(a["before_deg"]),
+                          "rmse_after_deg": _num(a["after_deg"]), "noise_floor_deg": _num(a["floor_deg"])}
+                    for smp, a in d.alone.items()}
     out["stop_reason"] = d.stop_reason
     out["command"] = add_command(d, command)
     out["unexplained"] = unexplained_report.json_section(d)
@@ -346,6 +350,27 @@ def nearest_on_bound(d: Diagnosis) -> dict | None:
             "bound": bound, "side": SIDES.get(best.effect, "")}
 
 
+def alone_lines(d: Diagnosis) -> list[str]:
+    """The samples differ: each diagnosed alone, where some are explained and some are not (``Diagnosis.alone``)."""
+    if not d.alone:
+        return []
+    out = ["  per sample (each diagnosed alone, as the samples differ):"]
+    for smp, a in d.alone.items():
+        ratio = a["after_deg"] / a["floor_deg"] if a["floor_deg"] > 0 else math.inf
+        if a["recommended"]:
+            label = f" ({a['explanation']} explanation)" if a["explanation"] else ""
+            out.append(f"    {smp}: add {', then '.join(a['recommended'])}{label}: {a['before_deg']:.3f} -> "
+                       f"{a['after_deg']:.3f} deg ({ratio:.2f} x its noise floor)")
+        elif a["partial"]:
+            out.append(f"    {smp}: nothing the library has explains it: {', '.join(a['partial'])} lower it from "
+                       f"{a['before_deg']:.3f} to {a['after_deg']:.3f} deg, {ratio:.2f} x its noise floor (see "
+                       "'unexplained')")
+        else:
+            out.append(f"    {smp}: nothing to add alone ({a['before_deg']:.3f} deg, {ratio:.2f} x its noise floor)")
+    out.append("    (fit a sample alone from a file of its rows; what the others leave is in 'left' and 'unexplained')")
+    return out
+
+
 def answer_lines(d: Diagnosis) -> list[str]:
     """The answer first: what to add in order with the error before and after each step, what is left and what
     it follows, per sample, and the instruments' findings (rows set aside, lag)."""
@@ -409,6 +434,7 @@ def answer_lines(d: Diagnosis) -> list[str]:
     else:
         out.append(f"answer: nothing to add: the model is at {_times(steps[0].rmse_deg, floor)} the noise floor "
                    f"({steps[0].rmse_deg:.3f} vs {floor:.3f} deg)")
+    out += alone_lines(d)
     near = nearest_on_bound(d)
     if near is not None:
         out.append(f"  nearest: {near['effect']} lowers the error most ({near['heldout_rmse_deg']:.3f} deg held out, "
