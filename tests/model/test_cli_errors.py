@@ -239,14 +239,17 @@ def test_fix_of_one_samples_copy_holds_it(data_csv, capsys):
     assert held["rmse_deg"] > 1.05 * free["rmse_deg"]
 
 
-def test_diagnose_of_a_constant_time_column_says_why_one_row_is_left(data_csv, tmp_path, capsys):
-    """Every stamp repeated: all rows but one are set aside. Before: 'the selected rows: column 'stroke_mm'
-    never changes', naming neither the file nor the time column."""
+@pytest.mark.parametrize("command", ["diagnose", "fit"])
+def test_a_constant_time_column_is_refused_when_the_file_is_read(data_csv, tmp_path, capsys, command):
+    """Every stamp repeated. Before: 'the selected rows: column 'stroke_mm' never changes', naming neither the file
+    nor the time column; then diagnose set aside all rows but one and said so, while fit fitted the rows as they were
+    (the bad-input search: whole-second stamps, 97 % repeated, fitted with exit 0). The reader refuses it now, for
+    every command, naming the line and the column."""
     f = _variant(data_csv, tmp_path / "t0.csv", time_s="0.0")
-    err = _fails_cleanly(["model", "diagnose", str(f), "--pattern", TUBE2, "-q", "--candidates", "slack"], capsys,
-                         str(f), "rows left after dropping or setting aside", "repeated time stamp",
-                         "check the time_s column", "fix:")
-    assert len(err.strip().splitlines()) == 1 and "the selected rows" not in err, err
+    err = _fails_cleanly(["model", command, str(f), "--pattern", TUBE2, "-q"], capsys,
+                         f"{f}:2: column 'time_s' never changes: 0 s on every row of sample", "not a time",
+                         "fix: check the time_s column")
+    assert len(err.strip().splitlines()) == 1, err
 
 
 def test_too_few_rows_for_the_parameters_says_what_to_do(data_csv, tmp_path, capsys):
@@ -682,3 +685,63 @@ def test_a_log_cut_to_a_few_rows_is_named_as_such_not_given_another_time_unit(tm
                           "--motor", str(BENCH / "motor.csv"), "--bench", str(BENCH / "bench.yaml"), "-o", str(out)],
                          capsys, f"{daq}: 3 rows, too few for a daq log", "a file cut short?")
     assert "time_unit" not in err and len(err.strip().splitlines()) == 1 and not out.exists(), err
+
+
+def _rewrite(src, dst, edit):
+    """``src``'s lines, each passed through ``edit(line_number, line)`` (1-based), written to ``dst``."""
+    lines = open(src).read().splitlines()
+    dst.write_text("\n".join(edit(k, ln) for k, ln in enumerate(lines, 1)) + "\n")
+    return dst
+
+
+def test_a_sample_named_with_a_hash_is_refused_not_read_as_comments(data_csv, tmp_path, capsys):
+    """The bad-input search: samples renamed '#2' were skipped whole as comment lines, the fit ran on the other
+    sample with exit 0."""
+    second = next(ln.split(",")[0] for ln in open(data_csv).read().splitlines()[1:] if not ln.startswith("1,"))
+    f = _rewrite(data_csv, tmp_path / "hash.csv",
+                 lambda k, ln: "#" + ln if k > 1 and ln.split(",")[0] == second else ln)
+    first_hash = next(k for k, ln in enumerate(f.read_text().splitlines(), 1) if ln.startswith("#"))
+    line = _one_line_with_fix(["model", "fit", str(f), "--pattern", TUBE2, "-q"], capsys,
+                              f"{f}:{first_hash}: the line starts with '#'", "holds a data row")
+    assert "rename the sample" in line
+    # a comment line (fewer cells, words) is still a comment
+    g = _rewrite(data_csv, tmp_path / "note.csv", lambda k, ln: ln + "\n# pulled by hand, 21 C" if k == 5 else ln)
+    assert main(["model", "fit", str(g), "--pattern", TUBE2, "-q"]) == 0
+
+
+def test_whole_second_time_stamps_are_refused(data_csv, tmp_path, capsys):
+    """The bad-input search: time rounded to whole seconds (97 % of the stamps repeated) was fitted with exit 0."""
+    rows = open(data_csv).read().splitlines()
+    head = rows[0].split(",")
+    k = head.index("time_s")
+
+    def whole(n, ln):
+        if n == 1:
+            return ln
+        cells = ln.split(",")
+        cells[k] = str(int(float(cells[k])))
+        return ",".join(cells)
+
+    f = _rewrite(data_csv, tmp_path / "coarse.csv", whole)
+    _one_line_with_fix(["model", "fit", str(f), "--pattern", TUBE2, "-q"], capsys,
+                       str(f), "column 'time_s' repeats the time before it", "whole seconds?")
+
+
+def test_a_repeated_header_and_quoted_decimal_commas_are_named(data_csv, tmp_path, capsys):
+    text = open(data_csv).read().splitlines()
+    joined = tmp_path / "joined.csv"
+    joined.write_text("\n".join(text[:40] + [text[0]] + text[40:]) + "\n")
+    _one_line_with_fix(["model", "fit", str(joined), "--pattern", TUBE2, "-q"], capsys,
+                       f"{joined}:41: the line repeats the header (line 1)", "two files joined?")
+    k = text[0].split(",").index("stroke_mm")
+
+    def comma(n, ln):
+        if n == 1:
+            return ln
+        cells = ln.split(",")
+        cells[k] = '"' + cells[k].replace(".", ",") + '"'
+        return ",".join(cells)
+
+    f = _rewrite(data_csv, tmp_path / "comma.csv", comma)
+    _one_line_with_fix(["model", "fit", str(f), "--pattern", TUBE2, "-q"], capsys,
+                       "column 'stroke_mm' is not a number", "(a decimal comma)", "write decimal points")

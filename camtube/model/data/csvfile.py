@@ -6,6 +6,7 @@ import csv
 import difflib
 import io
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -55,8 +56,10 @@ def _to_float(col: tuple, name: str, lines: np.ndarray, source: str, finite: boo
                 float(cell)
             except ValueError:
                 what = "is empty" if not cell.strip() else f"is not a number: {cell!r}"
-                raise _err(source, int(lines[k]), f"column {name!r} {what}",
-                           "every cell of the measurement columns must be a number") from None
+                comma = re.fullmatch(r"\s*[-+]?\d*,\d+\s*", cell) is not None
+                raise _err(source, int(lines[k]), f"column {name!r} {what}" + (" (a decimal comma)" if comma else ""),
+                           "write decimal points (0.5, not 0,5): export the file with a point as the decimal separator"
+                           if comma else "every cell of the measurement columns must be a number") from None
         raise  # pragma: no cover - numpy and float() disagree
     if finite:
         bad = np.flatnonzero(~np.isfinite(arr))
@@ -150,9 +153,19 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
             if header is not None and len(rec) > 1 and not any(c.strip() for c in rec):
                 separators_only.append(ln)
                 continue
+            if (header is not None and rec and rec[0].lstrip().startswith("#") and len(rec) == len(header)
+                    and len(rec) > 1 and all(_is_number(c) for c in rec[1:] if c.strip())
+                    and sum(_is_number(c) for c in rec[1:]) >= len(rec) - 2):
+                # a data row whose sample is named '#...': read as a comment, the whole sample would vanish
+                raise _err(source, ln, f"the line starts with '#', so it is a comment, yet it holds a data row (sample "
+                                       f"{rec[0].strip()!r}?): every row of that sample would be skipped",
+                           "rename the sample so that it does not start with '#', e.g. S" + rec[0].strip().lstrip("#"))
             if not rec or not any(c.strip() for c in rec) or rec[0].lstrip().startswith("#"):
                 comments += header is not None and bool(rec) and rec[0].lstrip().startswith("#")
                 continue
+            if header is not None and [c.strip() for c in rec] == header:
+                raise _err(source, ln, f"the line repeats the header (line {header_line}): two files joined?",
+                           "delete the repeated header line (and check that the rows below it belong to this record)")
             if header is None:
                 header = [c.strip() for c in rec]
                 header_line = ln
@@ -311,11 +324,34 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
             raise _err(source, int(ln[k]),
                        f"column {name!r} goes backwards within sample {sample[k]!r}: {arr[k]:g} after "
                        f"{arr[k - 1]:g} (line {int(ln[k - 1])})", fix)
+    _check_time_resolution(num["time_s"], sample, ln, source)
     data = Dataset(sample, cyc_f.astype(np.int64), num["time_s"], num["stroke_mm"], num["force_N"],
                    num["angle_deg"], extra)
     if among:
         missing_lines = np.sort(np.concatenate((missing_lines, np.asarray(among, dtype=np.int64))))
     return Measurements(data, missing_lines, backward_lines, source)
+
+
+#: A time stamp may repeat the one before it (same sample) on at most this share of a sample's rows: a logger's
+#: glitches; more is a time column too coarse for the rate (whole seconds), or not the time (as ingest's logs).
+MAX_REPEATED_TIME_SHARE = 0.05
+
+
+def _check_time_resolution(t: np.ndarray, sample: np.ndarray, ln: np.ndarray, source: str) -> None:
+    """Refuse a sample whose time stamps repeat on more than :data:`MAX_REPEATED_TIME_SHARE` of its rows."""
+    starts = np.flatnonzero(np.concatenate(([True], sample[1:] != sample[:-1])))
+    ends = np.concatenate((starts[1:], [t.size]))
+    for a, b in zip(starts, ends):
+        rep = np.flatnonzero(t[a + 1:b] == t[a:b - 1]) + a + 1
+        if b - a >= 20 and rep.size == b - a - 1:
+            raise _err(source, int(ln[a]), f"column 'time_s' never changes: {t[a]:g} s on every row of sample "
+                       f"{sample[a]!r}, not a time", "check the time_s column: the time since the record began, in s")
+        if b - a >= 20 and rep.size > MAX_REPEATED_TIME_SHARE * (b - a):
+            k = int(rep[0])
+            raise _err(source, int(ln[k]), f"column 'time_s' repeats the time before it on {rep.size} of {b - a} rows "
+                       f"of sample {sample[k]!r} (here {t[k]:g} s again): a time rounded coarser than the sampling "
+                       "(whole seconds?)", "write the time with the resolution of the instruments' clock (ms: "
+                       "0.020, 0.040, ...)")
 
 
 def load_csv(path: str | Path) -> Dataset:
