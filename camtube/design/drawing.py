@@ -834,6 +834,11 @@ def _rectangle(piece: _Piece) -> tuple[float, float, float, float] | None:
         on_y = abs(y - y0) <= TOL.gap or abs(y - y1) <= TOL.gap
         if not (on_x or on_y):
             return None
+    # every corner of the box drawn (a chamfered or notched corner has its vertices on the box's edges, and a small
+    # chamfer's missing area is within the area test below: it was cut square, the beam outside the drawn corner)
+    for cx, cy in ((x0, y0), (x1, y0), (x1, y1), (x0, y1)):
+        if not any(abs(x - cx) <= TOL.gap and abs(y - cy) <= TOL.gap for x, y in piece.points):
+            return None
     from shapely.geometry import Polygon
 
     area = Polygon(piece.points).area

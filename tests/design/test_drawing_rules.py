@@ -191,6 +191,25 @@ def test_two_crossing_slits_are_still_one_line_for_the_pair(tmp_path):
     assert "fix: move the two cuts apart in the drawing, or delete one" in lines[0]
 
 
+@pytest.mark.parametrize("c", [0.01, 0.03])
+def test_a_notch_with_small_chamfered_corners_is_cut_as_drawn_not_square(tmp_path, c):
+    """The bad-input search: a 0.5 x 2.5 mm notch with 0.03 mm chamfers (its eight vertices on the bounding box's
+    edges, its missing area within the rectangle test's tolerance) was cut as the plain rectangle: every pass ran
+    through the square corners, 21 um outside the drawn cut."""
+    from shapely.geometry import Polygon
+
+    s = Sheet()
+    draw_outline(s)
+    x0, y0, x1, y1 = 3.0, 1.0, 3.5, 3.5
+    pts = [(x0 + c, y0), (x1 - c, y0), (x1, y0 + c), (x1, y1 - c), (x1 - c, y1), (x0 + c, y1), (x0, y1 - c),
+           (x0, y0 + c)]
+    draw_polygon(s, pts, "NOTCHES")
+    cut = load_drawing(save(s, tmp_path), [], DrawingOptions()).pattern.cuts[0]
+    assert cut.outline is not None and len(cut.outline) >= 8, cut
+    drawn = Polygon(pts)
+    assert Polygon(cut.outline).area == pytest.approx(drawn.area, abs=1e-9)
+
+
 def test_a_slit_across_the_seam_is_joined(tmp_path):
     s = Sheet()
     draw_outline(s)
