@@ -462,7 +462,9 @@ def test_a_measurement_file_whose_rows_all_start_with_a_hash_says_why(tmp_path):
     data = tmp_path / "d.csv"
     data.write_text("sample,cycle,time_s,stroke_mm,force_N,angle_deg\n#1,1,0,0,0,0\n#1,1,1,1,1,1\n")
     r = camtube("model", "fit", str(data), "--pattern", "tube2")
-    assert_refused(r, f"{data}:1", "start with '#' and are read as comments")
+    # the first such row is named: a data row whose sample starts with '#' (the whole sample would be skipped)
+    assert_refused(r, f"{data}:2", "the line starts with '#', so it is a comment, yet it holds a data row",
+                   "rename the sample")
 
 
 def test_nul_bytes_in_a_measurement_file_are_refused_not_read_as_a_sample_name(tmp_path):

@@ -189,7 +189,7 @@ def load_drawing(path: str | os.PathLike, overrides: Iterable[str], options) -> 
     len_opt = _agree("length", options.length_mm, raw.get("tube", {}).get("length"), file)
 
     doc = _read_document(path, file)
-    factor, unit = _units(doc, options.units, file)
+    factor, unit = _units(doc, options.units, file, path)
     layer_names = _layer_names(doc)
     roles = _layer_roles(options.layers, layer_names, file)
     rd = _Reading(file, factor, unit, roles, _hidden_layers(doc))
@@ -302,16 +302,30 @@ def _read_document(path, file: str):
         raise PatternError([Issue("file", "not a valid DXF file: it ends inside a section (cut short: a copy or "
                                   "download that did not finish?)", None, "a whole DXF file (R12 or later)",
                                   "save the drawing as DXF again from your CAD program", file)]) from None
-    except (ValueError, IndexError, KeyError, TypeError, AttributeError, UnicodeError) as exc:
-        # a damaged file ezdxf's reader fails on without a DXFError of its own
+    except (ValueError, IndexError, KeyError, TypeError, AttributeError, UnicodeError, OverflowError) as exc:
+        # a damaged file ezdxf's reader fails on without a DXFError of its own (inf as a whole number: OverflowError)
         why = " ".join(str(exc).split())[:120] or type(exc).__name__
         raise PatternError([Issue("file", f"not a valid DXF file ({type(exc).__name__}: {why})", None,
                                   "a DXF file (R12 or later)", "save the drawing as DXF again from your CAD program",
                                   file)]) from None
 
 
-def _units(doc, given: str | None, file: str) -> tuple[float, str]:
-    code = int(doc.header.get("$INSUNITS", 0) or 0)
+def _declares_units(path) -> bool:
+    """Whether the file itself holds ``$INSUNITS``: ezdxf gives a file without a HEADER section (as scripts and old
+    CAM exporters write) its default header, whose unit is m; such a drawing is unitless, as one saying 0."""
+    try:
+        return b"$INSUNITS" in Path(path).read_bytes()
+    except OSError:
+        return True
+
+
+def _units(doc, given: str | None, file: str, path=None) -> tuple[float, str]:
+    try:
+        code = int(doc.header.get("$INSUNITS", 0) or 0) if path is None or _declares_units(path) else 0
+    except (ValueError, OverflowError, TypeError):
+        raise PatternError([Issue("$INSUNITS", "the drawing's unit code is not a whole number", doc.header.get(
+            "$INSUNITS"), "mm, inch, ... ", "pass --units mm (or inch, um, ...), or set the drawing's units",
+            file)]) from None
     if given is not None:
         name = given.strip().lower()
         if name not in UNIT_NAMES:
@@ -324,6 +338,11 @@ def _units(doc, given: str | None, file: str) -> tuple[float, str]:
         return UNIT_NAMES[name], name
     if code in INSUNITS:
         return INSUNITS[code][1], INSUNITS[code][0]
+    if code == 0 and path is not None and not _declares_units(path):
+        raise PatternError([Issue("$INSUNITS", "the drawing does not say its unit (no $INSUNITS in the file: DXF R12, or "
+                                  "no HEADER section): its size is unknown", None, "mm, inch, ... ",
+                                  "pass --units mm (or inch, um, ...), or save the drawing with its units from a CAD "
+                                  "program", file)])
     if code == 0:
         raise PatternError([Issue("$INSUNITS", "the drawing is unitless ($INSUNITS = 0): its size is unknown", 0,
                                   "mm, inch, ... ", "pass --units mm (or inch, um, ...), or set the drawing's units",

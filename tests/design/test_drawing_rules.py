@@ -210,6 +210,40 @@ def test_a_notch_with_small_chamfered_corners_is_cut_as_drawn_not_square(tmp_pat
     assert Polygon(cut.outline).area == pytest.approx(drawn.area, abs=1e-9)
 
 
+def _headerless(k: float) -> str:
+    """A DXF of an ENTITIES section only (as scripts and old CAM exporters write): a tube of r_o 0.75 mm and two notches,
+    drawn at ``k`` drawing units per mm; no $INSUNITS anywhere."""
+    def line(a, b, layer):
+        return f"0\nLINE\n8\n{layer}\n10\n{a[0] * k}\n20\n{a[1] * k}\n11\n{b[0] * k}\n21\n{b[1] * k}\n"
+
+    def rect(x0, y0, x1, y1, layer):
+        return (line((x0, y0), (x1, y0), layer) + line((x1, y0), (x1, y1), layer) + line((x1, y1), (x0, y1), layer)
+                + line((x0, y1), (x0, y0), layer))
+
+    ent = rect(0, 0, 14.0, 2 * math.pi * 0.75, "CONSTRUCTION") + rect(2, 1, 2.5, 3.5, "NOTCHES")
+    return "0\nSECTION\n2\nENTITIES\n" + ent + "0\nENDSEC\n0\nEOF\n"
+
+
+def test_a_drawing_without_a_header_asks_for_its_unit_and_takes_units(tmp_path):
+    """The bad-input search: ezdxf gives a file without a HEADER section its default header (unit m): a tube drawn in
+    inches was cut 39x too large with exit 0, and --units inch was refused quoting a $INSUNITS the file does not hold."""
+    path = tmp_path / "inch.dxf"
+    path.write_text(_headerless(1 / 25.4))
+    with pytest.raises(PatternError) as err:
+        load_drawing(path, [], DrawingOptions())
+    assert "does not say its unit (no $INSUNITS in the file" in str(err.value) and "--units" in str(err.value)
+    loaded = load_drawing(path, [], DrawingOptions(units="inch"))
+    assert loaded.pattern.tube.outer_radius_mm == pytest.approx(0.75, abs=1e-6)
+
+
+def test_inf_in_a_whole_number_code_is_one_line_not_a_traceback(tmp_path):
+    path = tmp_path / "inf.dxf"
+    text = _headerless(1.0).replace("0\nLINE\n8\nNOTCHES\n", "0\nLINE\n8\nNOTCHES\n62\ninf\n", 1)
+    path.write_text(text)
+    with pytest.raises(PatternError, match="not a valid DXF file"):
+        load_drawing(path, [], DrawingOptions(units="mm"))
+
+
 def test_a_slit_across_the_seam_is_joined(tmp_path):
     s = Sheet()
     draw_outline(s)
