@@ -501,8 +501,20 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
         else:
             _fill(rd, entity, ent)
         return
+    if t in CURVES:
+        bad = _damaged_number(entity)
+        if bad:
+            # (an inf vertex was dropped by ezdxf's path, the notch cut as a triangle; an inf arc angle made the arc
+            # vanish as "zero length": both with exit 0)
+            if role == "ignore":
+                ent.status = "aside:ignored layer"
+            else:
+                rd.refuse(ent.describe(), f"{bad} is not a finite number (nan or inf)",
+                          "redraw or delete it (the file may be damaged: export it again)", entities=[ent])
+            return
     if t == "LWPOLYLINE" and role != "ignore" and (entity.dxf.get("const_width", 0.0) or any(
-            w0 or w1 for _, _, w0, w1 in entity.get_points("xyse"))):
+            w0 or w1 for _, _, w0, w1 in entity.get_points("xyse"))) or \
+            t == "POLYLINE" and role != "ignore" and _polyline_width(entity):
         rd.refuse(ent.describe(), "is a polyline with a width: the drawing shows a band, camtube would cut its "
                   "centre line", "set the polyline's width to 0 (draw the cut's outline instead)", entities=[ent])
         return
@@ -533,6 +545,46 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
                           "redraw it with its radius, or export the drawing again", entities=[ent])
             return
     _flatten(rd, entity, ent, layer, role)
+
+
+def _finite(v) -> bool:
+    try:
+        return all(math.isfinite(float(c)) for c in (v if hasattr(v, "__iter__") else (v,)))
+    except (TypeError, ValueError):
+        return True   # (not a number: a name, a handle)
+
+
+def _damaged_number(entity) -> str:
+    """What of ``entity`` holds a number that is not finite (a damaged file), in words, or "" (its DXF attributes, and
+    a polyline's vertices, a spline's points, knots and weights: ezdxf's path drops what it cannot place)."""
+    for name, value in entity.dxfattribs().items():
+        if name == "radius":
+            continue   # (a circle's or arc's radius has its own line: not a number >= 0)
+        if isinstance(value, (int, float)) and not isinstance(value, bool) or hasattr(value, "__iter__") and \
+                not isinstance(value, str):
+            if not _finite(value):
+                return f"its {name.replace('_', ' ')} ({name})"
+    t = entity.dxftype()
+    if t == "LWPOLYLINE":
+        if not all(_finite(p) for p in entity.get_points("xyb")):
+            return "one of its vertices"
+    elif t == "POLYLINE":
+        if not all(_finite(v.dxf.location) and _finite(v.dxf.get("bulge", 0.0)) for v in entity.vertices):
+            return "one of its vertices"
+    elif t == "SPLINE":
+        for what, values in (("one of its control points", entity.control_points),
+                             ("one of its fit points", entity.fit_points), ("one of its knots", entity.knots),
+                             ("one of its weights", entity.weights)):
+            if not all(_finite(v) for v in values):
+                return what
+    return ""
+
+
+def _polyline_width(entity) -> bool:
+    """An old-style POLYLINE drawn with a width (its default widths, or a vertex's)."""
+    if entity.dxf.get("default_start_width", 0.0) or entity.dxf.get("default_end_width", 0.0):
+        return True
+    return any(v.dxf.get("start_width", 0.0) or v.dxf.get("end_width", 0.0) for v in entity.vertices)
 
 
 def _control_polygon(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
@@ -708,11 +760,15 @@ def _flatten(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
             p = _unclamped_spline_path(entity, TOL.chord / rd.factor)
         if p is None:
             p = ezpath.make_path(entity, segments=16, level=8)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, ArithmeticError) as exc:
+        # (an ELLIPSE of axis ratio 0: ezdxf divides by its minor axis, ZeroDivisionError)
         if role == "ignore":
             ent.status = "aside:ignored layer"
         else:
-            rd.refuse(ent.describe(), f"cannot be read as a curve ({exc})", "redraw it as a polyline", entities=[ent])
+            why = str(exc) or type(exc).__name__
+            if entity.dxftype() == "ELLIPSE" and not float(entity.dxf.get("ratio", 1.0)):
+                why = "an ellipse of axis ratio 0, a line"
+            rd.refuse(ent.describe(), f"cannot be read as a curve ({why})", "redraw it as a polyline", entities=[ent])
         return
     distance = TOL.chord / rd.factor
     found = False

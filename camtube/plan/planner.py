@@ -354,6 +354,10 @@ def _plan(source, process, ordering, outer_radius_mm, length_mm, name, progress)
         raise PatternError([Issue("process.drill_passes", "must be at least 1", proc.drill_passes, ">= 1",
                                   "set process.drill_passes to 1 or more")])
     design = src.contours
+    if not design:
+        # (a pattern of notch.count 0 and no holes: max() of an empty sequence, a traceback)
+        raise PatternError([Issue("cuts", "the pattern has no cuts: nothing to plan", 0, ">= 1 cut",
+                                  "set notch.count to 1 or more, or add holes or cuts")])
     for i, c in enumerate(design):
         if len(c.points) < (3 if c.closed else 2):
             raise PatternError([Issue(_describe(c, i), "too few points for a " + ("closed contour" if c.closed

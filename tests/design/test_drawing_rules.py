@@ -324,6 +324,74 @@ def test_a_circle_whose_radius_is_negative_or_nan_is_refused_on_a_cut_layer(tmp_
         load_drawing(save(s, tmp_path), [], DrawingOptions())
 
 
+def test_an_inf_vertex_or_angle_is_refused_not_dropped(tmp_path):
+    """The bad-input search: an LWPOLYLINE vertex of inf was dropped by ezdxf's path and the notch cut as a triangle; an
+    ARC's start angle of inf made the arc vanish ("zero length"): both with exit 0."""
+    s = Sheet()
+    draw_outline(s)
+    pl = s.msp.add_lwpolyline([s.at(3.0, 1.0), s.at(3.5, 1.0), s.at(3.5, 2.0), s.at(3.0, 2.0)], close=True,
+                              dxfattribs={"layer": "NOTCHES"})
+    pts = list(pl.get_points("xyseb"))
+    pts[1] = (float("inf"),) + tuple(pts[1][1:])
+    pl.set_points(pts, "xyseb")
+    with pytest.raises(PatternError, match=r"LWPOLYLINE #\w+ on layer NOTCHES: one of its vertices is not a finite"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    s.doc.layers.add("SLITS")
+    s.msp.add_arc(s.at(6.0, MID), 0.5, 0.0, 90.0, dxfattribs={"layer": "SLITS"}).dxf.start_angle = float("inf")
+    with pytest.raises(PatternError, match=r"ARC #\w+ on layer SLITS: its start angle \(start_angle\) is not a finite"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+
+
+def test_an_ellipse_of_axis_ratio_zero_is_one_line_on_a_cut_layer_and_set_aside_elsewhere(tmp_path):
+    """The bad-input search: an ELLIPSE whose ratio (group 40) is 0.0, as a program other than ezdxf writes a flat one,
+    was a ZeroDivisionError traceback on any layer (ezdxf clamps the ratio on saving: the text is patched here)."""
+    import re
+
+    for layer in ("HOLES", "CONSTRUCTION"):
+        s = Sheet()
+        draw_outline(s)
+        draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+        s.msp.add_ellipse(s.at(6.0, MID), (0.2, 0, 0), 0.5, dxfattribs={"layer": layer})
+        path = save(s, tmp_path)
+        text = path.read_text()
+        patched = re.sub(r"(AcDbEllipse\n(?:.*\n)*? 40\n)0\.5\n", r"\g<1>0.0\n", text, count=1)
+        assert patched != text
+        path.write_text(patched)
+        if layer == "CONSTRUCTION":
+            assert len(load_drawing(path, [], DrawingOptions()).pattern.cuts) == 1
+        else:
+            with pytest.raises(PatternError, match=r"ELLIPSE #\w+ on layer HOLES: cannot be read as a curve \(an ellipse "
+                               "of axis ratio 0"):
+                load_drawing(path, [], DrawingOptions())
+
+
+def test_an_old_style_polyline_with_a_width_is_refused_as_an_lwpolyline_is(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    pl = s.msp.add_polyline2d([s.at(3.0, 1.0), s.at(3.5, 1.0), s.at(3.5, 2.0), s.at(3.0, 2.0)], close=True,
+                              dxfattribs={"layer": "NOTCHES"})
+    pl.dxf.default_start_width = 0.1
+    pl.dxf.default_end_width = 0.1
+    with pytest.raises(PatternError, match=r"POLYLINE #\w+ on layer NOTCHES: is a polyline with a width"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+
+
+def test_a_pattern_without_cuts_is_one_line_for_every_job_not_a_traceback(tmp_path):
+    """The bad-input search: notch.count 0 and no holes was ValueError (max() of an empty sequence) in toolpath,
+    build and cad."""
+    from tests.test_cli_errors import camtube
+
+    for cmd in ("toolpath", "build", "cad"):
+        out = tmp_path / cmd
+        r = camtube(cmd, "tube1", "--set", "notch.count=0", "--set", "holes=[]", "-o", str(out))
+        assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+        assert "the pattern has no cuts" in r.stderr and "fix: set notch.count to 1 or more" in r.stderr, r.stderr
+        assert len(r.stderr.strip().splitlines()) == 1 and not out.exists()
+
+
 def test_a_bad_tag_is_named_on_one_line(tmp_path):
     s = Sheet()
     draw_outline(s)
