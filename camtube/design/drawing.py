@@ -127,6 +127,7 @@ class _Reading:
     unit: str
     roles: dict[str, str]             # upper-case layer -> role (explicit overrides)
     hidden: dict[str, str]            # upper-case names of layers not shown or not printed -> why they are set aside
+    frozen: set[str] = field(default_factory=set)   # upper-case names of frozen layers (hide a block reference whole)
     entities: list[_Entity] = field(default_factory=list)
     pieces: list[_Piece] = field(default_factory=list)
     issues: list[Issue] = field(default_factory=list)
@@ -192,7 +193,8 @@ def load_drawing(path: str | os.PathLike, overrides: Iterable[str], options) -> 
     factor, unit = _units(doc, options.units, file, path)
     layer_names = _layer_names(doc)
     roles = _layer_roles(options.layers, layer_names, file)
-    rd = _Reading(file, factor, unit, roles, _hidden_layers(doc))
+    rd = _Reading(file, factor, unit, roles, _hidden_layers(doc),
+                  {layer.dxf.name.upper() for layer in doc.layers if layer.is_frozen()})
 
     for entity in doc.modelspace():
         _walk(rd, entity, "", "")
@@ -426,6 +428,11 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
 
         if entity.dxf.get("invisible", 0):   # (CAD programs show neither it nor its block's entities)
             unplaced().status = "aside:invisible entity"
+            return
+        if layer.upper() in rd.frozen and layer.upper() not in rd.roles:
+            # a block reference on a frozen layer is not shown at all, whatever its entities' layers (one that is only
+            # off hides its layer-0 entities, which take its layer); its block's notches were cut
+            unplaced().status = "aside:hidden layer"
             return
         if block is None or block.block.is_xref:
             ent = unplaced()

@@ -244,6 +244,22 @@ def test_inf_in_a_whole_number_code_is_one_line_not_a_traceback(tmp_path):
         load_drawing(path, [], DrawingOptions(units="mm"))
 
 
+def test_a_block_reference_on_a_frozen_layer_is_set_aside_whole(tmp_path):
+    """The bad-input search: an INSERT on a frozen layer, its block's outline on layer NOTCHES, was cut, though
+    AutoCAD shows none of it. (An INSERT on a layer that is only off hides its layer-0 entities alone.)"""
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    block = s.doc.blocks.new("N")
+    block.add_lwpolyline([(0, 0), (0.5, 0), (0.5, 1.0), (0, 1.0)], close=True, dxfattribs={"layer": "NOTCHES"})
+    s.doc.layers.add("FROZEN").freeze()
+    s.msp.add_blockref("N", s.at(6.0, 1.0), dxfattribs={"layer": "FROZEN"})
+    loaded = load_drawing(save(s, tmp_path), [], DrawingOptions())
+    assert len(loaded.pattern.cuts) == 1 and "1 (hidden layer)" in loaded.summary, loaded.summary
+    again = load_drawing(save(s, tmp_path), [], DrawingOptions(layers=(("FROZEN", "notch"),)))
+    assert len(again.pattern.cuts) == 2
+
+
 def test_a_slit_across_the_seam_is_joined(tmp_path):
     s = Sheet()
     draw_outline(s)
