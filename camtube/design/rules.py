@@ -279,7 +279,19 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
             if origin == "notch" and circ - arc < rules.min_backbone_arc_mm:
                 seen_keys.add("arc")  # per-notch arcs: every notch is checked, the key is reported once
         if cut.kind == "slit":
-            pass
+            if cut.outline:
+                xs = [p[0] for p in cut.outline]
+                ys = [p[1] for p in cut.outline]
+                span = max(ys) - min(ys)
+                if max(xs) - min(xs) < rules.min_web_mm and span > circ - rules.min_backbone_arc_mm - TOL.rule:
+                    # (a ring: a notch of that arc is refused; the slit cut the tube in two, or over itself, exit 0)
+                    what = ("runs all the way round the tube (and over itself)" if span > circ + TOL.rule else
+                            "runs all the way round the tube: it cuts it in two" if span >= circ - TOL.rule else
+                            f"leaves a backbone of {circ - span:.4f} mm around the tube")
+                    err(key_arc, f"{_describe(cut)} spans {span:.4f} mm around the tube at one place along it: it "
+                        f"{what}", round(span, 9), f"<= 2 pi r_o - rules.min_backbone_arc = "
+                        f"{circ - rules.min_backbone_arc_mm:.4f} mm", "draw the slit shorter around the tube"
+                        if not _is_key(origin) else "shorten the slit")
         elif cut.kind == "hole" and cut.arc_mm >= circ / 2.0:
             err(key_arc, "hole is wider than half the circumference", cut.arc_mm, f"< {circ / 2:.4f} mm",
                 "use a smaller hole")

@@ -260,6 +260,19 @@ def test_a_block_reference_on_a_frozen_layer_is_set_aside_whole(tmp_path):
     assert len(again.pattern.cuts) == 2
 
 
+@pytest.mark.parametrize("extra_mm", [0.0, 1.0])
+def test_a_slit_all_the_way_round_the_tube_is_refused(tmp_path, extra_mm):
+    """The bad-input search: a LINE slit at one x as long as the circumference (or longer) was accepted with exit 0:
+    it cuts the tube in two (and the longer one cuts part of itself twice); a notch of that arc is refused."""
+    s = Sheet()
+    draw_outline(s)
+    draw_polygon(s, [(6.0, 1.0), (6.5, 1.0), (6.5, 2.0), (6.0, 2.0)], "NOTCHES")
+    s.doc.layers.add("SLITS")
+    s.msp.add_line(s.at(3.0, 0.5), s.at(3.0, 0.5 + C + extra_mm), dxfattribs={"layer": "SLITS"})
+    with pytest.raises(PatternError, match=r"LINE #\w+ on layer SLITS: slit at x=3 mm.* runs all the way round the tube"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+
+
 def test_a_slit_across_the_seam_is_joined(tmp_path):
     s = Sheet()
     draw_outline(s)
