@@ -1080,9 +1080,10 @@ def _cuts(rd: _Reading, outline: _Piece | None, ro: float, length: float):
                           f"draw the slit as an open path, or map the layer to notch (--layer {p.layer}=notch) "
                           "to cut out the area", entities=p.entities)
                 continue
-            if len(pts) > 3 and not LineString(pts).is_simple:
-                # (accepted: the beam passed the crossing twice, where two crossing slits are refused as overlapping)
-                rd.refuse(desc, "the slit crosses itself (the beam would pass the crossing twice)",
+            if len(pts) >= 3 and not LineString(pts).is_simple:
+                # (accepted: the beam passed the crossing twice, where two crossing slits are refused as overlapping;
+                # three points that run back over themselves too)
+                rd.refuse(desc, "the slit crosses or runs back over itself (the beam would pass there twice)",
                           "redraw it as a path that does not cross itself, or as separate slits that meet end to end",
                           entities=p.entities)
                 continue

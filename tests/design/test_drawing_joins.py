@@ -201,8 +201,14 @@ def test_a_slit_that_crosses_itself_is_refused(tmp_path):
     """The bad-input search: one polyline on a slit layer crossing itself was cut (the beam over the crossing twice),
     where two crossing slits are refused as overlapping."""
     path = drawing(tmp_path, lambda m: m.add_lwpolyline([(2, 1), (4, 3), (4, 1), (2, 3)], dxfattribs={"layer": "SLITS"}))
-    with pytest.raises(PatternError, match=r"LWPOLYLINE #\w+ on layer SLITS: the slit crosses itself"):
+    with pytest.raises(PatternError, match=r"LWPOLYLINE #\w+ on layer SLITS: the slit crosses or runs back over itself"):
         load_drawing(path, [], DrawingOptions())
+    # three points that run back over themselves (x 3.5..4 cut twice): accepted before, as only paths of four or more
+    # points were checked
+    back = drawing(tmp_path, lambda m: m.add_lwpolyline([(3, 3), (4, 3), (3.5, 3)], dxfattribs={"layer": "SLITS"}),
+                   "back.dxf")
+    with pytest.raises(PatternError, match=r"LWPOLYLINE #\w+ on layer SLITS: the slit crosses or runs back over itself"):
+        load_drawing(back, [], DrawingOptions())
     # a zigzag that does not cross itself is a slit
     ok = drawing(tmp_path, lambda m: m.add_lwpolyline([(2, 1), (3, 3), (4, 1), (5, 3)], dxfattribs={"layer": "SLITS"}),
                  "ok.dxf")
