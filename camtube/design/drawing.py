@@ -273,13 +273,16 @@ def _settings_raw(overrides: list[str], file: str, folder: Path) -> dict:
 
 
 def _agree(what: str, option, value, file: str):
+    for v in (option, value):
+        # (a bool is an int: `--set tube.outer_radius=true` was a tube of 1 mm, where a YAML pattern refuses it)
+        if v is not None and not (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(float(v))
+                                  and float(v) > 0):
+            raise PatternError([Issue(f"tube.{what.replace(' ', '_')}", f"the {what} must be a positive number", v,
+                                      "> 0 mm", "pass a positive number of mm", file)])
     if option is not None and value is not None and abs(float(option) - float(value)) > TOL.zero:
         raise PatternError([Issue(f"tube.{what.replace(' ', '_')}", f"the {what} is given twice, differently",
                                   f"{option:g} and {value:g}", "one value", "give it once", file)])
     v = option if option is not None else value
-    if v is not None and not (isinstance(v, (int, float)) and float(v) > 0 and math.isfinite(float(v))):
-        raise PatternError([Issue(f"tube.{what.replace(' ', '_')}", f"the {what} must be a positive number", v,
-                                  "> 0 mm", "pass a positive number of mm", file)])
     return float(v) if v is not None else None
 
 

@@ -421,6 +421,17 @@ def test_a_pattern_without_cuts_is_one_line_for_every_job_not_a_traceback(tmp_pa
         assert len(r.stderr.strip().splitlines()) == 1 and not out.exists()
 
 
+@pytest.mark.parametrize("value", ["true", "abc"])
+def test_a_tube_radius_set_on_a_drawing_that_is_not_a_number_is_refused(value):
+    """The bad-input search: --set tube.outer_radius=true on a drawing was a tube of 1 mm (a bool is an int), exit 0;
+    a YAML pattern refuses it."""
+    from tests.conftest import ROOT
+    from tests.test_cli_errors import camtube
+
+    r = camtube("design", str(ROOT / "examples" / "dxf" / "blocks.dxf"), "--set", f"tube.outer_radius={value}", "-q")
+    assert r.returncode == 2 and "tube.outer_radius: the outer radius must be a positive number" in r.stderr, r.stderr
+
+
 def test_a_bad_tag_is_named_on_one_line(tmp_path):
     s = Sheet()
     draw_outline(s)
