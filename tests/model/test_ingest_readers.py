@@ -276,3 +276,21 @@ def test_a_motion_that_cannot_fix_the_offset_is_refused():
         align_xcorr("motor", t_ref, wave(t_ref), t_inst, wave(t_inst + 0.3))
     c = align_xcorr("motor", t_ref, wave(t_ref), t_inst, wave(t_inst + 0.3), max_lag_s=4.0)
     assert c.to_ref(np.array([50.0]))[0] == pytest.approx(50.3, abs=0.002)
+
+
+def test_a_log_column_named_twice_is_refused_not_read_from_its_first_copy():
+    """The bad-input search: a motor log headed t_us,enc_counts,enc_counts was read from the first copy with exit 0;
+    the measurement reader refuses duplicate columns."""
+    text = "t_us,enc_counts,enc_counts\n0,0,0\n1000,5,10\n2000,9,18\n"
+    with pytest.raises(DataError, match=r"m\.csv:1: the header names column 'enc_counts' 2 times"):
+        parse_series(text, "m.csv", "t_us", "us", "enc_counts")
+    # another column twice, not read, is no matter
+    parse_series("t_us,enc_counts,note,note\n0,0,a,b\n1000,5,a,b\n", "m.csv", "t_us", "us", "enc_counts")
+
+
+def test_a_map_key_given_twice_is_refused():
+    """The bad-input search: --map motor.gear_ratio=64 --map motor.gear_ratio=32 took the last with exit 0 (the stroke
+    halved, E_t read 12 GPa); --fix given twice is refused."""
+    with pytest.raises(DataError, match=r"--map motor.gear_ratio is given 2 times \('64', '32'\); fix: give it once"):
+        bench_map_from_dict({}, "bench.yaml", ["motor.gear_ratio=64", "motor.gear_ratio=32"])
+    assert bench_map_from_dict({}, "bench.yaml", ["motor.gear_ratio=64"]).motor.gear_ratio == 64

@@ -236,6 +236,11 @@ def bench_map_from_dict(doc: dict, source: str = "<bench map>", overrides: list[
         if len(parts) != 2:
             raise DataError(f"--map {item!r}: the key must be SECTION.NAME; fix: e.g. --map motor.gear_ratio=64 "
                             "(sections: tracker, daq, motor, angle)")
+        given = [o for o in overrides if "=" in o and o.split("=", 1)[0].strip() == k.strip()]
+        if len(given) > 1:
+            # (the last one won without a word: a gear ratio of 64 then 32 halved the stroke, E_t read 12 GPa)
+            raise DataError(f"--map {k.strip()} is given {len(given)} times ("
+                            + ", ".join(repr(o.split('=', 1)[1].strip()) for o in given) + "); fix: give it once")
         doc.setdefault(parts[0], {})[parts[1]] = v
     base = BenchMap()
     sections = {}
@@ -351,6 +356,11 @@ def parse_series(text: str, source: str, time: str, time_unit: str, value: str, 
         raise DataError(f"{source}:{hline}: the columns are not separated by commas; fix: save the log as "
                         "comma-separated values with a decimal point")
     wanted = [("time", time), ("value", value)] + ([("trigger", trigger)] if trigger else [])
+    twice = [col for _, col in wanted if header.count(col) > 1]
+    if twice:
+        # (the first of two same-named columns was read without a word; the measurement reader refuses them)
+        raise DataError(f"{source}:{hline}: the header names column {twice[0]!r} {header.count(twice[0])} times; fix: "
+                        "keep one column of each name (rename or delete the copy)")
     idx = {}
     for what, col in wanted:
         if col not in header:
