@@ -140,7 +140,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
     )
     from camtube.io import write_together
     from camtube.model.core.build import (
-        build_registry, check_fix_and_init, fitted_and_held, history_warning, parse_in_range, split_names,
+        build_registry, check_fix_and_init, check_init_fitted, fitted_and_held, history_warning, parse_in_range,
+        split_names,
     )
     from camtube.model.core.fit import FitError, fit
     from camtube.model.core.predict import model_for_pattern, pattern_values
@@ -214,6 +215,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     check_fix_and_init(held, init)
     params = model.make_params(rows, names, fixed, initial=init,
                                per_sample=split_names(args.per_sample, "--per-sample"))
+    check_init_fitted(init, params.varying, split_names(args.per_sample, "--per-sample"))
     warn = history_warning(model, args.branch, min((len(set(rows.cycle[sl].tolist()))
                                                     for _, sl in rows.sample_slices()), default=0),
                            params.varying)

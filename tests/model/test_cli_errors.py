@@ -255,7 +255,9 @@ def test_a_constant_time_column_is_refused_when_the_file_is_read(data_csv, tmp_p
 def test_too_few_rows_for_the_parameters_says_what_to_do(data_csv, tmp_path, capsys):
     f = tmp_path / "few.csv"
     f.write_text("".join(open(data_csv).readlines()[:4]))
-    _fails_cleanly(["model", "fit", str(f), "--pattern", TUBE2, "-q", "--fit", "E_t,L0,arm_scale", "--no-deadband",
+    # (E_t and L0 together are refused on their own: only L0 / E_t is determined)
+    _fails_cleanly(["model", "fit", str(f), "--pattern", TUBE2, "-q", "--effects", "slack", "--fit",
+                    "E_t,arm_scale,slack.deadband_mm", "--no-deadband",
                     "--cycles", "all", "--branch", "both"], capsys, f"{f}: 3 data rows cannot fit 3 parameters", "fix:")
 
 
@@ -745,3 +747,23 @@ def test_a_repeated_header_and_quoted_decimal_commas_are_named(data_csv, tmp_pat
     f = _rewrite(data_csv, tmp_path / "comma.csv", comma)
     _one_line_with_fix(["model", "fit", str(f), "--pattern", TUBE2, "-q"], capsys,
                        "column 'stroke_mm' is not a number", "(a decimal comma)", "write decimal points")
+
+
+def test_e_t_and_l0_fitted_together_are_refused(data_csv, capsys):
+    """The bad-input search: --fit E_t,L0 gave E_t +- 9e5 GPa (correlation 1) with exit 0, wrote the JSON, and a
+    synthesis took it as a calibration."""
+    line = _one_line_with_fix(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--fit", "L0,E_t"], capsys,
+                              "--fit names both E_t and L0", "only as L0 / E_t")
+    assert "fit one of them" in line
+
+
+@pytest.mark.parametrize("init,words", [
+    ("L0=50", ["--init L0: L0 is not fitted", "--fix L0=VALUE"]),
+    ("slack.deadband_mm@1=0.1", ["--init slack.deadband_mm@1: slack.deadband_mm is not fitted per sample",
+                                 "--per-sample slack"]),
+])
+def test_an_init_of_a_parameter_not_fitted_is_refused(data_csv, capsys, init, words):
+    """The bad-input search: --init L0=50 held L0 at 50 (E_t moved by 29 %), and --init NAME@S without --per-sample
+    was ignored, both with exit 0."""
+    _one_line_with_fix(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--effects", "slack", "--init", init],
+                       capsys, *words)

@@ -130,7 +130,28 @@ def fitted_and_held(model: JointModel, fit_text: str | None, fix_items: Iterable
         if both:
             raise FitError(f"--fit and --fix both name {', '.join(both)}: a parameter is either fitted or held; "
                            f"fix: drop it from --fit to hold it, or drop --fix {both[0]}=... to fit it")
+        if {"E_t", "L0"} <= set(names) and not any(e.source for e in model.effects):
+            # (fitted together: E_t +- 9e5 GPa, correlation 1, exit 0 and a JSON a synthesis took as a calibration)
+            raise FitError("--fit names both E_t and L0, which enter the model only as L0 / E_t (the tendon's "
+                           "compliance): together neither is determined; fix: fit one of them and hold the other at its "
+                           "measured value (the pattern's tendon length, or --fix L0=VALUE)")
     return names, held
+
+
+def check_init_fitted(init: Mapping[str, float], varying: Sequence[str], per_sample: Sequence[str]) -> None:
+    """Refuse an ``--init`` for a parameter that is not fitted: the start of a held parameter became its held value
+    (``--init L0=50`` held L0 at 50 and moved E_t by 29 %), and a sample's copy of a parameter not fitted per sample was
+    ignored."""
+    for name in init:
+        if name in varying:
+            continue
+        base, _, smp = name.partition("@")
+        if smp and base in varying:
+            raise FitError(f"--init {name}: {base} is not fitted per sample, so it has no copy for sample {smp}; fix: "
+                           f"add --per-sample {base.split('.')[0] if '.' in base else base}, or give --init "
+                           f"{base}=VALUE")
+        raise FitError(f"--init {name}: {base} is not fitted (--init starts a fitted parameter); fix: add it to "
+                       f"--fit to fit it from that value, or hold it there with --fix {name}=VALUE")
 
 
 def build_registry(effect_files: Iterable[str] = ()) -> tuple[Registry, tuple]:
