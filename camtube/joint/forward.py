@@ -280,6 +280,11 @@ def _fit_params(doc, path: Path) -> dict[str, float]:
     """
     if not isinstance(doc, dict):
         return {}
+    if doc.get("success") is False:
+        # (a fit that did not converge was designed with, without a word)
+        raise CamtubeError(f"{path}: success: false: this fit did not converge ({str(doc.get('message', ''))[:80]}), so "
+                           "its values are not estimates; fix: fit again until it converges (more --starts, fewer "
+                           "parameters) and pass that JSON")
     where, block = "params", doc.get("params")
     if not isinstance(block, dict) and isinstance(doc.get("final"), dict):
         where, block = "final.params", doc["final"].get("params")
@@ -295,6 +300,15 @@ def _fit_params(doc, path: Path) -> dict[str, float]:
             raise CamtubeError(f"{path}: {key}: not a finite number ({got}); fix: write the fitted value there, or "
                                "pass the JSON of 'camtube model fit --json' or 'camtube model diagnose --json' as "
                                "written")
+        se = entry.get("stderr") if isinstance(entry, dict) else None
+        if isinstance(entry, dict) and str(name).split("@")[0] in ("E_t", "L0", "arm_scale") and \
+                isinstance(se, (int, float)) and \
+                not isinstance(se, bool) and not (math.isfinite(se) and se <= abs(v)):
+            # (E_t 28 +- 9e5 GPa, fitted beside L0: not an estimate, and it was designed with; an effect's value may be
+            # near zero within its error, a slack of 0.00003 +- 0.0006 mm: the base parameters only)
+            raise CamtubeError(f"{path}: {where}.{name}: {v:g} +- {se:g}: its standard error exceeds the value, so "
+                               "the data did not determine it; fix: fit it again with the parameters it trades against "
+                               "held (see the fit's correlations), and pass that JSON")
         sums.setdefault(str(name).split("@")[0], []).append(float(v))
     return {k: sum(v) / len(v) for k, v in sums.items()}
 

@@ -149,6 +149,27 @@ def test_calibration_slack_and_bad_files(tmp_path):
         Mechanics.from_fit_json(bad)
 
 
+def test_a_calibration_that_did_not_converge_or_determine_e_t_is_refused(tmp_path):
+    """The bad-input search: a fit JSON with success false, or E_t 28 +- 9e5 GPa (fitted beside L0), was designed
+    with, without a word. An effect's value within its error of zero (a slack of 0.00003 +- 0.0006 mm) is taken."""
+    from camtube.errors import CamtubeError
+
+    def fit_json(success=True, se=0.007, slack=(0.1, 0.01)):
+        return json.dumps({"schema": "camtube.fit/1", "success": success, "message": "m", "params": {
+            "E_t": {"value": 28.0, "stderr": se, "unit": "GPa", "fitted": True},
+            "slack.deadband_mm": {"value": slack[0], "stderr": slack[1], "unit": "mm", "fitted": True}}})
+
+    path = tmp_path / "f.json"
+    path.write_text(fit_json(success=False))
+    with pytest.raises(CamtubeError, match="success: false: this fit did not converge"):
+        Mechanics.from_fit_json(path)
+    path.write_text(fit_json(se=9e5))
+    with pytest.raises(CamtubeError, match=r"params.E_t: 28 \+- 900000: its standard error exceeds the value"):
+        Mechanics.from_fit_json(path)
+    path.write_text(fit_json(slack=(3e-5, 6e-4)))
+    assert Mechanics.from_fit_json(path).slack_mm == pytest.approx(3e-5)
+
+
 def test_centerline_png_draws_the_3d_shape():
     """The 3-D picture is a PNG that reads back, of the size asked for."""
     import io
