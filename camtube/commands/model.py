@@ -230,6 +230,9 @@ def cmd_fit(args: argparse.Namespace) -> int:
     print(fit_text(result, title))
     if warn:
         print(warn)
+    slow = _slow_sampling(raw)
+    if slow:
+        print(slow)
     if args.deadband:
         slack = find_slack(select_cycles(raw, args.cycles), args.deadband_threshold)
         for smp in rows.samples:
@@ -274,6 +277,27 @@ def cmd_synth(args: argparse.Namespace) -> int:
     print(f"wrote {path}: {len(data)} rows, {args.samples} sample(s) x {args.cycles} cycles, "
           f"stroke 0-{pattern.rules.max_stroke_mm:g} mm; a perfect fit leaves RMSE ~{floor:.3f} deg")
     return 0
+
+
+def _slow_sampling(data) -> str:
+    """A note when a sample's rows come slower than 1 Hz, as ``model diagnose`` says: a time column in ms read as s
+    (its time effects then read their constants 1000x wrong)."""
+    import numpy as np
+
+    from camtube.model.diagnose.instruments import SLOW_RATE_HZ
+
+    slow = []
+    t = np.asarray(data.time_s, float)
+    for smp, sl in data.sample_slices():
+        dt = np.diff(t[sl])
+        dt = dt[dt > 0]
+        if dt.size and 1.0 / float(np.median(dt)) < SLOW_RATE_HZ:
+            slow.append(f"{smp} a row every {float(np.median(dt)):.3g} s")
+    if not slow:
+        return ""
+    return ("note: sampling: " + ", ".join(slow) + f", slower than {SLOW_RATE_HZ:g} Hz; if the time column is in ms, "
+            "give it in s (time_s, divided by 1000): the model's time constants (creep, relaxation, a lag) are read "
+            "in s")
 
 
 def _check_stroke_spikes(raw, source: str) -> None:

@@ -767,3 +767,14 @@ def test_an_init_of_a_parameter_not_fitted_is_refused(data_csv, capsys, init, wo
     was ignored, both with exit 0."""
     _one_line_with_fix(["model", "fit", str(data_csv), "--pattern", TUBE2, "-q", "--effects", "slack", "--init", init],
                        capsys, *words)
+
+
+def test_model_fit_notes_a_time_column_in_ms_as_diagnose_does(data_csv, tmp_path, capsys):
+    """The bad-input search: model fit read a time in ms as s without a word (its time effects read their constants
+    1000x wrong); model diagnose says so."""
+    f = _variant(data_csv, tmp_path / "ms.csv", scale={"time_s": 1000.0})
+    assert main(["model", "fit", str(f), "--pattern", TUBE2]) == 0
+    out = capsys.readouterr().out
+    assert "slower than 1 Hz; if the time column is in ms, give it in s" in out, out
+    assert main(["model", "fit", str(data_csv), "--pattern", TUBE2]) == 0
+    assert "slower than 1 Hz" not in capsys.readouterr().out
