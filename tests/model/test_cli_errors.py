@@ -778,3 +778,15 @@ def test_model_fit_notes_a_time_column_in_ms_as_diagnose_does(data_csv, tmp_path
     assert "slower than 1 Hz; if the time column is in ms, give it in s" in out, out
     assert main(["model", "fit", str(data_csv), "--pattern", TUBE2]) == 0
     assert "slower than 1 Hz" not in capsys.readouterr().out
+
+
+def test_a_sample_cut_to_a_few_rows_is_refused_naming_it(data_csv, tmp_path, capsys):
+    """The bad-input search: a second sample cut to 3 rows was fitted (its own RMSE, pulling on E_t) and its slack
+    printed as a measured 0.000 mm, exit 0."""
+    lines = open(data_csv).read().splitlines()
+    second = next(ln.split(",")[0] for ln in lines[1:] if ln.split(",")[0] != lines[1].split(",")[0])
+    kept = [ln for ln in lines if ln.split(",")[0] != second] + [ln for ln in lines if ln.split(",")[0] == second][:3]
+    f = tmp_path / "cut.csv"
+    f.write_text("\n".join(kept) + "\n")
+    _one_line_with_fix(["model", "fit", str(f), "--pattern", TUBE2, "-q", "--cycles", "all", "--branch", "both",
+                        "--no-deadband"], capsys, f"sample '{second}' has 3 row(s) selected, too few to fit")
