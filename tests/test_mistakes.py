@@ -397,6 +397,16 @@ def ingest_argv(tmp_path, *extra) -> list[str]:
             "--motor", str(BENCH / "motor.csv"), "-o", str(tmp_path / "data.csv"), *extra]
 
 
+def test_a_tracker_rest_that_runs_into_the_first_pull_is_refused(tmp_path):
+    """The bad-input search: tracker.rest_s = 10 s over a rest of 4 s read zero bend (and the force's zero) over the
+    first pull: angles -11 to 21 deg, E_t 24 GPa, exit 0."""
+    r = camtube(*ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"), "--map", "tracker.rest_s=10"))
+    assert_refused(r, "aurora-export.csv", "the joint bends by", "within tracker.rest_s = 10 s",
+                   "fix: give the rest before the first pull (--map tracker.rest_s=")
+    assert listing(tmp_path) == []
+    assert camtube(*ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"))).returncode == 0
+
+
 @pytest.mark.parametrize("extra,words", [("notes: 1\n", ("notes: unknown section",)),
                                          ("angle: 3\n", ("angle: expected a mapping of keys, got 3",))])
 def test_a_bench_map_section_that_is_not_a_mapping(tmp_path, extra, words):

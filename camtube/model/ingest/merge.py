@@ -95,6 +95,33 @@ def _pick_tools(log: TrackerLog, bm: BenchMap):
     return tip, base
 
 
+#: Within ``tracker.rest_s`` the joint may bend by at most this share of the record's largest bend (the noise of a
+#: still joint is far below it; a rest window that runs into the first pull holds part of it).
+REST_MOTION_SHARE = 0.1
+
+
+def _check_rest_still(bend, source: str, rest_s: float) -> None:
+    """Refuse a rest window (``tracker.rest_s``) in which the joint bends: zero bend (and the force's zero with
+    ``offset_V: rest``) was read as the median over the first pull (a rest of 10 s over a pull from 4 s: angles -11 to
+    21 deg, E_t 24 GPa, exit 0)."""
+    t = np.asarray(bend.time_s, float)
+    a = np.asarray(bend.angle_deg, float)
+    ok = np.isfinite(a)
+    if not ok.any():
+        return
+    t, a = t[ok] - t[ok][0], a[ok]
+    top = float(np.max(np.abs(a - np.median(a[t <= rest_s]))))
+    window = a[t <= rest_s]
+    # (robust to a spike or two of interference: the window's 2nd to 98th percentile)
+    spread = float(np.subtract(*np.percentile(window, [98, 2]))) if window.size else 0.0
+    if top > 0 and spread > REST_MOTION_SHARE * top:
+        moved = np.flatnonzero(np.abs(a - a[0]) > REST_MOTION_SHARE * top)
+        first = float(t[moved[0]]) if moved.size else rest_s
+        raise DataError(f"{source}: the joint bends by {spread:.3g} deg within tracker.rest_s = {rest_s:g} s (it moves "
+                        f"from {first:.3g} s): zero bend would be read over the first pull; fix: give the rest before "
+                        f"the first pull (--map tracker.rest_s={max(0.8 * first, 0.1):.2g} or less)")
+
+
 def _angle_from_poses(tracker: TrackerLog, bench: BenchMap):
     tip, base = _pick_tools(tracker, bench)
     tm = bench.tracker
@@ -119,6 +146,7 @@ def _angle_from_poses(tracker: TrackerLog, bench: BenchMap):
                         f"{'' if bend.n_rest == 1 else 's'}{every}: zero bend read from so few carries their noise "
                         f"into every angle; fix: give the rest before the first pull, at least {MIN_REST_FRAMES} "
                         f"frames (--map tracker.rest_s={max(MIN_REST_FRAMES * dt, 0.1):.2g} or more; default 1)")
+    _check_rest_still(bend, tracker.source, tm.rest_s)
     flagged: dict = {}
     for role, tool in (("tip", tip), ("base", base)):
         if tool is None:
