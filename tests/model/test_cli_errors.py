@@ -790,3 +790,14 @@ def test_a_sample_cut_to_a_few_rows_is_refused_naming_it(data_csv, tmp_path, cap
     f.write_text("\n".join(kept) + "\n")
     _one_line_with_fix(["model", "fit", str(f), "--pattern", TUBE2, "-q", "--cycles", "all", "--branch", "both",
                         "--no-deadband"], capsys, f"sample '{second}' has 3 row(s) selected, too few to fit")
+
+
+def test_a_header_with_units_after_the_names_is_told_to_rename_not_convert(data_csv, tmp_path, capsys):
+    """The bad-input search: 'time_s [s]' was told to "convert 'time_s [s]' from s [s] to s"."""
+    text = open(data_csv).read().splitlines()
+    f = tmp_path / "units.csv"
+    f.write_text("\n".join([text[0].replace("time_s", "time_s [s]").replace("stroke_mm", "stroke_mm (mm)")]
+                           + text[1:]) + "\n")
+    line = _one_line_with_fix(["model", "fit", str(f), "--pattern", TUBE2, "-q"], capsys,
+                              "rename 'time_s [s]' -> 'time_s', 'stroke_mm (mm)' -> 'stroke_mm' (the unit is in the name)")
+    assert "convert" not in line

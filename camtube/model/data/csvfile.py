@@ -196,7 +196,12 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
         if cased:
             hints.append("rename " + ", ".join(f"{h!r} -> {c!r}" for h, c in cased) + " (the names are written as "
                          f"{', '.join(COLUMNS)}, letter case included)")
-        for c in [c for c in missing if c not in {c for _, c in cased}]:
+        # the name with its unit written after it ('time_s [s]', 'stroke_mm (mm)'): a rename, not a conversion
+        suffixed = [(h, c) for c in missing for h in header if c not in {c for _, c in cased}
+                    and re.fullmatch(re.escape(c) + r"\s*[\[(].*[\])]\s*", h.strip(), flags=re.IGNORECASE)]
+        if suffixed:
+            hints.append("rename " + ", ".join(f"{h!r} -> {c!r}" for h, c in suffixed) + " (the unit is in the name)")
+        for c in [c for c in missing if c not in {c for _, c in cased} | {c for _, c in suffixed}]:
             quantity, unit = c.rsplit("_", 1) if "_" in c else (c, "")
             other = [h for h in header if "_" in h and h.rsplit("_", 1)[0].lower() == quantity.lower()
                      and h.rsplit("_", 1)[1] != unit]
