@@ -801,3 +801,14 @@ def test_a_header_with_units_after_the_names_is_told_to_rename_not_convert(data_
     line = _one_line_with_fix(["model", "fit", str(f), "--pattern", TUBE2, "-q"], capsys,
                               "rename 'time_s [s]' -> 'time_s', 'stroke_mm (mm)' -> 'stroke_mm' (the unit is in the name)")
     assert "convert" not in line
+
+
+@pytest.mark.parametrize("command", ["fit", "diagnose"])
+def test_an_output_under_a_file_is_refused_before_the_work(data_csv, tmp_path, capsys, command):
+    """The bad-input search: --json base.csv/x.json was found only after the whole fit or diagnosis had run and
+    printed its report."""
+    blocker = tmp_path / "base.csv"
+    blocker.write_text("x")
+    assert main(["model", command, str(data_csv), "--pattern", TUBE2, "--json", str(blocker / "x.json")]) == 2
+    cap = capsys.readouterr()
+    assert "is a file, not a folder" in cap.err and cap.out == "", (cap.out[:200], cap.err)

@@ -213,3 +213,11 @@ def check_suffix(path: str | None, suffixes: tuple[str, ...], option: str) -> No
         raise DataError(f"{option} {path}: writes {suffixes[0][1:].upper()}, so the file must end in "
                         f"{' or '.join(suffixes)} (got {p.suffix or 'no suffix'!r}); "
                         f"fix: e.g. {option.split('/')[-1]} {stem}{suffixes[0]}")
+    # a folder on the way that is a file: found before the fit or the diagnosis runs, not once it has printed its
+    # whole report (--json base.csv/x.json)
+    for parent in p.parents:
+        if parent.exists() or parent.is_symlink():
+            if not parent.is_dir():
+                raise DataError(f"{option} {path}: {parent} is a file, not a folder; fix: write the output elsewhere, "
+                                "or rename that file")
+            break
