@@ -132,6 +132,9 @@ def test_a_wrong_return_or_exit_in_apply_is_one_line_with_a_fix(tmp_path, capsys
      ["two different effects named 'broken'", "fix: give each Effect a name of its own"]),
     (HEAD + "    return x" + TAIL.replace('0.0, 2.0, 1.0', '2.0, 0.0, 1.0'),
      ["parameter 'gain' has lo 2 > hi 0", "fix: swap them"]),
+    # (the bad-input search: a start outside the bounds loaded, and the fit said "ended on its bound")
+    (HEAD + "    return x" + TAIL.replace('0.0, 2.0, 1.0', '0.0, 2.0, 5.0'),
+     ["parameter 'gain' starts at 5, outside its bounds 0..2", "fix: give a start within them"]),
 ])
 def test_a_file_that_exits_raises_or_defines_nothing_usable(tmp_path, capsys, data_csv, text, words):
     f = tmp_path / "eff.py"

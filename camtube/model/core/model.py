@@ -247,6 +247,12 @@ class Effect:
             if q.lo > q.hi:
                 raise ValueError(f"effect {self.name!r}: parameter {q.name!r} has lo {q.lo:g} > hi {q.hi:g}; "
                                  "fix: swap them (Param(name, unit, lo, hi, init))")
+            if not callable(q.init) and not (q.lo <= float(q.init) <= q.hi):
+                # (a start outside the bounds was clipped to one, and the fit then said the parameter "ended on its
+                # bound")
+                raise ValueError(f"effect {self.name!r}: parameter {q.name!r} starts at {float(q.init):g}, outside its "
+                                 f"bounds {q.lo:g}..{q.hi:g}; fix: give a start within them (Param(name, unit, lo, hi, "
+                                 "init))")
         unknown = [k for k in self.off if k not in {p.name for p in self.params}]
         if unknown:
             raise ValueError(f"effect {self.name!r}: off names unknown parameter(s) {', '.join(unknown)}")
