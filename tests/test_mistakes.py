@@ -975,3 +975,19 @@ def test_a_cut_the_passes_cannot_offset_is_named_by_its_file_and_origin(tmp_path
         r = camtube("toolpath", str(path), "-o", str(tmp_path / "o"), "-q")
         assert_refused(r, f"{path}: CIRCLE #", "on layer HOLES (hole at x", "the contour vanishes")
     assert not (tmp_path / "o").exists()
+
+
+def test_a_set_without_a_value_names_the_option_not_the_preset(tmp_path):
+    """The bad-input search: --set notch.count= (an empty shell variable) was told "required key is missing; fix: add
+    'count:'" in the shipped preset file."""
+    r = camtube("design", "tube1", "--set", "notch.count=")
+    assert_refused(r, "--set notch.count=: no value after the equals sign", "fix: write the value")
+    assert "presets" not in r.stderr
+
+
+def test_a_name_too_long_for_a_file_name_is_named_by_its_key(tmp_path):
+    """The bad-input search: a name of 300 characters failed as "cannot write: File name too long" on the output
+    folder."""
+    r = camtube("toolpath", "tube1", "--set", "name=" + "x" * 300, "-o", str(tmp_path / "out"))
+    assert_refused(r, "name: is 300 characters long", "fix: shorten the name")
+    assert not (tmp_path / "out").exists()

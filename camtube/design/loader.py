@@ -63,6 +63,11 @@ def parse_override(item: str) -> tuple[str, Any]:
         raise PatternError([Issue("--set", "expected KEY=VALUE", item, "e.g. notch.count=20",
                                   "write the key, an equals sign and the value")])
     key, _, value = item.partition("=")
+    if not value.strip():
+        # (an empty value parsed as null: "required key is missing; fix: add 'count:'" to the shipped preset file)
+        raise PatternError([Issue(f"--set {key.strip()}=", "no value after the equals sign", item,
+                                  f"e.g. {key.strip()}=VALUE", f"write the value: --set {key.strip()}=VALUE (an empty "
+                                  "shell variable?)")])
     try:
         parsed = parse_yaml(value)
     except NumberTooLongError as exc:
@@ -364,6 +369,8 @@ def build_settings(raw: dict, file: str | None = None) -> tuple[Tube, Process, T
 #: Characters a file name on Windows may not hold (besides '/' and '\\', refused as folders).
 WINDOWS_RESERVED = '<>:"|?*'
 #: Device names Windows reserves, with any extension (NUL.ngc is the null device there).
+#: Longest pattern name in bytes: its longest output file, NAME.toolpath.dxf, within a file name's 255 bytes.
+MAX_NAME_BYTES = 200
 WINDOWS_DEVICES = frozenset({"CON", "PRN", "AUX", "NUL", *(f"COM{i}" for i in range(1, 10)),
                              *(f"LPT{i}" for i in range(1, 10))})
 
@@ -392,6 +399,11 @@ def check_name(r: _Reader, name) -> None:
     elif name.split(".")[0].strip().upper() in WINDOWS_DEVICES:
         r.issue("name", f"is {name.split('.')[0]!r}, a device name on Windows (NUL.ngc is the null device there, not "
                 "a file)", name, "any name but CON, PRN, AUX, NUL, COM1-9, LPT1-9", f"write e.g. name: {name}-joint")
+    elif len(str(name).encode("utf-8")) > MAX_NAME_BYTES:
+        # (300 characters: "cannot write: File name too long" named the output folder, not the key)
+        r.issue("name", f"is {len(str(name))} characters long: the output files are named after it (NAME.toolpath.dxf, "
+                "...), and a file name holds at most 255 bytes", str(name)[:40] + "...",
+                f"at most {MAX_NAME_BYTES} bytes", "shorten the name")
     elif any(c in str(name) for c in WINDOWS_RESERVED):
         # (written on Linux, a*b?.ngc cannot be copied to the controller's PC if that runs Windows, nor typed in a
         # shell without quotes)
