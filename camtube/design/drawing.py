@@ -544,6 +544,11 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
     if t == "SPLINE" and entity.dxf.degree == 1:
         _control_polygon(rd, entity, ent, layer, role)
         return
+    if t == "POLYLINE" and entity.dxf.get("flags", 0) & 4:
+        # PEDIT Spline: the frame's control points and the curve's fit points in one list of vertices (read as one
+        # ring, "the outline crosses itself"); CAD programs show the fit points' curve, which is what is cut
+        _spline_fit_polyline(rd, entity, ent, layer, role)
+        return
     if t in ("CIRCLE", "ARC"):
         # a radius of nan was dropped without a word (the drawing then 'has no cuts'), a negative one cut as its size
         r = float(entity.dxf.get("radius", 0.0))
@@ -595,6 +600,31 @@ def _polyline_width(entity) -> bool:
     if entity.dxf.get("default_start_width", 0.0) or entity.dxf.get("default_end_width", 0.0):
         return True
     return any(v.dxf.get("start_width", 0.0) or v.dxf.get("end_width", 0.0) for v in entity.vertices)
+
+
+def _spline_fit_polyline(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
+    """A POLYLINE smoothed by PEDIT Spline (flag 4): its fit vertices (vertex flag 8), the curve CAD programs show;
+    its frame's control points (vertex flag 16) are left out."""
+    fit = [tuple(v.dxf.location) for v in entity.vertices if v.dxf.get("flags", 0) & 8]
+    if len(fit) < 2:
+        if role == "ignore":
+            ent.status = "aside:ignored layer"
+        else:
+            rd.refuse(ent.describe(), "is a spline-fit POLYLINE (PEDIT Spline) without its fit points",
+                      "convert it to a plain polyline or a SPLINE in CAD (PEDIT > Decurve, or SPLINE > Object)",
+                      entities=[ent])
+        return
+    if _beyond_any_tube(rd, ent, layer, role, fit):
+        return
+    pts = _dedupe([(v[0] * rd.factor, v[1] * rd.factor) for v in fit])
+    closed = bool(entity.is_closed) or (len(pts) > 2 and _isclose(pts[0], pts[-1], TOL.gap))
+    if closed and len(pts) > 1 and _isclose(pts[0], pts[-1], TOL.gap):
+        pts = pts[:-1]
+    if len(pts) < 2 or (closed and len(pts) < 3):
+        if not _no_area(rd, ent, layer, role, pts):
+            ent.status = "aside:zero length"
+        return
+    rd.pieces.append(_Piece(pts, closed, [ent], layer, role))
 
 
 def _control_polygon(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:

@@ -432,6 +432,27 @@ def test_a_tube_radius_set_on_a_drawing_that_is_not_a_number_is_refused(value):
     assert r.returncode == 2 and "tube.outer_radius: the outer radius must be a positive number" in r.stderr, r.stderr
 
 
+def test_a_spline_fit_polyline_is_cut_along_its_fit_points(tmp_path):
+    """The bad-input search: a POLYLINE smoothed by PEDIT Spline (its frame's corners, vertex flag 16, and the curve's
+    fit points, flag 8, in one list) was refused as "the outline crosses itself"; CAD programs show the fit points'
+    curve."""
+    from shapely.geometry import Polygon
+
+    s = Sheet()
+    draw_outline(s)
+    p = s.msp.add_polyline2d([s.at(2, 3), s.at(3, 3), s.at(3, 4), s.at(2, 4)], close=True,
+                             dxfattribs={"layer": "NOTCHES"})
+    p.dxf.flags = p.dxf.flags | 4
+    for v in p.vertices:
+        v.dxf.flags = 16
+    fit = [(2.5 + 0.45 * math.cos(2 * math.pi * k / 24), 3.5 + 0.45 * math.sin(2 * math.pi * k / 24))
+           for k in range(24)]
+    p.append_vertices([s.at(x, y) for x, y in fit], dxfattribs={"flags": 8})
+    cut = load_drawing(save(s, tmp_path), [], DrawingOptions()).pattern.cuts[0]
+    assert cut.outline is not None and len(cut.outline) == 24
+    assert Polygon(cut.outline).area == pytest.approx(Polygon(fit).area, rel=1e-9)
+
+
 def test_a_bad_tag_is_named_on_one_line(tmp_path):
     s = Sheet()
     draw_outline(s)
