@@ -147,7 +147,16 @@ def check_feeds(job, machine) -> None:
         f"too slow for machine {profile.name}: the longest cut move ({L:.4g} mm) would get F = {f:.3g} {unit}, "
         f"written {printed} with {profile.feed_decimals} decimals (off by more than {100 * FEED_ROUNDING:g} %); "
         "the job would be meaningless", f"{v:g} mm/s", f">= {v_min:.3g} mm/s on this machine",
-        f"set process.scan_speed_mm_s to at least {v_min:.3g}")])
+        f"set the machine profile's feed_decimals to {_decimals_needed(f, FEED_ROUNDING)} or more (the G-code then "
+        f"carries the feed), or process.scan_speed_mm_s to at least {v_min:.3g}")])
+
+
+def _decimals_needed(feed: float, share: float) -> int:
+    """Fewest decimals with which ``feed`` is written within ``share`` of itself (half a unit of the last one)."""
+    d = 0
+    while 0.5 * 10.0 ** -d > share * feed and d < 12:
+        d += 1
+    return d
 
 
 def check_speeds(job, machine) -> None:

@@ -88,3 +88,21 @@ def test_a_key_left_out_of_a_profile_is_said_to_be_missing(tmp_path, drop, words
     m.write_text(text)
     assert_refused(camtube("toolpath", TUBE1, "-q", "-o", str(tmp_path / "o"), "--machine", str(m)), *words)
     assert listing(tmp_path) == ["m.yaml"]
+
+
+def test_feeds_the_profile_cannot_carry_name_the_decimals_that_would(tmp_path):
+    """The bad-input search: a profile with feed_decimals 0 and a long slit was told to raise the scan speed to 583
+    mm/s (23x the process's); the profile's decimals are the fix."""
+    m = tmp_path / "m.yaml"
+    assert "feed_decimals: " in ROTARY
+    import re
+
+    m.write_text(re.sub(r"feed_decimals: \d+", "feed_decimals: 0", ROTARY))
+    r = camtube("toolpath", TUBE1, "-q", "--set", "process.scan_speed_mm_s=0.5", "-o", str(tmp_path / "o"),
+                "--machine", str(m))
+    assert_refused(r, "process.scan_speed_mm_s: too slow for machine", "fix: set the machine profile's feed_decimals to")
+    want = int(re.search(r"feed_decimals to (\d+) or more", r.stderr).group(1))
+    m.write_text(re.sub(r"feed_decimals: \d+", f"feed_decimals: {want}", ROTARY))
+    ok = camtube("toolpath", TUBE1, "-q", "--set", "process.scan_speed_mm_s=0.5", "-o", str(tmp_path / "o"),
+                 "--machine", str(m))
+    assert ok.returncode == 0, ok.stderr
