@@ -991,3 +991,10 @@ def test_a_name_too_long_for_a_file_name_is_named_by_its_key(tmp_path):
     r = camtube("toolpath", "tube1", "--set", "name=" + "x" * 300, "-o", str(tmp_path / "out"))
     assert_refused(r, "name: is 300 characters long", "fix: shorten the name")
     assert not (tmp_path / "out").exists()
+
+
+def test_a_max_lag_shorter_than_the_clocks_offset_is_named_in_the_fix(tmp_path):
+    """The bad-input search: --max-lag 0.1 with the example logs 0.6 s apart was told only to check that the logs
+    belong to the same run."""
+    r = camtube(*ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"), "--max-lag", "0.1"))
+    assert_refused(r, "both show motion", "give a larger --max-lag", "--max-lag 0.1 s")

@@ -277,7 +277,9 @@ def align_xcorr(name: str, ref_t: np.ndarray, ref_y: np.ndarray, t: np.ndarray, 
         ws.append(se)
     if not wt:
         raise DataError(f"no stretch of the recording where the tracker and the {name} log both show motion; fix: "
-                        "check that both logs belong to the same run (or add a trigger column)")
+                        "check that both logs belong to the same run (or add a trigger column)"
+                        + ("" if max_lag_s is None else f"; if their clocks start more than --max-lag {max_lag_s:g} s "
+                           "apart, give a larger --max-lag"))
     wt_a, wl_a = np.asarray(wt), np.asarray(wl)
     t_mid = 0.5 * (t[0] + t[-1])
     c, d, sc, sd = _weighted_line(wt_a, wl_a, np.asarray(ws), t_mid)
