@@ -277,8 +277,10 @@ def _solve_count_at(goal: Goal, mech: Mechanics, grid: _Grid, target: BendTarget
         if g >= 0.0:
             if prev is None:
                 return _Fail("goal.bends[].stroke_mm", f"the bend needs {_len(g + stroke + mech.slack_mm, 3)} mm of tendon "
-                             f"travel even without stretching the tendon, more than the stroke "
-                             f"{target.stroke_mm:g} mm", "bend")
+                             f"travel even without stretching the tendon"
+                             + (f" ({_len(mech.slack_mm, 3)} mm of it the calibration's slack, taken up before the "
+                                "tendon pulls)" if mech.slack_mm > 0 else "")
+                             + f", more than the stroke {target.stroke_mm:g} mm", "bend")
             bracket = (prev, float(f))
             break
         prev, g_prev = float(f), g

@@ -4,6 +4,7 @@ and the limits kept. The target shares are recomputed here from the goal's words
 the solver."""
 from __future__ import annotations
 
+import json
 import re
 import time
 
@@ -139,6 +140,21 @@ def test_a_bend_too_small_for_its_stroke_asks_for_less_stroke_and_that_target_is
     assert bend == pytest.approx(0.1) and stroke < 1.5
     d = synthesize(small.with_bends([type(b)(b.angle_deg, 0.1, stroke)]))   # the nearest target is feasible
     assert d.directions[0].count >= 1
+
+
+def test_a_calibration_slack_that_takes_the_stroke_is_named_in_the_infeasible_line(tmp_path):
+    """The bad-input search: a calibration with 1.4 mm of slack made 60 deg at 1.5 mm infeasible, and the line said
+    only that the bend needs 2.4 mm of travel, never the slack."""
+    from camtube.joint.forward import Mechanics
+
+    goal = load_goal(ROOT / "examples" / "goals" / "01-tube1-uniform-60.yaml")
+    cal = tmp_path / "fit.json"
+    cal.write_text(json.dumps({"schema": "camtube.fit/1", "params": {
+        "E_t": {"value": 28.0, "stderr": 0.01, "unit": "GPa", "fitted": True},
+        "slack.deadband_mm": {"value": 1.4, "stderr": 0.01, "unit": "mm", "fitted": True}}}))
+    with pytest.raises(InfeasibleGoal) as ei:
+        synthesize(goal, Mechanics.from_fit_json(cal))
+    assert "(1.400 mm of it the calibration's slack" in str(ei.value), str(ei.value)
 
 
 def test_fe_fit_hinge_design_meets_the_goal_under_that_model(tmp_path):
