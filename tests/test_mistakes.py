@@ -998,3 +998,17 @@ def test_a_max_lag_shorter_than_the_clocks_offset_is_named_in_the_fix(tmp_path):
     belong to the same run."""
     r = camtube(*ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"), "--max-lag", "0.1"))
     assert_refused(r, "both show motion", "give a larger --max-lag", "--max-lag 0.1 s")
+
+
+def test_a_tracker_quaternion_that_is_not_of_length_one_is_named(tmp_path):
+    """The bad-input search: quaternions of length 2 (every frame state OK) were told "no frame in which the coil is
+    tracked; fix: check the tool names", though the names were right."""
+    lines = (BENCH / "aurora-export.csv").read_text().splitlines()
+    out = [lines[0]] + [",".join(c if not 6 <= i <= 9 else f"{2 * float(c):.7f}" for i, c in enumerate(ln.split(",")))
+                        for ln in lines[1:]]
+    trk = tmp_path / "trk.csv"
+    trk.write_text("\n".join(out) + "\n")
+    argv = ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"))
+    argv[argv.index("--tracker") + 1] = str(trk)
+    r = camtube(*argv)
+    assert_refused(r, f"{trk}:2:", "quaternion", "has length 2, not 1", "not a rotation")

@@ -135,6 +135,18 @@ def _angle_from_poses(tracker: TrackerLog, bench: BenchMap):
         bend = bend_angle(tip.time_s - t0, tip.quat_wxyz, tip.valid, None if base is None else base.quat_wxyz,
                           None if base is None else base.valid, rest_s=tm.rest_s)
     except ValueError:
+        for role, tool in (("tip", tip), ("base", base)):
+            if tool is None:
+                continue
+            ok = np.array([str(st).strip().lower() == "ok" for st in tool.state], dtype=bool)
+            if ok.any() and not tool.valid.any():
+                # (every frame state OK, but no quaternion of length 1: "check the tool names", which were right)
+                k = int(np.flatnonzero(ok)[0])
+                with np.errstate(invalid="ignore"):
+                    norm = float(np.sqrt(np.sum(tool.quat_wxyz[k] ** 2)))
+                raise DataError(f"{tracker.source}:{int(tracker.lines[k])}: the {role} coil's quaternion (Q0, Qx, Qy, "
+                                f"Qz of {tool.label!r}) has length {norm:.4g}, not 1, in every frame tracked OK: it is "
+                                "not a rotation; fix: export the quaternion columns as the tracker gives them") from None
         raise DataError(f"{tracker.source}: no frame in which the tip{' and the base' if base else ''} coil is "
                         "tracked (state OK); fix: check the tool names (tracker.tip, tracker.base)") from None
     if bend.n_rest < MIN_REST_FRAMES:
