@@ -827,3 +827,13 @@ def test_stroke_and_angle_columns_swapped_are_named_as_swapped(data_csv, tmp_pat
                               "columns 'stroke_mm' and 'angle_deg' look swapped",
                               "fix: exchange the names 'stroke_mm' and 'angle_deg' in the header")
     assert "radians" not in line
+
+
+def test_a_title_above_the_header_is_named_as_such(data_csv, tmp_path, capsys):
+    """The bad-input search: a title line above the header was taken as the header: "2 cells but the header (line 1)
+    has 1 columns"."""
+    f = tmp_path / "titled.csv"
+    f.write_text("Bench export v2\ndate,2024-01-01\n" + open(data_csv).read())
+    _one_line_with_fix(["model", "fit", str(f), "--pattern", TUBE2, "-q"], capsys,
+                       f"{f}:1: the first line ('Bench export v2') names none of the columns", "a title above the header?",
+                       "delete the lines above the header")

@@ -172,6 +172,11 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
                 _check_separator(header, source, ln)
                 continue
             if len(rec) != len(header):
+                if len(header) < len(rec) and not any(c in header for c in COLUMNS):
+                    # (a title or an export note above the header: it was taken as the header)
+                    raise _err(source, header_line, f"the first line ({', '.join(header)[:40]!r}) names none of the "
+                               f"columns and has {len(header)} cell(s), line {ln} has {len(rec)}: a title above the "
+                               "header?", f"delete the lines above the header, which names {', '.join(COLUMNS)}")
                 raise _err(source, ln, f"{len(rec)} cells but the header (line {header_line}) has "
                                        f"{len(header)} columns", "one cell per column on every line")
             rows.append(rec)
