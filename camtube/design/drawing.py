@@ -900,12 +900,33 @@ def _dedupe(pts: list[tuple[float, float]]) -> list[tuple[float, float]]:
     return out
 
 
+def _refuse_open_copies(rd: _Reading) -> None:
+    """An open piece on a cut layer drawn twice (the same points, either way round): refused naming both, and the copy
+    left out of the chaining (a LINE pasted twice in a notch of four LINEs read as three open paths, "close the
+    outline"; a slit pasted twice as "a closed outline on a slit layer")."""
+    seen: dict[tuple, _Piece] = {}
+    copies = []
+    for p in rd.pieces:
+        if p.closed or p.role == "ignore":
+            continue
+        key = tuple((round(x / TOL.gap), round(y / TOL.gap)) for x, y in p.points)
+        first = seen.get((p.layer, key)) or seen.get((p.layer, key[::-1]))
+        if first is None:
+            seen[(p.layer, key)] = p
+            continue
+        copies.append(p)
+        rd.refuse(f"{p.describe()} and {first.describe()}", "the same path drawn twice (pasted twice?)",
+                  "delete one of the two", entities=p.entities)
+    rd.pieces = [p for p in rd.pieces if not any(p is c for c in copies)]
+
+
 def _close_and_chain(rd: _Reading) -> None:
     """Chain the open pieces of each layer with ezdxf.edgeminer: into loops (outlines), and, on a slit
     layer, pieces drawn end to end into one open path (a slit broken at a point, a zig-zag of LINEs)."""
     from ezdxf import edgeminer as em
     from ezdxf.math import Vec3
 
+    _refuse_open_copies(rd)
     by_layer: dict[str, list[_Piece]] = {}
     for p in rd.pieces:
         if not p.closed:

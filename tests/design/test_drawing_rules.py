@@ -453,6 +453,28 @@ def test_a_spline_fit_polyline_is_cut_along_its_fit_points(tmp_path):
     assert Polygon(cut.outline).area == pytest.approx(Polygon(fit).area, rel=1e-9)
 
 
+@pytest.mark.parametrize("layer", ["NOTCHES", "SLITS"])
+def test_a_line_pasted_twice_is_named_as_a_copy(tmp_path, layer):
+    """The bad-input search: a notch of four LINEs with one pasted twice was refused as three open paths ("close the
+    outline", which was closed); a slit LINE pasted twice as "a closed outline on a slit layer"."""
+    s = Sheet()
+    draw_outline(s)
+    s.doc.layers.add("SLITS")
+    if layer == "NOTCHES":
+        pts = [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)]
+        for a, b in zip(pts, pts[1:] + pts[:1]):
+            s.msp.add_line(s.at(*a), s.at(*b), dxfattribs={"layer": layer})
+        s.msp.add_line(s.at(*pts[0]), s.at(*pts[1]), dxfattribs={"layer": layer})
+    else:
+        draw_polygon(s, [(6.0, 1.0), (6.5, 1.0), (6.5, 2.0), (6.0, 2.0)], "NOTCHES")
+        for _ in range(2):
+            s.msp.add_line(s.at(3.0, 1.0), s.at(3.0, 2.0), dxfattribs={"layer": layer})
+    with pytest.raises(PatternError) as err:
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    lines = str(err.value).splitlines()
+    assert len(lines) == 1 and "the same path drawn twice" in lines[0] and lines[0].count("LINE #") == 2, lines
+
+
 def test_a_bad_tag_is_named_on_one_line(tmp_path):
     s = Sheet()
     draw_outline(s)
@@ -610,12 +632,14 @@ def test_curves_on_an_ignored_layer_are_set_aside_without_being_flattened(tmp_pa
 
 @pytest.mark.parametrize("add,words", [
     (lambda s: s.msp.add_lwpolyline([s.at(5.0, 2.0), s.at(5.0, 2.0), s.at(5.0, 4.5), s.at(5.0, 4.5)], close=True,
-                                    dxfattribs={"layer": "NOTCHES"}), r"LWPOLYLINE #\w+ on layer NOTCHES"),
+                                    dxfattribs={"layer": "NOTCHES"}), r"LWPOLYLINE #\w+ on layer NOTCHES: NOAREA"),
+    # (two LINEs drawn over each other are one path drawn twice: named so, since the bad-input search of issue 19)
     (lambda s: (s.msp.add_line(s.at(5.0, 2.0), s.at(5.0, 4.5), dxfattribs={"layer": "HOLES"}),
                 s.msp.add_line(s.at(5.0, 4.5), s.at(5.0, 2.0), dxfattribs={"layer": "HOLES"})),
-     r"2 LINEs \(#\w+, #\w+\) on layer HOLES"),
+     r"LINE #\w+ on layer HOLES and LINE #\w+ on layer HOLES: the same path drawn twice \(pasted twice\?\); fix: "
+     r"delete one of the two"),
     (lambda s: s.msp.add_open_spline([s.at(5.0, 2.0), s.at(5.0, 4.5), s.at(5.0, 2.0)], degree=1,
-                           dxfattribs={"layer": "NOTCHES"}), r"SPLINE #\w+ on layer NOTCHES"),
+                           dxfattribs={"layer": "NOTCHES"}), r"SPLINE #\w+ on layer NOTCHES: NOAREA"),
 ], ids=["rectangle-0-wide", "two-lines-over-each-other", "degree-1-spline-out-and-back"])
 def test_a_closed_outline_with_a_length_but_no_area_is_refused(tmp_path, add, words):
     """A rectangle 0 mm wide and 2.5 mm long on NOTCHES was set aside as 'zero length' (exit 0) though docs/dxf.md
@@ -625,8 +649,8 @@ def test_a_closed_outline_with_a_length_but_no_area_is_refused(tmp_path, add, wo
     draw_outline(s)
     draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
     add(s)
-    with pytest.raises(PatternError, match=words + ": the closed outline encloses no area; fix: delete it or "
-                       "redraw it"):
+    with pytest.raises(PatternError, match=words.replace("NOAREA", "the closed outline encloses no area; fix: delete "
+                                                           "it or redraw it")):
         load_drawing(save(s, tmp_path), [], DrawingOptions())
     s = Sheet()
     draw_outline(s)
