@@ -1012,3 +1012,17 @@ def test_a_tracker_quaternion_that_is_not_of_length_one_is_named(tmp_path):
     argv[argv.index("--tracker") + 1] = str(trk)
     r = camtube(*argv)
     assert_refused(r, f"{trk}:2:", "quaternion", "has length 2, not 1", "not a rotation")
+
+
+def test_a_motor_counter_that_wraps_is_refused_naming_the_line(tmp_path):
+    """The bad-input search: a 16-bit encoder register (counts mod 65536) wrote 12 cycles to 1 mm for 3 cycles to
+    2.5 mm with exit 0."""
+    lines = (BENCH / "motor.csv").read_text().splitlines()
+    out = [lines[0]] + [",".join([c[0], str(int(float(c[1])) % 65536)] + c[2:]) for c in
+                        (ln.split(",") for ln in lines[1:])]
+    mot = tmp_path / "mot.csv"
+    mot.write_text("\n".join(out) + "\n")
+    argv = ingest_argv(tmp_path, "--bench", str(BENCH / "bench.yaml"))
+    argv[argv.index("--motor") + 1] = str(mot)
+    r = camtube(*argv)
+    assert_refused(r, f"{mot}:", "about 2^16: a 16-bit position counter that wrapped", "fix: unwrap the counts")

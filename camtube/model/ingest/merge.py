@@ -122,6 +122,33 @@ def _check_rest_still(bend, source: str, rest_s: float) -> None:
                         f"the first pull (--map tracker.rest_s={max(0.8 * first, 0.1):.2g} or less)")
 
 
+#: Counter widths whose wrap a motor log may show (an unsigned or a signed 16- or 32-bit position register).
+COUNTER_WRAPS = (2 ** 16, 2 ** 32)
+
+
+def _check_counter_wrap(motor, m) -> None:
+    """Refuse a motor log of encoder counts that jumps by about a counter's span between two lines: a 16- or 32-bit
+    position register that wrapped (a 16-bit wrap wrote 12 cycles to 1 mm for 3 cycles to 2.5 mm, exit 0; the signed
+    one drew the fixes --map motor.sign=-1, then daq.N_per_V=-2.5)."""
+    if m.stroke_unit != "counts":
+        return
+    v = np.asarray(motor.value, float)
+    if v.size < 3:
+        return
+    step = np.diff(v)
+    typical = float(np.median(np.abs(step[step != 0]))) if np.any(step != 0) else 0.0
+    for span in COUNTER_WRAPS:
+        jump = np.flatnonzero((np.abs(np.abs(step) - span) < 0.02 * span) & (np.abs(step) > 20 * max(typical, 1.0)))
+        if jump.size:
+            k = int(jump[0])
+            bits = 16 if span == 2 ** 16 else 32
+            raise DataError(f"{motor.source}:{int(motor.lines[k + 1])}: column {motor.column!r} jumps by "
+                            f"{step[k]:+.0f} counts from the line before, about 2^{bits}: a {bits}-bit position counter "
+                            f"that wrapped ({jump.size} time(s)); fix: unwrap the counts before ingest ({span} added where the "
+                            "count falls across the wrap, taken off where it rises across it), or log the position in "
+                            "a wider register")
+
+
 def _angle_from_poses(tracker: TrackerLog, bench: BenchMap):
     tip, base = _pick_tools(tracker, bench)
     tm = bench.tracker
@@ -260,6 +287,7 @@ def ingest(tracker: TrackerLog | Series, daq: Series, motor: Series, bench: Benc
     # ---- units and signs of the motor and the DAQ
     _check_duration("motor", motor, bench.motor.time_unit, bench.motor.time, span)
     _check_duration("daq", daq, bench.daq.time_unit, bench.daq.time, span)
+    _check_counter_wrap(motor, bench.motor)
     stroke = stroke_mm(motor, bench.motor)
     if -float(stroke.min()) > float(stroke.max()):
         raise DataError(f"{motor.source}: column {motor.column!r} gives a stroke that runs negative "
