@@ -283,7 +283,13 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
                 xs = [p[0] for p in cut.outline]
                 ys = [p[1] for p in cut.outline]
                 span = max(ys) - min(ys)
-                if max(xs) - min(xs) < rules.min_web_mm and span > circ - rules.min_backbone_arc_mm - TOL.rule:
+                if span > circ + TOL.rule and max(xs) - min(xs) >= rules.min_web_mm:
+                    # (a helix of three turns was refused only by the G-code's safety check, naming no entity)
+                    err(key_arc, f"{_describe(cut)} winds {span / circ:.2f} turns around the tube, more than the "
+                        "rotary job cuts in one slit (its G-code would wind the axis up)", round(span, 9),
+                        f"<= 2 pi r_o = {circ:.4f} mm around the tube", "draw it to less than one turn around the tube"
+                        if not _is_key(origin) else "shorten the slit")
+                elif max(xs) - min(xs) < rules.min_web_mm and span > circ - rules.min_backbone_arc_mm - TOL.rule:
                     # (a ring: a notch of that arc is refused; the slit cut the tube in two, or over itself, exit 0)
                     what = ("runs all the way round the tube (and over itself)" if span > circ + TOL.rule else
                             "runs all the way round the tube: it cuts it in two" if span >= circ - TOL.rule else

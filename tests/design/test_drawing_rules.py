@@ -273,6 +273,16 @@ def test_a_slit_all_the_way_round_the_tube_is_refused(tmp_path, extra_mm):
         load_drawing(save(s, tmp_path), [], DrawingOptions())
 
 
+def test_a_slit_winding_more_than_one_turn_is_refused_naming_it(tmp_path):
+    """The bad-input search: a helical slit of several turns was refused only by the G-code's safety check ("143 unsafe
+    moves"), naming no entity, after the summary said it was imported."""
+    s = Sheet()   # (no outline drawn: the tube given, as a drawing of a helix unrolled past the sheet is)
+    s.doc.layers.add("SLITS")
+    s.msp.add_line(s.at(3.0, 0.5), s.at(6.0, 0.5 + 2.5 * C), dxfattribs={"layer": "SLITS"})
+    with pytest.raises(PatternError, match=r"LINE #\w+ on layer SLITS: slit at .* winds 2.50 turns around the tube"):
+        load_drawing(save(s, tmp_path), [], DrawingOptions(outer_radius_mm=1.0, length_mm=10.0))
+
+
 def test_a_slit_across_the_seam_is_joined(tmp_path):
     s = Sheet()
     draw_outline(s)
