@@ -1005,11 +1005,85 @@ def _largest_rectangle_with_a_cut_outside(pieces, cut_pieces, bounds):
     return (p, outside[0]) if outside and (inside or p.role == "ignore" or larger) else None
 
 
+def _overshooting_frame(pieces) -> list:
+    """Two horizontal and two vertical straight open pieces (2 points each) on one layer that cross one another near
+    their ends, each running on past the crossings (by more than :data:`TOL.gap`, less than a fifth of its length): a
+    rectangle drawn with its LINEs extended past the corners. The four pieces, or []."""
+    def straight(p, axis):
+        if p.closed or len(p.points) != 2:
+            return False
+        (xa, ya), (xb, yb) = p.points
+        return abs(ya - yb) <= TOL.gap < abs(xa - xb) if axis == "h" else abs(xa - xb) <= TOL.gap < abs(ya - yb)
+
+    by_layer: dict[str, tuple[list, list]] = {}
+    for p in pieces:
+        for axis, k in (("h", 0), ("v", 1)):
+            if straight(p, axis):
+                by_layer.setdefault(p.layer, ([], []))[k].append(p)
+    for hs, vs in by_layer.values():
+        if len(hs) < 2 or len(vs) < 2 or len(hs) * len(vs) > 400:
+            continue
+        for i, h0 in enumerate(hs):
+            for h1 in hs[i + 1:]:
+                for j, v0 in enumerate(vs):
+                    for v1 in vs[j + 1:]:
+                        frame = [h0, h1, v0, v1]
+                        if _crossing_frame(h0, h1, v0, v1):
+                            return frame
+    return []
+
+
+def _crossing_frame(h0, h1, v0, v1) -> bool:
+    ys = sorted((h0.points[0][1], h1.points[0][1]))
+    xs = sorted((v0.points[0][0], v1.points[0][0]))
+    if ys[1] - ys[0] <= TOL.gap or xs[1] - xs[0] <= TOL.gap:
+        return False
+    for h in (h0, h1):
+        lo, hi = sorted(x for x, _ in h.points)
+        if not (lo < xs[0] - TOL.gap and hi > xs[1] + TOL.gap and max(xs[0] - lo, hi - xs[1]) < 0.2 * (hi - lo)):
+            return False
+    for v in (v0, v1):
+        lo, hi = sorted(y for _, y in v.points)
+        if not (lo < ys[0] - TOL.gap and hi > ys[1] + TOL.gap and max(ys[0] - lo, hi - ys[1]) < 0.2 * (hi - lo)):
+            return False
+    return True
+
+
+def _overshoot(p, frame) -> float:
+    """How far the straight piece ``p`` of ``frame`` runs on past the frame's crossing lines."""
+    hs = [q for q in frame if abs(q.points[0][1] - q.points[1][1]) <= TOL.gap]
+    vs = [q for q in frame if q not in hs]
+    if p in hs:
+        lo, hi = sorted(x for x, _ in p.points)
+        xs = sorted(q.points[0][0] for q in vs)
+        return max(xs[0] - lo, hi - xs[1])
+    lo, hi = sorted(y for _, y in p.points)
+    ys = sorted(q.points[0][1] for q in hs)
+    return max(ys[0] - lo, hi - ys[1])
+
+
 def _find_outline(rd: _Reading, ro: float | None, length: float | None):
     """The tube outline piece (or None), and r_o and L (checked against it, or taken from it)."""
     cut_pieces = [p for p in rd.pieces if p.role != "ignore"]
     if not cut_pieces:
         return None, ro or 1.0, length or 1.0  # nothing to cut: refused as such by the caller
+    frame = _overshooting_frame(rd.pieces)
+    if frame and frame[0].role == "ignore":
+        # construction lines that cross: a frame only where no closed rectangle is drawn as big as it (the outline)
+        xs = sorted(q.points[0][0] for q in frame[2:])
+        ys = sorted(q.points[0][1] for q in frame[:2])
+        if any(box is not None and box[0] <= xs[0] + TOL.gap and box[2] >= xs[1] - TOL.gap
+               and box[1] <= ys[0] + TOL.gap and box[3] >= ys[1] - TOL.gap for box in map(_rectangle, rd.pieces)):
+            frame = []
+    if frame:
+        # (four LINEs extended past the corners, as CAD leaves them: no closed outline, and a notch was named "the tube
+        # outline" with a LINE "outside it")
+        over = max(_overshoot(p, frame) for p in frame)
+        rd.refuse(", ".join(p.describe() for p in frame), f"cross one another near their ends instead of meeting (they "
+                  f"run on past the corners by up to {over:.4g} mm): a frame of four lines that is not a closed outline",
+                  "trim them at the corners in CAD (TRIM, or FILLET with radius 0), so that their ends meet",
+                  entities=[e for p in frame for e in p.entities])
+        return None, ro or 1.0, length or 1.0
     import numpy as np
 
     # per cut piece: x range and the y of its centre (a cut may cross the seam line drawn whole)

@@ -283,6 +283,34 @@ def test_a_slit_winding_more_than_one_turn_is_refused_naming_it(tmp_path):
         load_drawing(save(s, tmp_path), [], DrawingOptions(outer_radius_mm=1.0, length_mm=10.0))
 
 
+@pytest.mark.parametrize("layer", ["0", "CONSTRUCTION"])
+def test_an_outline_of_lines_that_overshoot_the_corners_is_named(tmp_path, layer):
+    """The bad-input search: the outline drawn as four LINEs extended 0.1 mm past each corner (as CAD leaves them) was
+    not closed, and the only notch was named "the tube outline" with a LINE "outside it"."""
+    s = Sheet()
+    e = 0.1
+    for a, b in [((-e, 0.0), (10.0 + e, 0.0)), ((10.0, -e), (10.0, C + e)), ((10.0 + e, C), (-e, C)),
+                 ((0.0, C + e), (0.0, -e))]:
+        s.msp.add_line(s.at(*a), s.at(*b), dxfattribs={"layer": layer})
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    with pytest.raises(PatternError) as err:
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    text = str(err.value)
+    assert "cross one another near their ends instead of meeting" in text and text.count("LINE #") == 4, text
+    assert "TRIM" in text and "would be the tube outline" not in text
+
+
+def test_construction_lines_that_cross_beside_a_drawn_outline_are_no_matter(tmp_path):
+    s = Sheet()
+    draw_outline(s)
+    e = 0.1
+    for a, b in [((2.0 - e, 0.5), (4.0 + e, 0.5)), ((4.0, 0.5 - e), (4.0, 2.5 + e)), ((4.0 + e, 2.5), (2.0 - e, 2.5)),
+                 ((2.0, 2.5 + e), (2.0, 0.5 - e))]:
+        s.msp.add_line(s.at(*a), s.at(*b), dxfattribs={"layer": "CONSTRUCTION"})
+    draw_polygon(s, [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)], "NOTCHES")
+    assert len(load_drawing(save(s, tmp_path), [], DrawingOptions()).pattern.cuts) == 1
+
+
 def test_a_slit_across_the_seam_is_joined(tmp_path):
     s = Sheet()
     draw_outline(s)
