@@ -516,11 +516,8 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
         if bad:
             # (an inf vertex was dropped by ezdxf's path, the notch cut as a triangle; an inf arc angle made the arc
             # vanish as "zero length": both with exit 0)
-            if role == "ignore":
-                ent.status = "aside:ignored layer"
-            else:
-                rd.refuse(ent.describe(), f"{bad} is not a finite number (nan or inf)",
-                          "redraw or delete it (the file may be damaged: export it again)", entities=[ent])
+            _refuse_if_cut(rd, ent, role, f"{bad} is not a finite number (nan or inf)",
+                           "redraw or delete it (the file may be damaged: export it again)")
             return
     if t == "LWPOLYLINE" and role != "ignore" and (entity.dxf.get("const_width", 0.0) or any(
             w0 or w1 for _, _, w0, w1 in entity.get_points("xyse"))) or \
@@ -553,13 +550,18 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
         # a radius of nan was dropped without a word (the drawing then 'has no cuts'), a negative one cut as its size
         r = float(entity.dxf.get("radius", 0.0))
         if not (math.isfinite(r) and r >= 0.0):
-            if role == "ignore":
-                ent.status = "aside:ignored layer"
-            else:
-                rd.refuse(ent.describe(), f"has a radius of {r:g}, not a number >= 0 (the file may be damaged)",
-                          "redraw it with its radius, or export the drawing again", entities=[ent])
+            _refuse_if_cut(rd, ent, role, f"has a radius of {r:g}, not a number >= 0 (the file may be damaged)",
+                           "redraw it with its radius, or export the drawing again")
             return
     _flatten(rd, entity, ent, layer, role)
+
+
+def _refuse_if_cut(rd: _Reading, ent: _Entity, role: str, message: str, fix: str) -> None:
+    """Refuse ``ent`` on a cut layer; on an ignored one it is set aside (nothing of it is cut)."""
+    if role == "ignore":
+        ent.status = "aside:ignored layer"
+    else:
+        rd.refuse(ent.describe(), message, fix, entities=[ent])
 
 
 def _finite(v) -> bool:
@@ -616,8 +618,14 @@ def _spline_fit_polyline(rd: _Reading, entity, ent: _Entity, layer: str, role: s
         return
     if _beyond_any_tube(rd, ent, layer, role, fit):
         return
-    pts = _dedupe([(v[0] * rd.factor, v[1] * rd.factor) for v in fit])
-    closed = bool(entity.is_closed) or (len(pts) > 2 and _isclose(pts[0], pts[-1], TOL.gap))
+    _vertex_piece(rd, ent, layer, role, fit, bool(entity.is_closed))
+
+
+def _vertex_piece(rd: _Reading, ent: _Entity, layer: str, role: str, vertices, flagged_closed: bool) -> None:
+    """The piece through ``vertices`` (drawing units), closed when flagged so or when it ends where it began; a path
+    of one point set aside as of zero length, a closed one of two refused or set aside (:func:`_no_area`)."""
+    pts = _dedupe([(v[0] * rd.factor, v[1] * rd.factor) for v in vertices])
+    closed = flagged_closed or (len(pts) > 2 and _isclose(pts[0], pts[-1], TOL.gap))
     if closed and len(pts) > 1 and _isclose(pts[0], pts[-1], TOL.gap):
         pts = pts[:-1]
     if len(pts) < 2 or (closed and len(pts) < 3):
@@ -638,15 +646,7 @@ def _control_polygon(rd: _Reading, entity, ent: _Entity, layer: str, role: str) 
                   f"{(max(zs) - min(zs)) * rd.factor:.4g} mm)", "flatten the drawing (FLATTEN) to the XY plane",
                   entities=[ent])
         return
-    pts = _dedupe([(v[0] * rd.factor, v[1] * rd.factor) for v in cps])
-    closed = bool(entity.closed) or (len(pts) > 2 and _isclose(pts[0], pts[-1], TOL.gap))
-    if closed and len(pts) > 1 and _isclose(pts[0], pts[-1], TOL.gap):
-        pts = pts[:-1]
-    if len(pts) < 2 or (closed and len(pts) < 3):
-        if not _no_area(rd, ent, layer, role, pts):
-            ent.status = "aside:zero length"
-        return
-    rd.pieces.append(_Piece(pts, closed, [ent], layer, role))
+    _vertex_piece(rd, ent, layer, role, cps, bool(entity.closed))
 
 
 def _not_finite(rd: _Reading, ent: _Entity, coords: Sequence[float]) -> bool:
