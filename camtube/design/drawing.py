@@ -325,8 +325,9 @@ def _declares_units(path) -> bool:
 
 
 def _units(doc, given: str | None, file: str, path=None) -> tuple[float, str]:
+    declared = path is None or _declares_units(path)
     try:
-        code = int(doc.header.get("$INSUNITS", 0) or 0) if path is None or _declares_units(path) else 0
+        code = int(doc.header.get("$INSUNITS", 0) or 0) if declared else 0
     except (ValueError, OverflowError, TypeError):
         raise PatternError([Issue("$INSUNITS", "the drawing's unit code is not a whole number", doc.header.get(
             "$INSUNITS"), "mm, inch, ... ", "pass --units mm (or inch, um, ...), or set the drawing's units",
@@ -343,7 +344,7 @@ def _units(doc, given: str | None, file: str, path=None) -> tuple[float, str]:
         return UNIT_NAMES[name], name
     if code in INSUNITS:
         return INSUNITS[code][1], INSUNITS[code][0]
-    if code == 0 and path is not None and not _declares_units(path):
+    if not declared:
         raise PatternError([Issue("$INSUNITS", "the drawing does not say its unit (no $INSUNITS in the file: DXF R12, or "
                                   "no HEADER section): its size is unknown", None, "mm, inch, ... ",
                                   "pass --units mm (or inch, um, ...), or save the drawing with its units from a CAD "
@@ -438,13 +439,9 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
             unplaced().status = "aside:hidden layer"
             return
         if block is None or block.block.is_xref:
-            ent = unplaced()
-            if rd.role(layer) == "ignore":
-                ent.status = "aside:ignored layer"
-            else:
-                what = "an external reference (XREF)" if block is not None else "a block missing from the drawing"
-                rd.refuse(ent.describe(), f"places {what} {name!r}: its content is not in this file",
-                          "bind the XREF into the drawing (XREF > Bind) and save again", entities=[ent])
+            what = "an external reference (XREF)" if block is not None else "a block missing from the drawing"
+            _refuse_if_cut(rd, unplaced(), rd.role(layer), f"places {what} {name!r}: its content is not in this file",
+                           "bind the XREF into the drawing (XREF > Bind) and save again")
             return
         if name in blocks or len(blocks) >= MAX_BLOCK_DEPTH:
             ent = unplaced()
@@ -463,16 +460,12 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
         bad = [(axis, float(entity.dxf.get(f"{axis}scale", 1.0))) for axis in "xy"]
         bad = [(axis, v) for axis, v in bad if not (math.isfinite(v) and lo <= abs(v) <= hi)]
         if bad:
-            ent = unplaced()
-            if rd.role(layer) == "ignore":
-                ent.status = "aside:ignored layer"
-            else:
-                axis, v = bad[0]
-                why = ("flattens it to a line or a point" if v == 0 else "is not a finite number" if not math.isfinite(v)
-                       else "makes it too small to cut" if abs(v) < lo else "makes it too large for any tube")
-                rd.refuse(ent.describe(), f"scales block {name!r} by {v:g} along {axis.upper()} ({axis}scale), which "
-                          f"{why}", "set the INSERT's X and Y scale to the block's size in the drawing (e.g. 1) in "
-                          "CAD, or delete the INSERT", f"|scale| {lo:g} to {hi:g}", entities=[ent])
+            axis, v = bad[0]
+            why = ("flattens it to a line or a point" if v == 0 else "is not a finite number" if not math.isfinite(v)
+                   else "makes it too small to cut" if abs(v) < lo else "makes it too large for any tube")
+            _refuse_if_cut(rd, unplaced(), rd.role(layer), f"scales block {name!r} by {v:g} along {axis.upper()} "
+                           f"({axis}scale), which {why}", "set the INSERT's X and Y scale to the block's size in the "
+                           "drawing (e.g. 1) in CAD, or delete the INSERT", f"|scale| {lo:g} to {hi:g}")
             return
         copies = list(entity.multi_insert()) if entity.mcount > 1 else [entity]
         for k, ins in enumerate(copies):
@@ -485,11 +478,8 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
             for sub, why in skipped:
                 ent = _Entity(sub.dxftype(), "-", layer if sub.dxf.get("layer", "0") == "0" else sub.dxf.layer, tag)
                 rd.entities.append(ent)
-                if rd.role(ent.layer) == "ignore":
-                    ent.status = "aside:ignored layer"
-                else:
-                    rd.refuse(ent.describe(), f"cannot place this block entity: {why}",
-                              "explode the block in CAD (EXPLODE), or scale it uniformly", entities=[ent])
+                _refuse_if_cut(rd, ent, rd.role(ent.layer), f"cannot place this block entity: {why}",
+                               "explode the block in CAD (EXPLODE), or scale it uniformly")
         for att in getattr(entity, "attribs", []):
             ent = _Entity("ATTRIB", att.dxf.handle or "-", layer, via)
             ent.status = "aside:annotation"
@@ -526,12 +516,8 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
                   "centre line", "set the polyline's width to 0 (draw the cut's outline instead)", entities=[ent])
         return
     if t not in CURVES:
-        if role == "ignore":
-            ent.status = "aside:ignored layer"
-        else:
-            rd.refuse(ent.describe(), f"a {t} cannot be read as a cut", "explode it into lines, arcs or polylines, "
-                      "or move it to a CONSTRUCTION layer", "LINE, ARC, CIRCLE, ELLIPSE, SPLINE, (LW)POLYLINE",
-                      [ent])
+        _refuse_if_cut(rd, ent, role, f"a {t} cannot be read as a cut", "explode it into lines, arcs or polylines, or "
+                       "move it to a CONSTRUCTION layer", "LINE, ARC, CIRCLE, ELLIPSE, SPLINE, (LW)POLYLINE")
         return
     if t == "SPLINE" and role != "ignore" and entity.control_point_count() == 0:
         rd.refuse(ent.describe(), "is a SPLINE given by fit points only: its shape depends on the CAD program that "
@@ -556,12 +542,12 @@ def _walk(rd: _Reading, entity, via: str, insert_layer: str, blocks: tuple[str, 
     _flatten(rd, entity, ent, layer, role)
 
 
-def _refuse_if_cut(rd: _Reading, ent: _Entity, role: str, message: str, fix: str) -> None:
+def _refuse_if_cut(rd: _Reading, ent: _Entity, role: str, message: str, fix: str, allowed: str = "") -> None:
     """Refuse ``ent`` on a cut layer; on an ignored one it is set aside (nothing of it is cut)."""
     if role == "ignore":
         ent.status = "aside:ignored layer"
     else:
-        rd.refuse(ent.describe(), message, fix, entities=[ent])
+        rd.refuse(ent.describe(), message, fix, allowed, entities=[ent])
 
 
 def _finite(v) -> bool:
@@ -609,12 +595,8 @@ def _spline_fit_polyline(rd: _Reading, entity, ent: _Entity, layer: str, role: s
     its frame's control points (vertex flag 16) are left out."""
     fit = [tuple(v.dxf.location) for v in entity.vertices if v.dxf.get("flags", 0) & 8]
     if len(fit) < 2:
-        if role == "ignore":
-            ent.status = "aside:ignored layer"
-        else:
-            rd.refuse(ent.describe(), "is a spline-fit POLYLINE (PEDIT Spline) without its fit points",
-                      "convert it to a plain polyline or a SPLINE in CAD (PEDIT > Decurve, or SPLINE > Object)",
-                      entities=[ent])
+        _refuse_if_cut(rd, ent, role, "is a spline-fit POLYLINE (PEDIT Spline) without its fit points",
+                       "convert it to a plain polyline or a SPLINE in CAD (PEDIT > Decurve, or SPLINE > Object)")
         return
     if _beyond_any_tube(rd, ent, layer, role, fit):
         return
@@ -802,13 +784,10 @@ def _flatten(rd: _Reading, entity, ent: _Entity, layer: str, role: str) -> None:
             p = ezpath.make_path(entity, segments=16, level=8)
     except (TypeError, ValueError, ArithmeticError) as exc:
         # (an ELLIPSE of axis ratio 0: ezdxf divides by its minor axis, ZeroDivisionError)
-        if role == "ignore":
-            ent.status = "aside:ignored layer"
-        else:
-            why = str(exc) or type(exc).__name__
-            if entity.dxftype() == "ELLIPSE" and not float(entity.dxf.get("ratio", 1.0)):
-                why = "an ellipse of axis ratio 0, a line"
-            rd.refuse(ent.describe(), f"cannot be read as a curve ({why})", "redraw it as a polyline", entities=[ent])
+        why = str(exc) or type(exc).__name__
+        if entity.dxftype() == "ELLIPSE" and not float(entity.dxf.get("ratio", 1.0)):
+            why = "an ellipse of axis ratio 0, a line"
+        _refuse_if_cut(rd, ent, role, f"cannot be read as a curve ({why})", "redraw it as a polyline")
         return
     distance = TOL.chord / rd.factor
     found = False
