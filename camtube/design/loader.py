@@ -368,9 +368,9 @@ def build_settings(raw: dict, file: str | None = None) -> tuple[Tube, Process, T
 
 #: Characters a file name on Windows may not hold (besides '/' and '\\', refused as folders).
 WINDOWS_RESERVED = '<>:"|?*'
-#: Device names Windows reserves, with any extension (NUL.ngc is the null device there).
 #: Longest pattern name in bytes: its longest output file, NAME.toolpath.dxf, within a file name's 255 bytes.
 MAX_NAME_BYTES = 200
+#: Device names Windows reserves, with any extension (NUL.ngc is the null device there).
 WINDOWS_DEVICES = frozenset({"CON", "PRN", "AUX", "NUL", *(f"COM{i}" for i in range(1, 10)),
                              *(f"LPT{i}" for i in range(1, 10))})
 

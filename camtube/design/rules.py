@@ -126,9 +126,10 @@ def _row_too_long(pattern: Pattern, origins: list, err) -> None:
         "or shorten notch.spacing / notch.first_offset")
 
 
-def _report_crossing_slits(pairs: list[tuple[int, int]], cuts, origins, err) -> None:
-    """Drawn slits that overlap: one line per pair, and one line for each group of three or more that overlap one
-    another (a T or a star of slits from one point: one mistake, not one line per pair)."""
+def _report_crossing_slits(pairs: list[tuple[int, int]], cuts, origins, err, overlap) -> None:
+    """Drawn slits that overlap: a pair as any two overlapping cuts (``overlap(i, j)``), and one line for each group of
+    three or more that overlap one another (a T or a star of slits from one point: one mistake, not one line per
+    pair)."""
     parent: dict[int, int] = {}
 
     def root(k: int) -> int:
@@ -143,9 +144,7 @@ def _report_crossing_slits(pairs: list[tuple[int, int]], cuts, origins, err) -> 
         groups.setdefault(root(k), []).append(k)
     for members in sorted(groups.values()):
         if len(members) == 2:
-            i, j = next(pair for pair in pairs if set(pair) == set(members))   # (in the sweep's order, as before)
-            err(_pair_key(origins[i], origins[j], cuts[i], cuts[j]), f"{_describe(cuts[j])} overlaps {_describe(cuts[i])}",
-                None, "cuts must not overlap", "move the two cuts apart in the drawing, or delete one")
+            overlap(*next(pair for pair in pairs if set(pair) == set(members)))   # (in the sweep's order)
             continue
         names = [origins[k] for k in members]
         err(", ".join(names[:-1]) + f" and {names[-1]}",
@@ -315,8 +314,18 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
     order = sorted(range(len(pattern.cuts)), key=lambda i: pattern.cuts[i].x_start_mm)
     thinned_by_kerf = not pattern.process.kerf_mm > 0
     cuts = pattern.cuts
-    reported = 0
     crossing: list[tuple[int, int]] = []   # drawn slits that overlap, (i, j) by index
+
+    def overlap(i: int, j: int) -> None:
+        """The line for cut ``j`` overlapping cut ``i`` (``i`` first in the sweep)."""
+        a, b = cuts[i], cuts[j]
+        hole_pair = "hole" in (a.kind, b.kind)
+        drawn = not (_is_key(origins[i]) and _is_key(origins[j]))
+        what = "collides with" if hole_pair else "overlaps"
+        err(_pair_key(origins[i], origins[j], a, b), f"{_describe(b)} {what} {_describe(a)}", None,
+            "cuts must not overlap", "move the two cuts apart in the drawing, or delete one" if drawn else
+            "move the hole along x or around the tube" if hole_pair else "increase notch.spacing or move the cut")
+
     for a_pos, i in enumerate(order):
         a = cuts[i]
         for j in order[a_pos + 1:]:
@@ -333,12 +342,8 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
             elif cuts_overlap(a, b, ro):
                 if drawn and a.kind == b.kind == "slit":
                     crossing.append((i, j))   # reported below: three slits from one point are one mistake
-                    reported += 1
-                    continue
-                what = "collides with" if hole_pair else "overlaps"
-                err(key, f"{_describe(b)} {what} {_describe(a)}", None, "cuts must not overlap",
-                    "move the two cuts apart in the drawing, or delete one" if drawn else
-                    "move the hole along x or around the tube" if hole_pair else "increase notch.spacing or move the cut")
+                else:
+                    overlap(i, j)
             else:
                 d = cut_distance_mm(a, b, ro)
                 widen = ("move the two cuts apart in the drawing" if drawn else
@@ -357,10 +362,9 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
                          round(d, 9),
                          f">= rules.min_web + kerf = {rules.min_web_mm + ASSUMED_KERF_MM:g} mm as drawn",
                          f"set process.kerf to the beam's kerf (kerf compensation), or {widen}")
-            reported += 1
         if len(errors) > 50:
             break
-    _report_crossing_slits(crossing, cuts, origins, err)
+    _report_crossing_slits(crossing, cuts, origins, err, overlap)
 
     if pattern.notches and not errors:
         for d in bends_at_stroke(pattern):
