@@ -147,7 +147,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import check_fittable, check_row_count, find_slack, load_csv, prepare, remove_deadband, select_cycles
     from camtube.model.data.csvfile import check_signs, check_time_varies, check_zeros
-    from camtube.model.diagnose.instruments import check_units
+    from camtube.model.diagnose.instruments import check_units, sampling_rates, slow_sampling_line
     from camtube.errors import DataError
     from camtube.model.report.fit import fit_json, fit_text
 
@@ -216,7 +216,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     check_fix_and_init(held, init)
     params = model.make_params(rows, names, fixed, initial=init,
                                per_sample=split_names(args.per_sample, "--per-sample"))
-    check_init_fitted(init, params.varying, split_names(args.per_sample, "--per-sample"))
+    check_init_fitted(init, params.varying)
     warn = history_warning(model, args.branch, min((len(set(rows.cycle[sl].tolist()))
                                                     for _, sl in rows.sample_slices()), default=0),
                            params.varying)
@@ -231,9 +231,9 @@ def cmd_fit(args: argparse.Namespace) -> int:
     print(fit_text(result, title))
     if warn:
         print(warn)
-    slow = _slow_sampling(raw)
+    slow = slow_sampling_line(sampling_rates(raw)[0])   # (as model diagnose says it: a time column in ms)
     if slow:
-        print(slow)
+        print(f"note: {slow}")
     if args.deadband:
         slack = find_slack(select_cycles(raw, args.cycles), args.deadband_threshold)
         for smp in rows.samples:
@@ -294,27 +294,6 @@ def _check_sample_rows(rows, source: str) -> None:
             raise DataError(f"{source}: sample {smp!r} has {n} row(s) selected, too few to fit (at least "
                             f"{MIN_FIT_ROWS}); fix: give that sample's whole record (--cycles all --branch both), or "
                             "leave its rows out of the file")
-
-
-def _slow_sampling(data) -> str:
-    """A note when a sample's rows come slower than 1 Hz, as ``model diagnose`` says: a time column in ms read as s
-    (its time effects then read their constants 1000x wrong)."""
-    import numpy as np
-
-    from camtube.model.diagnose.instruments import SLOW_RATE_HZ
-
-    slow = []
-    t = np.asarray(data.time_s, float)
-    for smp, sl in data.sample_slices():
-        dt = np.diff(t[sl])
-        dt = dt[dt > 0]
-        if dt.size and 1.0 / float(np.median(dt)) < SLOW_RATE_HZ:
-            slow.append(f"{smp} a row every {float(np.median(dt)):.3g} s")
-    if not slow:
-        return ""
-    return ("note: sampling: " + ", ".join(slow) + f", slower than {SLOW_RATE_HZ:g} Hz; if the time column is in ms, "
-            "give it in s (time_s, divided by 1000): the model's time constants (creep, relaxation, a lag) are read "
-            "in s")
 
 
 def _check_stroke_spikes(raw, source: str) -> None:

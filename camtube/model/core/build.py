@@ -138,7 +138,7 @@ def fitted_and_held(model: JointModel, fit_text: str | None, fix_items: Iterable
     return names, held
 
 
-def check_init_fitted(init: Mapping[str, float], varying: Sequence[str], per_sample: Sequence[str]) -> None:
+def check_init_fitted(init: Mapping[str, float], varying: Sequence[str]) -> None:
     """Refuse an ``--init`` for a parameter that is not fitted: the start of a held parameter became its held value
     (``--init L0=50`` held L0 at 50 and moved E_t by 29 %), and a sample's copy of a parameter not fitted per sample was
     ignored."""

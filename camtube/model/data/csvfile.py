@@ -334,9 +334,9 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
             raise _err(source, int(ln[k]),
                        f"column {name!r} goes backwards within sample {sample[k]!r}: {arr[k]:g} after "
                        f"{arr[k - 1]:g} (line {int(ln[k - 1])})", fix)
-    _check_time_resolution(num["time_s"], sample, ln, source)
     data = Dataset(sample, cyc_f.astype(np.int64), num["time_s"], num["stroke_mm"], num["force_N"],
                    num["angle_deg"], extra)
+    _check_time_resolution(data, ln, source)
     if among:
         missing_lines = np.sort(np.concatenate((missing_lines, np.asarray(among, dtype=np.int64))))
     return Measurements(data, missing_lines, backward_lines, source)
@@ -347,19 +347,22 @@ def _parse(text: str, source: str, strict: bool) -> Measurements:
 MAX_REPEATED_TIME_SHARE = 0.05
 
 
-def _check_time_resolution(t: np.ndarray, sample: np.ndarray, ln: np.ndarray, source: str) -> None:
-    """Refuse a sample whose time stamps repeat on more than :data:`MAX_REPEATED_TIME_SHARE` of its rows."""
-    starts = np.flatnonzero(np.concatenate(([True], sample[1:] != sample[:-1])))
-    ends = np.concatenate((starts[1:], [t.size]))
-    for a, b in zip(starts, ends):
+def _check_time_resolution(data: Dataset, ln: np.ndarray, source: str) -> None:
+    """Refuse a sample whose time stamps repeat on more than :data:`MAX_REPEATED_TIME_SHARE` of its rows (``ln``: the
+    file line of each row)."""
+    t = data.time_s
+    for smp, sl in data.sample_slices():
+        a, b = sl.start, sl.stop
+        if b - a < 20:
+            continue
         rep = np.flatnonzero(t[a + 1:b] == t[a:b - 1]) + a + 1
-        if b - a >= 20 and rep.size == b - a - 1:
+        if rep.size == b - a - 1:
             raise _err(source, int(ln[a]), f"column 'time_s' never changes: {t[a]:g} s on every row of sample "
-                       f"{sample[a]!r}, not a time", "check the time_s column: the time since the record began, in s")
-        if b - a >= 20 and rep.size > MAX_REPEATED_TIME_SHARE * (b - a):
+                       f"{smp!r}, not a time", "check the time_s column: the time since the record began, in s")
+        if rep.size > MAX_REPEATED_TIME_SHARE * (b - a):
             k = int(rep[0])
             raise _err(source, int(ln[k]), f"column 'time_s' repeats the time before it on {rep.size} of {b - a} rows "
-                       f"of sample {sample[k]!r} (here {t[k]:g} s again): a time rounded coarser than the sampling "
+                       f"of sample {smp!r} (here {t[k]:g} s again): a time rounded coarser than the sampling "
                        "(whole seconds?)", "write the time with the resolution of the instruments' clock (ms: "
                        "0.020, 0.040, ...)")
 

@@ -621,11 +621,9 @@ class Instruments:
                        "model of the rows' stamps fits them, so they are set aside; a stroke logged at a finer "
                        "resolution, or at the load cell's instant, measures them")
         out.append("sampling: " + ", ".join(f"{s} {r:.4g} Hz" for s, r in self.rates_hz.items()))
-        slow = {smp: r for smp, r in self.rates_hz.items() if 0.0 < r < SLOW_RATE_HZ}
+        slow = slow_sampling_line(self.rates_hz)
         if slow:
-            out.append("sampling: " + ", ".join(f"{smp} a row every {1.0 / r:.3g} s" for smp, r in slow.items())
-                       + f", slower than {SLOW_RATE_HZ:g} Hz; if the time column is in ms, give it in s (time_s, "
-                         "divided by 1000): the model's time constants (creep, relaxation, a lag) are read in s")
+            out.append(slow)
         out.extend(self.rate_changes)
         out.extend(zero_lines(self.zeros, self.rezero))
         lg = self.lag
@@ -1236,7 +1234,19 @@ def _force_ahead(force: np.ndarray, stroke: np.ndarray, t: np.ndarray, slices: l
     return out & ~known
 
 
-def _rates(data: Dataset) -> tuple[dict, tuple]:
+def slow_sampling_line(rates_hz: Mapping[str, float]) -> str:
+    """``"sampling: S1 a row every 25 s, slower than 1 Hz; ..."`` for the samples of ``rates_hz`` (Hz) slower than
+    :data:`SLOW_RATE_HZ` (a time column in ms read as s), or ""."""
+    slow = {smp: r for smp, r in rates_hz.items() if 0.0 < r < SLOW_RATE_HZ}
+    if not slow:
+        return ""
+    return ("sampling: " + ", ".join(f"{smp} a row every {1.0 / r:.3g} s" for smp, r in slow.items())
+            + f", slower than {SLOW_RATE_HZ:g} Hz; if the time column is in ms, give it in s (time_s, divided by 1000): "
+              "the model's time constants (creep, relaxation, a lag) are read in s")
+
+
+def sampling_rates(data: Dataset) -> tuple[dict, tuple]:
+    """Each sample's rate (Hz, from its median time step), and notes on a rate that changes along a sample."""
     rates, notes = {}, []
     for s, sl in data.sample_slices():
         dt = np.diff(data.time_s[sl])
@@ -1677,7 +1687,7 @@ def check_instruments(data: Dataset, lag_ms: float | Mapping[str, float] | None 
     # aside the top of each stroke, and the speed read across that gap (the end of the pull, the dwell and the start
     # of the release in one step) took the guide's friction out of 9,000 rows (bench-heldout19)
     clean = _with_speed(data.take(kept), data, kept, rep)
-    rates, notes = _rates(clean)
+    rates, notes = sampling_rates(clean)
     zeros = read_zero(clean)
     if rezero:
         clean, zeros = rezero_force(clean, zeros)
@@ -2028,25 +2038,26 @@ def unit_mistake(model, data: Dataset, fixed: Mapping[str, float], fit_names: Se
         small = expected > 0 and float(np.ptp(rows.angle_deg)) < UNIT_ANGLE_SPAN * expected
         if lo <= r0.params["E_t"] <= hi and not small:
             return None
-        # the misfit against the angle's own spread (a tracker's unit scales both)
-        miss0 = r0.rmse / (float(np.std(rows.angle_deg)) or 1.0)
+        def spread_miss(r, d: Dataset) -> float:
+            """The misfit against the angle's own spread (a tracker's unit scales both)."""
+            return r.rmse / (float(np.std(d.angle_deg)) or 1.0)
+
+        miss0 = spread_miss(r0, rows)
         # two columns whose names were swapped (stroke and angle: a stroke of 30 mm, an angle of 2.5 "deg" read as
         # radians, and the conversion the line gave fitted E_t 1.9 GPa at 16 deg RMS, exit 0)
         swaps = []
         for a, b in (("stroke_mm", "angle_deg"), ("stroke_mm", "force_N"), ("force_N", "angle_deg")):
             d = replace(rows, **{a: np.asarray(getattr(rows, b), float), b: np.asarray(getattr(rows, a), float)})
             r = paper(d)
-            if r is not None and lo <= r.params["E_t"] <= hi and r.rmse < r0.rmse:
-                ratio = r.rmse / (float(np.std(d.angle_deg)) or 1.0)
-                if ratio <= UNIT_FALL * miss0:
-                    swaps.append((ratio, r, a, b))
+            if r is not None and lo <= r.params["E_t"] <= hi and r.rmse < r0.rmse and \
+                    spread_miss(r, d) <= UNIT_FALL * miss0:
+                swaps.append((spread_miss(r, d), r, a, b))
         tried = []
         for col, factor, unit, conversion in UNIT_MISTAKES:
             d = replace(rows, **{col: np.asarray(getattr(rows, col), float) * factor})
             r = paper(d)
-            if r is not None and lo <= r.params["E_t"] <= hi and (
-                    r.rmse / (float(np.std(d.angle_deg)) or 1.0) <= UNIT_FALL * miss0):
-                tried.append((r, col, unit, conversion, r.rmse / (float(np.std(d.angle_deg)) or 1.0)))
+            if r is not None and lo <= r.params["E_t"] <= hi and spread_miss(r, d) <= UNIT_FALL * miss0:
+                tried.append((r, col, unit, conversion, spread_miss(r, d)))
     # a swap is named when it fits better than every unit, each against its own angle's spread (an angle in radians
     # against a stroke in mm is nearly linear either way round: the unit fits it far better)
     best_unit = min((ratio for *_, ratio in tried), default=math.inf)

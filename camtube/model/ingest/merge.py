@@ -110,8 +110,8 @@ def _check_rest_still(bend, source: str, rest_s: float) -> None:
     if not ok.any():
         return
     t, a = t[ok] - t[ok][0], a[ok]
-    top = float(np.max(np.abs(a - np.median(a[t <= rest_s]))))
     window = a[t <= rest_s]
+    top = float(np.max(np.abs(a - np.median(window))))
     # (robust to a spike or two of interference: the window's 2nd to 98th percentile)
     spread = float(np.subtract(*np.percentile(window, [98, 2]))) if window.size else 0.0
     if top > 0 and spread > REST_MOTION_SHARE * top:
@@ -165,7 +165,7 @@ def _angle_from_poses(tracker: TrackerLog, bench: BenchMap):
         for role, tool in (("tip", tip), ("base", base)):
             if tool is None:
                 continue
-            ok = np.array([str(st).strip().lower() == "ok" for st in tool.state], dtype=bool)
+            ok = tool.state_ok
             if ok.any() and not tool.valid.any():
                 # (every frame state OK, but no quaternion of length 1: "check the tool names", which were right)
                 k = int(np.flatnonzero(ok)[0])

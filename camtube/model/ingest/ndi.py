@@ -92,9 +92,14 @@ class ToolTrack:
     error_mm: np.ndarray
 
     @property
+    def state_ok(self) -> np.ndarray:
+        """(n,) bool: the tracker's state is ``OK``."""
+        return np.array([str(s).strip().lower() == "ok" for s in self.state], dtype=bool)
+
+    @property
     def valid(self) -> np.ndarray:
         """(n,) bool: state ``OK`` and a finite quaternion of length 1 (+- 1 %)."""
-        ok = np.array([str(s).strip().lower() == "ok" for s in self.state], dtype=bool)
+        ok = self.state_ok
         q = self.quat_wxyz
         with np.errstate(invalid="ignore"):
             norm = np.sqrt(np.sum(q * q, axis=1))
