@@ -115,6 +115,7 @@ def cad_outputs(pattern: Pattern, job, *, step: bool = True, pictures: bool = Tr
     # (a Ctrl-C while they import is raised here, once they are whole: see import_whole)
     import_whole("trimesh", *(("build123d",) if step else ()))
     from camtube.cad.mesh import stl_bytes
+    from camtube.cad.solid import volume_mm3
     from camtube.cad.verify import report_json, report_text, verify
 
     name = pattern.name
@@ -127,7 +128,7 @@ def cad_outputs(pattern: Pattern, job, *, step: bool = True, pictures: bool = Tr
     files[f"{name}.design.stl"] = stl_bytes(m.design_mesh)
     files[f"{name}.ascut.stl"] = stl_bytes(m.ascut_mesh)
     report = verify(pattern, design_mesh=m.design_mesh, ascut=m.ascut, ascut_mesh=m.ascut_mesh,
-                    solid_volume_mm3=float(m.solid.volume) if m.solid is not None else None,
+                    solid_volume_mm3=volume_mm3(m.solid) if m.solid is not None else None,
                     step_volume_mm3=step_volume, segments=m.segments)
     files[f"{name}.verify.txt"] = report_text(report).encode("utf-8")
     files[f"{name}.verify.json"] = report_json(report).encode("utf-8")

@@ -48,12 +48,12 @@ def test_design_mesh_removes_the_drawn_area(name):
 @pytest.mark.parametrize("name", ["circle_hole", "seam_split", "slits", "blocks"])
 def test_exact_solid_of_drawn_cuts(name):
     pytest.importorskip("build123d")
-    from camtube.cad.solid import design_solid
+    from camtube.cad.solid import design_solid, volume_mm3
 
     pattern, cuts = load(name)
     solid = design_solid(pattern)
     assert solid.is_valid
-    assert float(solid.volume) == pytest.approx(truth_volume(pattern, cuts), rel=1e-5)
+    assert volume_mm3(solid) == pytest.approx(truth_volume(pattern, cuts), rel=1e-5)
 
 
 def test_drawn_tool_walls_are_radial():
@@ -88,3 +88,95 @@ def test_verification_of_a_drawing_passes_and_says_what_it_skipped(tmp_path):
     assert report.passed, report_text(report)
     assert "are not rectangles" in report_text(report)
     assert not any(c.name.endswith(".phi") for c in report.checks)
+
+
+@pytest.mark.parametrize("name", ["bulges", "spline"])
+def test_exact_solid_of_drawn_curves(name):
+    """Fillets (polyline bulges) and a spline: walled by curves through their chords, the volume still the drawing's."""
+    pytest.importorskip("build123d")
+    from camtube.cad.solid import design_solid, volume_mm3
+
+    pattern, cuts = load(name)
+    solid = design_solid(pattern)
+    assert solid.is_valid
+    assert volume_mm3(solid) == pytest.approx(truth_volume(pattern, cuts), rel=1e-5)
+
+
+def _tool_faces(tool) -> int:
+    return len(tool.faces())
+
+
+def test_a_drawn_circle_is_walled_by_curves_not_a_face_per_chord():
+    """The CIRCLE hole (flattened to hundreds of chords) is a prism of four faces: two caps, two half walls; its
+    volume is nearer the circle's area mapped radially than the chords' polygon is."""
+    pytest.importorskip("build123d")
+    from camtube.cad.mesh import design_regions
+    from camtube.cad.solid import drawn_tool, smooth_runs, volume_mm3
+
+    pattern, cuts = load("circle_hole")
+    hole = design_regions(pattern)[[c.kind for c in pattern.cuts].index("hole")]
+    pts = hole.points
+    assert len(pts) > 100   # the reader's chords
+    assert [len(r) for r in smooth_runs(pts)] == [len(pts) // 2 + 1, len(pts) - len(pts) // 2 + 1]
+    r0, r1 = 0.6, 1.1
+    want = cuts[2]["area_mm2"] / RO * (r1**2 - r0**2) / 2
+    smooth, faceted = drawn_tool(pts, RO, r0, r1), drawn_tool(pts, RO, r0, r1, smooth=False)
+    assert _tool_faces(smooth) == 4 and _tool_faces(faceted) == len(pts) + 2
+    assert smooth.is_valid
+    assert abs(volume_mm3(smooth) / want - 1) < 0.25 * abs(volume_mm3(faceted) / want - 1)   # 1.5e-5, 1e-4
+
+
+def test_a_drawn_polygon_keeps_its_corners():
+    """A 24-gon drawn as such (15 deg turns, edges alike) is not rounded: a curve through its vertices would leave
+    its edges by far more than the pass tolerance, so each edge keeps its face and the volume is the polygon's."""
+    pytest.importorskip("build123d")
+    from shapely.geometry import Polygon
+
+    from camtube.cad.solid import drawn_tool
+
+    pts = [(3.0 + 0.3 * math.cos(2 * math.pi * k / 24), 2.0 + 0.3 * math.sin(2 * math.pi * k / 24)) for k in range(24)]
+    r0, r1 = 0.6, 1.1
+    tool = drawn_tool(pts, RO, r0, r1)
+    assert _tool_faces(tool) == 24 + 2
+    assert float(tool.volume) == pytest.approx(Polygon(pts).area / RO * (r1**2 - r0**2) / 2, rel=1e-7)
+
+
+def test_a_rounded_rectangle_keeps_its_sides_as_lines():
+    """Four sides and four fillets of chords: the sides stay one face each, each fillet one curved face."""
+    from camtube.cad.solid import smooth_runs
+
+    x0, y0, x1, y1, r = 2.0, 1.0, 2.5, 3.0, 0.1
+    pts = []
+    for cx, cy, a0 in ((x1 - r, y0 + r, -90), (x1 - r, y1 - r, 0), (x0 + r, y1 - r, 90), (x0 + r, y0 + r, 180)):
+        pts += [(cx + r * math.cos(math.radians(a0 + 90 * k / 40)), cy + r * math.sin(math.radians(a0 + 90 * k / 40)))
+                for k in range(41)]
+    runs = smooth_runs(pts)
+    assert sorted(len(r) for r in runs) == [2] * 4 + [41] * 4
+
+
+def test_many_drawn_holes_cut_in_one_boolean(tmp_path):
+    """Sixty round holes: each adds four faces to the solid (a face per chord took minutes and gigabytes for a
+    hundred, scripts/bench_cad.py), and the volume is the drawing's."""
+    pytest.importorskip("build123d")
+    import ezdxf
+
+    from camtube.cad.solid import design_solid, volume_mm3
+
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    circ, length, radius = 2 * math.pi * RO, 8.0, 0.1
+    msp.add_lwpolyline([(0, 0), (length, 0), (length, circ), (0, circ)], close=True, dxfattribs={"layer": "OUTLINE"})
+    for i in range(12):
+        for j in range(5):
+            msp.add_circle((0.6 + 0.6 * i, 0.5 + j * circ / 5), radius, dxfattribs={"layer": "HOLES"})
+    path = tmp_path / "holes.dxf"
+    doc.saveas(path)
+    pattern = load_drawing(path, [f"tube.inner_radius={RI}"], DrawingOptions()).pattern
+    assert len(pattern.cuts) == 60
+    solid = design_solid(pattern)
+    assert solid.is_valid
+    assert len(solid.faces()) <= 4 + 4 * 60
+    ring = RO**2 - RI**2
+    want = math.pi * ring * length - 60 * math.pi * radius**2 / RO * ring / 2
+    assert volume_mm3(solid) == pytest.approx(want, rel=1e-6)
