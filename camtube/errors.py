@@ -29,6 +29,9 @@ class Issue:
         Source file, if known.
     line : int | None
         1-based line in the source file, if known.
+    kind : str
+        What kind of problem, for a program that acts on it (not printed): ``"holes_collide"`` (two holes
+        overlap or leave too thin a web); empty for the rest.
     """
 
     key: str
@@ -38,6 +41,7 @@ class Issue:
     fix: str = ""
     file: str | None = None
     line: int | None = None
+    kind: str = ""
 
     def __str__(self) -> str:
         where = self.file or ""

@@ -55,7 +55,7 @@ def cmd_synthesize(args: argparse.Namespace) -> int:
         first = exc.issues[0]
         more = f" (and {len(exc.issues) - 1} more)" if len(exc.issues) > 1 else ""
         fix = f"relax the goal's lengths or limits behind {first.key}"
-        if first.key.startswith("holes[") and "collides with hole" in first.message:
+        if first.kind == "holes_collide":
             # (each direction's tendon is anchored in a hole at the same x: directions 10 deg apart collide there;
             # no length or limit fixes that)
             fix = ("set the bending directions (goal.bends[].angle_deg) further apart: each direction's tendon is "

@@ -221,8 +221,8 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
     errors: list[Issue] = []
     warnings: list[Issue] = []
 
-    def err(key, msg, value=None, allowed="", fix=""):
-        errors.append(Issue(key, msg, value, allowed, fix, file, lines.get(key)))
+    def err(key, msg, value=None, allowed="", fix="", kind=""):
+        errors.append(Issue(key, msg, value, allowed, fix, file, lines.get(key), kind))
 
     def warn(key, msg, value=None, allowed="", fix=""):
         warnings.append(Issue(key, msg, value, allowed, fix, file, lines.get(key)))
@@ -324,7 +324,8 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
         what = "collides with" if hole_pair else "overlaps"
         err(_pair_key(origins[i], origins[j], a, b), f"{_describe(b)} {what} {_describe(a)}", None,
             "cuts must not overlap", "move the two cuts apart in the drawing, or delete one" if drawn else
-            "move the hole along x or around the tube" if hole_pair else "increase notch.spacing or move the cut")
+            "move the hole along x or around the tube" if hole_pair else "increase notch.spacing or move the cut",
+            kind="holes_collide" if a.kind == b.kind == "hole" else "")
 
     for a_pos, i in enumerate(order):
         a = cuts[i]
@@ -351,7 +352,8 @@ def check(pattern: Pattern, origins: Sequence[str] | None = None, file: str | No
                 if d < rules.min_web_mm - TOL.rule:  # (the CAD verification's min_web: the same slack)
                     what = "is too close to" if not hole_pair else "collides with (web too thin)"
                     err(key, f"{_describe(b)} {what} {_describe(a)}: web {d:.4g} mm", round(d, 9),
-                        f">= rules.min_web = {rules.min_web_mm:g} mm", widen)
+                        f">= rules.min_web = {rules.min_web_mm:g} mm", widen,
+                        kind="holes_collide" if a.kind == b.kind == "hole" else "")
                 elif thinned_by_kerf and d < rules.min_web_mm + ASSUMED_KERF_MM - TOL.rule:
                     # without kerf compensation each side of the web is cut half a kerf wider than drawn: as cut it is
                     # thinner than the limit, and the CAD verification (which cuts it so) fails it
