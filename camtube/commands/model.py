@@ -146,7 +146,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from camtube.model.core.fit import FitError, fit
     from camtube.model.core.predict import model_for_pattern, pattern_values
     from camtube.model.data import check_fittable, check_row_count, find_slack, load_csv, prepare, remove_deadband, select_cycles
-    from camtube.model.data.csvfile import check_signs, check_time_varies, check_zeros
+    from camtube.model.data.csvfile import check_sample_rows, check_signs, check_time_varies, check_zeros
     from camtube.model.diagnose.instruments import check_units, sampling_rates, slow_sampling_line
     from camtube.errors import DataError
     from camtube.model.report.fit import fit_json, fit_text
@@ -203,7 +203,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     # (the rows' count is checked once the parameters are known: as many rows as parameters or fewer is the fit's
     # own refusal, which names both)
     check_fittable(rows, chosen, min_rows=0)
-    _check_sample_rows(rows, args.data)
+    check_sample_rows(rows, args.data)
     check_signs(rows, args.data)
     check_zeros(raw, args.data,   # (every row: the slack deadband's removal shifts the stroke by its own zero)
                 "" if args.rezero else " (or re-zero the force at the rests of the whole record: --set-aside "
@@ -278,22 +278,6 @@ def cmd_synth(args: argparse.Namespace) -> int:
     print(f"wrote {path}: {len(data)} rows, {args.samples} sample(s) x {args.cycles} cycles, "
           f"stroke 0-{pattern.rules.max_stroke_mm:g} mm; a perfect fit leaves RMSE ~{floor:.3f} deg")
     return 0
-
-
-def _check_sample_rows(rows, source: str) -> None:
-    """Refuse a sample with fewer than ``MIN_FIT_ROWS`` rows selected: it was fitted with an RMSE of its own, pulling
-    on E_t, and its slack printed as a measured 0.000 mm (a sample cut short to 3 rows, or one whose rows were set
-    aside)."""
-    from camtube.errors import DataError
-    from camtube.model.data.csvfile import MIN_FIT_ROWS
-
-    slices = rows.sample_slices()
-    for smp, sl in slices if len(slices) > 1 else ():   # (one sample: the whole file's row checks name it)
-        n = sl.stop - sl.start
-        if n < MIN_FIT_ROWS:
-            raise DataError(f"{source}: sample {smp!r} has {n} row(s) selected, too few to fit (at least "
-                            f"{MIN_FIT_ROWS}); fix: give that sample's whole record (--cycles all --branch both), or "
-                            "leave its rows out of the file")
 
 
 def _check_stroke_spikes(raw, source: str) -> None:

@@ -440,6 +440,25 @@ def check_fittable(data: Dataset, what: str = "the selected rows", min_rows: int
                             "is actuated (check the file and the --cycles selection)")
 
 
+def check_sample_rows(data: Dataset, source: str) -> None:
+    """Refuse a sample (of two or more) with fewer than :data:`MIN_FIT_ROWS` rows selected: it was fitted with an RMSE
+    of its own, pulling on E_t, and its slack printed as a measured 0.000 mm (a sample cut short to 3 rows, or one
+    whose rows were set aside). One sample: :func:`check_fittable`'s row count names it.
+
+    Raises
+    ------
+    DataError
+        Naming ``source``, the sample, its rows and the fix.
+    """
+    slices = data.sample_slices()
+    for smp, sl in slices if len(slices) > 1 else ():
+        n = sl.stop - sl.start
+        if n < MIN_FIT_ROWS:
+            raise DataError(f"{source}: sample {smp!r} has {n} row(s) selected, too few to fit (at least "
+                            f"{MIN_FIT_ROWS}); fix: give that sample's whole record (--cycles all --branch both), or "
+                            "leave its rows out of the file")
+
+
 #: A column whose correlation with the tendon's tension is below this (in a sample) runs the opposite way to the
 #: model's convention (on the bench records every sample's stroke and angle correlate with the force by 0.74 or more).
 SIGN_CORRELATION = -0.3
