@@ -884,7 +884,7 @@ def _refuse_open_copies(rd: _Reading) -> None:
     left out of the chaining (a LINE pasted twice in a notch of four LINEs read as three open paths, "close the
     outline"; a slit pasted twice as "a closed outline on a slit layer")."""
     seen: dict[tuple, _Piece] = {}
-    copies = []
+    copies: dict[str, list[tuple[_Piece, _Piece]]] = {}   # layer -> (copy, first)
     for p in rd.pieces:
         if p.closed or p.role == "ignore":
             continue
@@ -892,11 +892,22 @@ def _refuse_open_copies(rd: _Reading) -> None:
         first = seen.get((p.layer, key)) or seen.get((p.layer, key[::-1]))
         if first is None:
             seen[(p.layer, key)] = p
+        else:
+            copies.setdefault(p.layer, []).append((p, first))
+    for layer, pairs in copies.items():
+        p, first = pairs[0]
+        if len(pairs) == 1:
+            rd.refuse(f"{p.describe()} and {first.describe()}", "the same path drawn twice (pasted twice?)",
+                      "delete one of the two", entities=p.entities)
             continue
-        copies.append(p)
-        rd.refuse(f"{p.describe()} and {first.describe()}", "the same path drawn twice (pasted twice?)",
-                  "delete one of the two", entities=p.entities)
-    rd.pieces = [p for p in rd.pieces if not any(p is c for c in copies)]
+        # an outline of LINEs pasted twice: one line for the copy, not one a LINE
+        handles = [f"#{e.handle}" for c, _ in pairs for e in c.entities]
+        shown = ", ".join(handles[:8]) + (", ..." if len(handles) > 8 else "")
+        rd.refuse(f"{p.describe()} and {first.describe()}, and {len(pairs) - 1} more on layer {layer}",
+                  f"{len(pairs)} paths drawn twice (pasted twice?)", f"delete the copies ({shown})",
+                  entities=[e for c, _ in pairs for e in c.entities])
+    gone = {id(c) for pairs in copies.values() for c, _ in pairs}
+    rd.pieces = [p for p in rd.pieces if id(p) not in gone]
 
 
 def _close_and_chain(rd: _Reading) -> None:

@@ -513,6 +513,22 @@ def test_a_line_pasted_twice_is_named_as_a_copy(tmp_path, layer):
     assert len(lines) == 1 and "the same path drawn twice" in lines[0] and lines[0].count("LINE #") == 2, lines
 
 
+def test_a_notch_of_lines_pasted_twice_is_one_line(tmp_path):
+    """A notch of four LINEs pasted twice whole printed one line per LINE (four); it is one line naming the copies."""
+    s = Sheet()
+    draw_outline(s)
+    pts = [(3.0, 1.0), (3.5, 1.0), (3.5, 2.0), (3.0, 2.0)]
+    handles = []
+    for copy in range(2):
+        for a, b in zip(pts, pts[1:] + pts[:1]):
+            handles.append(s.msp.add_line(s.at(*a), s.at(*b), dxfattribs={"layer": "NOTCHES"}).dxf.handle)
+    with pytest.raises(PatternError) as err:
+        load_drawing(save(s, tmp_path), [], DrawingOptions())
+    lines = str(err.value).splitlines()
+    assert len(lines) == 1, lines
+    assert "4 paths drawn twice" in lines[0] and all(f"#{h}" in lines[0] for h in handles[4:]), lines
+
+
 def test_a_bad_tag_is_named_on_one_line(tmp_path):
     s = Sheet()
     draw_outline(s)
