@@ -45,8 +45,9 @@ def test_design_mesh_removes_the_drawn_area(name):
     assert float(mesh.volume) == pytest.approx(want, rel=2e-4)  # polygonal tube (256 sides): ~1e-4
 
 
-@pytest.mark.parametrize("name", ["circle_hole", "seam_split", "slits", "blocks"])
+@pytest.mark.parametrize("name", ["circle_hole", "seam_split", "slits", "blocks", "bulges", "spline"])
 def test_exact_solid_of_drawn_cuts(name):
+    """The B-rep removes the drawing's area; fillets (bulges) and a spline walled by curves through their chords."""
     pytest.importorskip("build123d")
     from camtube.cad.solid import design_solid, volume_mm3
 
@@ -88,18 +89,6 @@ def test_verification_of_a_drawing_passes_and_says_what_it_skipped(tmp_path):
     assert report.passed, report_text(report)
     assert "are not rectangles" in report_text(report)
     assert not any(c.name.endswith(".phi") for c in report.checks)
-
-
-@pytest.mark.parametrize("name", ["bulges", "spline"])
-def test_exact_solid_of_drawn_curves(name):
-    """Fillets (polyline bulges) and a spline: walled by curves through their chords, the volume still the drawing's."""
-    pytest.importorskip("build123d")
-    from camtube.cad.solid import design_solid, volume_mm3
-
-    pattern, cuts = load(name)
-    solid = design_solid(pattern)
-    assert solid.is_valid
-    assert volume_mm3(solid) == pytest.approx(truth_volume(pattern, cuts), rel=1e-5)
 
 
 def _tool_faces(tool) -> int:
