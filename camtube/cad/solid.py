@@ -132,7 +132,6 @@ def drawn_tool(points, outer_radius_mm: float, r0: float, r1: float, smooth: boo
     from OCP.BRepLib import BRepLib
     from OCP.Geom import Geom_CylindricalSurface
     from OCP.Geom2d import Geom2d_Line
-    from OCP.GeomAbs import GeomAbs_C1
     from OCP.gp import gp_Ax3, gp_Dir, gp_Dir2d, gp_Pnt, gp_Pnt2d
     from OCP.ShapeFix import ShapeFix_Solid
     from OCP.TopAbs import TopAbs_SHELL
@@ -169,7 +168,7 @@ def drawn_tool(points, outer_radius_mm: float, r0: float, r1: float, smooth: boo
         ring = []
         for curve, first, last in pieces:
             edge = BRepBuilderAPI_MakeEdge(curve, surface, first, last).Edge()
-            BRepLib.BuildCurves3d_s(edge, 1e-8, GeomAbs_C1, 14, 500)
+            BRepLib.BuildCurves3d_s(edge)
             ring.append(edge)
         wire = BRepBuilderAPI_MakeWire()
         for edge in ring:
