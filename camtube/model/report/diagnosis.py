@@ -206,6 +206,7 @@ def diagnosis_dict(d: Diagnosis, command: str = "", meta: dict | None = None) ->
     out["per_sample"] = list(d.per_sample)
     out["held"] = {k: _num(v) for k, v in d.held.items()}
     out["sample_notes"] = list(d.sample_notes)
+    out["stiffness_note"] = d.stiffness_note or None
     out["alone"] = {smp: {"recommended": list(a["recommended"]), "explanation": a["explanation"] or None,
                           "partial": list(a["partial"]), "rmse_before_deg": _num(a["before_deg"]),
                           "rmse_after_deg": _num(a["after_deg"]), "noise_floor_deg": _num(a["floor_deg"])}
@@ -434,6 +435,8 @@ def answer_lines(d: Diagnosis) -> list[str]:
     else:
         out.append(f"answer: nothing to add: the model is at {_times(steps[0].rmse_deg, floor)} the noise floor "
                    f"({steps[0].rmse_deg:.3f} vs {floor:.3f} deg)")
+    if d.stiffness_note:
+        out.append(f"  {d.stiffness_note}")
     out += alone_lines(d)
     near = nearest_on_bound(d)
     if near is not None:
