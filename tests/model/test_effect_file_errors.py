@@ -111,6 +111,9 @@ def test_a_broken_check_names_the_effect_and_its_file():
     ('    raise SystemExit(5)', ["called sys.exit()", "fix: correct the effect's function"]),
     ('    raise ValueError("bad")', ["ValueError: bad", "fix: correct the effect's function"]),
     ('    return x * np.nan', ["non-finite angle", "fix: an effect returned NaN or inf", "broken ("]),
+    # (the bad-input search: ``s -= k`` changed the array the model keeps for the effects after it: exit 0, 72 deg)
+    ('    x *= p["gain"]\n    return x', ["eff.py:7), stage stroke: changes the stroke array it is given in place",
+                                        "fix: return a new array at that line"]),
 ])
 def test_a_wrong_return_or_exit_in_apply_is_one_line_with_a_fix(tmp_path, capsys, data_csv, body, words):
     f = tmp_path / "eff.py"

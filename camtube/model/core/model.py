@@ -328,6 +328,11 @@ def _call(effect: Effect, stage: str, ctx: Context, signal: np.ndarray, p: dict)
             return f"effect {effect.name!r}"
         return f"effect {effect.name!r} ({effect.source}{_user_line(effect, stage, exc)})"
 
+    if effect.source:
+        # a user's effect gets its input read-only: one that changed it in place (``s -= k``) changed the array the
+        # model holds for every later effect and evaluation (a slack refit went from 0.30 to 20 deg, exit 0)
+        signal = signal.view()
+        signal.flags.writeable = False
     try:
         out = effect.function(stage)(ctx, signal, p)
     except KeyError as exc:
@@ -339,6 +344,10 @@ def _call(effect: Effect, stage: str, ctx: Context, signal: np.ndarray, p: dict)
     except BaseException as exc:  # noqa: BLE001 - a user's effect may raise anything: report it with its line
         if not effect.source:
             raise
+        if isinstance(exc, ValueError) and "read-only" in str(exc):
+            raise FitError(f"{where(exc)}, stage {stage}: changes the {stage} array it is given in place (the model "
+                           "keeps that array for the effects after it); fix: return a new array at that line "
+                           "(s = s - k, not s -= k)") from None
         what = user_raised(exc)
         raise FitError(f"{where(exc)}, stage {stage}: {what}; fix: correct the effect's function at that "
                        "line") from None
