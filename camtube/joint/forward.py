@@ -260,6 +260,13 @@ class Mechanics:
                 raise CamtubeError(f"{p}: parameter {name} = {v:g}{' ' + unit if unit else ''}: beyond any joint's "
                                    f"(at most {top:g}{' ' + unit if unit else ''}); fix: pass the JSON of a fit whose "
                                    "parameters are physical (hold a parameter with --fix NAME=VALUE)")
+            bounds = _effect_bounds(name)
+            if name in used and bounds is not None and not bounds[0] <= v <= bounds[1]:
+                # (friction.mu = 1.5 was designed with, a bend of 0 deg at 3 N; a kerf of 20 mm, a value in um, was
+                # blamed on the goal's limits): no fit gives a value outside its effect's range
+                raise CamtubeError(f"{p}: parameter {name} = {v:g}: outside the range a fit takes it in ({bounds[0]:g} "
+                                   f"to {bounds[1]:g}, its effect's), so it is no fit's value (another unit?); fix: pass "
+                                   "the JSON of 'camtube model fit --json' or 'camtube model diagnose --json' as written")
             if name in used:
                 values[used[name]] = v
             else:
@@ -267,6 +274,20 @@ class Mechanics:
         if values.get("sheath_loss", 0.0) < 0.0:  # a negative mu is a gain, not a loss: keep it at 0
             values["sheath_loss"] = 0.0
         return cls(**values, source=str(p), ignored=tuple(sorted(ignored)))
+
+
+def _effect_bounds(name: str) -> tuple[float, float] | None:
+    """``(lo, hi)`` of a built-in effect's parameter ``effect.param`` (None for a base parameter or an unknown one)."""
+    eff_name, dot, pname = name.partition(".")
+    if not dot:
+        return None
+    from camtube.model.core.registry import builtin_registry
+
+    reg = builtin_registry()
+    if eff_name not in reg:
+        return None
+    spec = next((q for q in reg.get_effect(eff_name).params if q.name == pname), None)
+    return None if spec is None else (float(spec.lo), float(spec.hi))
 
 
 def _fit_params(doc, path: Path) -> dict[str, float]:
@@ -292,6 +313,10 @@ def _fit_params(doc, path: Path) -> dict[str, float]:
         return {}
     sums: dict[str, list[float]] = {}
     for name, entry in block.items():
+        if isinstance(entry, dict) and entry.get("fitted") is False:
+            # held in that fit (the pattern's L0 of 70 mm, say): not measured, so not a calibration; it overrode the
+            # goal's tendon length of 200 mm, and the design's angles were those of a 70 mm tendon
+            continue
         key = f"{where}.{name}" + (".value" if isinstance(entry, dict) else "")
         v = entry.get("value") if isinstance(entry, dict) else entry
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):

@@ -198,3 +198,25 @@ def test_the_copies_of_a_fit_s_bounds_agree_with_the_model_s():
     assert {k: v[0] for k, v in CALIBRATION_MIN.items()} == {k: bounds[k][0] for k in CALIBRATION_MIN}
     for f in (SCHEMA["tendon"]["modulus_gpa"], GOAL_SCHEMA["tendon"]["modulus_gpa"]):
         assert (f.lo, f.hi) == bounds["E_t"]
+
+
+def test_a_calibration_takes_only_what_its_fit_measured_and_within_the_fit_ranges(tmp_path):
+    """The bad-input search: a fit's held L0 (70 mm, the pattern's, ``fitted: false``) overrode a design's 200 mm
+    tendon; a friction.mu of 1.5 (a fit keeps it within -0.9..0.9) was designed with: a bend of 0 deg at 3 N."""
+    from camtube.errors import CamtubeError
+
+    path = tmp_path / "f.json"
+    path.write_text(json.dumps({"schema": "camtube.fit/1", "params": {
+        "E_t": {"value": 27.9, "stderr": 0.01, "unit": "GPa", "fitted": True},
+        "L0": {"value": 70.0, "stderr": None, "unit": "mm", "fitted": False}}}))
+    mech = Mechanics.from_fit_json(path)
+    assert mech.tendon_modulus_gpa == pytest.approx(27.9)
+    assert mech.tendon_length_mm == Mechanics().tendon_length_mm   # the pattern's, not the fit's held 70
+    p = load_pattern("tube1")
+    long = replace(p, tendon=replace(p.tendon, length_mm=200.0))
+    assert simulate(long, 1.0, mech).direction(180.0).bend_deg < simulate(p, 1.0, mech).direction(180.0).bend_deg
+    for name, value in (("friction.mu", 1.5), ("kerf.kerf_mm", 20.0), ("toe.toe_mm", 30.0)):
+        path.write_text(json.dumps({"schema": "camtube.fit/1", "params": {
+            "E_t": {"value": 27.9, "stderr": 0.01, "fitted": True}, name: {"value": value, "fitted": True}}}))
+        with pytest.raises(CamtubeError, match=rf"{name} = {value:g}: outside the range a fit takes it in"):
+            Mechanics.from_fit_json(path)
