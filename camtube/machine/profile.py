@@ -238,6 +238,32 @@ WARN_FACTOR_RANGE = (1.0, 1000.0)
 ROTARY_RANGE_LIMIT_DEG = 36000.0
 
 
+#: Axis letters of G-code that turn (degrees): A, B, C; the others move (mm).
+ANGULAR_AXES = "ABC"
+
+
+def _check_axis_roles(ck, axes: tuple[str, str, str], rotary: bool, dialect: str) -> None:
+    """The letters fit their roles: the axial and focus axes move in mm, so neither is angular (axes [X, Z, A] drove
+    the focus to 168 mm and the tube's axis to the focus, exit 0); the circumferential axis is angular on a rotary
+    stage under LinuxCNC (whose A, B, C are degrees and X..W millimetres) and linear without one (rotary: false sent
+    millimetres of the unrolled surface to A)."""
+    axial, circ, focus = axes
+    for role, letter in (("axial", axial), ("focus", focus)):
+        if letter in ANGULAR_AXES:
+            ck.add("axes", f"the {role} axis {letter} turns (A, B and C are rotary axes in G-code), but it must move "
+                   "in mm", list(axes), "axes: [axial, circumferential, focus], axial and focus linear (X Y Z U V W)",
+                   "e.g. axes: [X, A, Z] on a rotary stage, [X, Y, Z] without one")
+            return
+    if rotary and dialect == "linuxcnc" and circ not in ANGULAR_AXES:
+        ck.add("axes", f"rotary: true, but the circumferential axis {circ} is a linear axis under LinuxCNC (its "
+               "moves are in mm, the stage's in degrees)", list(axes), "A, B or C for the rotary stage",
+               f"e.g. axes: [{axial}, A, {focus}], or rotary: false if {circ} carries the unrolled surface in mm")
+    elif not rotary and circ in ANGULAR_AXES:
+        ck.add("axes", f"rotary: false (the second axis carries the unrolled surface in mm), but {circ} is a rotary "
+               "axis (degrees)", list(axes), "a linear axis (X Y Z U V W) without a rotary stage",
+               f"set rotary: true if {circ} turns the tube, or use a linear letter, e.g. axes: [{axial}, Y, {focus}]")
+
+
 def _hint(word: str, options) -> str:
     m = closest(word, options)
     return f"did you mean '{m}'?" if m else f"remove it (known: {', '.join(options)})"
@@ -322,25 +348,31 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
     axes = m["axes"]
     if not (isinstance(axes, list) and len(axes) == 3 and all(isinstance(a, str) and len(a) == 1
                                                               and a.upper() in "XYZABCUVW" for a in axes)
-            and len(set(axes)) == 3):
+            and len({a.upper() for a in axes}) == 3):   # (x and X are one axis: it was "limits.A ... X, X, Z")
         ck.add("axes", "must list three different axis letters: axial, circumferential, focus", axes,
                "three of X Y Z A B C U V W", "e.g. axes: [X, A, Z]")
         axes = ["X", "A", "Z"]
+        axes_named = False   # (the limits' letters are then not checked against a guess)
+    else:
+        axes_named = True
     axes = tuple(a.upper() for a in axes)
+    if axes_named:
+        _check_axis_roles(ck, axes, rotary if isinstance(rotary, bool) else True, dialect)
     limits = []
     lim = m["limits"]
     if not isinstance(lim, dict):
         ck.add("limits", "must map each axis letter to max_velocity and max_acceleration", lim, "",
                "e.g. limits: {X: {max_velocity: 50, max_acceleration: 500}}")
         lim = {}
-    for letter in axes:
+    for letter in axes if axes_named else ():
         if letter not in lim:
             ck.add(f"limits.{letter}", "no limits for this axis", None, "max_velocity > 0, max_acceleration > 0",
                    f"add limits.{letter}: {{max_velocity: .., max_acceleration: ..}}")
     for letter, v in lim.items():
         key = f"limits.{letter}"
         if letter not in axes:
-            ck.add(key, "not one of the profile's axes", letter, ", ".join(axes), _hint(letter, axes))
+            if axes_named:
+                ck.add(key, "not one of the profile's axes", letter, ", ".join(axes), _hint(letter, axes))
             continue
         if not isinstance(v, dict):
             ck.add(key, "must be a mapping", v, "max_velocity, max_acceleration", "e.g. {max_velocity: 50, ...}")

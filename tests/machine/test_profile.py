@@ -106,3 +106,27 @@ def test_feeds_the_profile_cannot_carry_name_the_decimals_that_would(tmp_path):
     ok = camtube("toolpath", TUBE1, "-q", "--set", "process.scan_speed_mm_s=0.5", "-o", str(tmp_path / "o"),
                  "--machine", str(m))
     assert ok.returncode == 0, ok.stderr
+
+
+@pytest.mark.parametrize("axes,rotary,words", [
+    ("[X, Z, A]", "true", ("machine.axes", "the focus axis A turns", "must move in mm")),
+    ("[A, X, Z]", "true", ("machine.axes", "the axial axis A turns")),
+    ("[X, Y, Z]", "true", ("machine.axes", "rotary: true, but the circumferential axis Y is a linear axis")),
+    ("[X, A, Z]", "false", ("machine.axes", "rotary: false", "but A is a rotary axis")),
+    ("[x, X, Z]", "true", ("machine.axes", "three different axis letters")),
+])
+def test_axis_letters_must_fit_their_roles(tmp_path, axes, rotary, words):
+    """The bad-input search: axes [X, Z, A] drove the focus axis to 168 mm (exit 0); [A, X, Z] the linear stage to
+    191 mm; rotary: false sent mm to A; [x, X, Z] was told "limits.A ... allowed X, X, Z"."""
+    import re
+
+    text = re.sub(r"axes: \[[^\]]*\]", f"axes: {axes}", ROTARY)
+    text = re.sub(r"rotary: (true|false)", f"rotary: {rotary}", text)
+    # limits for every letter named (so the roles, not a missing limit, are what is refused)
+    if "A" not in axes:
+        text = text.replace("    A: {max_velocity: 3600, max_acceleration: 36000}", "    Y: {max_velocity: 50, "
+                            "max_acceleration: 500}")
+    m = tmp_path / "m.yaml"
+    m.write_text(text)
+    assert_refused(camtube("toolpath", TUBE1, "-q", "-o", str(tmp_path / "o"), "--machine", str(m)), *words)
+    assert listing(tmp_path) == ["m.yaml"]
