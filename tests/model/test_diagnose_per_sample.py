@@ -478,3 +478,22 @@ def test_one_sample_explained_alone_is_said_per_sample_when_the_other_is_beyond_
     assert any(ln.strip().startswith("S2: nothing the library has explains it") for ln in lines), lines
     js = diagnosis_dict(d)["alone"]
     assert js["S1"]["recommended"] == d.alone["S1"]["recommended"] and js["S2"]["recommended"] == []
+
+
+def test_two_tubes_whose_tendons_differ_in_stiffness_get_e_t_per_sample_and_nothing_else():
+    """An independent bench simulator: two samples of the paper's physics whose tendons' stiffness differ by 5-6 %
+    (each tube tied with its own tendon) were left at 7-11x the floor, read as a kerf on its bound and a drift in
+    time. The search runs again with E_t per sample: nothing to add, at the floor, and the answer says why."""
+    p, rec, d = _two_samples(Tendon(), Tendon(modulus_scale=0.94))
+    assert d.recommended == () and d.partial == ()
+    assert d.final.rmse_deg <= 1.1 * d.noise_floor_deg
+    assert "E_t" in d.per_sample or any(k.startswith("E_t@") for k in d.final.params)
+    assert "the samples' tendons differ in stiffness" in d.stiffness_note
+    e = {k: v for k, v in d.final.params.items() if k.startswith("E_t@")}
+    assert len(e) == 2 and min(e.values()) / max(e.values()) == pytest.approx(0.94, abs=0.02)
+    text = diagnosis_text(d)
+    assert "the samples' tendons differ in stiffness" in text and "--per-sample E_t" in add_command(d, "camtube model fit F")
+    assert diagnosis_dict(d)["stiffness_note"].startswith("the samples' tendons differ in stiffness")
+    # the same tendon in both: no second search
+    _, _, same = _two_samples(Tendon(), Tendon())
+    assert same.stiffness_note == "" and same.recommended == ()

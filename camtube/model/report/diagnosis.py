@@ -110,9 +110,10 @@ def add_command(d: Diagnosis, prefix: str) -> str:
     import shlex
 
     effects = list(d.final.effects)
-    if not effects or not prefix:
+    if not (effects or d.final.per_sample) or not prefix:
         return ""
-    cmd = f"{prefix} --effects {','.join(effects)}"
+    # (no effects but E_t per sample, the samples' tendons differing: the paper's model with it)
+    cmd = f"{prefix} --effects {','.join(effects)}" if effects else prefix
     if tuple(d.fit_params) != ("E_t",):  # model fit's default: E_t plus every effect parameter
         cmd += f" --fit {','.join(fit_names(d, effects)) or 'none'}"
     if d.final.per_sample:
@@ -565,9 +566,9 @@ def diagnosis_text(d: Diagnosis, command: str = "", title: str = "") -> str:
             lines.append(f"  {cmd}")
     else:
         lines.append("recommended: nothing")
-        cmd = add_command(d, command) if d.baseline else ""
+        cmd = add_command(d, command) if d.baseline or d.stiffness_note else ""
         if cmd:
-            lines.append("the model with its baseline:")
+            lines.append("the model with its baseline:" if d.baseline else "the model with E_t per sample:")
             lines.append(f"  {cmd}")
     lines += partial_lines(d)
     for old, new in d.replaced:
