@@ -397,6 +397,13 @@ def build_profile(raw: Any, name: str, file: str | None = None, lines: dict[str,
         ck.add("blending", "GRBL has no path tolerance (G64)", blending, "controller | exact_stop",
                "write blending: controller")
     corner = ck.choice(m.get("corner_strategy", "none"), "corner_strategy", CORNER_STRATEGIES)
+    if dialect == "linuxcnc" and blending == "controller" and corner == "none":
+        # LinuxCNC starts in G64 without a tolerance: it rounds each corner as far as speed asks, here with the beam
+        # on (the planner stops at each corner as under G61, and the G61 line was left out, exit 0)
+        ck.add("blending", "controller on LinuxCNC leaves its start-up mode (G64, corners blended without a "
+               "tolerance), and with corner_strategy: none the beam stays on through each corner: it would round them",
+               blending, "exact_stop | a path tolerance (mm) with corner_strategy none on LinuxCNC",
+               "write blending: exact_stop (G61), or a path tolerance such as 0.001")
     if corner == "overtravel" and dialect != "linuxcnc":
         ck.add("corner_strategy", "overtravel needs motion-synchronised gating (dialect linuxcnc)", corner,
                "none for grbl", "write corner_strategy: none")

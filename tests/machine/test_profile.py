@@ -35,6 +35,9 @@ BASES = {"rotary": ROTARY, "grbl": GRBL}
     ("rotary", "blending: exact_stop", "blending: 1e-9", ("machine.blending", "got 1e-09", ">= 0.000001 and <= 0.01 mm")),
     ("rotary", "blending: exact_stop", "blending: 1e9", ("machine.blending", "a path tolerance", "<= 0.01 mm")),
     ("rotary", "blending: exact_stop", "blending: 0", ("machine.blending", "got 0")),
+    # (the bad-input search: the G61 line left out, LinuxCNC's G64 rounding every corner with the beam on, exit 0)
+    ("rotary", "blending: exact_stop", "blending: controller", ("machine.blending", "controller on LinuxCNC",
+                                                                "would round them", "exact_stop (G61)")),
     ("rotary", "decimals: 6 ", "decimals: 50 ", ("machine.decimals", "got 50", ">= 0 and <= 9")),
     ("rotary", "feed_decimals: 3", "feed_decimals: 30", ("machine.feed_decimals", "got 30", "<= 9")),
     ("rotary", "X: {max_velocity: 50, max_acceleration: 500}", "X: {max_velocity: 50, max_acceleration: 1e-300}",
