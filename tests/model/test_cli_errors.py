@@ -837,3 +837,15 @@ def test_a_title_above_the_header_is_named_as_such(data_csv, tmp_path, capsys):
     _one_line_with_fix(["model", "fit", str(f), "--pattern", TUBE2, "-q"], capsys,
                        f"{f}:1: the first line ('Bench export v2') names none of the columns", "a title above the header?",
                        "delete the lines above the header")
+
+
+def test_max_effects_0_does_not_blame_the_library(tmp_path, capsys):
+    """The bad-input search: --max-effects 0 on a file slack explains answered "nothing the library has explains the
+    misfit" (and pointed at writing an effect); nothing was searched for, and the answer says so."""
+    path = tmp_path / "d.csv"
+    assert main(["model", "synth", "--pattern", TUBE2, "-o", str(path), "--cycles", "3", "--slack", "0.15", "-q"]) == 0
+    capsys.readouterr()
+    assert main(["model", "diagnose", str(path), "--pattern", TUBE2, "--candidates", "slack", "--max-effects", "0"]) == 0
+    out = capsys.readouterr().out
+    answer = next(line for line in out.splitlines() if line.startswith("answer:"))
+    assert "no effect was searched for (--max-effects 0)" in answer and "library" not in answer, answer
