@@ -658,6 +658,9 @@ def test_a_rest_shorter_than_three_tracker_frames_is_refused(tmp_path, capsys, r
     ("motor.counts_per_rev=0.5", ["motor.counts_per_rev: '0.5' is not a count", "e.g. 512"]),
     ("daq.N_per_V=2000", ["column 'load_V' gives forces up to", "more than the 200 N", "check daq.force_unit and daq.N_per_V"]),
     ("daq.offset_V=5", ["at the rest before the first pull", "its zero (daq.offset_V = 5.0)", "--map daq.offset_V=rest"]),
+    # (the bad-input search: 0.5 V high, the rest read -0.96 N, a tendon pushing, and a fit of 19.5 deg RMS followed)
+    ("daq.offset_V=0.5", ["gives -0.95 N at the rest before the first pull", "a slack tendon cannot push",
+                          "--map daq.offset_V=rest"]),
     ("motor.lead_mm_per_rev=1e-12", ["column 'enc_counts' moves, but gives a stroke of at most",
                                      "motor.lead_mm_per_rev"]),
     ("motor.lead_mm_per_rev=100", ["gives a stroke of up to", "more than the 100 mm"]),

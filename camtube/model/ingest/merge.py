@@ -9,6 +9,7 @@ outside its recording, gives no row either. Every row left out is counted by cau
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -73,6 +74,10 @@ class Ingested:
 #: unit or scale is wrong (the presets' strokes are 2-5 mm; a UHMWPE tendon of r_t 0.04 mm breaks near 15 N).
 MAX_STROKE_MM = 100.0
 MAX_FORCE_N = 200.0
+#: The rest before the first pull may read below zero by this many times the cell's row noise, or this share of
+#: the force's span, before the zero is refused (a slack tendon cannot push).
+REST_PUSH_NOISE = 5.0
+REST_PUSH_SHARE = 0.05
 #: Smallest peak stroke (mm) of a log that moves: below it the motor's scale is wrong (a lead of 1e-12 mm per rev).
 MIN_STROKE_MM = 1e-3
 #: Fewest rows a motor or DAQ log may hold: a test of cycles logged in fewer is a file cut short.
@@ -408,5 +413,13 @@ def _check_magnitudes(motor: Series, stroke: np.ndarray, daq: Series, force: np.
         if span > 0 and abs(rest) > span:
             raise DataError(f"{daq.source}: column {daq.column!r} gives {rest:.4g} N at the rest before the first pull "
                             f"(the first {bench.tracker.rest_s:g} s), beyond the {span:.3g} N the force spans: its zero "
+                            f"(daq.offset_V = {bench.daq.offset_V}) is not the load cell's reading at rest; fix: "
+                            "--map daq.offset_V=rest (the median over that rest)")
+        quiet = force[at_rest]
+        noise = 1.4826 * float(np.median(np.abs(np.diff(quiet)))) / math.sqrt(2.0) if quiet.size > 2 else 0.0
+        if span > 0 and rest < -max(REST_PUSH_NOISE * noise, REST_PUSH_SHARE * span):
+            # (offset_V 0.5 V too high: -0.96 N at rest, written without a word; a fit then gave 19.5 deg RMS)
+            raise DataError(f"{daq.source}: column {daq.column!r} gives {rest:.4g} N at the rest before the first pull "
+                            f"(the first {bench.tracker.rest_s:g} s): a slack tendon cannot push, so its zero "
                             f"(daq.offset_V = {bench.daq.offset_V}) is not the load cell's reading at rest; fix: "
                             "--map daq.offset_V=rest (the median over that rest)")
