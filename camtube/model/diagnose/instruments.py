@@ -293,6 +293,8 @@ class Zero:
     first_deg: float = math.nan
     rests_at_first_N: float = math.nan
     first_cycle: int = 1
+    wander_N: float = 0.0
+    local_N: float = 0.0
 
     @property
     def drifts(self) -> bool:
@@ -313,9 +315,21 @@ class Zero:
         return float(np.median(self.rests.force_N)) if self.rests is not None and self.rests.force_N.size else 0.0
 
     @property
+    def wanders(self) -> bool:
+        """The zero moves away and back: the rests (each the median of it and its neighbours) leave the line through
+        them by more than :data:`ZERO_Z` of their rest-to-rest noise (``local_N``, from second differences, which a
+        smooth drift leaves out) and the cell's row noise, with no step from one rest to the next above
+        :data:`ZERO_JUMP` of that excursion. (A zero 0.11 N up and back to zero over the record has no line to speak
+        of: it was read as steady, and 4.4x the floor was left; an independent bench simulator.)"""
+        return (self.wander_N > ZERO_Z * self.local_N and self.wander_N > self.row_noise_N
+                and self.jump_N <= ZERO_JUMP * self.wander_N)
+
+    @property
     def drift_corrected(self) -> bool:
-        """A drift of a cell zeroed before the test, smooth: corrected (:func:`rezero_force`)."""
-        return self.drifts and self.smooth and self.zeroed
+        """A drift of a cell zeroed before the test, smooth (along a line, or away and back): corrected
+        (:func:`rezero_force`)."""
+        return (self.drifts and self.smooth and self.zeroed) or (
+            self.wanders and abs(self.start_N) <= ZERO_START * self.wander_N + 2.0 * self.local_N)
 
     @property
     def rezeroes(self) -> bool:
@@ -408,9 +422,13 @@ def read_zero(data: Dataset) -> dict:
         first = _before_first_pull(data, sl)
         if first:
             first["rests_at_first_N"] = float(z.mean() + b * (first.pop("first_time_s") - t.mean()))
+        # away from the line and back: the rests' medians about it, and their noise from rest to rest
+        wander = float(np.max(np.abs(_rest_medians(z) - z.mean() - b * dt))) if z.size > 2 else 0.0
+        d2 = z[2:] - 2.0 * z[1:-1] + z[:-2]
+        local = float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / math.sqrt(6.0)) if d2.size else 0.0
         out[smp] = Zero(z.size, float(np.median(z[:3])), float(np.median(z[-3:])), b * span,
                         scatter / math.sqrt(sxx) * span, scatter, rests.row_noise_N, jump, rests=rests,
-                        **_bend_at_rest(data, sl, rests), **first)
+                        **_bend_at_rest(data, sl, rests), **first, wander_N=wander, local_N=local)
     return out
 
 
@@ -509,6 +527,13 @@ def zero_lines(zeros: dict, enabled: bool, option: str = "--no-rezero to keep it
                        f"{BELOW_ZERO_NOISE:g}x its noise ({z.row_noise_N:.2g} N): a tendon cannot push, so that is "
                        f"the cell's zero (not zeroed before the test, or drifting); corrected, the force re-zeroed "
                        f"at every rest ({option})")
+            continue
+        if not (z.drifts and z.smooth and z.zeroed):   # away and back
+            out.append(f"load cell zero: at {smp}'s rests (motor at zero, tendon slack) the force moves away and back "
+                       f"({z.start_N:.3g} N at the start, {z.end_N:.3g} N at the end, up to {z.wander_N:.3g} N off that "
+                       f"line, smoothly from rest to rest: {z.wander_N / max(z.local_N, 1e-300):.0f}x their noise): the "
+                       "load cell's zero wanders (an instrument's, not the tendon's); corrected, the force re-zeroed at "
+                       f"every rest ({option})")
             continue
         out.append(f"load cell zero: at {smp}'s rests (motor at zero, tendon slack) the force moves from "
                    f"{z.start_N:.3g} to {z.end_N:.3g} N, a drift of {z.change_N:+.3g} N over the record "
