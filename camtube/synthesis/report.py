@@ -27,6 +27,18 @@ def _list(vals) -> str:
     return "[" + ", ".join(_num(v) for v in vals) + "]"
 
 
+def _other_strokes(goal) -> str:
+    """The check line's note for directions whose target stroke is not the first's (each direction's bend is read at
+    its own stroke: the 0 deg direction of a two-direction goal, 30 deg at 1.2 mm, was checked at the first's 1.5 mm,
+    37.5 deg), "" when every direction has the first's."""
+    first = goal.bends[0]
+    others = [b for b in goal.bends[1:] if b.stroke_mm != first.stroke_mm]
+    if not others:
+        return ""
+    return (f" (for the {first.angle_deg:g} deg direction; "
+            + "; ".join(f"--stroke {b.stroke_mm:g} for the {b.angle_deg:g} deg direction" for b in others) + ")")
+
+
 def pattern_yaml(design: Design, process: object | None = None) -> str:
     """The pattern YAML of ``design`` (per-notch lists from the tip; one anchor hole per direction)."""
     g = design.goal
@@ -40,7 +52,8 @@ def pattern_yaml(design: Design, process: object | None = None) -> str:
         + "; ".join(f"{b.bend_deg:g} deg at {b.stroke_mm:g} mm towards {b.angle_deg:g} deg" for b in g.bends),
         f"# Check: camtube design THIS.yaml --stroke {g.bends[0].stroke_mm:g} --overcut {design.mechanics.kerf_mm:g}"
         + (f" --hinge {design.mechanics.hinge}" if design.mechanics.hinge != "fe_row" else "")
-        + (" --calibration FIT.json (the same fit)" if design.mechanics.source != "defaults" else ""),
+        + (" --calibration FIT.json (the same fit)" if design.mechanics.source != "defaults" else "")
+        + _other_strokes(g),
         f"name: {json.dumps(p.name)}",   # quoted: a name YAML would read as a date or a number stays text
         f"tube: {{outer_radius: {_num(t.outer_radius_mm)}, inner_radius: {_num(t.inner_radius_mm)}, "
         f"length: {_num(t.length_mm)}, material: {t.material}}}",

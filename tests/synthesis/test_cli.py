@@ -46,6 +46,12 @@ def test_written_pattern_builds_verifies_and_resimulates(goal, stroke, tmp_path)
     b = camtube("build", str(out), "-o", str(tmp_path / "job"), "-q", "--no-step", "--no-pictures")
     assert b.returncode == 0 and "verification: PASS" in b.stdout, b.stdout + b.stderr
     assert any(p.suffix == ".ngc" for p in (tmp_path / "job").iterdir())
+    # the written check reads each direction at its own stroke (07's 0 deg direction was checked at 1.5 mm, not 1.2)
+    check = next(line for line in out.read_text().splitlines() if line.startswith("# Check:"))
+    first, *rest = stroke.items()
+    assert f"--stroke {first[1]:g} " in check
+    for angle, mm in rest:
+        assert mm == first[1] or f"--stroke {mm:g} for the {angle:g} deg direction" in check, check
     p = load_pattern(out)
     targets = {"01": {180.0: 60.0}, "07": {180.0: 45.0, 0.0: 30.0}, "10": {270.0: 43.125},
                "13": {180.0: 45.0, 90.0: 45.0}}[goal[:2]]
