@@ -985,6 +985,16 @@ def test_a_set_without_a_value_names_the_option_not_the_preset(tmp_path):
     assert "presets" not in r.stderr
 
 
+def test_a_set_given_twice_with_different_values_is_refused(tmp_path):
+    """The bad-input search: --set notch.count=10 --set notch.count=3 cut 3 notches without a word (ingest refuses a
+    --map given twice); the same value twice is harmless."""
+    r = camtube("toolpath", "tube1", "-q", "-o", str(tmp_path / "o"), "--set", "notch.count=10", "--set", "notch.count=3")
+    assert_refused(r, "--set notch.count: given twice, with different values", "keep one of 'notch.count=10' and "
+                   "'notch.count=3'")
+    assert "presets" not in r.stderr and not (tmp_path / "o").exists()
+    assert camtube("design", "tube1", "--set", "notch.count=10", "--set", "notch.count=10").returncode == 0
+
+
 def test_a_name_too_long_for_a_file_name_is_named_by_its_key(tmp_path):
     """The bad-input search: a name of 300 characters failed as "cannot write: File name too long" on the output
     folder."""

@@ -118,8 +118,15 @@ def apply_overrides(raw: dict, overrides: Iterable[str], file: str | None = None
 
     raw = copy.deepcopy(raw) if raw else {}
     issues = []
+    given: dict[str, str] = {}
     for item in overrides:
         key, value = parse_override(item)
+        if key.strip() in given and given[key.strip()] != item:
+            # (--set notch.count=10 --set notch.count=3 cut 3 notches without a word; ingest --map refuses this too)
+            issues.append(Issue(f"--set {key.strip()}", "given twice, with different values", item,
+                                f"one --set {key.strip()}=VALUE", f"keep one of {given[key.strip()]!r} and {item!r}"))
+            continue
+        given[key.strip()] = item
         parts = key.split(".")
         if _schema_node(parts) is None:
             from camtube.design.schema import iter_fields
