@@ -264,9 +264,11 @@ class Mechanics:
             if name in used and bounds is not None and not bounds[0] <= v <= bounds[1]:
                 # (friction.mu = 1.5 was designed with, a bend of 0 deg at 3 N; a kerf of 20 mm, a value in um, was
                 # blamed on the goal's limits): no fit gives a value outside its effect's range
-                raise CamtubeError(f"{p}: parameter {name} = {v:g}: outside the range a fit takes it in ({bounds[0]:g} "
-                                   f"to {bounds[1]:g}, its effect's), so it is no fit's value (another unit?); fix: pass "
-                                   "the JSON of 'camtube model fit --json' or 'camtube model diagnose --json' as written")
+                lo, hi, unit = bounds
+                u = f" {unit}" if unit else ""
+                raise CamtubeError(f"{p}: parameter {name} = {v:g}{u}: outside the range a fit takes it in ({lo:g} to "
+                                   f"{hi:g}{u}, its effect's), so it is no fit's value (another unit?); fix: pass the "
+                                   "JSON of 'camtube model fit --json' or 'camtube model diagnose --json' as written")
             if name in used:
                 values[used[name]] = v
             else:
@@ -276,8 +278,9 @@ class Mechanics:
         return cls(**values, source=str(p), ignored=tuple(sorted(ignored)))
 
 
-def _effect_bounds(name: str) -> tuple[float, float] | None:
-    """``(lo, hi)`` of a built-in effect's parameter ``effect.param`` (None for a base parameter or an unknown one)."""
+def _effect_bounds(name: str) -> tuple[float, float, str] | None:
+    """``(lo, hi, unit)`` of a built-in effect's parameter ``effect.param`` (None for a base parameter or an unknown
+    one)."""
     eff_name, dot, pname = name.partition(".")
     if not dot:
         return None
@@ -287,7 +290,7 @@ def _effect_bounds(name: str) -> tuple[float, float] | None:
     if eff_name not in reg:
         return None
     spec = next((q for q in reg.get_effect(eff_name).params if q.name == pname), None)
-    return None if spec is None else (float(spec.lo), float(spec.hi))
+    return None if spec is None else (float(spec.lo), float(spec.hi), str(spec.unit or ""))
 
 
 def _fit_params(doc, path: Path) -> dict[str, float]:
