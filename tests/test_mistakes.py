@@ -995,6 +995,15 @@ def test_a_set_given_twice_with_different_values_is_refused(tmp_path):
     assert camtube("design", "tube1", "--set", "notch.count=10", "--set", "notch.count=10").returncode == 0
 
 
+def test_a_mapping_set_on_a_section_merges_into_it(tmp_path):
+    """The bad-input search: --set 'notch={count: 3}' replaced the section: four "required key is missing" lines at
+    the preset's lines that hold those keys. It sets the keys it gives, as --set notch.count=3 does."""
+    a = camtube("design", "tube1", "--set", "notch={count: 3}")
+    b = camtube("design", "tube1", "--set", "notch.count=3")
+    assert a.returncode == b.returncode == 0, a.stderr
+    assert a.stdout == b.stdout and "3 / 1" in a.stdout
+
+
 def test_a_name_too_long_for_a_file_name_is_named_by_its_key(tmp_path):
     """The bad-input search: a name of 300 characters failed as "cannot write: File name too long" on the output
     folder."""

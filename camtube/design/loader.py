@@ -108,11 +108,21 @@ def _schema_node(parts: list[str]):
     return node
 
 
+def _merge(into: dict, update: dict) -> None:
+    """``update``'s keys into ``into``, mappings into mappings (in place)."""
+    for k, v in update.items():
+        if isinstance(v, dict) and isinstance(into.get(k), dict):
+            _merge(into[k], v)
+        else:
+            into[k] = v
+
+
 def apply_overrides(raw: dict, overrides: Iterable[str], file: str | None = None) -> dict:
     """Return a copy of ``raw`` with ``key=value`` overrides applied.
 
     Keys are dotted paths (``notch.count``, ``process.repeats``,
-    ``holes.0.x``); an unknown key is an error with a "did you mean".
+    ``holes.0.x``); an unknown key is an error with a "did you mean". A mapping given for a section
+    (``notch={count: 3}``) merges into it; a key given twice with different values is refused.
     """
     import copy
 
@@ -159,7 +169,12 @@ def apply_overrides(raw: dict, overrides: Iterable[str], file: str | None = None
                 continue
             node[int(last)] = value
         elif isinstance(node, dict):
-            node[last] = value
+            if isinstance(value, dict) and isinstance(node.get(last), dict):
+                # a mapping set on a section merges into it, as its keys set one by one would (--set 'notch={count:
+                # 3}' replaced the section: four "required key is missing" lines at the preset's lines that hold them)
+                _merge(node[last], value)
+            else:
+                node[last] = value
         # else: not a mapping in the YAML (holes: [[1, 2]]); the check of the YAML names the entry
     if issues:
         raise PatternError(issues)
