@@ -217,6 +217,10 @@ def _sections(r: Reader, raw: dict, name: str) -> dict:
     return out
 
 
+#: A share of goal.distribution must be at least this fraction of the largest: a notch given less bends next to nothing.
+MIN_SHARE = 0.01
+
+
 def build_goal(raw: dict, file: str | None = None, lines: dict[str, int] | None = None,
                name: str | None = None) -> Goal:
     """Validate raw goal data; raises :class:`~camtube.errors.PatternError` listing every problem."""
@@ -282,6 +286,15 @@ def build_goal(raw: dict, file: str | None = None, lines: dict[str, int] | None 
         if goal["notches"] not in (None, "auto") and goal["notches"] != len(dist):
             r.issue("goal.notches", f"disagrees with the {len(dist)} shares of goal.distribution", goal["notches"],
                     f"{len(dist)} or auto", "remove goal.notches (the list sets the count)")
+        top = max(dist)
+        small = [i for i, v in enumerate(dist) if not v >= MIN_SHARE * top]
+        if top > 0 and small:
+            # (a share of 1e-9: "a notch must bend 0.00 deg, more than 0.75 of its closure angle", a notch that bends
+            # nothing, narrower than any cut)
+            r.issue("goal.distribution", f"share {small[0] + 1} (from the tip) is {dist[small[0]]:g}, under "
+                    f"{MIN_SHARE:.0%} of the largest ({top:g}): that notch would bend next to nothing, narrower than "
+                    "any cut", list(dist), f"every share >= {MIN_SHARE:g} x the largest",
+                    "leave that notch out (fewer shares) or give it a share of its own")
     curve = goal["curve"]
     if curve and not arcs:  # with a centre line: one issue, from _check_centerline
         if len(bends) > 1:

@@ -83,6 +83,9 @@ limits: {max_strain: 0.04}
     (("tube: {", "tendon: {radius: 0.5}\ntube: {"), ["tendon.radius", "thicker than the tube's lumen", ":1:",
                                                        "< tube.inner_radius = 0.45 mm"]),
     (("goal:", "goal:\n  distribution: tipfirst"), ["goal.distribution", "did you mean 'tip_first'"]),
+    # (the bad-input search: "a notch must bend 0.00 deg, more than 0.75 of its closure angle")
+    (("goal:", "goal:\n  distribution: [1, 1e-9, 1, 1]"), ["goal.distribution", "share 2 (from the tip) is 1e-09",
+                                                          "bend next to nothing", "fix: leave that notch out"]),
     (("goal:", "goal:\n  curve: [2, 4]\n  curve_length: 10"), ["goal.bends[0].bend_deg", "30.00"]),
     (("limits:", "limit:"), ["did you mean 'limits'"]),
     (("tube:", "name: runs/tube4\ntube:"), ["name", "must be a plain file name", ":1:", "runs/tube4"]),
