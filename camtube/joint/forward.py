@@ -125,6 +125,12 @@ CALIBRATION_MAX = {"E_t": (1000.0, "GPa"), "L0": (10_000.0, "mm"), "arm_scale": 
                    "slack.deadband_mm": (100.0, "mm"), "toe.toe_mm": (100.0, "mm"), "kerf.kerf_mm": (100.0, "mm"),
                    "series.compliance_mm_per_N": (100.0, "mm/N"), "friction.mu": (10.0, "")}
 
+#: The range a fit takes each effect parameter a calibration uses in, and its unit: the built-in effects' Param
+#: bounds (``tests/joint/test_forward.py`` holds them to the registry's; this stage does not import the model's).
+CALIBRATION_RANGE = {"slack.deadband_mm": (0.0, 10.0, "mm"), "toe.toe_mm": (0.0, 5.0, "mm"),
+                     "kerf.kerf_mm": (-0.5, 0.5, "mm"), "series.compliance_mm_per_N": (0.0, 10.0, "mm/N"),
+                     "friction.mu": (-0.9, 0.9, "")}
+
 #: The smallest value of each base parameter a calibration may give (and its unit): the lower bounds a fit takes them in
 #: (:data:`camtube.model.core.model.BASE_PARAMS`).
 CALIBRATION_MIN = {"E_t": (0.5, "GPa"), "L0": (1.0, "mm"), "arm_scale": (0.3, "")}
@@ -279,18 +285,8 @@ class Mechanics:
 
 
 def _effect_bounds(name: str) -> tuple[float, float, str] | None:
-    """``(lo, hi, unit)`` of a built-in effect's parameter ``effect.param`` (None for a base parameter or an unknown
-    one)."""
-    eff_name, dot, pname = name.partition(".")
-    if not dot:
-        return None
-    from camtube.model.core.registry import builtin_registry
-
-    reg = builtin_registry()
-    if eff_name not in reg:
-        return None
-    spec = next((q for q in reg.get_effect(eff_name).params if q.name == pname), None)
-    return None if spec is None else (float(spec.lo), float(spec.hi), str(spec.unit or ""))
+    """``(lo, hi, unit)`` of an effect parameter a calibration uses (:data:`CALIBRATION_RANGE`), None for the rest."""
+    return CALIBRATION_RANGE.get(name)
 
 
 def _fit_params(doc, path: Path) -> dict[str, float]:

@@ -220,3 +220,16 @@ def test_a_calibration_takes_only_what_its_fit_measured_and_within_the_fit_range
             "E_t": {"value": 27.9, "stderr": 0.01, "fitted": True}, name: {"value": value, "fitted": True}}}))
         with pytest.raises(CamtubeError, match=rf"{name} = {value:g}( mm)?: outside the range a fit takes it in"):
             Mechanics.from_fit_json(path)
+
+
+def test_the_calibration_ranges_are_the_effects_bounds():
+    """joint.forward keeps the ranges a fit takes the calibrated effect parameters in (it does not import the model's
+    registry, a higher floor): they must be the built-in effects' Param bounds and units."""
+    from camtube.joint.forward import CALIBRATION_RANGE
+    from camtube.model.core.registry import builtin_registry
+
+    reg = builtin_registry()
+    for name, (lo, hi, unit) in CALIBRATION_RANGE.items():
+        eff, pname = name.split(".")
+        spec = next(q for q in reg.get_effect(eff).params if q.name == pname)
+        assert (spec.lo, spec.hi, spec.unit) == (lo, hi, unit), name
