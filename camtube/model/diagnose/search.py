@@ -2102,13 +2102,14 @@ class Search:
         """Why the search should run again with E_t per sample, or "" (the usual answer).
 
         Two tubes on one bench rarely share their tendon's stiffness to the percent: each is tied with its own
-        tendon, of its own length (L0) and make. 5 % between two samples of the paper's physics left the model
-        at 7-11x the floor, read as a kerf on its bound and a drift in time (an independent bench simulator).
-        Tried where the answer is not complete (a complete one has nothing left for it to explain), with several
-        samples, E_t fitted and shared: on the final chain's search rows, E_t per sample must lower the held-out
-        error significantly (``z``), by ``min_gain``, with a BIC lower by ``bic_threshold``, and explain
-        :data:`STIFFNESS_SHARE` of the held-out misfit above the floor (a joint whose moment arm changes with the
-        angle, beyond the library, was read as moduli 0.3 % apart explaining a quarter of it).
+        tendon, of its own length (L0) and make, and the tendon's stretch is most of the stroke. 5 % between two
+        samples of the paper's physics left the model at 7-11x the floor, read as a kerf on its bound and a drift
+        in time; 0.7 % was read as a toe, complete at 1.12x (an independent bench simulator).
+        With several samples and E_t fitted and shared, tried on the model as given (an effect of a complete answer
+        may stand in for it) and, where the answer is not complete, on the final chain: on the search rows E_t per
+        sample must lower the held-out error significantly (``z``), by ``min_gain``, with a BIC lower by
+        ``bic_threshold``, and explain :data:`STIFFNESS_SHARE` of the held-out misfit above the floor (a joint whose
+        moment arm changes with the angle, beyond the library, was read as moduli 0.3 % apart explaining a quarter).
         """
         s, ch = self.settings, self.chain
         if not s.per_sample or len(self.data.samples) < 2 or "E_t" not in self.base_names or "E_t" in self.base_ps:
@@ -2128,12 +2129,11 @@ class Search:
 
         # the model as given (a complete answer may have an effect standing in for the samples' stiffness: a toe
         # took a control's 6 % at 1.12x the floor), then the final chain where the answer is not complete
-        tries = [(self.given_model, self.base_ho, (self.given_model, self.base_names, self.base_ps, self.base_fit,
-                                                   self.base_ho, self.base_mse))]
+        tries = [(self.given_model, self.base_names, self.base_ps, self.base_fit, self.base_ho, self.base_mse)]
         if d.explanation != "complete" and ch.current is not self.given_model:
-            tries.append((ch.current, ch.heldout_rmse_deg, (ch.current, ch.names, ch.per_sample, ch.fit,
-                                                             ch.heldout_rmse_deg, ch.block_mse)))
-        for model, ho0, args in tries:
+            tries.append((ch.current, ch.names, ch.per_sample, ch.fit, ch.heldout_rmse_deg, ch.block_mse))
+        for args in tries:
+            model, ho0 = args[0], args[4]
             ho = lowers(*args)
             if ho is not None:
                 return (f"the samples' tendons differ in stiffness: with E_t per sample the held-out RMSE falls from "
