@@ -119,11 +119,9 @@ def row_webs_mm(x_mm, width_mm) -> list[tuple[float, float]]:
 
 #: The schemas of the files a calibration is read from (``model fit --json``, ``model diagnose --json``).
 CALIBRATION_SCHEMAS = ("camtube.fit/1", "camtube.diagnose/1")
-#: The largest value of each parameter a calibration may give (and its unit): the stiffest fibre's modulus, a tendon
-#: of 10 m, an arm ten times the section's, a slack, toe or kerf of 100 mm, a compliance of 100 mm/N, mu of 10.
-CALIBRATION_MAX = {"E_t": (1000.0, "GPa"), "L0": (10_000.0, "mm"), "arm_scale": (10.0, ""),
-                   "slack.deadband_mm": (100.0, "mm"), "toe.toe_mm": (100.0, "mm"), "kerf.kerf_mm": (100.0, "mm"),
-                   "series.compliance_mm_per_N": (100.0, "mm/N"), "friction.mu": (10.0, "")}
+#: The largest value of each base parameter a calibration may give (and its unit): the stiffest fibre's modulus, a
+#: tendon of 10 m, an arm ten times the section's (an effect parameter's range is :data:`CALIBRATION_RANGE`).
+CALIBRATION_MAX = {"E_t": (1000.0, "GPa"), "L0": (10_000.0, "mm"), "arm_scale": (10.0, "")}
 
 #: The range a fit takes each effect parameter a calibration uses in, and its unit: the built-in effects' Param
 #: bounds (``tests/joint/test_forward.py`` holds them to the registry's; this stage does not import the model's).
@@ -260,14 +258,14 @@ class Mechanics:
                 raise CamtubeError(f"{p}: parameter {name} = {v:g}{' ' + unit if unit else ''}: below any fit's (at "
                                    f"least {low:g}{' ' + unit if unit else ''}, the lower bound a fit takes it in); fix: "
                                    "pass the JSON of a fit whose parameters are physical")
-            if name in used and v > CALIBRATION_MAX[name][0]:
+            if name in CALIBRATION_MAX and v > CALIBRATION_MAX[name][0]:
                 # (E_t = 1e300 GPa was taken: a tendon that does not stretch, the design computed without a word)
                 top, unit = CALIBRATION_MAX[name]
                 raise CamtubeError(f"{p}: parameter {name} = {v:g}{' ' + unit if unit else ''}: beyond any joint's "
                                    f"(at most {top:g}{' ' + unit if unit else ''}); fix: pass the JSON of a fit whose "
                                    "parameters are physical (hold a parameter with --fix NAME=VALUE)")
-            bounds = _effect_bounds(name)
-            if name in used and bounds is not None and not bounds[0] <= v <= bounds[1]:
+            bounds = CALIBRATION_RANGE.get(name)
+            if bounds is not None and not bounds[0] <= v <= bounds[1]:
                 # (friction.mu = 1.5 was designed with, a bend of 0 deg at 3 N; a kerf of 20 mm, a value in um, was
                 # blamed on the goal's limits): no fit gives a value outside its effect's range
                 lo, hi, unit = bounds
@@ -282,11 +280,6 @@ class Mechanics:
         if values.get("sheath_loss", 0.0) < 0.0:  # a negative mu is a gain, not a loss: keep it at 0
             values["sheath_loss"] = 0.0
         return cls(**values, source=str(p), ignored=tuple(sorted(ignored)))
-
-
-def _effect_bounds(name: str) -> tuple[float, float, str] | None:
-    """``(lo, hi, unit)`` of an effect parameter a calibration uses (:data:`CALIBRATION_RANGE`), None for the rest."""
-    return CALIBRATION_RANGE.get(name)
 
 
 def _fit_params(doc, path: Path) -> dict[str, float]:
