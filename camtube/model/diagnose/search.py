@@ -300,6 +300,11 @@ class Diagnosis:
         Each sample diagnosed alone, when the samples differ in that some are explained alone (something recommended)
         and some are not (their built-ins leave them partial), so no union could be fitted: ``{sample: {"recommended",
         "explanation", "partial", "before_deg", "after_deg", "floor_deg"}}``; empty otherwise.
+    stiffness_note : str
+        Why the search ran again with E_t per sample (:meth:`Search.stiffness_differs`) when that answer was kept;
+        ``""`` otherwise.
+    max_effects : int or None
+        The most effects the search could recommend (``--max-effects``; 0: none was searched for).
     replaced : tuple[tuple[tuple[str, ...], str], ...]
         Effects chosen earlier and dropped for a later one that explains what they did: ``((old, ...), new)``.
     chosen_round : dict
@@ -360,6 +365,7 @@ class Diagnosis:
     noise_lags_rows: dict = field(default_factory=dict)
     alone: dict = field(default_factory=dict)
     stiffness_note: str = ""
+    max_effects: int | None = None
     cache: Cache = field(default_factory=Cache, init=False, compare=False, repr=False)
 
     @property
@@ -2213,7 +2219,8 @@ class Search:
                          held={k: v for k, v in self.held.items() if k.split(".")[0] in set(recommended)
                                or ("@" in k and recommended and k.split(".")[0] in set(self.baseline_added))
                                or set(BASELINE_STAND_INS.get(k.split(".")[0], ())) & set(recommended)},
-                         noise_lag_rows=max(lags.values(), default=1), noise_lags_rows=lags, alone=dict(self.alone))
+                         noise_lag_rows=max(lags.values(), default=1), noise_lags_rows=lags, alone=dict(self.alone),
+                         max_effects=s.max_effects)
 
 
 #: The share of the held-out misfit above the floor that E_t per sample must explain for the search to run again

@@ -429,7 +429,7 @@ def answer_lines(d: Diagnosis) -> list[str]:
         out.append("answer: nothing the library has explains the misfit; the built-ins that lower it ("
                    + ", ".join(d.partial) + f") leave {_times(d.partial_steps[-1].rmse_deg, floor)} the noise floor "
                    "and are not recommended (see 'partial' and 'unexplained')")
-    elif steps[0].rmse_deg > REACH_RATIO * floor and d.stop_reason.startswith("stopped after 0 effects"):
+    elif steps[0].rmse_deg > REACH_RATIO * floor and d.max_effects == 0:
         # (--max-effects 0: no candidate was tried, so the library is not to blame: it said "write an effect" where
         # slack explained the data)
         out.append(f"answer: no effect was searched for (--max-effects 0): the model stays at "
