@@ -9,13 +9,12 @@ outside its recording, gives no row either. Every row left out is counted by cau
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from camtube.errors import DataError
-from camtube.model.data.dataset import Dataset
+from camtube.model.data.dataset import Dataset, rest_noise
 from camtube.model.ingest.clock import align_trigger, align_xcorr
 from camtube.model.ingest.cycles import cycle_numbers, cycle_starts
 from camtube.model.ingest.ndi import TrackerLog
@@ -415,8 +414,7 @@ def _check_magnitudes(motor: Series, stroke: np.ndarray, daq: Series, force: np.
                             f"(the first {bench.tracker.rest_s:g} s), beyond the {span:.3g} N the force spans: its zero "
                             f"(daq.offset_V = {bench.daq.offset_V}) is not the load cell's reading at rest; fix: "
                             "--map daq.offset_V=rest (the median over that rest)")
-        quiet = force[at_rest]
-        noise = 1.4826 * float(np.median(np.abs(np.diff(quiet)))) / math.sqrt(2.0) if quiet.size > 2 else 0.0
+        noise = rest_noise(force, [np.flatnonzero(at_rest)])   # (the cell's row-to-row noise there)
         if span > 0 and rest < -max(REST_PUSH_NOISE * noise, REST_PUSH_SHARE * span):
             # (offset_V 0.5 V too high: -0.96 N at rest, written without a word; a fit then gave 19.5 deg RMS)
             raise DataError(f"{daq.source}: column {daq.column!r} gives {rest:.4g} N at the rest before the first pull "
