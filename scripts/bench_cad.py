@@ -13,7 +13,7 @@ verification and the volume errors of the presets.
 
 Drawn curves: a drawing of round holes (CIRCLEs, flattened to 256 chords each) as a solid, its
 curves walled by one face a run (``drawn_tool``'s default) against a face per chord
-(``smooth=False``, as before): seconds, the ratio, the faces and the process's peak memory.
+(``design_solid(p, smooth=False)``, as before): seconds, the ratio, the faces and the process's peak memory.
 Before, a hundred such holes took 9 min and 19 GB in ``camtube build``.
 """
 from __future__ import annotations
@@ -109,10 +109,6 @@ def drawn_holes() -> None:
     from camtube.cad import solid
     from camtube.design.source import load_source
 
-    def faceted(*args):
-        return plain(*args, smooth=False)
-
-    plain = solid.drawn_tool
     print("\n== drawn round holes (256 chords each) as a solid ==")
     with tempfile.TemporaryDirectory() as tmp:
         times = {}
@@ -120,11 +116,7 @@ def drawn_holes() -> None:
             path = Path(tmp) / f"holes{n}.dxf"
             holes_drawing(path, n)
             p = load_source(path, ["tube.inner_radius=0.45"]).pattern
-            solid.drawn_tool = plain if mode == "curves" else faceted
-            try:
-                t, s = best_of(lambda: solid.design_solid(p), repeat=1)
-            finally:
-                solid.drawn_tool = plain
+            t, s = best_of(lambda: solid.design_solid(p, smooth=mode == "curves"), repeat=1)
             times[(n, mode)] = t
             peak_gb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6
             print(f"{n:4d} holes, a face per {'run' if mode == 'curves' else 'chord'}: {t:7.2f} s, {len(s.faces())} faces, "

@@ -188,11 +188,12 @@ def drawn_tool(points, outer_radius_mm: float, r0: float, r1: float, smooth: boo
     return bd.Solid(fix.Solid())
 
 
-def cut_tools(pattern: Pattern):
+def cut_tools(pattern: Pattern, smooth: bool = True):
     """One radial-walled solid per cut of ``pattern`` (list of build123d Solids).
 
     Rectangles are revolved annular sectors; drawn outlines (and slits, as the
-    kerf region of :func:`camtube.cad.mesh.design_regions`) are :func:`drawn_tool` prisms.
+    kerf region of :func:`camtube.cad.mesh.design_regions`) are :func:`drawn_tool` prisms
+    (``smooth``: see there).
     """
     import build123d as bd
 
@@ -210,7 +211,7 @@ def cut_tools(pattern: Pattern):
                 regions = design_regions(pattern)
             reg = regions[i]
             pts = reg.points if hasattr(reg, "points") else list(reg.exterior.coords)[:-1]
-            tools.append(drawn_tool(pts, ro, ri - margin, ro + margin))
+            tools.append(drawn_tool(pts, ro, ri - margin, ro + margin, smooth=smooth))
             continue
         sweep = math.degrees(c.arc_mm / ro)
         key = (c.width_mm, sweep)
@@ -220,8 +221,9 @@ def cut_tools(pattern: Pattern):
     return tools
 
 
-def design_solid(pattern: Pattern):
-    """The tube with its cuts as one build123d ``Solid`` (mm).
+def design_solid(pattern: Pattern, smooth: bool = True):
+    """The tube with its cuts as one build123d ``Solid`` (mm); ``smooth`` as :func:`drawn_tool`'s (False: a face per
+    chord of a drawn curve, for the benchmark's comparison).
 
     Raises
     ------
@@ -233,7 +235,7 @@ def design_solid(pattern: Pattern):
     t = pattern.tube
     tube = bd.Solid.make_cylinder(t.outer_radius_mm, t.length_mm, bd.Plane.YZ) - bd.Solid.make_cylinder(
         t.inner_radius_mm, t.length_mm, bd.Plane.YZ)
-    tools = cut_tools(pattern)
+    tools = cut_tools(pattern, smooth)
     out = tube.cut(*tools) if tools else tube
     solids = out.solids()
     if len(solids) != 1:
