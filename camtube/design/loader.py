@@ -131,12 +131,13 @@ def apply_overrides(raw: dict, overrides: Iterable[str], file: str | None = None
     given: dict[str, str] = {}
     for item in overrides:
         key, value = parse_override(item)
-        if key.strip() in given and given[key.strip()] != item:
+        name = key.strip()
+        if name in given and given[name] != item:
             # (--set notch.count=10 --set notch.count=3 cut 3 notches without a word; ingest --map refuses this too)
-            issues.append(Issue(f"--set {key.strip()}", "given twice, with different values", item,
-                                f"one --set {key.strip()}=VALUE", f"keep one of {given[key.strip()]!r} and {item!r}"))
+            issues.append(Issue(f"--set {name}", "given twice, with different values", item,
+                                f"one --set {name}=VALUE", f"keep one of {given[name]!r} and {item!r}"))
             continue
-        given[key.strip()] = item
+        given[name] = item
         parts = key.split(".")
         if _schema_node(parts) is None:
             from camtube.design.schema import iter_fields
