@@ -58,7 +58,7 @@ from camtube.model.unexplained import report as unexplained_report
 SPEED_TARGETS_S = {10_000: 5.0, 200_000: 20.0}
 
 #: Either toe law explains a toe region (they are one family: the diagnosis declares them indistinguishable).
-TOES = {"toe", "toe_shape"}
+TOES = {"toe", "toe_shape", "toe_soft"}
 
 
 def n_hidden(hidden) -> int:

@@ -33,7 +33,7 @@ from camtube.model.sim.bench import (
     Backbone, Clock, Drive, Guide, LoadCell, Protocol, SampleBench, Tendon, Tracker, simulate_bench,
 )
 
-TOES = {"toe", "toe_shape"}
+TOES = {"toe", "toe_shape", "toe_soft"}
 #: Mechanisms by family: the effects of the library that are the right answer (empty: none is; the answer is
 #: nothing recommended, and what is left follows ``follows``).
 FAMILIES = {

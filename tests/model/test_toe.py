@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from camtube.design.loader import load_pattern
+from camtube.model.core.registry import builtin_registry
 from camtube.model.core.predict import joint_stiffness_nmm_per_rad, model_for_pattern, pattern_values
 from camtube.model.data.dataset import Dataset
 from camtube.model.diagnose import diagnose
@@ -76,6 +77,35 @@ def test_shape_one_is_the_truth_simulators_exponential_toe(tube2):
     np.testing.assert_allclose(elong[::5], want, rtol=1e-4, atol=1e-6)
 
 
+
+@pytest.mark.parametrize("shape,share", [(0.7, 0.3), (1.5, 0.6), (3.0, 0.9)])
+def test_soft_toe_law_matches_quadrature(tube2, shape, share):
+    """toe_soft: stiffness fraction share + (1 - share)(1 - exp(-(u/lam)^k)), integrated by quadrature and inverted
+    by brentq; it starts at the share's stiffness (finite) and its linear part is shifted by the offset."""
+    from scipy.integrate import quad
+    from scipy.optimize import brentq
+    from scipy.special import gamma
+
+    offset = 0.2
+    forces = [0.002, 0.05, 0.3, 1.0, 2.5, 8.0]
+    data = _const_force_data(forces)
+    m = model_for_pattern(tube2, ["toe_soft"])
+    vals = m.initial_values(data, pattern_values(tube2)) | {"toe_soft.offset_mm": offset, "toe_soft.shape": shape,
+                                                            "toe_soft.share": share}
+    c = m.compliance_mm_per_N(vals)
+    elong = 5.0 - np.radians(m.predict(data, vals)) * m.geometry.moment_arm_mm
+    lam = offset / ((1.0 - share) * gamma(1.0 + 1.0 / shape))
+
+    def tension(e):
+        crimped = quad(lambda u: -math.expm1(-(u / lam) ** shape), 0.0, e, epsabs=1e-13, epsrel=1e-11)[0]
+        return (share * e + (1.0 - share) * crimped) / c
+
+    want = [brentq(lambda e: tension(e) - f, 0.0, c * f / share + 1.0, xtol=1e-12) for f in forces]
+    np.testing.assert_allclose(elong[::5], want, rtol=5e-4, atol=2e-6)
+    # finite stiffness at zero force: never softer than the straight share alone, softer than the whole tendon
+    assert c * forces[0] < elong[0] <= c * forces[0] / share * (1.0 + 5e-4)
+    assert elong[-1] - c * forces[-1] == pytest.approx(offset, rel=0.02)
+
 def test_force_average_keeps_a_ramp_and_lowers_the_noise():
     rng = np.random.default_rng(3)
     n = 400
@@ -143,6 +173,34 @@ def _generate(pattern, law, seed, n_cycles=10, rate_hz=10.0, peak_N=3.0, sa=0.25
     return data, math.hypot(sa, math.degrees(c / arm) * sf)
 
 
+def _exp_compliance_tension(e, c, d, f0):
+    """N: a tendon whose elongation is c T + d (1 - exp(-T / f0)): extra compliance d / f0 at zero force, fading
+    (finite stiffness at zero force), inverted on a grid of tensions."""
+    t = np.concatenate([[0.0], np.geomspace(1e-7, 50.0, 20001)])
+    return np.interp(e, c * t + d * -np.expm1(-t / f0), t)
+
+
+def _fung_tension(e, c, b):
+    """N: Fung's exponential law T = (exp(b e) - 1) / (b C0), its stiffness exp(b e) / C0 finite at zero force and
+    capped at 1 / C (then linear), C0 = 3 C."""
+    c0 = 3.0 * c
+    e_cap = math.log(c0 / c) / b
+    t_cap = (math.exp(b * e_cap) - 1.0) / (b * c0)
+    return np.where(e < e_cap, np.expm1(b * np.minimum(e, e_cap)) / (b * c0), t_cap + (e - e_cap) / c)
+
+
+@pytest.mark.parametrize("form", ["exponential compliance", "fung"])
+def test_diagnosis_on_toes_stiff_at_zero_force(tube2, form):
+    """Toes that start at a finite stiffness (no toe_shape: its stiffness starts at zero): a toe of the family is
+    recommended, alone, and reaches the floor."""
+    law = {"exponential compliance": lambda e, c: _exp_compliance_tension(e, c, 0.08, 0.7),
+           "fung": lambda e, c: _fung_tension(e, c, 12.0)}[form]
+    data, floor = _generate(tube2, law, seed=23)
+    d = diagnose(model_for_pattern(tube2), data, ("E_t",), pattern_values(tube2))
+    toes = {e.name for e in builtin_registry().effects if e.family == "toe"}
+    assert len(d.recommended) == 1 and d.recommended[0] in toes, (d.recommended, d.stop_reason)
+    assert d.final.rmse_deg <= 1.15 * floor, (d.final.rmse_deg, floor)
+
 @pytest.mark.parametrize("form", ["logistic", "cubic"])
 def test_diagnosis_on_a_toe_form_the_library_does_not_have(tube2, form):
     law = {"logistic": lambda e, c: _logistic_tension(e, c, 0.15, 0.05),
@@ -150,9 +208,10 @@ def test_diagnosis_on_a_toe_form_the_library_does_not_have(tube2, form):
     data, floor = _generate(tube2, law, seed=11)
     d = diagnose(model_for_pattern(tube2), data, ("E_t",), pattern_values(tube2))
     first = d.candidates[0]
-    assert {"toe", "toe_shape"} & ({first.effect} | set(first.equivalent)), [c.effect for c in d.candidates[:4]]
+    toes = {e.name for e in builtin_registry().effects if e.family == "toe"}   # toe, toe_shape, toe_soft
+    assert toes & ({first.effect} | set(first.equivalent)), [c.effect for c in d.candidates[:4]]
     # one effect was hidden: one is recommended (no spurious offset on top), and it reaches the floor
-    assert len(d.recommended) == 1 and d.recommended[0] in ("toe", "toe_shape"), (d.recommended, d.stop_reason)
+    assert len(d.recommended) == 1 and d.recommended[0] in toes, (d.recommended, d.stop_reason)
     assert d.final.rmse_deg < 0.5 * d.waterfall[0].rmse_deg
     assert d.final.rmse_deg <= 1.15 * floor, (d.final.rmse_deg, floor)
     for name, se in d.final.stderr.items():

@@ -9,7 +9,7 @@ from __future__ import annotations
 from camtube.model.effects.builtin import (  # noqa: F401
     ANGLE_BIAS, BUILTIN_EFFECTS, BUILTINS, CARRIAGE_GAP, CARRIAGE_HOLD, CHORDS, CREEP, FLAT_WALLS, FORCE_ZERO, FRICTION, HARDSTOP, KERF,
     PLAY,
-    SERIES, SLACK, TOE, TOE_SHAPE, VISCOELASTIC,
+    SERIES, SLACK, TOE, TOE_SHAPE, TOE_SOFT, VISCOELASTIC,
 )
 from camtube.model.effects.builtin import _flat_wall_ybar  # noqa: F401  (tests check it)
 from camtube.model.effects.history import carriage_hold, first_order_lag, monotone_segments, play_operator  # noqa: F401

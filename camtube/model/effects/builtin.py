@@ -21,6 +21,8 @@ friction       elongation  tendon-sheath friction: mean tension differs from the
 toe            elongation  toe region of the tendon (quadratic, then linear) (toe_mm)
 toe_shape      elongation  toe region of fitted shape: Weibull fibre recruitment, at a short force
                            average (offset_mm, shape)
+toe_soft       elongation  toe region that starts at a share of the stiffness: straight fibres carry load from
+                           zero force, the crimped ones straighten as toe_shape's (offset_mm, shape, share)
 viscoelastic   elongation  standard linear solid: delayed elongation (ratio, tau_s)
 series         elongation  extra series compliance: sheath/tube compression (compliance_mm_per_N)
 kerf           kinematics  notch arc widened by the kerf: phi, hence the arm, change (kerf_mm)
@@ -704,6 +706,57 @@ TOE_SHAPE = Effect(
 )
 
 
+
+def _toe_soft(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
+    from scipy.special import gamma
+
+    offset = max(p["offset_mm"], 0.0)
+    k = p["shape"]
+    share = min(max(p["share"], 0.0), 0.999)
+    if offset <= 0.0:
+        return elong
+    c = ctx.compliance_mm_per_N
+    m = float(gamma(1.0 + 1.0 / k))         # mean straightening elongation of a crimped fibre, in Weibull scales
+    lam = offset / ((1.0 - share) * m)       # Weibull scale (mm): the crimped share's mean is the offset over (1 - share)
+
+    def extra(f: np.ndarray) -> np.ndarray:
+        t_max = c * max(float(f.max(initial=0.0)), 0.0) / lam
+        if t_max <= 0.0:
+            return np.zeros(f.shape)
+        # the stiffness fraction at normalised elongation x is share + (1 - share)(1 - exp(-x^shape)), so the
+        # normalised tension is share x + (1 - share) tau_w(x) (tau_w: toe_shape's law); it is at least
+        # x - (1 - share) m, so toe_shape's table up to t_max + m + 1 covers every row
+        q = np.arange(TOE_GRID + 1) / TOE_GRID
+        xg, tg = _toe_table(k, t_max + m + 1.0)
+        xj = np.interp(t_max * q**2, share * xg + (1.0 - share) * tg, xg)
+        return toe_rows(np.asarray(f, float), c, lam, t_max, xj)  # 0 .. offset_mm
+
+    return toe_elongation(ctx, elong, extra, key=("toe_soft", c, offset, k, share))
+
+
+TOE_SOFT = Effect(
+    name="toe_soft", stage="elongation", pure=True,
+    params=(Param("offset_mm", "mm", 1e-3, 5.0, lambda d, c: 0.03 * _stroke_span(d),
+                  "elongation the toe adds once every fibre is straight: the linear part of the law is shifted by it",
+                  log=True, kind="length"),
+            Param("shape", "", 0.5, 10.0, 1.5,
+                  "Weibull modulus of the crimped fibres' straightening elongations (as toe_shape's)",
+                  log=True, starts=(0.8, 1.5, 3.5)),
+            Param("share", "", 0.02, 0.98, 0.5,
+                  "share of the tendon's stiffness that carries load from zero force (its straight fibres): the "
+                  "tendon starts at this share of E_t, never slack",
+                  starts=(0.2, 0.5, 0.8))),
+    apply=_toe_soft,
+    meaning="toe region that starts stiff: part of the tendon (a straight core, fibres without crimp) carries load "
+            "from zero force, so the tendon starts at a share of its stiffness and stiffens to E_t as the crimped "
+            "fibres straighten one after another (Weibull); an exponential or Fung-type toe, soft but never slack",
+    signature="the residual is curved against force: it moves quickly at low force and is constant at "
+              "high force (the tendon stretches more than linear at the start), without a deadband",
+    family="toe",
+    off={"offset_mm": 1e-3},
+)
+
+
 VISCOELASTIC = Effect(
     name="viscoelastic", stage="elongation", pure=True,
     params=(Param("ratio", "", 0.0, 20.0, 0.1,
@@ -1047,7 +1100,7 @@ FORCE_ZERO = Effect(
 )
 
 #: The built-in effects, in their documented order.
-BUILTIN_EFFECTS = (SLACK, PLAY, CARRIAGE_HOLD, CARRIAGE_GAP, CREEP, CREEP_LOAD, FRICTION, CAPSTAN, TOE, TOE_SHAPE, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
+BUILTIN_EFFECTS = (SLACK, PLAY, CARRIAGE_HOLD, CARRIAGE_GAP, CREEP, CREEP_LOAD, FRICTION, CAPSTAN, TOE, TOE_SHAPE, TOE_SOFT, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
                    HARDSTOP, REST_ANGLE, RELAXATION, RELAXATION2, ANGLE_BIAS, FORCE_ZERO)
 #: Built-in effect names in that order.
 BUILTINS = tuple(e.name for e in BUILTIN_EFFECTS)

@@ -268,6 +268,7 @@ SIDES = {
                     "carriage, not in the tendon); a displacement gauge on the carriage would measure it",
     "toe": "tendon (its fibres straighten one after another)",
     "toe_shape": "tendon (its fibres straighten one after another)",
+    "toe_soft": "tendon (part of it carries load from zero force, the crimped fibres straighten one after another)",
     "creep": "tendon (it lengthens under load); a drifting load-cell zero also grows with time: the rests at zero "
              "stroke show it (the instruments' line on the load cell's zero), and so does a re-zero with the tendon "
              "unloaded after the test",
