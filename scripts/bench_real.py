@@ -40,7 +40,7 @@ FAMILIES = {
     "control": (set(), None),
     "toe": (TOES, None),
     "slack": ({"slack"}, None),
-    "lost motion": ({"slack", "play", "carriage_hold", "carriage_gap"}, None),  # the drive: a carriage its rail holds, or backlash
+    "lost motion": ({"slack", "play", "play_held", "carriage_hold", "carriage_gap"}, None),  # the drive: a carriage its rail holds, or backlash
     "creep": ({"creep", "creep_load", "viscoelastic"}, None),  # a slow viscoelastic element and creep: known equivalents
     "backbone": ({"relaxation", "relaxation2"}, None),  # the backbone relaxing: one arm or two (its set: the baseline's rest_angle)
     "backbone3": ({"relaxation", "relaxation2"}, None),  # a backbone with three arms: the same family

@@ -22,6 +22,6 @@ from __future__ import annotations
 
 #: Names of the built-in effects, for ``--help`` without importing the effect code
 #: (a test checks it against :data:`camtube.model.effects.BUILTINS`).
-EFFECT_NAMES = ("slack", "play", "carriage_hold", "carriage_gap", "creep", "creep_load", "friction", "capstan", "toe", "toe_shape", "toe_soft", "viscoelastic", "series", "kerf", "flat_walls",
+EFFECT_NAMES = ("slack", "play", "play_held", "carriage_hold", "carriage_gap", "creep", "creep_load", "friction", "capstan", "toe", "toe_shape", "toe_soft", "viscoelastic", "series", "kerf", "flat_walls",
                 "chords", "hardstop", "rest_angle", "relaxation", "relaxation2", "angle_bias",
                 "force_zero")

@@ -59,7 +59,7 @@ BATCHES = {"first": (FIRST, FIRST_SEED), "fresh": (FRESH, FRESH_SEED)}
 
 #: The effects of the library that are the right answer for each mechanism (empty: none is).
 FAM = {"toe": {"toe", "toe_shape", "toe_soft"}, "slack": {"slack"},
-       "lost_motion": {"slack", "play", "carriage_hold", "carriage_gap"},
+       "lost_motion": {"slack", "play", "play_held", "carriage_hold", "carriage_gap"},
        "creep": {"creep", "creep_load", "viscoelastic"}, "relaxation": {"relaxation", "relaxation2"},
        "capstan": {"friction", "capstan"}, "fz_drift": set(), "lag": set(), "az_drift": set(), None: set()}
 

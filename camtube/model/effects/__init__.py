@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from camtube.model.effects.builtin import (  # noqa: F401
     ANGLE_BIAS, BUILTIN_EFFECTS, BUILTINS, CARRIAGE_GAP, CARRIAGE_HOLD, CHORDS, CREEP, FLAT_WALLS, FORCE_ZERO, FRICTION, HARDSTOP, KERF,
-    PLAY,
+    PLAY, PLAY_HELD,
     SERIES, SLACK, TOE, TOE_SHAPE, TOE_SOFT, VISCOELASTIC,
 )
 from camtube.model.effects.builtin import _flat_wall_ybar  # noqa: F401  (tests check it)

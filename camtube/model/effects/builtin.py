@@ -9,6 +9,8 @@ name           stage       physics (parameters)
 =============  ==========  =====================================================
 slack          stroke      tendon slack: a deadband at low stroke (deadband_mm)
 play           stroke      lost motion in the drive, direction dependent (play_mm)
+play_held      stroke      the same with the carriage held by its rail: it stands a gap above the motor after an
+                           unloading (play_mm)
 carriage_hold  stroke      lost motion in the drive: the rail's friction holds the carriage while the tension
                            is low, until it lets go (ratio: the friction over the tension held at rest)
 carriage_gap   stroke      the same within a nut's gap that binds: the far flank pushes the held carriage down
@@ -161,6 +163,31 @@ PLAY = Effect(
     off={"play_mm": 0.0},
 )
 
+
+
+def _play_held(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
+    # the carriage moves only when a flank of the nut pushes it: play's operator referred to the pushing flank (a gap
+    # above play's), so it starts on the motor and, after an unloading, stands a gap above it
+    w = p["play_mm"]
+    return np.maximum(play_operator(ctx.data, stroke, w) + w, 0.0)
+
+
+PLAY_HELD = Effect(
+    name="play_held", stage="stroke", pure=True,
+    params=(Param("play_mm", "mm", 0.0, 10.0, lambda d, c: 0.02 * _stroke_span(d),
+                  "the nut's gap: how far the motor moves after a reversal before the carriage follows",
+                  kind="length"),),
+    apply=_play_held,
+    family="drive",
+    meaning="lost motion in the drive, with the carriage held by its rail: it moves only when a flank of the "
+            "nut pushes it, so after each unloading it stands a gap above the motor (the tendon keeps that "
+            "stroke while the motor rests at zero) and the next pull moves the motor through the gap first",
+    signature="the residual flips sign with the direction of motion, with a constant size, and the joint stays "
+              "bent after each unloading while the motor rests at zero; the first pull, before any unloading, "
+              "differs",
+    history=True,
+    off={"play_mm": 0.0},
+)
 
 def _bottom_tension_N(s: np.ndarray, f: np.ndarray) -> float:
     """The tension the tendon keeps while the motor stands at the bottom of its stroke ``s`` (the 90th percentile
@@ -1100,7 +1127,7 @@ FORCE_ZERO = Effect(
 )
 
 #: The built-in effects, in their documented order.
-BUILTIN_EFFECTS = (SLACK, PLAY, CARRIAGE_HOLD, CARRIAGE_GAP, CREEP, CREEP_LOAD, FRICTION, CAPSTAN, TOE, TOE_SHAPE, TOE_SOFT, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
+BUILTIN_EFFECTS = (SLACK, PLAY, PLAY_HELD, CARRIAGE_HOLD, CARRIAGE_GAP, CREEP, CREEP_LOAD, FRICTION, CAPSTAN, TOE, TOE_SHAPE, TOE_SOFT, VISCOELASTIC, SERIES, KERF, FLAT_WALLS, CHORDS,
                    HARDSTOP, REST_ANGLE, RELAXATION, RELAXATION2, ANGLE_BIAS, FORCE_ZERO)
 #: Built-in effect names in that order.
 BUILTINS = tuple(e.name for e in BUILTIN_EFFECTS)

@@ -260,6 +260,8 @@ SIDES = {
              "differs)",
     "play": "drive (lost motion between the motor and the carriage) or a tendon that slips at the guide; a "
             "displacement gauge on the carriage would tell",
+    "play_held": "drive (the nut's gap, with the carriage held by its rail: lost motion between the motor and the "
+                 "carriage, not in the tendon); a displacement gauge on the carriage would measure it",
     "carriage_hold": "drive (the rail's friction holds the carriage within the nut's gap while the tendon's tension "
                      "is low: lost motion between the motor and the carriage, not in the tendon); a displacement "
                      "gauge on the carriage would measure it",
