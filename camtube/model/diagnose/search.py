@@ -1076,7 +1076,8 @@ class Search:
         self.retry_pool: list[Effect] = []
         self.stop = ""
         #: the chain once its first effect was chosen (model, names, per-sample names, search fit, held-out RMSE,
-        #: block MSE): where the samples' stiffness is tested besides the model as given (:meth:`stiffness_differs`)
+        #: block MSE, held values then): where the samples' stiffness is tested besides the model as given
+        #: (:meth:`stiffness_differs`)
         self.first_chain: tuple | None = None
 
     def _fx(self, model: JointModel, held: Mapping[str, float] | None = None) -> dict:
@@ -1622,7 +1623,8 @@ class Search:
         self._refit_search(c.values)
         ch.heldout_rmse_deg, ch.block_mse = c.heldout_rmse_deg, c.block_mse
         if self.first_chain is None:
-            self.first_chain = (ch.current, ch.names, list(ch.per_sample), ch.fit, ch.heldout_rmse_deg, ch.block_mse)
+            self.first_chain = (ch.current, ch.names, list(ch.per_sample), ch.fit, ch.heldout_rmse_deg, ch.block_mse,
+                                self._fx(ch.current))
         # the next round tries only the effects that helped in this one (held-out RMSE down by min_gain):
         # one that explained nothing on the simpler model is not retried (speed; see the module docstring)
         useful = {x.effect for x in ranked if x.heldout_rmse_deg <= (1.0 - self.settings.min_gain) * ranked_base_ho}
@@ -2129,12 +2131,16 @@ class Search:
             return ""
 
         def lowers(model: JointModel, names: tuple, ps: Sequence[str], fit: FitResult, ho0: float,
-                   mse0: np.ndarray) -> float | None:
-            """The held-out RMSE with E_t per sample when it passes the tests, else None."""
-            fx = self._fx(model)
+                   mse0: np.ndarray, fx: dict | None = None) -> float | None:
+            """The held-out RMSE with E_t per sample when it passes the tests, else None (``fx``: the values held
+            when that chain was the search's; default: those held now)."""
+            fx = self._fx(model) if fx is None else fx
             trial = list(ps) + ["E_t"]
-            f = _search_fit(model, self.search, names, fit.params, fx, per_sample=trial)
-            ho, mse = _cv(model, self.search, names, f.params, fx, self.fold, self.block, per_sample=trial)
+            try:
+                f = _search_fit(model, self.search, names, fit.params, fx, per_sample=trial)
+                ho, mse = _cv(model, self.search, names, f.params, fx, self.fold, self.block, per_sample=trial)
+            except FitError:   # (a test of the samples' stiffness that cannot be fitted tells nothing)
+                return None
             excess = ho0 ** 2 - self.floor ** 2
             ok = (_significant(_gain_zs(mse0, mse, self.strata), s.z) and f.bic - fit.bic < -s.bic_threshold
                   and ho <= (1.0 - s.min_gain) * ho0 and ho ** 2 - self.floor ** 2 <= (1.0 - STIFFNESS_SHARE) * excess)
