@@ -3,6 +3,7 @@ them by issue 19's acceptance.
 
     python scripts/indep_bench/run.py first OUTDIR    # the batch that found the samples' stiffness and the wandering zero
     python scripts/indep_bench/run.py fresh OUTDIR    # the fresh batch drawn once those were settled (h01-h14)
+    python scripts/indep_bench/run.py fresh2 OUTDIR   # the second fresh batch (g01-g14), drawn after toe_soft, play_held
     python scripts/indep_bench/run.py score OUTDIR    # score what is in OUTDIR again
 
 Each file: two samples of about 30,000 rows, 25-100 Hz, 50 cycles; ``NAME.csv`` with ``NAME.truth.json`` (the
@@ -55,7 +56,23 @@ FRESH = [
     ("h14_mix_toe_lost", "tube3", "toe", [], "lost_motion", 0.0),
 ]
 FRESH_SEED = 7001
-BATCHES = {"first": (FIRST, FIRST_SEED), "fresh": (FRESH, FRESH_SEED)}
+#: Drawn once toe_soft, play_held, the per-sample tries by family and the samples' stiffness on the first chain were
+#: settled (the session of 2026-12-08): new seeds, other tubes and pairings, two weak mechanisms in one file.
+FRESH2 = [
+    ("g01_control_et", "tube3", None, [], None, 0.03), ("g02_control", "tube1", None, [], None, 0.0),
+    ("g03_toe", "tube1", "toe", ["creep"], None, 0.03), ("g04_slack", "tube3", "slack", ["toe"], None, 0.0),
+    ("g05_lostmotion", "tube2", "lost_motion", ["capstan"], None, 0.03),
+    ("g06_creep", "tube1", "creep", ["slack", "fz_drift"], None, 0.0),
+    ("g07_relax", "tube2", "relaxation", ["creep"], None, 0.0),
+    ("g08_capstan", "tube3", "capstan", ["relaxation"], None, 0.03),
+    ("g09_fzdrift", "tube3", "fz_drift", ["creep"], None, 0.0), ("g10_lag", "tube1", "lag", ["toe"], None, 0.0),
+    ("g11_azdrift", "tube2", "az_drift", ["slack"], None, 0.03),
+    ("g12_mix_lost_toe", "tube1", "lost_motion", [], "toe", 0.0),
+    ("g13_mix_creep_relax", "tube3", "creep", [], "relaxation", 0.0),
+    ("g14_mix_capstan_slack", "tube2", "capstan", [], "slack", 0.03),
+]
+FRESH2_SEED = 9001
+BATCHES = {"first": (FIRST, FIRST_SEED), "fresh": (FRESH, FRESH_SEED), "fresh2": (FRESH2, FRESH2_SEED)}
 
 #: The effects of the library that are the right answer for each mechanism (empty: none is).
 FAM = {"toe": {"toe", "toe_shape", "toe_soft"}, "slack": {"slack"},
@@ -121,14 +138,16 @@ def score(outdir: Path) -> int:
             ok = not wrong and found
         m = re.search(r"set aside counted: RMSE ([\d.]+) -> ([\d.]+) deg", txt)
         rows.append((name, t["tube"], int(t["rate"]), "/".join(str(x) for x in doms), ",".join(rec) or "-",
-                     d.get("explanation") or "-", ratio, ok, float(m.group(2)) / t["floor_with_spikes"] if m else float("nan")))
-    print("| file | tube | Hz | dominant | recommended | label | final / true floor | w/ artefacts | right |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    for name, tube, rate, dom, rec, label, ratio, ok, ratio_all in rows:
-        print(f"| {name} | {tube} | {rate} | {dom} | {rec} | {label} | {ratio:.2f} | {ratio_all:.2f} | "
+                     d.get("explanation") or "-", ratio, ok, float(m.group(2)) / t["floor_with_spikes"] if m else float("nan"),
+                     d["noise_floor_deg"] / t["floor_no_spikes"]))
+    print("| file | tube | Hz | dominant | recommended | label | final / true floor | w/ artefacts | floor est / true | right |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for name, tube, rate, dom, rec, label, ratio, ok, ratio_all, fl in rows:
+        print(f"| {name} | {tube} | {rate} | {dom} | {rec} | {label} | {ratio:.2f} | {ratio_all:.2f} | {fl:.2f} | "
               f"{'RIGHT' if ok else 'wrong'} |")
     right = sum(r[7] for r in rows)
-    print(f"\n{right} of {len(rows)} right")
+    floors = sum(abs(r[9] - 1.0) <= 0.2 for r in rows)
+    print(f"\n{right} of {len(rows)} right; the noise floor within 20 % of the true one in {floors} of {len(rows)}")
     return 0
 
 
