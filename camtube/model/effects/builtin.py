@@ -686,16 +686,17 @@ def _kept_toe_rows(ctx: Context, f: np.ndarray, key: tuple, compute: Callable[[]
     return recently_used(hit[1], key, lambda: _read_only(compute()), TOE_ROWS_KEPT)
 
 
-def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
+def _weibull_toe(ctx: Context, elong: np.ndarray, offset_mm: float, k: float, share: float, name: str) -> np.ndarray:
+    """``elong`` plus the toe of a tendon whose crimped fibres straighten at Weibull-distributed elongations (modulus
+    ``k``) and whose straight ``share`` of the stiffness carries load from zero force (``toe_shape``: none), the linear
+    law shifted by ``offset_mm`` at high force; ``name`` keys its rows (:func:`toe_elongation`)."""
     from scipy.special import gamma
 
-    mean = max(p["offset_mm"], 0.0)
-    k = p["shape"]
-    if mean <= 0.0:
+    if offset_mm <= 0.0:
         return elong
     c = ctx.compliance_mm_per_N
-    m = float(gamma(1.0 + 1.0 / k))        # mean straightening elongation in units of the Weibull scale
-    lam = mean / m                          # Weibull scale (mm)
+    m = float(gamma(1.0 + 1.0 / k))         # mean straightening elongation of a crimped fibre, in Weibull scales
+    lam = offset_mm / ((1.0 - share) * m)    # Weibull scale (mm): the crimped share's mean is the offset over (1 - share)
 
     def extra(f: np.ndarray) -> np.ndarray:
         # normalised tension tau = c f / lam (the linear tendon's elongation / lam); its largest value is that of the
@@ -703,15 +704,20 @@ def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
         t_max = c * max(float(f.max(initial=0.0)), 0.0) / lam
         if t_max <= 0.0:
             return np.zeros(f.shape)
-        # tabulate tau(x) once, invert by interpolation; tau(x) >= x - m, so x_max covers every row
+        # the stiffness fraction at normalised elongation x is share + (1 - share)(1 - exp(-x^k)), so the normalised
+        # tension is share x + (1 - share) tau_w(x) (tau_w: weibull_toe_force; with no share, tau_w itself, to the
+        # bit); it is at least x - m, so a table up to t_max + m + 1 covers every row. Tabulated once, inverted by
+        # interpolation. speed: x on a grid uniform in sqrt(tau) (one small interp), then the rows in one compiled pass
         q = np.arange(TOE_GRID + 1) / TOE_GRID
         xg, tg = _toe_table(k, t_max + m + 1.0)
-        # speed: x on a grid uniform in sqrt(tau) (one small interp), then the rows in one compiled pass
-        xj = np.interp(t_max * q**2, tg, xg)
+        xj = np.interp(t_max * q**2, share * xg + (1.0 - share) * tg, xg)
         return toe_rows(np.asarray(f, float), c, lam, t_max, xj)  # 0 .. offset_mm
 
-    return toe_elongation(ctx, elong, extra, key=("toe_shape", c, mean, k))
+    return toe_elongation(ctx, elong, extra, key=(name, c, offset_mm, k, share))
 
+
+def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
+    return _weibull_toe(ctx, elong, max(p["offset_mm"], 0.0), p["shape"], 0.0, "toe_shape")
 
 TOE_SHAPE = Effect(
     name="toe_shape", stage="elongation", pure=True,
@@ -733,33 +739,8 @@ TOE_SHAPE = Effect(
 )
 
 
-
 def _toe_soft(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
-    from scipy.special import gamma
-
-    offset = max(p["offset_mm"], 0.0)
-    k = p["shape"]
-    share = min(max(p["share"], 0.0), 0.999)
-    if offset <= 0.0:
-        return elong
-    c = ctx.compliance_mm_per_N
-    m = float(gamma(1.0 + 1.0 / k))         # mean straightening elongation of a crimped fibre, in Weibull scales
-    lam = offset / ((1.0 - share) * m)       # Weibull scale (mm): the crimped share's mean is the offset over (1 - share)
-
-    def extra(f: np.ndarray) -> np.ndarray:
-        t_max = c * max(float(f.max(initial=0.0)), 0.0) / lam
-        if t_max <= 0.0:
-            return np.zeros(f.shape)
-        # the stiffness fraction at normalised elongation x is share + (1 - share)(1 - exp(-x^shape)), so the
-        # normalised tension is share x + (1 - share) tau_w(x) (tau_w: toe_shape's law); it is at least
-        # x - (1 - share) m, so toe_shape's table up to t_max + m + 1 covers every row
-        q = np.arange(TOE_GRID + 1) / TOE_GRID
-        xg, tg = _toe_table(k, t_max + m + 1.0)
-        xj = np.interp(t_max * q**2, share * xg + (1.0 - share) * tg, xg)
-        return toe_rows(np.asarray(f, float), c, lam, t_max, xj)  # 0 .. offset_mm
-
-    return toe_elongation(ctx, elong, extra, key=("toe_soft", c, offset, k, share))
-
+    return _weibull_toe(ctx, elong, max(p["offset_mm"], 0.0), p["shape"], min(max(p["share"], 0.0), 0.999), "toe_soft")
 
 TOE_SOFT = Effect(
     name="toe_soft", stage="elongation", pure=True,
