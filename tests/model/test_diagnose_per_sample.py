@@ -533,24 +533,3 @@ def test_the_stiffness_test_on_the_first_chain_holds_what_was_held_then():
     # the fit refused the copy and the diagnosis ended in a traceback)
     note = search.stiffness_differs(d)
     assert "(the model with slack)" in note, note
-
-def test_a_further_form_of_one_family_does_not_push_another_family_out_of_the_per_sample_tries():
-    """The per-sample tries are counted in families: three toe laws at the top leave room for three more families
-    (a backbone's relaxation shown by one sample only was pushed out by a second toe law, and nothing was
-    recommended at 9x the floor)."""
-    from camtube.model.diagnose.search import PER_SAMPLE_TRIES, _per_sample_tries
-
-    reg = builtin_registry()
-    order = ["toe", "toe_shape", "toe_soft", "viscoelastic", "capstan", "relaxation", "kerf", "slack"]
-    fits = [[reg.get(name), None, reg.get(name).full_names(), None, 1.0 + 0.1 * i, None, ()]
-            for i, name in enumerate(reversed(order))]          # given in another order than held-out
-    fits.append([reg.get("flat_walls"), None, (), None, 0.5, None, ()])   # no parameters: nothing per sample
-    tried = [row[0].name for row in _per_sample_tries(fits)]
-    assert PER_SAMPLE_TRIES == 4 and tried == ["slack", "kerf", "relaxation", "capstan"], tried
-    fits_toes_first = sorted(fits, key=lambda r: -r[4])
-    for k, row in enumerate(fits_toes_first):
-        row[4] = 1.0 + 0.1 * k                                    # toe best, slack worst
-    tried = [row[0].name for row in _per_sample_tries(fits_toes_first)]
-    families = {reg.get(n).family or n for n in tried}
-    assert tried[:3] == ["toe", "toe_shape", "toe_soft"] and len(families) == PER_SAMPLE_TRIES, tried
-    assert "relaxation" in tried and "kerf" not in tried, tried

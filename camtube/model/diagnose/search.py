@@ -160,9 +160,8 @@ PARTIAL_RATIO = 1.5
 #: (99.96 %) and 17x -> 2.0x (98.6 %) (bench-heldout54).
 PARTIAL_SHARE_FAR = 0.98
 PARTIAL_RATIO_FAR = 3.0
-#: Families of candidates (best held-out first) also tried with per-sample parameters in each round (see
-#: :func:`_per_sample_tries`): samples that differ a lot make the shared version of the right effect rank low (two
-#: slacks 4x apart), so more than the top two.
+#: Candidates (best held-out first) also tried with per-sample parameters in each round: samples that differ
+#: a lot make the shared version of the right effect rank low (two slacks 4x apart), so more than the top two.
 PER_SAMPLE_TRIES = 4
 #: Solver steps (per start) a candidate's refit on all rows may take: one that needs more has a direction the
 #: data barely resolve (an effect that trades with E_t); the refits of accepted candidates take 4-20.
@@ -1409,7 +1408,7 @@ class Search:
                 self.cand_held[(eff.name, ())] = held
             fits.append([eff, m, eff.full_names(), f, ho, mse, ()])
         if try_per_sample:
-            tries = _per_sample_tries(fits)
+            tries = sorted([r for r in fits if r[2]], key=lambda r: r[4])[:PER_SAMPLE_TRIES]
             # the tries are independent: one per core
             for row, got in zip(tries, self._forked_fits(lambda i: self._per_sample_try(tries[i]),
                                                          [r[1] for r in tries])):
@@ -2266,22 +2265,6 @@ def _modulus_values(d: Diagnosis) -> str:
     vals = {k.split("@")[1]: v for k, v in d.final.params.items() if k.startswith("E_t@")}
     return f"; E_t {', '.join(f'{smp} {v:.3g}' for smp, v in vals.items())} GPa" if vals else ""
 
-
-def _per_sample_tries(fits: list) -> list:
-    """The rows of :meth:`Search._fit_candidates` whose effects are also fitted per sample: by held-out RMSE, those of
-    the best :data:`PER_SAMPLE_TRIES` families (an effect without a family is its own), every member of a family
-    before the last family's first (a further form of one family does not push another family's effect out: a
-    second toe law put a backbone's relaxation, shown by one sample only, out of the tries, and nothing was
-    recommended at 9x the floor)."""
-    tries, families = [], set()
-    for row in sorted([r for r in fits if r[2]], key=lambda r: r[4]):
-        fam = row[0].family or row[0].name
-        if fam not in families:
-            if len(families) == PER_SAMPLE_TRIES:
-                break
-            families.add(fam)
-        tries.append(row)
-    return tries
 
 def _sample_notes(model: JointModel, r: FitResult, samples: Sequence[str], ps: Sequence[str]) -> list[str]:
     """Which samples differ in each per-sample parameter (values more than three combined errors apart)."""
