@@ -2120,20 +2120,19 @@ class Search:
         in time; 0.7 % was read as a toe, complete at 1.12x (an independent bench simulator).
         With several samples and E_t fitted and shared, tried on the model as given (an effect of a complete answer
         may stand in for it), on the chain with its first effect and, where the answer is not complete, on the final
-        chain: on the search rows E_t per
-        sample must lower the held-out error significantly (``z``), by ``min_gain``, with a BIC lower by
-        ``bic_threshold``, and explain :data:`STIFFNESS_SHARE` of the held-out misfit above the floor (a joint whose
-        moment arm changes with the angle, beyond the library, was read as moduli 0.3 % apart explaining a quarter).
+        chain: on the search rows E_t per sample must lower the held-out error significantly (``z``), by
+        ``min_gain``, with a BIC lower by ``bic_threshold``, and explain :data:`STIFFNESS_SHARE` of the held-out
+        misfit above the floor (a joint whose moment arm changes with the angle, beyond the library, was read as
+        moduli 0.3 % apart explaining a quarter).
         """
         s, ch = self.settings, self.chain
         if not s.per_sample or len(self.data.samples) < 2 or "E_t" not in self.base_names or "E_t" in self.base_ps:
             return ""
 
         def lowers(model: JointModel, names: tuple, ps: Sequence[str], fit: FitResult, ho0: float,
-                   mse0: np.ndarray, fx: dict | None = None) -> float | None:
+                   mse0: np.ndarray, fx: dict) -> float | None:
             """The held-out RMSE with E_t per sample when it passes the tests, else None (``fx``: the values held
-            when that chain was the search's; default: those held now)."""
-            fx = self._fx(model) if fx is None else fx
+            while that chain was the search's)."""
             trial = list(ps) + ["E_t"]
             try:
                 f = _search_fit(model, self.search, names, fit.params, fx, per_sample=trial)
@@ -2145,28 +2144,27 @@ class Search:
                   and ho <= (1.0 - s.min_gain) * ho0 and ho ** 2 - self.floor ** 2 <= (1.0 - STIFFNESS_SHARE) * excess)
             return ho if ok else None
 
-        # the model as given (a complete answer may have an effect standing in for the samples' stiffness: a toe
-        # took a control's 6 % at 1.12x the floor), the chain with its first effect (where that effect is most of
-        # the misfit, the samples' stiffness is less than half of it on the model as given: slack beside moduli
-        # 1.8 % apart, read as a viscoelastic tendon per sample), then the final chain where the answer is not
-        # complete
-        tries = [(self.given_model, self.base_names, self.base_ps, self.base_fit, self.base_ho, self.base_mse)]
+        # ``(where, chain)`` in turn: the model as given (a complete answer may have an effect standing in for the
+        # samples' stiffness: a toe took a control's 6 % at 1.12x the floor), the chain with its first effect (where
+        # that effect is most of the misfit, the samples' stiffness is less than half of it on the model as given:
+        # slack beside moduli 1.8 % apart, read as a viscoelastic tendon per sample), then the final chain where the
+        # answer is not complete
+        given = self.given_model
+        tries = [(" (the model as given)", (given, self.base_names, self.base_ps, self.base_fit, self.base_ho,
+                                             self.base_mse, self._fx(given)))]
         first = self.first_chain
-        if first is not None and first[0] is not self.given_model and first[0] is not ch.current:
-            tries.append(first)
-        if d.explanation != "complete" and ch.current is not self.given_model:
-            tries.append((ch.current, ch.names, ch.per_sample, ch.fit, ch.heldout_rmse_deg, ch.block_mse))
-        for args in tries:
-            model, ho0 = args[0], args[4]
-            ho = lowers(*args)
+        if first is not None and first[0] is not ch.current:
+            added = ", ".join(e.name for e in first[0].effects if e not in given.effects)
+            tries.append((f" (the model with {added})", first))
+        if d.explanation != "complete" and ch.current is not given:
+            tries.append(("", (ch.current, ch.names, ch.per_sample, ch.fit, ch.heldout_rmse_deg, ch.block_mse,
+                               self._fx(ch.current))))
+        for where, chain in tries:
+            ho = lowers(*chain)
             if ho is not None:
-                where = (" (the model as given)" if model is self.given_model else
-                         f" (the model with {', '.join(e.name for e in model.effects if e not in self.given_model.effects)})"
-                         if first is not None and model is first[0] else "")
                 return (f"the samples' tendons differ in stiffness: with E_t per sample the held-out RMSE falls from "
-                        f"{ho0:.3f} to {ho:.3f} deg{where}, so the "
-                        "search ran again with E_t per sample from the start (each tube tied with its own tendon: "
-                        "another length L0 or make; --per-sample E_t)")
+                        f"{chain[4]:.3f} to {ho:.3f} deg{where}, so the search ran again with E_t per sample from the "
+                        "start (each tube tied with its own tendon: another length L0 or make; --per-sample E_t)")
         return ""
 
     def _notes(self) -> tuple[list[str], list[str]]:

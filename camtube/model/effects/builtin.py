@@ -164,7 +164,6 @@ PLAY = Effect(
 )
 
 
-
 def _play_held(ctx: Context, stroke: np.ndarray, p: dict) -> np.ndarray:
     # the carriage moves only when a flank of the nut pushes it: play's operator referred to the pushing flank (a gap
     # above play's), so it starts on the motor and, after an unloading, stands a gap above it
@@ -188,6 +187,7 @@ PLAY_HELD = Effect(
     history=True,
     off={"play_mm": 0.0},
 )
+
 
 def _bottom_tension_N(s: np.ndarray, f: np.ndarray) -> float:
     """The tension the tendon keeps while the motor stands at the bottom of its stroke ``s`` (the 90th percentile
@@ -689,7 +689,8 @@ def _kept_toe_rows(ctx: Context, f: np.ndarray, key: tuple, compute: Callable[[]
 def _weibull_toe(ctx: Context, elong: np.ndarray, offset_mm: float, k: float, share: float, name: str) -> np.ndarray:
     """``elong`` plus the toe of a tendon whose crimped fibres straighten at Weibull-distributed elongations (modulus
     ``k``) and whose straight ``share`` of the stiffness carries load from zero force (``toe_shape``: none), the linear
-    law shifted by ``offset_mm`` at high force; ``name`` keys its rows (:func:`toe_elongation`)."""
+    law shifted by ``offset_mm`` at high force (none when it is not positive); ``name`` keys its rows
+    (:func:`toe_elongation`)."""
     from scipy.special import gamma
 
     if offset_mm <= 0.0:
@@ -717,7 +718,8 @@ def _weibull_toe(ctx: Context, elong: np.ndarray, offset_mm: float, k: float, sh
 
 
 def _toe_shape(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
-    return _weibull_toe(ctx, elong, max(p["offset_mm"], 0.0), p["shape"], 0.0, "toe_shape")
+    return _weibull_toe(ctx, elong, p["offset_mm"], p["shape"], 0.0, "toe_shape")
+
 
 TOE_SHAPE = Effect(
     name="toe_shape", stage="elongation", pure=True,
@@ -740,7 +742,8 @@ TOE_SHAPE = Effect(
 
 
 def _toe_soft(ctx: Context, elong: np.ndarray, p: dict) -> np.ndarray:
-    return _weibull_toe(ctx, elong, max(p["offset_mm"], 0.0), p["shape"], min(max(p["share"], 0.0), 0.999), "toe_soft")
+    return _weibull_toe(ctx, elong, p["offset_mm"], p["shape"], min(max(p["share"], 0.0), 0.999), "toe_soft")
+
 
 TOE_SOFT = Effect(
     name="toe_soft", stage="elongation", pure=True,
