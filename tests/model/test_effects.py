@@ -365,3 +365,55 @@ def test_the_compiled_laws_work_where_numba_can_write_no_cache():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=str(ROOT))
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "[1.0, 2.0]"
+
+
+def _relaxed_numpy(data, theta, arms):
+    """The relaxing backbone's law as NumPy passes: :func:`camtube.model.effects.builtin._relaxed` with its compiled
+    path switched off."""
+    from unittest import mock
+
+    from camtube.model.effects import builtin
+
+    class Ctx:
+        pass
+
+    ctx = Ctx()
+    ctx.data = data
+    with mock.patch.object(builtin, "relaxed_compiled", lambda *a: None):
+        return builtin._relaxed(ctx, theta, arms)
+
+
+@pytest.mark.parametrize("arms", [((0.3, 2.0),), ((0.25, 0.7), (0.2, 40.0)), ((0.6, 1e-2),)])
+def test_the_compiled_relaxation_gives_the_numpy_laws_numbers_to_the_bit(arms):
+    """The compiled relaxing backbone (kernels.relaxed_rows) against its NumPy law, on jittered stamps of two samples:
+    a joint bent and unloaded (a rest floor), one whose angle starts below zero (no floor), one arm and two."""
+    from camtube.model.effects.builtin import _relaxed
+    from camtube.model.effects.history import relaxed_compiled
+
+    rng = np.random.default_rng(3)
+    n = 3000
+    t = np.concatenate([np.cumsum(rng.uniform(0.015, 0.025, n)), np.cumsum(rng.uniform(0.008, 0.012, n))])
+    phase = 2 * np.pi * np.arange(n) / 400
+    theta = np.concatenate([np.maximum(np.sin(phase), 0.0) * 0.5 + 0.002 * rng.normal(size=n) + 0.01,
+                            np.sin(phase) * 0.4 - 0.05])
+    data = _data(np.zeros(2 * n), time=t, samples=["S1"] * n + ["S2"] * n)
+    fast = relaxed_compiled(data, theta, arms)
+    assert fast is not None
+    slow = _relaxed_numpy(data, theta, arms)
+    assert np.array_equal(fast.view(np.int64), slow.view(np.int64))
+    assert np.array_equal(_relaxed(type("C", (), {"data": data})(), theta, arms), slow)
+    # the law does something here: the unloaded first sample stands above its angle (a slow arm; a 10 ms arm follows)
+    if max(tau for _, tau in arms) >= 1.0:
+        assert (slow[:n] > theta[:n] + 1e-3).sum() > 100
+
+
+def test_the_compiled_relaxation_leaves_uniform_stamps_and_non_finite_angles_to_numpy():
+    from camtube.model.effects.history import relaxed_compiled
+
+    theta = np.abs(np.sin(np.arange(200) / 20.0))
+    assert relaxed_compiled(_data(np.zeros(200)), theta, ((0.3, 2.0),)) is None   # uniform: scipy's lfilter
+    jittered = _data(np.zeros(200), time=np.cumsum(np.random.default_rng(1).uniform(0.9, 1.1, 200)))
+    assert relaxed_compiled(jittered, theta, ((0.3, 2.0),)) is not None
+    bad = theta.copy()
+    bad[5] = np.nan
+    assert relaxed_compiled(jittered, bad, ((0.3, 2.0),)) is None

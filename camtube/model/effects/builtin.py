@@ -56,7 +56,7 @@ from camtube.model.core.noise import white_noise_sd
 from camtube.model.core.params import Param
 from camtube.model.data.dataset import Dataset, recently_used, rests_of
 from camtube.model.effects.history import (  # noqa: F401
-    carriage_hold, first_order_lag, monotone_segments, play_operator,
+    carriage_hold, first_order_lag, monotone_segments, play_operator, relaxed_compiled,
 )
 from camtube.model.effects.kernels import toe_rows
 
@@ -1001,6 +1001,9 @@ def _relaxed(ctx: Context, theta: np.ndarray, arms: Sequence[tuple[float, float]
     stands at its rest plus the shares times them. Two passes: the second lets the arms follow the slack joint's
     own recovery (one arm's slack phases then decay by (1 - c) / tau, as the standard linear solid's do)."""
     th = np.asarray(theta, float)
+    fast = relaxed_compiled(ctx.data, th, arms)   # speed: the same law compiled, where it applies as written
+    if fast is not None:
+        return fast
     floor = _rest_floor(ctx.data, th)
     held = np.maximum(th, floor)
     for _ in range(2):

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from camtube.model.data.dataset import Dataset, recently_used
-from camtube.model.effects.kernels import hold_rows, lag_rows
+from camtube.model.effects.kernels import hold_rows, lag_rows, relaxed_rows
 
 # speed: derived per-Dataset data, cached (fits evaluate the model hundreds of times on the same rows)
 
@@ -121,6 +121,28 @@ def first_order_lag(data: Dataset, u: np.ndarray, tau_s: float) -> np.ndarray:
             v[sl] = lag_rows(np.ascontiguousarray(us, float), *_lag_steps(data, sl, dt, tau))
     return v
 
+
+
+def relaxed_compiled(data: Dataset, theta: np.ndarray, arms) -> np.ndarray | None:
+    """The angle with the relaxing arms ``arms`` ((share, time constant s), one or two) of
+    :func:`camtube.model.effects.builtin._relaxed`, by the compiled law
+    (:func:`camtube.model.effects.kernels.relaxed_rows`), sample by sample; None where that law does not apply as
+    written: a sample sampled uniformly (its lag is :func:`scipy.signal.lfilter`'s), a sample of one row, an angle
+    not finite, more than two arms. (speed: the same numbers; the lag's steps kept as :func:`first_order_lag` keeps
+    them.)"""
+    if not 1 <= len(arms) <= 2 or not np.isfinite(theta).all():
+        return None
+    sampling = _sampling(data)
+    if any(uniform or dt.size == 0 for _, _, uniform, dt in sampling):
+        return None
+    out = np.empty_like(theta)
+    (c1, tau1), (c2, tau2) = arms[0], arms[-1]
+    for sl, _, _, dt in sampling:
+        a1, g1 = _lag_steps(data, sl, dt, max(float(tau1), 1e-9))
+        a2, g2 = _lag_steps(data, sl, dt, max(float(tau2), 1e-9)) if len(arms) == 2 else (a1, g1)
+        out[sl] = relaxed_rows(np.ascontiguousarray(theta[sl], float), a1, g1, float(c1), a2, g2, float(c2),
+                               len(arms))
+    return out
 
 #: Lag steps kept per Dataset (the most recently used): a fit evaluates the lag many times with one ``tau``.
 LAG_STEPS_KEPT = 8

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["hold_rows", "lag_rows", "toe_rows"]
+__all__ = ["hold_rows", "lag_rows", "relaxed_rows", "toe_rows"]
 
 
 def _compiled(fn):
@@ -124,6 +124,63 @@ def toe_rows(f: np.ndarray, c: float, lam: float, t_max: float, xj: np.ndarray) 
     return out
 
 
+@_compiled
+def relaxed_rows(th: np.ndarray, a1: np.ndarray, g1: np.ndarray, c1: float, a2: np.ndarray, g2: np.ndarray,
+                 c2: float, arms: int) -> np.ndarray:  # pragma: no cover (compiled)
+    """(n,) one sample's angle with one or two relaxing arms of its backbone (``arms``; shares ``c1``, ``c2``; each
+    arm's steps' decay ``a`` and gain ``g`` (n - 1,), as :func:`lag_rows` takes them): the law of
+    :func:`camtube.model.effects.builtin._relaxed` for finite angles, operation for operation (the same numbers).
+
+    The rest floor: from the first row at or above the lowest angle after the largest (when that is above 0), that
+    angle; then two passes of ``held = max(th, floor + sum(c_j lag_j(held - floor)))``. (Compiled: a relaxing
+    backbone's evaluation was some twenty NumPy passes and four lag calls.)"""
+    n = th.size
+    out = np.empty(n)
+    if n == 0:
+        return out
+    top = 0
+    for k in range(1, n):
+        if th[k] > th[top]:
+            top = k
+    low = th[top]
+    for k in range(top + 1, n):
+        if th[k] < low:
+            low = th[k]
+    rest = low if low >= 0.0 else 0.0
+    first = n
+    if rest > 0.0:
+        for k in range(n):
+            if th[k] >= rest:
+                first = k
+                break
+    floor = np.zeros(n)
+    for k in range(first, n):
+        floor[k] = rest
+    held = np.empty(n)
+    for k in range(n):
+        held[k] = th[k] if th[k] >= floor[k] else floor[k]
+    for _ in range(2):
+        u0 = held[0] - floor[0]
+        v1 = u0
+        v2 = u0
+        tot = c1 * v1
+        if arms == 2:
+            tot = tot + c2 * v2
+        out[0] = tot
+        for k in range(1, n):
+            u = held[k] - floor[k]
+            v1 = a1[k - 1] * v1 + g1[k - 1] * u
+            tot = c1 * v1
+            if arms == 2:
+                v2 = a2[k - 1] * v2 + g2[k - 1] * u
+                tot = tot + c2 * v2
+            out[k] = tot
+        for k in range(n):
+            y = floor[k] + out[k]
+            held[k] = th[k] if th[k] >= y else y
+    return held
+
+
 def _warm() -> None:
     """Compile (or load) both laws now, in this process: forked workers then inherit them ready."""
     x = np.zeros(3)
@@ -131,6 +188,7 @@ def _warm() -> None:
     idx = np.zeros(1, np.int64)
     hold_rows(x, x, idx, idx + 3, x + 1.0, 1.0, 1.2, 0.5)
     toe_rows(x, 1.0, 1.0, 1.0, x)
+    relaxed_rows(x, x[:2], x[:2], 0.5, x[:2], x[:2], 0.5, 2)
 
 
 _warm()
