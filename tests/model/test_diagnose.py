@@ -364,3 +364,19 @@ def test_where_nothing_is_recommended_a_builtin_refused_only_for_its_bound_that_
     assert diagnosis_dict(hit)["nearest_on_bound"]["effect"] == "relaxation2"
     # one that does not halve what the partial effects leave is not named
     assert nearest_on_bound(replace(hit, partial_steps=steps[:2] + (replace(left, rmse_deg=2.0),))) is None
+
+
+def test_nothing_to_add_at_the_floor_skips_the_stiffness_test(monkeypatch):
+    """An answer of nothing to add at the noise floor stands whatever the samples' stiffness test would find (a second
+    search can only replace it with fewer effects): the test and its second search are not run (speed)."""
+    from camtube.model.diagnose import search as search_mod
+
+    p = load_pattern(PATTERNS / "tube2.yaml")
+    sim = simulate(p, Hidden(joint_friction_nmm=0.0), n_cycles=10, seed=3)
+
+    def refuse(self, d):
+        raise AssertionError("stiffness test run")
+
+    monkeypatch.setattr(search_mod.Search, "stiffness_differs", refuse)
+    d = diagnose(model_for_pattern(p), sim.data, ("E_t",), pattern_values(p))
+    assert d.recommended == () and d.final.rmse_deg <= 1.15 * d.noise_floor_deg

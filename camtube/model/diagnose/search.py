@@ -1007,6 +1007,8 @@ def diagnose(
     with one_blas_thread():  # speed: tall, thin linear algebra (see camtube.model.core.threads)
         search = Search(model, data, settings, candidates=candidates, registry=registry, baseline=baseline)
         d = search.run()
+        if not d.recommended and d.final.rmse_deg <= REACH_RATIO * d.noise_floor_deg:
+            return d   # nothing to add, at the floor: no answer with fewer effects could replace it (_stiffer_answer)
         note = search.stiffness_differs(d)
         if not note:
             return d
