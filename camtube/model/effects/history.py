@@ -122,7 +122,6 @@ def first_order_lag(data: Dataset, u: np.ndarray, tau_s: float) -> np.ndarray:
     return v
 
 
-
 def relaxed_compiled(data: Dataset, theta: np.ndarray, arms) -> np.ndarray | None:
     """The angle with the relaxing arms ``arms`` ((share, time constant s), one or two) of
     :func:`camtube.model.effects.builtin._relaxed`, by the compiled law
@@ -143,6 +142,7 @@ def relaxed_compiled(data: Dataset, theta: np.ndarray, arms) -> np.ndarray | Non
         out[sl] = relaxed_rows(np.ascontiguousarray(theta[sl], float), a1, g1, float(c1), a2, g2, float(c2),
                                len(arms))
     return out
+
 
 #: Lag steps kept per Dataset (the most recently used): a fit evaluates the lag many times with one ``tau``.
 LAG_STEPS_KEPT = 8
