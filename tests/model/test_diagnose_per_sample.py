@@ -499,7 +499,6 @@ def test_two_tubes_whose_tendons_differ_in_stiffness_get_e_t_per_sample_and_noth
     assert same.stiffness_note == "" and same.recommended == ()
 
 
-
 def test_stiffness_that_differs_beside_a_dominant_effect_is_found_on_the_chain_with_that_effect():
     """The independent simulator's lag file (slack beside moduli 1.8 % apart): on the model as given the samples'
     stiffness was a third of the misfit (slack the rest), below the half it must explain, so per-sample copies of a
@@ -527,7 +526,7 @@ def test_the_stiffness_test_on_the_first_chain_holds_what_was_held_then():
                          Clock(rate_hz=25.0), seed=5)
     search = Search(model_for_pattern(p), rec.data, SearchSettings(("E_t",), pattern_values(p)))
     d = search.run()
-    assert search.first_chain is not None and [e.name for e in search.first_chain[0].effects][-1] == "slack"
+    assert search.first_chain is not None and [e.name for e in search.first_chain.model.effects][-1] == "slack"
     search.held["slack.deadband_mm@S2"] = 0.0     # as a later per-sample step holding one sample's copy would
     # (the test then held S2's slack off in the chain as it was and found nothing; where that effect was shared then,
     # the fit refused the copy and the diagnosis ended in a traceback)

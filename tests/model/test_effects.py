@@ -374,13 +374,13 @@ def _relaxed_numpy(data, theta, arms):
 
     from camtube.model.effects import builtin
 
-    class Ctx:
-        pass
-
-    ctx = Ctx()
-    ctx.data = data
     with mock.patch.object(builtin, "relaxed_compiled", lambda *a: None):
-        return builtin._relaxed(ctx, theta, arms)
+        return builtin._relaxed(_ctx(data), theta, arms)
+
+
+def _ctx(data):
+    """The context a kinematics-stage law reads its rows from."""
+    return type("Ctx", (), {"data": data})()
 
 
 @pytest.mark.parametrize("arms", [((0.3, 2.0),), ((0.25, 0.7), (0.2, 40.0)), ((0.6, 1e-2),)])
@@ -401,7 +401,7 @@ def test_the_compiled_relaxation_gives_the_numpy_laws_numbers_to_the_bit(arms):
     assert fast is not None
     slow = _relaxed_numpy(data, theta, arms)
     assert np.array_equal(fast.view(np.int64), slow.view(np.int64))
-    assert np.array_equal(_relaxed(type("C", (), {"data": data})(), theta, arms), slow)
+    assert np.array_equal(_relaxed(_ctx(data), theta, arms), slow)
     # the law does something here: the unloaded first sample stands above its angle (a slow arm; a 10 ms arm follows)
     if max(tau for _, tau in arms) >= 1.0:
         assert (slow[:n] > theta[:n] + 1e-3).sum() > 100

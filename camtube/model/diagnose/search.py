@@ -913,6 +913,19 @@ class _Union(NamedTuple):
     problems: list              # resolution findings, (name, why)
 
 
+class _Tested(NamedTuple):
+    """A chain as the samples' stiffness test takes it (:meth:`Search.stiffness_differs`): as it was when the search
+    held it."""
+
+    model: JointModel
+    names: tuple                # fitted names
+    per_sample: list            # of them, those fitted per sample
+    fit: FitResult              # on the search rows
+    heldout_rmse_deg: float
+    block_mse: np.ndarray
+    held: dict                  # the values held then (:meth:`Search._fx`)
+
+
 @dataclass
 class _Chain:
     """The chain of effects the search stands on: the model and its fits (search rows and all rows)."""
@@ -1007,7 +1020,7 @@ def diagnose(
     with one_blas_thread():  # speed: tall, thin linear algebra (see camtube.model.core.threads)
         search = Search(model, data, settings, candidates=candidates, registry=registry, baseline=baseline)
         d = search.run()
-        if not d.recommended and d.final.rmse_deg <= REACH_RATIO * d.noise_floor_deg:
+        if not d.recommended and _at_floor(d):
             return d   # nothing to add, at the floor: no answer with fewer effects could replace it (_stiffer_answer)
         note = search.stiffness_differs(d)
         if not note:
@@ -1076,10 +1089,9 @@ class Search:
         self.retry_prev: tuple = ()
         self.retry_pool: list[Effect] = []
         self.stop = ""
-        #: the chain once its first effect was chosen (model, names, per-sample names, search fit, held-out RMSE,
-        #: block MSE, held values then): where the samples' stiffness is tested besides the model as given
-        #: (:meth:`stiffness_differs`)
-        self.first_chain: tuple | None = None
+        #: the chain once its first effect was chosen: where the samples' stiffness is tested besides the model as
+        #: given (:meth:`stiffness_differs`)
+        self.first_chain: _Tested | None = None
 
     def _fx(self, model: JointModel, held: Mapping[str, float] | None = None) -> dict:
         """The held values for a fit of ``model``: the user's ``fixed``, plus the per-sample copies held off
@@ -1624,8 +1636,8 @@ class Search:
         self._refit_search(c.values)
         ch.heldout_rmse_deg, ch.block_mse = c.heldout_rmse_deg, c.block_mse
         if self.first_chain is None:
-            self.first_chain = (ch.current, ch.names, list(ch.per_sample), ch.fit, ch.heldout_rmse_deg, ch.block_mse,
-                                self._fx(ch.current))
+            self.first_chain = _Tested(ch.current, ch.names, list(ch.per_sample), ch.fit, ch.heldout_rmse_deg,
+                                       ch.block_mse, self._fx(ch.current))
         # the next round tries only the effects that helped in this one (held-out RMSE down by min_gain):
         # one that explained nothing on the simpler model is not retried (speed; see the module docstring)
         useful = {x.effect for x in ranked if x.heldout_rmse_deg <= (1.0 - self.settings.min_gain) * ranked_base_ho}
@@ -2152,20 +2164,20 @@ class Search:
         # slack beside moduli 1.8 % apart, read as a viscoelastic tendon per sample), then the final chain where the
         # answer is not complete
         given = self.given_model
-        tries = [(" (the model as given)", (given, self.base_names, self.base_ps, self.base_fit, self.base_ho,
-                                             self.base_mse, self._fx(given)))]
+        tries = [(" (the model as given)", _Tested(given, self.base_names, self.base_ps, self.base_fit, self.base_ho,
+                                                    self.base_mse, self._fx(given)))]
         first = self.first_chain
-        if first is not None and first[0] is not ch.current:
-            added = ", ".join(e.name for e in first[0].effects if e not in given.effects)
+        if first is not None and first.model is not ch.current:
+            added = ", ".join(e.name for e in first.model.effects if e not in given.effects)
             tries.append((f" (the model with {added})", first))
         if d.explanation != "complete" and ch.current is not given:
-            tries.append(("", (ch.current, ch.names, ch.per_sample, ch.fit, ch.heldout_rmse_deg, ch.block_mse,
-                               self._fx(ch.current))))
+            tries.append(("", _Tested(ch.current, ch.names, ch.per_sample, ch.fit, ch.heldout_rmse_deg, ch.block_mse,
+                                      self._fx(ch.current))))
         for where, chain in tries:
             ho = lowers(*chain)
             if ho is not None:
                 return (f"the samples' tendons differ in stiffness: with E_t per sample the held-out RMSE falls from "
-                        f"{chain[4]:.3f} to {ho:.3f} deg{where}, so the search ran again with E_t per sample from the "
+                        f"{chain.heldout_rmse_deg:.3f} to {ho:.3f} deg{where}, so the search ran again with E_t per sample from the "
                         "start (each tube tied with its own tendon: another length L0 or make; --per-sample E_t)")
         return ""
 
@@ -2254,10 +2266,14 @@ def _stiffer_answer(d: Diagnosis, d2: Diagnosis) -> bool:
     reaches it too with fewer effects (one that stood in for the samples' stiffness goes, though per-sample copies of
     it may have ended a little lower: slack alone at 0.248 deg against slack and a viscoelastic tendon per sample at
     0.241, the floor 0.237; an answer at the floor is not traded for another of as many effects)."""
-    if d.final.rmse_deg <= REACH_RATIO * d.noise_floor_deg:
-        return (len(d2.recommended) < len(d.recommended)
-                and d2.final.rmse_deg <= REACH_RATIO * d2.noise_floor_deg)
+    if _at_floor(d):
+        return len(d2.recommended) < len(d.recommended) and _at_floor(d2)
     return d2.final.rmse_deg < d.final.rmse_deg
+
+
+def _at_floor(d: Diagnosis) -> bool:
+    """``d``'s final RMSE within :data:`REACH_RATIO` x its noise floor."""
+    return d.final.rmse_deg <= REACH_RATIO * d.noise_floor_deg
 
 
 def _modulus_values(d: Diagnosis) -> str:

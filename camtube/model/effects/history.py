@@ -96,6 +96,11 @@ def _sampling(data: Dataset) -> list:
     return hit
 
 
+def _lag_tau(tau_s: float) -> float:
+    """A lag's time constant as the laws take it (s): at least 1 ns."""
+    return max(float(tau_s), 1e-9)
+
+
 def first_order_lag(data: Dataset, u: np.ndarray, tau_s: float) -> np.ndarray:
     """``v`` with ``tau dv/dt = u - v`` per sample (exact for piecewise-constant ``u``), ``v_0 = u_0``.
 
@@ -105,7 +110,7 @@ def first_order_lag(data: Dataset, u: np.ndarray, tau_s: float) -> np.ndarray:
     """
     from scipy.signal import lfilter
 
-    tau = max(float(tau_s), 1e-9)
+    tau = _lag_tau(tau_s)
     v = np.empty_like(u)
     for sl, h, uniform, dt in _sampling(data):
         us = u[sl]
@@ -137,8 +142,8 @@ def relaxed_compiled(data: Dataset, theta: np.ndarray, arms) -> np.ndarray | Non
     out = np.empty_like(theta)
     (c1, tau1), (c2, tau2) = arms[0], arms[-1]
     for sl, _, _, dt in sampling:
-        a1, g1 = _lag_steps(data, sl, dt, max(float(tau1), 1e-9))
-        a2, g2 = _lag_steps(data, sl, dt, max(float(tau2), 1e-9)) if len(arms) == 2 else (a1, g1)
+        a1, g1 = _lag_steps(data, sl, dt, _lag_tau(tau1))
+        a2, g2 = _lag_steps(data, sl, dt, _lag_tau(tau2)) if len(arms) == 2 else (a1, g1)
         out[sl] = relaxed_rows(np.ascontiguousarray(theta[sl], float), a1, g1, float(c1), a2, g2, float(c2),
                                len(arms))
     return out

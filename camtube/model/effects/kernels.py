@@ -12,6 +12,8 @@ sample 64 us for the lag (243 before), 124 us for the carriage (2,245 before).
 ``toe_rows(f, c, lam, t_max, xj)``: the Weibull toe's extra elongation of
 :func:`camtube.model.effects.builtin.weibull_toe_force`, inverted by a table (no recursion: one pass over the rows
 instead of about ten NumPy passes, each writing an array; a toe file's fits spend a fifth of their time there).
+``relaxed_rows(th, a1, g1, c1, a2, g2, c2, arms)``: the relaxing backbone of
+:func:`camtube.model.effects.builtin._relaxed` (its rest floor and both passes of its lags in one loop per sample).
 
 The functions compile on the first import of this module (or load from numba's cache beside it, or in the user's
 cache when the package folder cannot be written, or compile in each process when neither can be), so that worker
@@ -182,7 +184,7 @@ def relaxed_rows(th: np.ndarray, a1: np.ndarray, g1: np.ndarray, c1: float, a2: 
 
 
 def _warm() -> None:
-    """Compile (or load) both laws now, in this process: forked workers then inherit them ready."""
+    """Compile (or load) every law now, in this process: forked workers then inherit them ready."""
     x = np.zeros(3)
     lag_rows(x, x[:2], x[:2])
     idx = np.zeros(1, np.int64)
