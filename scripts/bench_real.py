@@ -456,9 +456,14 @@ HELDOUT55_KINDS = USUAL_KINDS + [("backbone3", "lost motion"), ("creep", "sharp 
 #: load-cell zero beside a guide's friction: pairs no batch above drew.
 HELDOUT56_KINDS = USUAL_KINDS + [("lost motion", "creep"), ("toe", "backbone3"), ("zero drift", "friction"),
                                  "sharp friction", "tracker drift"]
+#: The fifty-seventh fresh held-out batch (issue 19, drawn after the session's exact speed changes, the diagnosis's
+#: results unchanged since bench-heldout56): record shapes drawn per file, a drifting load-cell zero beside a toe, a
+#: relaxing backbone beside a sharp guide, a creeping tendon beside slack.
+HELDOUT57_KINDS = USUAL_KINDS + [("zero drift", "toe"), ("backbone", "sharp friction"), ("creep", "slack"),
+                                 "sharp friction", "tracker drift"]
 #: Batches whose files draw their own record shapes (``draw_batch(shapes=True)``).
 SHAPED = {"bench-shapes", "bench-heldout52", "bench-heldout53", "bench-heldout54", "bench-heldout55",
-           "bench-heldout56"}
+           "bench-heldout56", "bench-heldout57"}
 BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KINDS),
            "bench-heldout": (20261207, HELDOUT_KINDS),
            "bench-heldout2": (20261224, HELDOUT2_KINDS), "bench-heldout3": (20261225, HELDOUT3_KINDS),
@@ -598,7 +603,9 @@ BATCHES = {"bench": (20261124, TUNE_KINDS), "bench-sharp": (20281128, SHARP_KIND
            # drawn once the partial label's second tier was settled (bench-heldout54 looked at); run once
            "bench-heldout55": (20281229, HELDOUT55_KINDS),
            # drawn a session later, the diagnosis unchanged since bench-heldout55; run once
-           "bench-heldout56": (20281230, HELDOUT56_KINDS)}
+           "bench-heldout56": (20281230, HELDOUT56_KINDS),
+           # drawn after the session's exact speed changes (results unchanged since bench-heldout56); run once
+           "bench-heldout57": (20281231, HELDOUT57_KINDS)}
 #: Batches whose carriages settle (:func:`settle_drives`); those before keep the law they were drawn with, where a
 #: carriage pulled off its rail's hold lands on the nut's flank in one step.
 SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldout26", "bench-heldout27",
@@ -609,7 +616,7 @@ SETTLED = {"bench-heldout23", "bench-heldout24", "bench-heldout25", "bench-heldo
            "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50",
            "bench-heldout51", "bench-shapes",
            "bench-heldout52", "bench-heldout53", "bench-heldout54", "bench-heldout55",
-           "bench-heldout56"}
+           "bench-heldout56", "bench-heldout57"}
 #: Batches whose trackers' artefacts are drawn too (:func:`rough_instruments`): dropouts written as values, bursts,
 #: filtered noise.
 ROUGH = {"bench-heldout15", "bench-heldout16"}
@@ -624,13 +631,13 @@ ROUGHER = {"bench-sharp", "bench-heldout17", "bench-heldout18", "bench-heldout19
            "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50",
            "bench-heldout51", "bench-shapes",
            "bench-heldout52", "bench-heldout53", "bench-heldout54", "bench-heldout55",
-           "bench-heldout56"}
+           "bench-heldout56", "bench-heldout57"}
 #: Batches whose load cells may not be zeroed before the test (:func:`untared`).
 UNTARED = {"bench-heldout41", "bench-heldout42", "bench-heldout43", "bench-heldout44", "bench-heldout45",
            "bench-heldout46", "bench-heldout47", "bench-heldout48", "bench-heldout49", "bench-heldout50",
            "bench-heldout51", "bench-shapes",
            "bench-heldout52", "bench-heldout53", "bench-heldout54", "bench-heldout55",
-           "bench-heldout56"}
+           "bench-heldout56", "bench-heldout57"}
 
 
 def _lag_found(lag_ms: float, se_ms: float, applied_ms: float, true_ms: float, row_ms: float) -> bool:
